@@ -1,0 +1,44 @@
+//! Lambertian reflection: f = albedo / π, sampled by the cosine-weighted hemisphere.
+
+use super::{LocalBsdf, LocalSample, TransportMode};
+use crate::math::{Color, Vec2, Vec3, INV_PI};
+use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+
+#[derive(Clone, Debug)]
+pub struct Diffuse {
+    pub albedo: Color,
+}
+
+impl LocalBsdf for Diffuse {
+    fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2, _mode: TransportMode) -> Option<LocalSample> {
+        let mut wi = sample_cosine_hemisphere(u);
+        if wo.z < 0.0 {
+            wi.z = -wi.z;
+        }
+        let pdf_w = cosine_hemisphere_pdf(wi.z.abs());
+        if pdf_w == 0.0 {
+            return None;
+        }
+        Some(LocalSample { wi, weight: self.albedo, pdf_w, pdf_rev_w: cosine_hemisphere_pdf(wo.z.abs()), delta: false })
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> Color {
+        if wo.z * wi.z > 0.0 {
+            self.albedo * INV_PI
+        } else {
+            Color::ZERO
+        }
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z * wi.z > 0.0 {
+            cosine_hemisphere_pdf(wi.z.abs())
+        } else {
+            0.0
+        }
+    }
+
+    fn is_delta(&self) -> bool {
+        false
+    }
+}

@@ -1,0 +1,178 @@
+//! Materials (BSDFs). Each material lives in its own file and works in the local shading frame
+//! (z = shading normal). This module wraps them for world-space use and owns the two things every
+//! material shares: the cosine factor and Veach's shading-normal correction for adjoint transport.
+//!
+//! Conventions (every integrator relies on them):
+//! - Directions `wo` and `wi` point away from the surface; `wo` is the direction the path arrived
+//!   from (towards the camera in radiance mode, towards the light in importance mode).
+//! - `f_cos` is the BSDF times the projected-solid-angle factor, with the shading-normal correction:
+//!   radiance mode  f_cos = f(wo, wi) · |ns·wi|;
+//!   importance mode f_cos = f(wo, wi) · |ns·wo| · |ng·wi| / |ng·wo|  (Veach 1997, §5.3).
+//!   In both, f_cos / |ng·wi| is the BSDF factor of the path measurement contribution f(x̄).
+//! - `pdf_w` is the solid-angle density of sampling `wi` given `wo`; `pdf_rev_w` of sampling `wo`
+//!   given `wi`. For a delta lobe both are the discrete probability of choosing that lobe and
+//!   `delta` is set; `eval` and `pdf` return zero for delta lobes.
+
+mod dielectric;
+mod diffuse;
+mod glossy;
+mod mirror;
+
+pub use dielectric::Dielectric;
+pub use diffuse::Diffuse;
+pub use glossy::Glossy;
+pub use mirror::Mirror;
+
+use crate::math::{Color, Frame, Vec2, Vec3};
+
+/// Which quantity a path carries: radiance (paths from the camera) or importance (from lights).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransportMode {
+    Radiance,
+    Importance,
+}
+
+/// The geometry a BSDF needs at a surface point.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingFrame {
+    /// Geometric normal (the side the surface's emission and `flip_normals` refer to).
+    pub ng: Vec3,
+    /// Orthonormal frame around the shading normal.
+    pub frame: Frame,
+}
+
+impl ShadingFrame {
+    pub fn new(ng: Vec3, ns: Vec3) -> ShadingFrame {
+        ShadingFrame { ng, frame: Frame::from_z(ns) }
+    }
+    #[inline]
+    pub fn ns(&self) -> Vec3 {
+        self.frame.z
+    }
+}
+
+/// A direction chosen by a material, in world space.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    /// f_cos / pdf_w: what the path throughput is multiplied by.
+    pub weight: Color,
+    pub pdf_w: f32,
+    pub pdf_rev_w: f32,
+    pub delta: bool,
+}
+
+/// A material evaluated for a pair of directions.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BsdfEval {
+    pub f_cos: Color,
+    pub pdf_w: f32,
+    pub pdf_rev_w: f32,
+}
+
+/// A material sample in the local frame, before the cosine and shading-normal factors.
+#[derive(Clone, Copy, Debug)]
+pub struct LocalSample {
+    pub wi: Vec3,
+    /// f(wo, wi) · |cos θi| / pdf (for delta lobes: the lobe's value / its selection probability).
+    pub weight: Color,
+    pub pdf_w: f32,
+    pub pdf_rev_w: f32,
+    pub delta: bool,
+}
+
+/// Behaviour every material file implements, in the local shading frame (z = normal).
+pub trait LocalBsdf {
+    /// `u_lobe` chooses among lobes, `u` warps within one.
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<LocalSample>;
+    /// f(wo, wi) without any cosine; zero for delta lobes.
+    fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Color;
+    /// Solid-angle pdf of sampling wi given wo; zero for delta lobes.
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// True when every lobe is a delta: such a vertex can never be connected to.
+    fn is_delta(&self) -> bool;
+}
+
+#[derive(Clone, Debug)]
+pub enum Material {
+    Diffuse(Diffuse),
+    Mirror(Mirror),
+    Dielectric(Dielectric),
+    Glossy(Glossy),
+}
+
+impl Material {
+    #[inline]
+    fn local(&self) -> &dyn LocalBsdf {
+        match self {
+            Material::Diffuse(m) => m,
+            Material::Mirror(m) => m,
+            Material::Dielectric(m) => m,
+            Material::Glossy(m) => m,
+        }
+    }
+
+    pub fn is_delta(&self) -> bool {
+        self.local().is_delta()
+    }
+
+    pub fn sample(&self, sf: &ShadingFrame, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
+        let wo_l = sf.frame.to_local(wo);
+        if wo_l.z == 0.0 {
+            return None;
+        }
+        let s = self.local().sample(wo_l, u_lobe, u, mode)?;
+        let wi = sf.frame.to_world(s.wi);
+        if !consistent_sides(sf, wo, wi, wo_l.z, s.wi.z) {
+            return None;
+        }
+        let weight = s.weight * adjoint_correction(sf, wo, wi, wo_l.z, mode);
+        (s.pdf_w > 0.0 && weight.is_finite()).then_some(BsdfSample { wi, weight, pdf_w: s.pdf_w, pdf_rev_w: s.pdf_rev_w, delta: s.delta })
+    }
+
+    pub fn eval(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3, mode: TransportMode) -> BsdfEval {
+        let wo_l = sf.frame.to_local(wo);
+        let wi_l = sf.frame.to_local(wi);
+        if wo_l.z == 0.0 || !consistent_sides(sf, wo, wi, wo_l.z, wi_l.z) {
+            return BsdfEval::default();
+        }
+        let m = self.local();
+        let f = m.eval(wo_l, wi_l, mode);
+        let f_cos = f * wi_l.z.abs() * adjoint_correction(sf, wo, wi, wo_l.z, mode);
+        BsdfEval { f_cos, pdf_w: m.pdf(wo_l, wi_l), pdf_rev_w: m.pdf(wi_l, wo_l) }
+    }
+
+    /// Solid-angle pdf of sampling wi given wo.
+    pub fn pdf(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3) -> f32 {
+        let wo_l = sf.frame.to_local(wo);
+        let wi_l = sf.frame.to_local(wi);
+        if !consistent_sides(sf, wo, wi, wo_l.z, wi_l.z) {
+            return 0.0;
+        }
+        self.local().pdf(wo_l, wi_l)
+    }
+}
+
+/// Rejects directions that the shading normal and the geometric normal place on different sides;
+/// following them would leak light through the surface.
+#[inline]
+fn consistent_sides(sf: &ShadingFrame, wo: Vec3, wi: Vec3, cos_s_o: f32, cos_s_i: f32) -> bool {
+    (wo.dot(sf.ng) * cos_s_o > 0.0) && (wi.dot(sf.ng) * cos_s_i > 0.0)
+}
+
+/// The factor that turns f·|ns·wi| into f_cos for the given transport mode (see module docs).
+#[inline]
+fn adjoint_correction(sf: &ShadingFrame, wo: Vec3, wi: Vec3, cos_s_o: f32, mode: TransportMode) -> f32 {
+    match mode {
+        TransportMode::Radiance => 1.0,
+        TransportMode::Importance => {
+            let num = cos_s_o.abs() * wi.dot(sf.ng).abs();
+            let den = wi.dot(sf.ns()).abs() * wo.dot(sf.ng).abs();
+            if den == 0.0 {
+                0.0
+            } else {
+                num / den
+            }
+        }
+    }
+}

@@ -1,0 +1,14 @@
+//! The path-space core shared by every integrator: geometry, sampling, materials, lights, the
+//! camera, scenes, and path vertices with their pdfs in area measure.
+
+pub mod bsdf;
+pub mod camera;
+pub mod geometry;
+pub mod light;
+pub mod math;
+pub mod measure;
+pub mod sampling;
+pub mod scene;
+
+pub use math::{Color, Vec2, Vec3};
+pub use scene::Scene;

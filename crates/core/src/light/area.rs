@@ -1,0 +1,160 @@
+//! Area lights: any triangle mesh or sphere with `emission`, one-sided on its normal side.
+//! Meshes are sampled uniformly by area (triangle chosen by area). Spheres are sampled by the cone
+//! they subtend when the shading point is outside (much less variance for small, far spheres) and
+//! uniformly by area from inside.
+
+use super::{LightLeSample, LightLiSample};
+use crate::geometry::{offset_ray_origin, Ray};
+use crate::math::{gamma, luminance, Color, Frame, Vec2, Vec3, PI};
+use crate::sampling::{
+    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere, sample_uniform_triangle, uniform_cone_pdf,
+    Distribution1D,
+};
+use crate::scene::ShapeGeometry;
+
+#[derive(Clone, Debug)]
+enum Emitter {
+    Triangles { tris: Vec<[Vec3; 3]>, pick: Distribution1D },
+    Sphere { center: Vec3, radius: f32 },
+}
+
+#[derive(Clone, Debug)]
+pub struct AreaLight {
+    pub shape: u32,
+    pub emission: Color,
+    pub area: f32,
+    flip: bool,
+    emitter: Emitter,
+}
+
+impl AreaLight {
+    pub fn new(shape: u32, geometry: &ShapeGeometry, emission: Color, flip_normals: bool) -> AreaLight {
+        let (emitter, area) = match geometry {
+            ShapeGeometry::Mesh(m) => {
+                let tris: Vec<[Vec3; 3]> = (0..m.indices.len()).map(|i| m.triangle(i)).collect();
+                let areas: Vec<f32> = (0..m.indices.len()).map(|i| m.triangle_area(i)).collect();
+                let total: f64 = areas.iter().map(|&a| a as f64).sum();
+                (Emitter::Triangles { tris, pick: Distribution1D::new(&areas) }, total as f32)
+            }
+            &ShapeGeometry::Sphere { center, radius } => (Emitter::Sphere { center, radius }, 4.0 * PI * radius * radius),
+        };
+        AreaLight { shape, emission, area, flip: flip_normals, emitter }
+    }
+
+    /// A uniformly distributed point on the surface with its outward (emitting-side) normal.
+    fn sample_area(&self, u: Vec2) -> (Vec3, Vec3, Vec3) {
+        let (p, n, err) = match &self.emitter {
+            Emitter::Triangles { tris, pick } => {
+                let (i, _, ux) = pick.sample(u.x);
+                let [a, b, c] = tris[i];
+                let (b1, b2) = sample_uniform_triangle(Vec2::new(ux, u.y));
+                let b0 = 1.0 - b1 - b2;
+                let p = b0 * a + b1 * b + b2 * c;
+                (p, (b - a).cross(c - a).normalize(), crate::geometry::ray::barycentric_error([b0, b1, b2], [a, b, c]))
+            }
+            &Emitter::Sphere { center, radius } => {
+                let n = sample_uniform_sphere(u);
+                let p = center + radius * n;
+                (p, n, (p.abs() + center.abs()) * gamma(6))
+            }
+        };
+        (p, if self.flip { -n } else { n }, err)
+    }
+
+    #[inline]
+    pub fn emitted(&self, n: Vec3, w: Vec3) -> Color {
+        if n.dot(w) > 0.0 {
+            self.emission
+        } else {
+            Color::ZERO
+        }
+    }
+
+    /// 1 − cos θmax of the cone a sphere subtends from `p`, or None when `p` is inside it.
+    fn sphere_cone(p: Vec3, center: Vec3, radius: f32) -> Option<f32> {
+        let d2 = (p - center).length_squared();
+        let r2 = radius * radius;
+        if d2 <= r2 {
+            return None;
+        }
+        let sin2 = r2 / d2;
+        let cos = (1.0 - sin2).max(0.0).sqrt();
+        Some(sin2 / (1.0 + cos))
+    }
+
+    pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightLiSample> {
+        if let Emitter::Sphere { center, radius } = self.emitter {
+            if let Some(h) = Self::sphere_cone(p, center, radius) {
+                return self.sample_sphere_cone(p, center, radius, h, u);
+            }
+        }
+        let (lp, n, _) = self.sample_area(u);
+        let to = lp - p;
+        let d2 = to.length_squared();
+        if !(d2 > 0.0) {
+            return None;
+        }
+        let distance = d2.sqrt();
+        let wi = to / distance;
+        let cos_l = n.dot(-wi).abs();
+        if cos_l == 0.0 {
+            return None;
+        }
+        let pdf_w = d2 / (cos_l * self.area);
+        Some(LightLiSample { wi, p: lp, n, distance, radiance: self.emitted(n, -wi), pdf_w, delta: false })
+    }
+
+    fn sample_sphere_cone(&self, p: Vec3, center: Vec3, radius: f32, h: f32, u: Vec2) -> Option<LightLiSample> {
+        let axis = center - p;
+        let dc = axis.length();
+        let frame = Frame::from_z(axis / dc);
+        let local = sample_uniform_cone(u, h);
+        let wi = frame.to_world(local).normalize();
+        // Nearest intersection of the sampled direction with the sphere, computed stably.
+        let cos_t = local.z;
+        let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
+        let ds = dc * cos_t - (radius * radius - dc * dc * sin2_t).max(0.0).sqrt();
+        let lp_raw = p + wi * ds;
+        let mut n = (lp_raw - center).normalize();
+        let lp = center + n * radius;
+        if self.flip {
+            n = -n;
+        }
+        let distance = (lp - p).length();
+        Some(LightLiSample { wi, p: lp, n, distance, radiance: self.emitted(n, -wi), pdf_w: uniform_cone_pdf(h), delta: false })
+    }
+
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3, light_p: Vec3, light_n: Vec3) -> f32 {
+        if let Emitter::Sphere { center, radius } = self.emitter {
+            if let Some(h) = Self::sphere_cone(p, center, radius) {
+                return uniform_cone_pdf(h);
+            }
+        }
+        let d2 = (light_p - p).length_squared();
+        let cos_l = light_n.dot(-wi).abs();
+        if cos_l == 0.0 {
+            return 0.0;
+        }
+        d2 / (cos_l * self.area)
+    }
+
+    pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<LightLeSample> {
+        let (p, n, err) = self.sample_area(u_pos);
+        let local = sample_cosine_hemisphere(u_dir);
+        let pdf_dir = cosine_hemisphere_pdf(local.z);
+        if pdf_dir == 0.0 {
+            return None;
+        }
+        let d = Frame::from_z(n).to_world(local);
+        let ray = Ray::new(offset_ray_origin(p, err, n, d), d);
+        Some(LightLeSample { ray, n, radiance: self.emission, pdf_pos: 1.0 / self.area, pdf_dir })
+    }
+
+    pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+        (1.0 / self.area, cosine_hemisphere_pdf(n.dot(dir)))
+    }
+
+    pub fn power(&self) -> f32 {
+        PI * self.area * luminance(self.emission)
+    }
+}

@@ -1,0 +1,51 @@
+//! Constant radiance from every direction at infinity.
+
+use super::{LightLeSample, LightLiSample};
+use crate::geometry::Ray;
+use crate::math::{luminance, Color, Frame, Vec2, Vec3, PI};
+use crate::sampling::{sample_concentric_disk, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
+
+#[derive(Clone, Debug)]
+pub struct EnvironmentLight {
+    pub radiance: Color,
+}
+
+impl EnvironmentLight {
+    pub fn sample_li(&self, u: Vec2) -> Option<LightLiSample> {
+        let wi = sample_uniform_sphere(u);
+        Some(LightLiSample { wi, p: wi, n: -wi, distance: f32::INFINITY, radiance: self.radiance, pdf_w: UNIFORM_SPHERE_PDF, delta: false })
+    }
+
+    pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2, bounds: (Vec3, f32)) -> LightLeSample {
+        let d = -sample_uniform_sphere(u_dir);
+        let ray = ray_from_bounding_disk(d, u_pos, bounds);
+        LightLeSample { ray, n: d, radiance: self.radiance, pdf_pos: disk_pdf(bounds), pdf_dir: UNIFORM_SPHERE_PDF }
+    }
+}
+
+pub fn pdf_li() -> f32 {
+    UNIFORM_SPHERE_PDF
+}
+
+pub fn pdf_le(bounds: (Vec3, f32)) -> (f32, f32) {
+    (disk_pdf(bounds), UNIFORM_SPHERE_PDF)
+}
+
+pub fn power(l: &EnvironmentLight, bounds: (Vec3, f32)) -> f32 {
+    4.0 * PI * PI * bounds.1 * bounds.1 * luminance(l.radiance)
+}
+
+/// Area pdf on the disk, perpendicular to the light's direction, that covers the scene's bounding
+/// sphere: where rays from a light at infinity start.
+pub fn disk_pdf(bounds: (Vec3, f32)) -> f32 {
+    1.0 / (PI * bounds.1 * bounds.1)
+}
+
+/// A ray travelling in direction `d` that starts on the bounding disk upstream of the scene.
+pub fn ray_from_bounding_disk(d: Vec3, u_pos: Vec2, bounds: (Vec3, f32)) -> Ray {
+    let (c, r) = bounds;
+    let f = Frame::from_z(d);
+    let q = sample_concentric_disk(u_pos) * r;
+    let o = c - d * r + f.x * q.x + f.y * q.y;
+    Ray::new(o, d)
+}

@@ -1,0 +1,184 @@
+//! Lights. Every light answers three questions (pdf measures are in the names):
+//! (a) `sample_li`: a direction towards it from a shading point (next-event estimation), with the
+//!     solid-angle pdf at that point — `pdf_li` gives that same pdf for a given direction;
+//! (b) `sample_le`: an emitted ray, with the positional pdf (area on the light, or on the disk a
+//!     distant light emits over) and the directional pdf (solid angle) kept separate;
+//! (c) `pdf_le`: those two pdfs for a given emitted ray.
+//! Delta lights report a pdf of 1 in their delta dimension and say so with `delta_position` /
+//! `delta_direction`. Light selection (by power) is `LightSampler`; its pmf is never folded into
+//! the pdfs here.
+
+mod area;
+mod environment;
+mod point;
+mod sun;
+
+pub use area::AreaLight;
+pub use environment::EnvironmentLight;
+pub use point::PointLight;
+pub use sun::SunLight;
+
+use crate::geometry::Ray;
+use crate::math::{luminance, Color, Vec2, Vec3};
+use crate::sampling::Distribution1D;
+use crate::scene::{LightDesc, ShapeGeometry};
+
+/// A direction towards a light from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightLiSample {
+    /// Unit direction from the shading point towards the light.
+    pub wi: Vec3,
+    /// The point on the light (for distant lights, unused: `distance` is infinite).
+    pub p: Vec3,
+    /// The light's surface normal at `p` (for distant lights, −wi).
+    pub n: Vec3,
+    pub distance: f32,
+    /// Radiance arriving along −wi (point lights: intensity / distance²).
+    pub radiance: Color,
+    /// Solid-angle pdf at the shading point; 1 for a delta light.
+    pub pdf_w: f32,
+    pub delta: bool,
+}
+
+/// A ray leaving a light.
+#[derive(Clone, Copy, Debug)]
+pub struct LightLeSample {
+    pub ray: Ray,
+    /// Normal at the ray origin (for distant lights: the ray direction).
+    pub n: Vec3,
+    /// Emitted radiance along the ray (point lights: intensity).
+    pub radiance: Color,
+    /// Area pdf of the origin (1 for a point light).
+    pub pdf_pos: f32,
+    /// Solid-angle pdf of the direction (1 for a delta direction).
+    pub pdf_dir: f32,
+}
+
+#[derive(Clone, Debug)]
+pub enum Light {
+    Area(AreaLight),
+    Point(PointLight),
+    Sun(SunLight),
+    Environment(EnvironmentLight),
+}
+
+impl Light {
+    pub fn area(shape: u32, geometry: &ShapeGeometry, emission: Color, flip_normals: bool) -> Light {
+        Light::Area(AreaLight::new(shape, geometry, emission, flip_normals))
+    }
+
+    pub fn from_desc(desc: &LightDesc) -> Light {
+        match *desc {
+            LightDesc::Point { position, intensity } => Light::Point(PointLight { position, intensity }),
+            LightDesc::Sun { direction, solid_angle, radiance } => Light::Sun(SunLight::new(direction, solid_angle, radiance)),
+            LightDesc::Environment { radiance } => Light::Environment(EnvironmentLight { radiance }),
+        }
+    }
+
+    /// At infinity: seen by rays that leave the scene.
+    pub fn is_infinite(&self) -> bool {
+        matches!(self, Light::Sun(_) | Light::Environment(_))
+    }
+
+    pub fn delta_position(&self) -> bool {
+        matches!(self, Light::Point(_))
+    }
+
+    /// No light here is a delta in direction: the sun has a finite cone so it takes part in MIS.
+    pub fn delta_direction(&self) -> bool {
+        false
+    }
+
+    pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightLiSample> {
+        match self {
+            Light::Area(l) => l.sample_li(p, u),
+            Light::Point(l) => l.sample_li(p),
+            Light::Sun(l) => l.sample_li(u),
+            Light::Environment(l) => l.sample_li(u),
+        }
+    }
+
+    /// Solid-angle pdf at `p` of `sample_li` choosing the point `light_p` (normal `light_n`) in
+    /// direction `wi`. For lights at infinity only `wi` matters. Zero for delta lights.
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3, light_p: Vec3, light_n: Vec3) -> f32 {
+        match self {
+            Light::Area(l) => l.pdf_li(p, wi, light_p, light_n),
+            Light::Point(_) => 0.0,
+            Light::Sun(l) => l.pdf_li(wi),
+            Light::Environment(_) => environment::pdf_li(),
+        }
+    }
+
+    /// Radiance an area light emits from a point with normal `n` in direction `w` (one-sided).
+    pub fn emitted(&self, n: Vec3, w: Vec3) -> Color {
+        match self {
+            Light::Area(l) => l.emitted(n, w),
+            _ => Color::ZERO,
+        }
+    }
+
+    /// Radiance a light at infinity sends along a ray leaving the scene in direction `dir`.
+    pub fn escaped(&self, dir: Vec3) -> Color {
+        match self {
+            Light::Sun(l) => l.escaped(dir),
+            Light::Environment(l) => l.radiance,
+            _ => Color::ZERO,
+        }
+    }
+
+    pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2, bounds: (Vec3, f32)) -> Option<LightLeSample> {
+        match self {
+            Light::Area(l) => l.sample_le(u_pos, u_dir),
+            Light::Point(l) => Some(l.sample_le(u_dir)),
+            Light::Sun(l) => Some(l.sample_le(u_pos, u_dir, bounds)),
+            Light::Environment(l) => Some(l.sample_le(u_pos, u_dir, bounds)),
+        }
+    }
+
+    /// (area pdf of the origin, solid-angle pdf of the direction) of an emitted ray.
+    /// For lights at infinity `dir` is the direction light travels and `p`, `n` are ignored.
+    pub fn pdf_le(&self, n: Vec3, dir: Vec3, bounds: (Vec3, f32)) -> (f32, f32) {
+        match self {
+            Light::Area(l) => l.pdf_le(n, dir),
+            Light::Point(_) => (1.0, crate::sampling::UNIFORM_SPHERE_PDF),
+            Light::Sun(l) => l.pdf_le(dir, bounds),
+            Light::Environment(_) => environment::pdf_le(bounds),
+        }
+    }
+
+    /// Emitted power (luminance), the weight of this light in light selection.
+    pub fn power(&self, bounds: (Vec3, f32)) -> f32 {
+        match self {
+            Light::Area(l) => l.power(),
+            Light::Point(l) => 4.0 * crate::math::PI * luminance(l.intensity),
+            Light::Sun(l) => l.power(bounds),
+            Light::Environment(l) => environment::power(l, bounds),
+        }
+    }
+}
+
+/// Chooses a light in proportion to its emitted power.
+#[derive(Clone, Debug, Default)]
+pub struct LightSampler {
+    dist: Distribution1D,
+}
+
+impl LightSampler {
+    pub fn new(lights: &[Light], bounds: (Vec3, f32)) -> LightSampler {
+        let w: Vec<f32> = lights.iter().map(|l| l.power(bounds).max(0.0)).collect();
+        LightSampler { dist: Distribution1D::new(&w) }
+    }
+
+    /// (light index, its selection probability, u reused within the choice) or None without lights.
+    pub fn sample(&self, u: f32) -> Option<(usize, f32, f32)> {
+        (!self.dist.is_empty()).then(|| self.dist.sample(u))
+    }
+
+    pub fn pmf(&self, light: usize) -> f32 {
+        if self.dist.is_empty() {
+            0.0
+        } else {
+            self.dist.pmf(light)
+        }
+    }
+}

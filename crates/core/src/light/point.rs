@@ -1,0 +1,30 @@
+//! An isotropic point light: delta in position, uniform in direction.
+
+use super::{LightLeSample, LightLiSample};
+use crate::geometry::Ray;
+use crate::math::{Color, Vec2, Vec3};
+use crate::sampling::{sample_uniform_sphere, UNIFORM_SPHERE_PDF};
+
+#[derive(Clone, Debug)]
+pub struct PointLight {
+    pub position: Vec3,
+    pub intensity: Color,
+}
+
+impl PointLight {
+    pub fn sample_li(&self, p: Vec3) -> Option<LightLiSample> {
+        let to = self.position - p;
+        let d2 = to.length_squared();
+        if !(d2 > 0.0) {
+            return None;
+        }
+        let distance = d2.sqrt();
+        let wi = to / distance;
+        Some(LightLiSample { wi, p: self.position, n: -wi, distance, radiance: self.intensity / d2, pdf_w: 1.0, delta: true })
+    }
+
+    pub fn sample_le(&self, u_dir: Vec2) -> LightLeSample {
+        let d = sample_uniform_sphere(u_dir);
+        LightLeSample { ray: Ray::new(self.position, d), n: d, radiance: self.intensity, pdf_pos: 1.0, pdf_dir: UNIFORM_SPHERE_PDF }
+    }
+}

@@ -1,0 +1,181 @@
+//! Assembling a scene in code: the loader and the tests both go through this one path, so a scene
+//! built by hand is checked and indexed exactly like one read from a file.
+
+use super::{RenderSettings, Scene, Shape};
+use crate::bsdf::Material;
+use crate::camera::Camera;
+use crate::geometry::{Accel, Primitive};
+use crate::light::{Light, LightSampler};
+use crate::math::{Color, Vec3};
+
+/// A triangle mesh in world space.
+#[derive(Clone, Debug, Default)]
+pub struct TriangleMesh {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals (same length as `positions`), if the mesh has them.
+    pub normals: Option<Vec<Vec3>>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+impl TriangleMesh {
+    pub fn triangle(&self, i: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[i];
+        [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
+    }
+
+    pub fn triangle_area(&self, i: usize) -> f32 {
+        let [a, b, c] = self.triangle(i);
+        0.5 * (b - a).cross(c - a).length()
+    }
+
+    /// Interpolated shading normal, if the mesh has normals and they do not cancel out.
+    pub fn shading_normal(&self, i: usize, b0: f32, b1: f32, b2: f32) -> Option<Vec3> {
+        let normals = self.normals.as_ref()?;
+        let [a, b, c] = self.indices[i];
+        let n = b0 * normals[a as usize] + b1 * normals[b as usize] + b2 * normals[c as usize];
+        (n.length_squared() > 0.0).then(|| n.normalize())
+    }
+
+    /// An axis-aligned unit square [-1,1]² in the z = 0 plane with normal +z (Mitsuba's rectangle).
+    pub fn unit_rectangle() -> TriangleMesh {
+        TriangleMesh {
+            positions: vec![Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0)],
+            normals: None,
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    /// The cube [-1,1]³ with outward normals (Mitsuba's cube).
+    pub fn unit_cube() -> TriangleMesh {
+        let mut positions = Vec::new();
+        let mut indices = Vec::new();
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                let n = Vec3::from_array(std::array::from_fn(|k| if k == axis { sign } else { 0.0 }));
+                let u = Vec3::from_array(std::array::from_fn(|k| if k == (axis + 1) % 3 { 1.0 } else { 0.0 }));
+                let v = n.cross(u);
+                let base = positions.len() as u32;
+                for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    positions.push(n + u * a + v * b);
+                }
+                indices.push([base, base + 1, base + 2]);
+                indices.push([base, base + 2, base + 3]);
+            }
+        }
+        TriangleMesh { positions, normals: None, indices }
+    }
+
+    /// Applies a point transform (and its normal transform) to the mesh.
+    pub fn transformed(mut self, m: &glam::Mat4) -> TriangleMesh {
+        for p in &mut self.positions {
+            *p = m.transform_point3(*p);
+        }
+        if let Some(ns) = &mut self.normals {
+            let nm = m.inverse().transpose();
+            for n in ns.iter_mut() {
+                *n = nm.transform_vector3(*n).normalize_or_zero();
+            }
+        }
+        // A mirroring transform turns the winding inside out; keep normals where they were.
+        if m.determinant() < 0.0 {
+            for t in &mut self.indices {
+                t.swap(1, 2);
+            }
+        }
+        self
+    }
+}
+
+#[derive(Clone, Debug)]
+pub enum ShapeGeometry {
+    Mesh(TriangleMesh),
+    Sphere { center: Vec3, radius: f32 },
+}
+
+/// Lights that are not shapes.
+#[derive(Clone, Debug)]
+pub enum LightDesc {
+    Point { position: Vec3, intensity: Color },
+    /// A distant disk light. `direction` points from the scene towards the sun.
+    Sun { direction: Vec3, solid_angle: f32, radiance: Color },
+    Environment { radiance: Color },
+}
+
+pub struct SceneBuilder {
+    camera: Camera,
+    settings: RenderSettings,
+    materials: Vec<Material>,
+    shapes: Vec<(ShapeGeometry, u32, Option<Color>, bool)>,
+    lights: Vec<LightDesc>,
+}
+
+impl SceneBuilder {
+    pub fn new(camera: Camera, settings: RenderSettings) -> SceneBuilder {
+        SceneBuilder { camera, settings, materials: Vec::new(), shapes: Vec::new(), lights: Vec::new() }
+    }
+
+    /// Returns the material's id for `add_shape`.
+    pub fn add_material(&mut self, m: Material) -> u32 {
+        self.materials.push(m);
+        (self.materials.len() - 1) as u32
+    }
+
+    /// `emission`, when given, makes the shape a one-sided area light on its normal side.
+    pub fn add_shape(&mut self, geometry: ShapeGeometry, material: u32, emission: Option<Color>, flip_normals: bool) {
+        self.shapes.push((geometry, material, emission, flip_normals));
+    }
+
+    pub fn add_light(&mut self, light: LightDesc) {
+        self.lights.push(light);
+    }
+
+    pub fn build(self) -> Scene {
+        let mut shapes = Vec::with_capacity(self.shapes.len());
+        let mut lights = Vec::new();
+        let mut prims = Vec::new();
+        for (geometry, material, emission, flip_normals) in self.shapes {
+            let shape_id = shapes.len() as u32;
+            match &geometry {
+                ShapeGeometry::Mesh(m) => {
+                    for (i, _) in m.indices.iter().enumerate() {
+                        let [p0, p1, p2] = m.triangle(i);
+                        if m.triangle_area(i) > 0.0 {
+                            prims.push(Primitive::Triangle { p0, e1: p1 - p0, e2: p2 - p0, shape: shape_id, index: i as u32 });
+                        }
+                    }
+                }
+                &ShapeGeometry::Sphere { center, radius } => prims.push(Primitive::Sphere { center, radius, shape: shape_id }),
+            }
+            let light = emission.map(|e| {
+                lights.push(Light::area(shape_id, &geometry, e, flip_normals));
+                (lights.len() - 1) as u32
+            });
+            shapes.push(Shape { geometry, material, light, flip_normals });
+        }
+        let accel = Accel::build(prims);
+        let (lo, hi) = accel.bounds();
+        let center = 0.5 * (lo + hi);
+        let radius = (0.5 * (hi - lo).length()).max(f32::MIN_POSITIVE);
+        let bounding_sphere = (center, radius);
+        let mut infinite_lights = Vec::new();
+        for desc in self.lights {
+            let light = Light::from_desc(&desc);
+            if light.is_infinite() {
+                infinite_lights.push(lights.len() as u32);
+            }
+            lights.push(light);
+        }
+        let light_sampler = LightSampler::new(&lights, bounding_sphere);
+        Scene {
+            camera: self.camera,
+            settings: self.settings,
+            materials: self.materials,
+            shapes,
+            lights,
+            light_sampler,
+            infinite_lights,
+            bounding_sphere,
+            accel,
+        }
+    }
+}

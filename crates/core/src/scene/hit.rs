@@ -1,0 +1,80 @@
+//! A ray's closest hit turned into the local geometry integrators shade with.
+
+use super::{Scene, ShapeGeometry};
+use crate::bsdf::ShadingFrame;
+use crate::geometry::ray::barycentric_error;
+use crate::geometry::sphere::refine_sphere_hit;
+use crate::geometry::{offset_ray_origin, PrimHit, Primitive, Ray, SHADOW_EPSILON};
+use crate::math::Vec3;
+
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    pub p: Vec3,
+    /// Conservative per-axis bound on the rounding error of `p`.
+    pub p_err: Vec3,
+    /// Geometric normal, unit, on the shape's outside (after `flip_normals`).
+    pub ng: Vec3,
+    /// Shading normal, unit, on the same side as `ng`.
+    pub ns: Vec3,
+    pub t: f32,
+    pub shape: u32,
+    pub material: u32,
+    /// Index into `Scene::lights` when the surface emits.
+    pub light: Option<u32>,
+}
+
+impl SurfaceHit {
+    pub(crate) fn new(scene: &Scene, ray: &Ray, h: PrimHit) -> SurfaceHit {
+        let prim = *scene.accel.primitive(h.prim);
+        let shape = &scene.shapes[prim.shape() as usize];
+        let (p, p_err, mut ng, mut ns) = match prim {
+            Primitive::Triangle { p0, e1, e2, index, .. } => {
+                let (_, b1, b2) = crate::geometry::triangle::intersect_triangle(ray.o, ray.d, f32::INFINITY, p0, e1, e2);
+                let b0 = 1.0 - b1 - b2;
+                let (p1, p2) = (p0 + e1, p0 + e2);
+                let p = b0 * p0 + b1 * p1 + b2 * p2;
+                let err = barycentric_error([b0, b1, b2], [p0, p1, p2]);
+                let ng = e1.cross(e2).normalize();
+                let ns = match &shape.geometry {
+                    ShapeGeometry::Mesh(m) => m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng),
+                    ShapeGeometry::Sphere { .. } => ng,
+                };
+                (p, err, ng, ns)
+            }
+            Primitive::Sphere { center, radius, .. } => {
+                let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
+                let n = (p - center).normalize();
+                (p, err, n, n)
+            }
+        };
+        if shape.flip_normals {
+            ng = -ng;
+            ns = -ns;
+        }
+        // Interpolated normals may face the other way than the geometry; keep them on ng's side.
+        if ns.dot(ng) < 0.0 {
+            ns = -ns;
+        }
+        SurfaceHit { p, p_err, ng, ns, t: h.t, shape: prim.shape(), material: shape.material, light: shape.light }
+    }
+
+    #[inline]
+    pub fn shading_frame(&self) -> ShadingFrame {
+        ShadingFrame::new(self.ng, self.ns)
+    }
+
+    /// A ray leaving the surface in direction `dir`, started safely off the surface.
+    #[inline]
+    pub fn spawn_ray(&self, dir: Vec3) -> Ray {
+        Ray::new(offset_ray_origin(self.p, self.p_err, self.ng, dir), dir)
+    }
+
+    /// A shadow ray towards `to`, stopping just short of it.
+    #[inline]
+    pub fn spawn_ray_to(&self, to: Vec3) -> Ray {
+        let o = offset_ray_origin(self.p, self.p_err, self.ng, to - self.p);
+        let d = to - o;
+        let len = d.length();
+        Ray { o, d: d / len, t_max: len * (1.0 - SHADOW_EPSILON) }
+    }
+}

@@ -1,0 +1,101 @@
+//! The scene: shapes in one BVH, materials, lights and the camera, plus the queries integrators
+//! make (closest hit, visibility). Scenes are read from TOML by `load` (format in
+//! `docs/scene-format.md`) or assembled in code with `SceneBuilder`.
+
+mod builder;
+mod hit;
+pub mod load;
+
+pub use builder::{LightDesc, SceneBuilder, ShapeGeometry, TriangleMesh};
+pub use hit::SurfaceHit;
+pub use load::{load_scene, load_scene_str, SceneError};
+
+use crate::bsdf::Material;
+use crate::camera::Camera;
+use crate::geometry::{Accel, Ray, SHADOW_EPSILON};
+use crate::light::{Light, LightSampler};
+use crate::math::Vec3;
+
+/// Integrator-independent render settings a scene file may carry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Longest path in segments, camera ray included (Mitsuba 3's convention):
+    /// 1 = emitters seen directly, 2 = direct lighting, …
+    pub max_depth: u32,
+    /// Russian roulette starts after this many segments.
+    pub rr_depth: u32,
+    /// Default samples per pixel when the command line gives none.
+    pub spp: u32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings { max_depth: 8, rr_depth: 5, spp: 64 }
+    }
+}
+
+/// One shape as the user described it, after transforms (world space).
+#[derive(Clone, Debug)]
+pub struct Shape {
+    pub geometry: ShapeGeometry,
+    pub material: u32,
+    /// Index into `Scene::lights` when the shape emits.
+    pub light: Option<u32>,
+    /// Flips the geometric (and shading) normal: emission and inside/outside follow it.
+    pub flip_normals: bool,
+}
+
+pub struct Scene {
+    pub camera: Camera,
+    pub settings: RenderSettings,
+    pub materials: Vec<Material>,
+    pub shapes: Vec<Shape>,
+    pub lights: Vec<Light>,
+    pub light_sampler: LightSampler,
+    /// Lights at infinity (sun, environment) that a ray escaping the scene can see.
+    pub infinite_lights: Vec<u32>,
+    /// Bounding sphere of the geometry (centre, radius): distant lights emit over its disk.
+    pub bounding_sphere: (Vec3, f32),
+    pub(crate) accel: Accel,
+}
+
+impl Scene {
+    /// The closest surface the ray hits.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        let h = self.accel.intersect(ray)?;
+        Some(SurfaceHit::new(self, ray, h))
+    }
+
+    /// True when nothing blocks the segment from a surface point to a point `to` (exclusive).
+    #[inline]
+    pub fn visible(&self, from: &SurfaceHit, to: Vec3) -> bool {
+        !self.accel.occluded(&from.spawn_ray_to(to))
+    }
+
+    /// True when nothing blocks the ray leaving a surface point in direction `dir` (a distant light).
+    #[inline]
+    pub fn unoccluded_towards(&self, from: &SurfaceHit, dir: Vec3) -> bool {
+        !self.accel.occluded(&from.spawn_ray(dir))
+    }
+
+    /// Visibility between two arbitrary points with error bounds (used by camera connections).
+    pub fn visible_between(&self, a: Vec3, b: Vec3) -> bool {
+        let d = b - a;
+        let len = d.length();
+        if !(len > 0.0) {
+            return true;
+        }
+        let ray = Ray { o: a, d: d / len, t_max: len * (1.0 - SHADOW_EPSILON) };
+        !self.accel.occluded(&ray)
+    }
+
+    pub fn material(&self, id: u32) -> &Material {
+        &self.materials[id as usize]
+    }
+
+    /// Number of primitives in the BVH (for benchmarks and reports).
+    pub fn primitive_count(&self) -> usize {
+        self.accel.primitive_count()
+    }
+}
