@@ -84,6 +84,24 @@ impl Camera {
         })
     }
 
+    /// The same view at another resolution (tests and previews render scenes smaller). The field of
+    /// view is kept along the axis it was given for.
+    pub fn with_resolution(&self, width: u32, height: u32) -> Camera {
+        let mut c = self.clone();
+        let aspect = width as f32 / height as f32;
+        let old_aspect = self.width as f32 / self.height as f32;
+        // Keep the horizontal extent when the old image was at least as wide as tall, else the vertical.
+        c.tan_half = if old_aspect >= 1.0 {
+            Vec2::new(self.tan_half.x, self.tan_half.x / aspect)
+        } else {
+            Vec2::new(self.tan_half.y * aspect, self.tan_half.y)
+        };
+        c.width = width;
+        c.height = height;
+        c.plane_area = 4.0 * c.tan_half.x * c.tan_half.y;
+        c
+    }
+
     pub fn pixel_count(&self) -> usize {
         self.width as usize * self.height as usize
     }

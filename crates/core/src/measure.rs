@@ -28,3 +28,11 @@ pub fn geometry_term(x: Vec3, nx: Vec3, y: Vec3, ny: Vec3) -> f32 {
     let inv = 1.0 / d2.sqrt();
     (nx.dot(d) * inv).abs() * (ny.dot(d) * inv).abs() / d2
 }
+
+/// Converts a density over the plane perpendicular to `dir` (the disk a light at infinity emits
+/// over, so the density of where a parallel ray starts) into an area density at a surface point
+/// with normal `n_to` that the ray reaches: p_A = p_⊥ · |cos θ_to| (dA_⊥ = |cos θ| dA).
+#[inline]
+pub fn perpendicular_to_area(pdf_perp: f32, dir: Vec3, n_to: Vec3) -> f32 {
+    pdf_perp * n_to.dot(dir).abs()
+}

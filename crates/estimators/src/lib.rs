@@ -1,2 +1,26 @@
+//! The statistics every test and study in the workspace stands on: running means and variances,
+//! per-region estimates, the agreement test, image metrics, bias/variance decomposition,
+//! log-log fits, efficiency. No rendering code lives here.
+
+pub mod agreement;
+pub mod bias_variance;
+pub mod binomial;
+pub mod blocks;
+pub mod efficiency;
+pub mod fit;
 pub mod image;
+pub mod metrics;
+pub mod running;
+
+#[cfg(test)]
+mod test_rng;
+
+pub use agreement::{agreement, agreement_with_reference, Agreement};
+pub use bias_variance::{BiasVariance, ImageBiasVariance, Interval};
+pub use binomial::{binomial_test, BinomialTest};
+pub use blocks::{block_means, BlockEstimate, RunningBlocks};
+pub use efficiency::{efficiency, time_to_mse, time_to_mse_extrapolated};
+pub use fit::{fit_line, fit_log_log, LineFit};
 pub use image::Image;
+pub use metrics::{image_metrics, psnr, ChannelMetrics, ImageMetrics};
+pub use running::{RunningImage, RunningStat};

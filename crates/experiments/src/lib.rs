@@ -1,1 +1,7 @@
+//! The binaries users run (`lt`, benches, experiments) and the I/O they share.
 
+pub mod bench;
+pub mod bench_cmd;
+pub mod compare;
+pub mod image_io;
+pub mod render_cmd;

@@ -5,6 +5,7 @@
 mod builder;
 mod hit;
 pub mod load;
+pub mod ray_stats;
 
 pub use builder::{LightDesc, SceneBuilder, ShapeGeometry, TriangleMesh};
 pub use hit::SurfaceHit;
@@ -63,6 +64,7 @@ impl Scene {
     /// The closest surface the ray hits.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        ray_stats::count_closest();
         let h = self.accel.intersect(ray)?;
         Some(SurfaceHit::new(self, ray, h))
     }
@@ -70,12 +72,14 @@ impl Scene {
     /// True when nothing blocks the segment from a surface point to a point `to` (exclusive).
     #[inline]
     pub fn visible(&self, from: &SurfaceHit, to: Vec3) -> bool {
+        ray_stats::count_shadow();
         !self.accel.occluded(&from.spawn_ray_to(to))
     }
 
     /// True when nothing blocks the ray leaving a surface point in direction `dir` (a distant light).
     #[inline]
     pub fn unoccluded_towards(&self, from: &SurfaceHit, dir: Vec3) -> bool {
+        ray_stats::count_shadow();
         !self.accel.occluded(&from.spawn_ray(dir))
     }
 
@@ -87,6 +91,7 @@ impl Scene {
             return true;
         }
         let ray = Ray { o: a, d: d / len, t_max: len * (1.0 - SHADOW_EPSILON) };
+        ray_stats::count_shadow();
         !self.accel.occluded(&ray)
     }
 

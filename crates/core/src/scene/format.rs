@@ -1,0 +1,148 @@
+//! The scene file as serde sees it (reference: docs/scene-format.md). Every table denies unknown
+//! keys; values that are checked after parsing keep their byte span (`Spanned`) so the error can
+//! name the line. Shapes, materials and lights are flat structs with a `type` key rather than
+//! tagged enums: serde buffers tagged enums, which would lose the spans.
+
+use crate::camera::FovAxis;
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt;
+use toml::Spanned;
+
+pub type S<T> = Spanned<T>;
+pub type V3 = [f64; 3];
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub camera: S<CameraDef>,
+    pub render: Option<RenderDef>,
+    #[serde(default)]
+    pub materials: BTreeMap<String, S<MaterialDef>>,
+    #[serde(default)]
+    pub shapes: Vec<S<ShapeDef>>,
+    #[serde(default)]
+    pub lights: Vec<S<LightDef>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDef {
+    pub eye: S<V3>,
+    pub target: S<V3>,
+    pub up: Option<S<V3>>,
+    pub fov: S<f64>,
+    pub fov_axis: Option<FovAxis>,
+    pub resolution: S<[u32; 2]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderDef {
+    pub max_depth: Option<S<u32>>,
+    pub rr_depth: Option<u32>,
+    pub spp: Option<S<u32>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDef {
+    #[serde(rename = "type")]
+    pub kind: S<String>,
+    pub albedo: Option<S<ColorDef>>,
+    pub reflectance: Option<S<ColorDef>>,
+    pub ior: Option<S<f64>>,
+    pub roughness: Option<S<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeDef {
+    #[serde(rename = "type")]
+    pub kind: S<String>,
+    pub material: S<String>,
+    pub emission: Option<S<ColorDef>>,
+    #[serde(default)]
+    pub flip_normals: bool,
+    // mesh
+    pub file: Option<S<String>>,
+    // sphere
+    pub center: Option<S<V3>>,
+    pub radius: Option<S<f64>>,
+    // mesh, quad, cube
+    pub to_world: Option<S<[[f64; 4]; 4]>>,
+    pub translate: Option<S<V3>>,
+    pub rotate: Option<S<RotateDef>>,
+    pub scale: Option<S<ScaleDef>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotateDef {
+    pub axis: V3,
+    /// Degrees, counter-clockwise looking down the axis (right-handed).
+    pub angle: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightDef {
+    #[serde(rename = "type")]
+    pub kind: S<String>,
+    pub position: Option<S<V3>>,
+    pub intensity: Option<S<ColorDef>>,
+    pub direction: Option<S<V3>>,
+    pub solid_angle: Option<S<f64>>,
+    pub radiance: Option<S<ColorDef>>,
+    pub irradiance: Option<S<ColorDef>>,
+}
+
+/// An RGB triple written as `[r, g, b]` or as one number for grey.
+#[derive(Clone, Copy, Debug)]
+pub struct ColorDef(pub V3);
+
+/// A scale written as `[x, y, z]` or as one number for a uniform scale.
+#[derive(Clone, Copy, Debug)]
+pub struct ScaleDef(pub V3);
+
+/// Accepts one number (repeated three times) or an array of exactly three numbers.
+struct TripleVisitor(&'static str);
+
+impl<'de> Visitor<'de> for TripleVisitor {
+    type Value = V3;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "{}: a number or an array of 3 numbers", self.0)
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<V3, E> {
+        Ok([v; 3])
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<V3, E> {
+        Ok([v as f64; 3])
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<V3, E> {
+        Ok([v as f64; 3])
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<V3, A::Error> {
+        let mut out = [0.0; 3];
+        for (i, slot) in out.iter_mut().enumerate() {
+            *slot = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
+        }
+        if seq.next_element::<de::IgnoredAny>()?.is_some() {
+            return Err(de::Error::invalid_length(4, &self));
+        }
+        Ok(out)
+    }
+}
+
+impl<'de> Deserialize<'de> for ColorDef {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(TripleVisitor("a colour")).map(ColorDef)
+    }
+}
+
+impl<'de> Deserialize<'de> for ScaleDef {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(TripleVisitor("a scale")).map(ScaleDef)
+    }
+}

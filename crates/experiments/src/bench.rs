@@ -1,0 +1,90 @@
+//! Throughput measurements shared by the criterion bench and `lt bench`: raw BVH traversal on
+//! incoherent rays, and integrator samples per second.
+
+use lt_core::geometry::Ray;
+use lt_core::sampling::{sample_uniform_sphere, Sampler};
+use lt_core::{Scene, Vec3};
+use lt_integrators::{make_integrator, IntegratorParams};
+use std::time::Instant;
+
+/// Incoherent rays: origins uniform in the scene's bounding box, directions uniform on the sphere.
+pub fn incoherent_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
+    let (c, r) = scene.bounding_sphere;
+    let half = Vec3::splat(r / 3f32.sqrt());
+    let mut s = Sampler::new(seed, 0, 0);
+    (0..count)
+        .map(|_| {
+            let u = Vec3::new(s.next_f32(), s.next_f32(), s.next_f32());
+            let o = c + (2.0 * u - Vec3::ONE) * half;
+            Ray::new(o, sample_uniform_sphere(s.next_2d()))
+        })
+        .collect()
+}
+
+/// Closest-hit rays per second on one thread, and the fraction that hit.
+pub fn closest_hit_rate(scene: &Scene, rays: &[Ray], repeats: usize) -> (f64, f64) {
+    let mut hits = 0usize;
+    let start = Instant::now();
+    for _ in 0..repeats {
+        for r in rays {
+            hits += scene.intersect(r).is_some() as usize;
+        }
+    }
+    let secs = start.elapsed().as_secs_f64();
+    let n = (rays.len() * repeats) as f64;
+    (n / secs, hits as f64 / n)
+}
+
+/// Shadow (any-hit) rays per second on one thread.
+pub fn shadow_rate(scene: &Scene, rays: &[Ray], repeats: usize) -> f64 {
+    let mut blocked = 0usize;
+    let start = Instant::now();
+    for _ in 0..repeats {
+        for r in rays {
+            blocked += scene.visible_between(r.o, r.at(1.0)) as usize;
+        }
+    }
+    std::hint::black_box(blocked);
+    (rays.len() * repeats) as f64 / start.elapsed().as_secs_f64()
+}
+
+/// Throughput of an integrator at the scene's resolution.
+#[derive(Clone, Copy, Debug)]
+pub struct IntegratorRate {
+    pub spp_per_second: f64,
+    pub samples_per_second: f64,
+    /// Closest-hit plus shadow rays per second, all threads together.
+    pub rays_per_second: f64,
+    pub closest_per_sample: f64,
+    pub shadow_per_sample: f64,
+}
+
+/// Runs `passes` passes of `integrator` on `threads` threads and counts the rays they trace.
+pub fn integrator_rate(scene: &Scene, integrator: &str, max_depth: Option<u32>, passes: u32, threads: usize) -> Result<IntegratorRate, String> {
+    let integ = make_integrator(integrator, scene, &IntegratorParams { max_depth, rr_depth: None })?;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
+    pool.broadcast(|_| lt_core::scene::ray_stats::take());
+    let start = Instant::now();
+    for pass in 0..passes {
+        std::hint::black_box(pool.install(|| integ.render_pass(scene, 1, pass)));
+    }
+    let secs = start.elapsed().as_secs_f64();
+    let counts = pool.broadcast(|_| lt_core::scene::ray_stats::take());
+    let (closest, shadow) = counts.iter().fold((0u64, 0u64), |a, c| (a.0 + c.0, a.1 + c.1));
+    let samples = passes as f64 * scene.camera.pixel_count() as f64;
+    Ok(IntegratorRate {
+        spp_per_second: passes as f64 / secs,
+        samples_per_second: samples / secs,
+        rays_per_second: (closest + shadow) as f64 / secs,
+        closest_per_sample: closest as f64 / samples,
+        shadow_per_sample: shadow as f64 / samples,
+    })
+}
+
+/// Peak resident memory of this process in MiB (Linux), if known.
+pub fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}

@@ -1,0 +1,75 @@
+//! `lt bench`: raw traversal and integrator throughput as a Markdown table (results/bench.md).
+
+use crate::bench::{closest_hit_rate, incoherent_rays, integrator_rate, peak_memory_mib, shadow_rate};
+use clap::Args;
+use lt_core::scene::load_scene;
+use std::fmt::Write;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Scene files to measure.
+    #[arg(default_values = ["scenes/cornell-box.toml", "scenes/veach-mis.toml"])]
+    pub scenes: Vec<PathBuf>,
+    /// Integrators to measure.
+    #[arg(long, value_delimiter = ',', default_value = "pt")]
+    pub integrators: Vec<String>,
+    /// Passes (spp) per integrator measurement.
+    #[arg(long, default_value_t = 16)]
+    pub passes: u32,
+    /// Threads for the integrator measurements (0 = one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    #[arg(long, default_value_t = 8)]
+    pub max_depth: u32,
+    /// Write the table here as well as printing it.
+    #[arg(long, short)]
+    pub output: Option<PathBuf>,
+}
+
+pub fn run(args: &BenchArgs) -> Result<String, String> {
+    let threads = if args.threads == 0 { std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1) } else { args.threads };
+    let mut out = String::new();
+    let cmd: Vec<String> = std::env::args().collect();
+    writeln!(out, "Command: `{}`  ", cmd.join(" ")).unwrap();
+    writeln!(out, "Machine: {} hardware threads; integrators on {threads} thread(s), max depth {}.\n", std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1), args.max_depth).unwrap();
+    writeln!(out, "| scene | primitives | closest hit Mrays/s (1 thread) | hit fraction | shadow Mrays/s (1 thread) |").unwrap();
+    writeln!(out, "|---|---:|---:|---:|---:|").unwrap();
+    let mut scenes = Vec::new();
+    for path in &args.scenes {
+        let scene = load_scene(path).map_err(|e| e.to_string())?;
+        let rays = incoherent_rays(&scene, 200_000, 1);
+        let (rate, hit) = closest_hit_rate(&scene, &rays, 5);
+        let shadow = shadow_rate(&scene, &rays, 5);
+        let name = path.file_stem().unwrap_or_default().to_string_lossy().to_string();
+        writeln!(out, "| {name} | {} | {:.2} | {:.2} | {:.2} |", scene.primitive_count(), rate / 1e6, hit, shadow / 1e6).unwrap();
+        scenes.push((name, scene, rate));
+    }
+    writeln!(out, "\n| scene | integrator | resolution | spp/s | Msamples/s | Mrays/s (all threads) | rays/s per thread vs raw closest hit | closest + shadow rays per sample |").unwrap();
+    writeln!(out, "|---|---|---|---:|---:|---:|---:|---|").unwrap();
+    for (name, scene, raw) in &scenes {
+        for integ in &args.integrators {
+            let r = integrator_rate(scene, integ, Some(args.max_depth), args.passes, threads)?;
+            writeln!(
+                out,
+                "| {name} | {integ} | {}×{} | {:.1} | {:.2} | {:.2} | {:.0} % | {:.2} + {:.2} |",
+                scene.camera.width,
+                scene.camera.height,
+                r.spp_per_second,
+                r.samples_per_second / 1e6,
+                r.rays_per_second / 1e6,
+                100.0 * r.rays_per_second / threads as f64 / raw,
+                r.closest_per_sample,
+                r.shadow_per_sample
+            )
+            .unwrap();
+        }
+    }
+    if let Some(m) = peak_memory_mib() {
+        writeln!(out, "\nPeak resident memory of the whole run: {m:.0} MiB.").unwrap();
+    }
+    if let Some(path) = &args.output {
+        crate::image_io::write_atomic(path, out.as_bytes())?;
+    }
+    Ok(out)
+}

@@ -1,0 +1,64 @@
+//! `pt-bsdf` — path tracing by BSDF sampling alone: light is found only when a sampled path hits an
+//! emitter or escapes to a light at infinity. It shares no light-sampling code with `pt`, which is
+//! why it is the independent cross-check of `pt` (the two must agree within their standard errors).
+//! It cannot see delta lights (point lights), and converges slowly for small lights.
+//!
+//! | key | type | default | meaning |
+//! |---|---|---|---|
+//! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
+//! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
+
+use crate::pixel::pixel_pass;
+use crate::pt::{escaped_radiance, russian_roulette, PtParams};
+use crate::Integrator;
+use lt_core::bsdf::TransportMode;
+use lt_core::math::Color;
+use lt_core::sampling::Sampler;
+use lt_core::{Scene, Vec2};
+use lt_estimators::Image;
+
+pub struct PtBsdf {
+    pub params: PtParams,
+}
+
+impl PtBsdf {
+    pub fn radiance(&self, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> Color {
+        let mut ray = scene.camera.generate_ray(raster);
+        let mut beta = Color::ONE;
+        let mut l = Color::ZERO;
+        for depth in 1..=self.params.max_depth {
+            let Some(hit) = scene.intersect(&ray) else {
+                l += beta * escaped_radiance(scene, ray.d, |_| 1.0);
+                break;
+            };
+            let wo = -ray.d;
+            if let Some(li) = hit.light {
+                l += beta * scene.lights[li as usize].emitted(hit.ng, wo);
+            }
+            if depth == self.params.max_depth {
+                break;
+            }
+            let u_lobe = sampler.next_f32();
+            let u = sampler.next_2d();
+            let Some(bs) = scene.material(hit.material).sample(&hit.shading_frame(), wo, u_lobe, u, TransportMode::Radiance) else {
+                break;
+            };
+            beta *= bs.weight;
+            if beta == Color::ZERO || !russian_roulette(&mut beta, depth, self.params.rr_depth, sampler) {
+                break;
+            }
+            ray = hit.spawn_ray(bs.wi);
+        }
+        l
+    }
+}
+
+impl Integrator for PtBsdf {
+    fn name(&self) -> &'static str {
+        "pt-bsdf"
+    }
+
+    fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
+        pixel_pass(scene, seed, pass, |s, raster| self.radiance(scene, raster, s))
+    }
+}
