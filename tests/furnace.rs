@@ -23,7 +23,7 @@ fn furnace(sphere: bool, scale: f32) -> Scene {
     let geometry = if sphere {
         ShapeGeometry::Sphere { center: Vec3::ZERO, radius: scale }
     } else {
-        ShapeGeometry::Mesh(TriangleMesh::unit_cube().transformed(&glam::Mat4::from_scale(Vec3::splat(scale))))
+        ShapeGeometry::Mesh(TriangleMesh::unit_cube().transformed(&lt_core::math::Mat4::from_scale(Vec3::splat(scale))))
     };
     // Normals flipped to face inwards: that is the side that emits and is seen.
     b.add_shape(geometry, m, Some(Color::splat(LE)), true);

@@ -7,8 +7,10 @@ pub mod geometry;
 pub mod light;
 pub mod math;
 pub mod measure;
+pub mod path;
 pub mod sampling;
 pub mod scene;
+pub mod testing;
 
 pub use math::{Color, Vec2, Vec3};
 pub use scene::Scene;

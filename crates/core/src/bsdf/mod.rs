@@ -176,3 +176,22 @@ fn adjoint_correction(sf: &ShadingFrame, wo: Vec3, wi: Vec3, cos_s_o: f32, mode:
         }
     }
 }
+
+/// Representative materials that the sampling tests sweep (name, material): every kind, GGX
+/// roughness from near-specular to very rough, and IORs seen from both sides of the interface.
+pub fn test_registry() -> Vec<(&'static str, Material)> {
+    let c = Color::new(0.9, 0.6, 0.3);
+    let glossy = |roughness| Material::Glossy(Glossy { reflectance: c, roughness });
+    let glass = |ior| Material::Dielectric(Dielectric { ior });
+    vec![
+        ("diffuse", Material::Diffuse(Diffuse { albedo: c })),
+        ("mirror", Material::Mirror(Mirror { reflectance: c })),
+        ("glossy-0.05", glossy(0.05)),
+        ("glossy-0.2", glossy(0.2)),
+        ("glossy-0.5", glossy(0.5)),
+        ("glossy-1.0", glossy(1.0)),
+        ("glass-1.5", glass(1.5)),
+        ("glass-1/1.5", glass(1.0 / 1.5)),
+        ("glass-2.4", glass(2.4)),
+    ]
+}

@@ -3,7 +3,7 @@
 
 use super::ray::Ray;
 use super::sphere::intersect_sphere;
-use super::triangle::intersect_triangle;
+use super::triangle::{intersect_triangle, ShearedRay};
 use crate::math::Vec3;
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
@@ -15,7 +15,7 @@ use obvhs::{Boundable, BvhBuildParams};
 /// A primitive in the BVH. `shape` indexes the scene's shapes; `index` is the triangle within its mesh.
 #[derive(Clone, Copy, Debug)]
 pub enum Primitive {
-    Triangle { p0: Vec3, e1: Vec3, e2: Vec3, shape: u32, index: u32 },
+    Triangle { p: [Vec3; 3], shape: u32, index: u32 },
     Sphere { center: Vec3, radius: f32, shape: u32 },
 }
 
@@ -26,11 +26,12 @@ impl Primitive {
         }
     }
 
+    /// Hit distance in (0, t_max) from the ray's true origin, or +∞.
     #[inline]
-    fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> f32 {
-        match *self {
-            Primitive::Triangle { p0, e1, e2, .. } => intersect_triangle(o, d, t_max, p0, e1, e2).0,
-            Primitive::Sphere { center, radius, .. } => intersect_sphere(o, d, t_max, center, radius),
+    pub fn intersect(&self, r: &ShearedRay, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        match self {
+            Primitive::Triangle { p, .. } => intersect_triangle(r, t_max, p).0,
+            &Primitive::Sphere { center, radius, .. } => intersect_sphere(o, d, t_max, center, radius),
         }
     }
 }
@@ -38,10 +39,8 @@ impl Primitive {
 impl Boundable for Primitive {
     fn aabb(&self) -> Aabb {
         match *self {
-            Primitive::Triangle { p0, e1, e2, .. } => {
-                let a = Vec3A::from(p0);
-                let b = Vec3A::from(p0 + e1);
-                let c = Vec3A::from(p0 + e2);
+            Primitive::Triangle { p, .. } => {
+                let [a, b, c] = p.map(Vec3A::from);
                 Aabb::new(a.min(b).min(c), a.max(b).max(c))
             }
             Primitive::Sphere { center, radius, .. } => {
@@ -92,9 +91,14 @@ impl Accel {
         self.bounds
     }
 
+    /// obvhs's wide-node test clamps the entry distance to an absolute 1e-4 (`cwbvh::node::EPSILON`),
+    /// which would cull every box closer than 1e-4 scene units — at millimetre scale, whole walls.
+    /// Traversal therefore starts `TRAVERSAL_BACKOFF` behind the real origin, so every true hit is
+    /// at least that far along the traversal ray; primitive tests subtract it again.
     #[inline]
     fn obvhs_ray(ray: &Ray) -> obvhs::ray::Ray {
-        obvhs::ray::Ray::new(ray.o.into(), ray.d.into(), 0.0, ray.t_max)
+        let o = ray.o - ray.d * TRAVERSAL_BACKOFF;
+        obvhs::ray::Ray::new(o.into(), ray.d.into(), 0.0, ray.t_max + TRAVERSAL_BACKOFF)
     }
 
     /// Closest hit along the ray within (0, t_max).
@@ -105,10 +109,13 @@ impl Accel {
         }
         let mut hit = RayHit::none();
         let prims = &self.prims;
+        let (o, d) = (ray.o, ray.d);
+        let sheared = ShearedRay::new(o, d);
         let found = self.bvh.ray_traverse(Self::obvhs_ray(ray), &mut hit, |r, id| {
-            prims[id].intersect(r.origin.into(), r.direction.into(), r.tmax)
+            // Tested from the real origin; the result is reported in traversal-ray distance.
+            prims[id].intersect(&sheared, o, d, r.tmax - TRAVERSAL_BACKOFF) + TRAVERSAL_BACKOFF
         });
-        found.then_some(PrimHit { t: hit.t, prim: hit.primitive_id })
+        found.then(|| PrimHit { t: hit.t - TRAVERSAL_BACKOFF, prim: hit.primitive_id })
     }
 
     /// True when anything blocks the ray within (0, t_max). Stops at the first blocker.
@@ -118,11 +125,15 @@ impl Accel {
             return false;
         }
         let prims = &self.prims;
-        !self.bvh.ray_traverse_miss(Self::obvhs_ray(ray), |r, id| {
-            prims[id].intersect(r.origin.into(), r.direction.into(), r.tmax)
-        })
+        let (o, d, t_max) = (ray.o, ray.d, ray.t_max);
+        let sheared = ShearedRay::new(o, d);
+        !self.bvh.ray_traverse_miss(Self::obvhs_ray(ray), |_, id| prims[id].intersect(&sheared, o, d, t_max) + TRAVERSAL_BACKOFF)
     }
 }
+
+/// How far behind its origin a ray's BVH traversal starts (see `Accel::obvhs_ray`): twice obvhs's
+/// clamp. Only box tests see it; primitives are always intersected from the true origin.
+const TRAVERSAL_BACKOFF: f32 = 2e-4;
 
 #[cfg(test)]
 mod tests {
@@ -130,40 +141,58 @@ mod tests {
     use crate::sampling::{sample_uniform_sphere, Sampler};
 
     fn brute_force(prims: &[Primitive], ray: &Ray) -> f32 {
-        prims.iter().map(|p| p.intersect(ray.o, ray.d, ray.t_max)).fold(f32::INFINITY, f32::min)
+        let r = ShearedRay::new(ray.o, ray.d);
+        prims.iter().map(|p| p.intersect(&r, ray.o, ray.d, ray.t_max)).fold(f32::INFINITY, f32::min)
     }
 
-    #[test]
-    fn bvh_agrees_with_brute_force_on_random_rays() {
-        let mut s = Sampler::new(1, 0, 0);
+    /// Random triangles and spheres at scale `scale`; rays from random points and from points on
+    /// the primitives (the short hits near edges and corners that a fixed epsilon would lose).
+    fn agrees_with_brute_force_at(scale: f32) {
+        let mut s = Sampler::new(1, scale.to_bits() as u64, 0);
         let mut prims = Vec::new();
         for i in 0..200u32 {
-            let c = (s.next_2d().extend(s.next_f32()) - 0.5) * 10.0;
+            let c = (s.next_2d().extend(s.next_f32()) - 0.5) * 10.0 * scale;
             if i % 3 == 0 {
-                prims.push(Primitive::Sphere { center: c, radius: 0.3 * s.next_f32() + 0.01, shape: i, });
+                prims.push(Primitive::Sphere { center: c, radius: (0.3 * s.next_f32() + 0.01) * scale, shape: i });
             } else {
-                let e1 = sample_uniform_sphere(s.next_2d());
-                let e2 = sample_uniform_sphere(s.next_2d());
-                prims.push(Primitive::Triangle { p0: c, e1, e2, shape: i, index: 0 });
+                let e1 = sample_uniform_sphere(s.next_2d()) * scale;
+                let e2 = sample_uniform_sphere(s.next_2d()) * scale;
+                prims.push(Primitive::Triangle { p: [c, c + e1, c + e2], shape: i, index: 0 });
             }
         }
         let accel = Accel::build(prims.clone());
-        for _ in 0..2000 {
-            let o = (s.next_2d().extend(s.next_f32()) - 0.5) * 12.0;
+        for k in 0..4000 {
+            let o = if k % 2 == 0 {
+                (s.next_2d().extend(s.next_f32()) - 0.5) * 12.0 * scale
+            } else {
+                match prims[k % prims.len()] {
+                    Primitive::Triangle { p, .. } => 0.4 * p[0] + 0.3 * p[1] + 0.3 * p[2],
+                    Primitive::Sphere { center, radius, .. } => center + Vec3::X * radius * 1.001,
+                }
+            };
             let mut ray = Ray::new(o, sample_uniform_sphere(s.next_2d()));
             if s.next_f32() < 0.3 {
-                ray.t_max = 3.0;
+                ray.t_max = 3.0 * scale;
             }
             let expected = brute_force(&prims, &ray);
             match accel.intersect(&ray) {
                 Some(h) => {
-                    assert_eq!(h.t, expected);
+                    // Adding and removing the traversal back-off rounds t by at most an ulp each way.
+                    let tol = 2.0 * f32::EPSILON * (expected + TRAVERSAL_BACKOFF);
+                    assert!((h.t - expected).abs() <= tol, "scale {scale}: {} vs {expected}", h.t);
                     let p = accel.primitive(h.prim);
-                    assert_eq!(p.intersect(ray.o, ray.d, ray.t_max), h.t);
+                    assert_eq!(p.intersect(&ShearedRay::new(ray.o, ray.d), ray.o, ray.d, ray.t_max), expected);
                 }
-                None => assert!(expected.is_infinite()),
+                None => assert!(expected.is_infinite(), "scale {scale}: BVH missed a hit at {expected}"),
             }
             assert_eq!(accel.occluded(&ray), expected.is_finite());
+        }
+    }
+
+    #[test]
+    fn bvh_agrees_with_brute_force_at_every_scale() {
+        for scale in [1e-3, 1.0, 1e6] {
+            agrees_with_brute_force_at(scale);
         }
     }
 }

@@ -1,37 +1,100 @@
-//! Ray–triangle intersection (Möller–Trumbore) on precomputed edges.
+//! Watertight ray–triangle intersection (Woop, Benthin & Wald, "Watertight Ray/Triangle
+//! Intersection", JCGT 2013). The ray is sheared so it runs along +z from the origin; the three
+//! 2-D edge functions are then evaluated exactly enough that a ray through a shared edge or vertex
+//! hits at least one of the triangles sharing it (Möller–Trumbore lets such rays slip through).
 
-use super::ray::Ray;
 use crate::math::Vec3;
 
-/// Returns the hit distance in (0, ray.t_max) or +∞, plus barycentrics (b1, b2) of the hit.
-#[inline]
-pub fn intersect_triangle(ray_o: Vec3, ray_d: Vec3, t_max: f32, p0: Vec3, e1: Vec3, e2: Vec3) -> (f32, f32, f32) {
-    let pvec = ray_d.cross(e2);
-    let det = e1.dot(pvec);
-    if det == 0.0 || !det.is_finite() {
-        return (f32::INFINITY, 0.0, 0.0);
-    }
-    let inv_det = 1.0 / det;
-    let tvec = ray_o - p0;
-    let b1 = tvec.dot(pvec) * inv_det;
-    if !(0.0..=1.0).contains(&b1) {
-        return (f32::INFINITY, 0.0, 0.0);
-    }
-    let qvec = tvec.cross(e1);
-    let b2 = ray_d.dot(qvec) * inv_det;
-    if b2 < 0.0 || b1 + b2 > 1.0 {
-        return (f32::INFINITY, 0.0, 0.0);
-    }
-    let t = e2.dot(qvec) * inv_det;
-    if t > 0.0 && t < t_max {
-        (t, b1, b2)
-    } else {
-        (f32::INFINITY, 0.0, 0.0)
+/// The per-ray part of the test, computed once and reused for every triangle the ray meets.
+#[derive(Clone, Copy, Debug)]
+pub struct ShearedRay {
+    o: Vec3,
+    k: [usize; 3],
+    s: Vec3,
+}
+
+impl ShearedRay {
+    pub fn new(o: Vec3, d: Vec3) -> ShearedRay {
+        let a = d.abs();
+        let kz = if a.x > a.y { if a.x > a.z { 0 } else { 2 } } else if a.y > a.z { 1 } else { 2 };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        // Keep the winding: swapping x and y mirrors the shear when the dominant axis is negative.
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        ShearedRay { o, k: [kx, ky, kz], s: Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]) }
     }
 }
 
-/// Convenience wrapper used by tests and non-hot paths.
-pub fn hit_triangle(ray: &Ray, p: [Vec3; 3]) -> Option<(f32, f32, f32)> {
-    let (t, b1, b2) = intersect_triangle(ray.o, ray.d, ray.t_max, p[0], p[1] - p[0], p[2] - p[0]);
-    t.is_finite().then_some((t, b1, b2))
+/// Returns the hit distance in (0, t_max) or +∞, plus barycentrics (b0, b1, b2) of p0, p1, p2.
+#[inline]
+pub fn intersect_triangle(r: &ShearedRay, t_max: f32, p: &[Vec3; 3]) -> (f32, [f32; 3]) {
+    const MISS: (f32, [f32; 3]) = (f32::INFINITY, [0.0; 3]);
+    let [kx, ky, kz] = r.k;
+    let a = p[0] - r.o;
+    let b = p[1] - r.o;
+    let c = p[2] - r.o;
+    let (ax, ay) = (a[kx] - r.s.x * a[kz], a[ky] - r.s.y * a[kz]);
+    let (bx, by) = (b[kx] - r.s.x * b[kz], b[ky] - r.s.y * b[kz]);
+    let (cx, cy) = (c[kx] - r.s.x * c[kz], c[ky] - r.s.y * c[kz]);
+    let mut u = cx * by - cy * bx;
+    let mut v = ax * cy - ay * cx;
+    let mut w = bx * ay - by * ax;
+    // An edge function that rounds to exactly zero is re-evaluated in double precision, which
+    // decides the edge case consistently for both triangles sharing the edge.
+    if u == 0.0 || v == 0.0 || w == 0.0 {
+        u = (cx as f64 * by as f64 - cy as f64 * bx as f64) as f32;
+        v = (ax as f64 * cy as f64 - ay as f64 * cx as f64) as f32;
+        w = (bx as f64 * ay as f64 - by as f64 * ax as f64) as f32;
+    }
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return MISS;
+    }
+    let det = u + v + w;
+    if det == 0.0 || !det.is_finite() {
+        return MISS;
+    }
+    let t_scaled = u * (r.s.z * a[kz]) + v * (r.s.z * b[kz]) + w * (r.s.z * c[kz]);
+    // Compare t against (0, t_max) before dividing, with the sign of det folded in.
+    let hit = if det < 0.0 { t_scaled < 0.0 && t_scaled > t_max * det } else { t_scaled > 0.0 && t_scaled < t_max * det };
+    if !hit {
+        return MISS;
+    }
+    let inv = 1.0 / det;
+    (t_scaled * inv, [u * inv, v * inv, w * inv])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{sample_uniform_sphere, Sampler};
+
+    #[test]
+    fn rays_through_a_shared_edge_never_slip_between_the_triangles() {
+        // A quad split along its diagonal; rays aimed exactly at points of the diagonal.
+        let q = [Vec3::new(-1.0, -1.0, 0.3), Vec3::new(1.0, -1.0, 0.3), Vec3::new(1.0, 1.0, 0.3), Vec3::new(-1.0, 1.0, 0.3)];
+        let (t1, t2) = ([q[0], q[1], q[2]], [q[0], q[2], q[3]]);
+        let mut s = Sampler::new(5, 0, 0);
+        for _ in 0..20_000 {
+            let target = q[0].lerp(q[2], s.next_f32());
+            let o = target + sample_uniform_sphere(s.next_2d()) * (0.1 + 10.0 * s.next_f32());
+            let d = (target - o).normalize();
+            let r = ShearedRay::new(o, d);
+            let hit = intersect_triangle(&r, f32::INFINITY, &t1).0.is_finite() || intersect_triangle(&r, f32::INFINITY, &t2).0.is_finite();
+            assert!(hit, "ray from {o} towards {target} slipped through the diagonal");
+        }
+    }
+
+    #[test]
+    fn barycentrics_reconstruct_the_hit_point() {
+        let p = [Vec3::new(0.0, 0.0, 2.0), Vec3::new(1.0, 0.0, 2.0), Vec3::new(0.0, 1.0, 2.5)];
+        let o = Vec3::new(0.2, 0.3, -1.0);
+        let d = (Vec3::new(0.25, 0.25, 2.125) - o).normalize();
+        let (t, b) = intersect_triangle(&ShearedRay::new(o, d), f32::INFINITY, &p);
+        let from_b = b[0] * p[0] + b[1] * p[1] + b[2] * p[2];
+        assert!((o + d * t - from_b).length() < 1e-5 && (from_b - Vec3::new(0.25, 0.25, 2.125)).length() < 1e-5);
+        assert!(intersect_triangle(&ShearedRay::new(o, d), t * 0.999, &p).0.is_infinite());
+        assert!(intersect_triangle(&ShearedRay::new(o, -d), f32::INFINITY, &p).0.is_infinite());
+    }
 }

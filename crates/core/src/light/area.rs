@@ -70,11 +70,14 @@ impl AreaLight {
         }
     }
 
-    /// 1 − cos θmax of the cone a sphere subtends from `p`, or None when `p` is inside it.
+    /// 1 − cos θmax of the cone a sphere subtends from `p`, or None when `p` is inside it or on
+    /// its surface. On the surface the cone degenerates into a half-space whose near intersection
+    /// is `p` itself, so points within a relative 1e-3 of the radius are sampled by area instead;
+    /// `sample_li` and `pdf_li` share this test, so the choice is always consistent.
     fn sphere_cone(p: Vec3, center: Vec3, radius: f32) -> Option<f32> {
         let d2 = (p - center).length_squared();
         let r2 = radius * radius;
-        if d2 <= r2 {
+        if d2 <= r2 * (1.0 + 1e-3) {
             return None;
         }
         let sin2 = r2 / d2;

@@ -140,7 +140,7 @@ impl SceneBuilder {
                     for (i, _) in m.indices.iter().enumerate() {
                         let [p0, p1, p2] = m.triangle(i);
                         if m.triangle_area(i) > 0.0 {
-                            prims.push(Primitive::Triangle { p0, e1: p1 - p0, e2: p2 - p0, shape: shape_id, index: i as u32 });
+                            prims.push(Primitive::Triangle { p: [p0, p1, p2], shape: shape_id, index: i as u32 });
                         }
                     }
                 }

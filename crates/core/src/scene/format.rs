@@ -126,7 +126,9 @@ impl<'de> Visitor<'de> for TripleVisitor {
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<V3, A::Error> {
         let mut out = [0.0; 3];
         for (i, slot) in out.iter_mut().enumerate() {
-            *slot = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
+            *slot = seq
+                .next_element()?
+                .ok_or_else(|| de::Error::invalid_length(i, &self))?;
         }
         if seq.next_element::<de::IgnoredAny>()?.is_some() {
             return Err(de::Error::invalid_length(4, &self));

@@ -4,6 +4,7 @@ use super::{Scene, ShapeGeometry};
 use crate::bsdf::ShadingFrame;
 use crate::geometry::ray::barycentric_error;
 use crate::geometry::sphere::refine_sphere_hit;
+use crate::geometry::triangle::{intersect_triangle, ShearedRay};
 use crate::geometry::{offset_ray_origin, PrimHit, Primitive, Ray, SHADOW_EPSILON};
 use crate::math::Vec3;
 
@@ -28,13 +29,12 @@ impl SurfaceHit {
         let prim = *scene.accel.primitive(h.prim);
         let shape = &scene.shapes[prim.shape() as usize];
         let (p, p_err, mut ng, mut ns) = match prim {
-            Primitive::Triangle { p0, e1, e2, index, .. } => {
-                let (_, b1, b2) = crate::geometry::triangle::intersect_triangle(ray.o, ray.d, f32::INFINITY, p0, e1, e2);
-                let b0 = 1.0 - b1 - b2;
-                let (p1, p2) = (p0 + e1, p0 + e2);
+            Primitive::Triangle { p: [p0, p1, p2], index, .. } => {
+                let sheared = ShearedRay::new(ray.o, ray.d);
+                let (_, [b0, b1, b2]) = intersect_triangle(&sheared, f32::INFINITY, &[p0, p1, p2]);
                 let p = b0 * p0 + b1 * p1 + b2 * p2;
                 let err = barycentric_error([b0, b1, b2], [p0, p1, p2]);
-                let ng = e1.cross(e2).normalize();
+                let ng = (p1 - p0).cross(p2 - p0).normalize();
                 let ns = match &shape.geometry {
                     ShapeGeometry::Mesh(m) => m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng),
                     ShapeGeometry::Sphere { .. } => ng,

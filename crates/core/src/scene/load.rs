@@ -31,14 +31,23 @@ impl std::fmt::Display for SceneError {
 impl std::error::Error for SceneError {}
 
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError { file: path.display().to_string(), line: None, column: None, message: e.to_string() })?;
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        file: path.display().to_string(),
+        line: None,
+        column: None,
+        message: format!("cannot read the scene file: {e}"),
+    })?;
     load_scene_str(&text, path)
 }
 
 /// Parses scene text; `path` names the file in errors and anchors relative mesh paths.
 pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let ctx = Ctx { file: path.display().to_string(), text, base_dir };
+    let ctx = Ctx {
+        file: path.display().to_string(),
+        text,
+        base_dir,
+    };
     let file: SceneFile = toml::from_str(text).map_err(|e| match e.span() {
         Some(span) => ctx.at(span, e.message().trim_end().to_string()),
         None => ctx.whole(e.message().trim_end().to_string()),
@@ -60,19 +69,32 @@ impl Ctx<'_> {
         let before = self.text.get(..start).unwrap_or(self.text);
         let line = before.matches('\n').count() + 1;
         let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
-        SceneError { file: self.file.clone(), line: Some(line), column: Some(column), message: message.into() }
+        SceneError {
+            file: self.file.clone(),
+            line: Some(line),
+            column: Some(column),
+            message: message.into(),
+        }
     }
 
     /// An error about the scene as a whole.
     pub fn whole(&self, message: impl Into<String>) -> SceneError {
-        SceneError { file: self.file.clone(), line: None, column: None, message: message.into() }
+        SceneError {
+            file: self.file.clone(),
+            line: None,
+            column: None,
+            message: message.into(),
+        }
     }
 
     /// A finite number (also after rounding to f32).
     pub fn num(&self, v: &S<f64>, key: &str) -> Result<f32, SceneError> {
         let x = *v.get_ref();
         if !(x as f32).is_finite() {
-            return Err(self.at(v.span(), format!("`{key}` must be a finite number, got {x}")));
+            return Err(self.at(
+                v.span(),
+                format!("`{key}` must be a finite number, got {x}"),
+            ));
         }
         Ok(x as f32)
     }
@@ -81,7 +103,10 @@ impl Ctx<'_> {
     pub fn positive(&self, v: &S<f64>, key: &str) -> Result<f32, SceneError> {
         let x = self.num(v, key)?;
         if !(x > 0.0) {
-            return Err(self.at(v.span(), format!("`{key}` must be positive, got {}", v.get_ref())));
+            return Err(self.at(
+                v.span(),
+                format!("`{key}` must be positive, got {}", v.get_ref()),
+            ));
         }
         Ok(x)
     }
@@ -90,13 +115,24 @@ impl Ctx<'_> {
     pub fn vec3(&self, v: &S<V3>, key: &str) -> Result<Vec3, SceneError> {
         let a = v.get_ref().map(|x| x as f32);
         if a.iter().any(|x| !x.is_finite()) {
-            return Err(self.at(v.span(), format!("`{key}` must have finite coordinates, got {:?}", v.get_ref())));
+            return Err(self.at(
+                v.span(),
+                format!(
+                    "`{key}` must have finite coordinates, got {:?}",
+                    v.get_ref()
+                ),
+            ));
         }
         Ok(Vec3::from_array(a))
     }
 
     /// A finite, non-negative colour; with `at_most_one`, a reflectance that conserves energy.
-    pub fn color(&self, v: &S<ColorDef>, key: &str, at_most_one: bool) -> Result<Color, SceneError> {
+    pub fn color(
+        &self,
+        v: &S<ColorDef>,
+        key: &str,
+        at_most_one: bool,
+    ) -> Result<Color, SceneError> {
         let c = v.get_ref().0;
         let f = c.map(|x| x as f32);
         if f.iter().any(|x| !x.is_finite()) {
@@ -112,16 +148,43 @@ impl Ctx<'_> {
     }
 
     /// A key the element must have; the error points at the element (`owner`).
-    pub fn need<'v, T>(&self, v: &'v Option<S<T>>, key: &str, owner: &Range<usize>, what: &str) -> Result<&'v S<T>, SceneError> {
-        v.as_ref().ok_or_else(|| self.at(owner.clone(), format!("missing required key `{key}` for {what}")))
+    pub fn need<'v, T>(
+        &self,
+        v: &'v Option<S<T>>,
+        key: &str,
+        owner: &Range<usize>,
+        what: &str,
+    ) -> Result<&'v S<T>, SceneError> {
+        v.as_ref().ok_or_else(|| {
+            self.at(
+                owner.clone(),
+                format!("missing required key `{key}` for {what}"),
+            )
+        })
     }
 
     /// Rejects keys given to an element type they do not apply to (serde only knows the union).
-    pub fn only(&self, given: &[(&str, Option<Range<usize>>)], allowed: &[&str], what: &str) -> Result<(), SceneError> {
+    pub fn only(
+        &self,
+        given: &[(&str, Option<Range<usize>>)],
+        allowed: &[&str],
+        what: &str,
+    ) -> Result<(), SceneError> {
         for (key, span) in given {
             if let (Some(span), false) = (span, allowed.contains(key)) {
-                let takes = if allowed.is_empty() { "no further keys".to_string() } else { allowed.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ") };
-                return Err(self.at(span.clone(), format!("key `{key}` does not apply to {what} (it takes {takes})")));
+                let takes = if allowed.is_empty() {
+                    "no further keys".to_string()
+                } else {
+                    allowed
+                        .iter()
+                        .map(|k| format!("`{k}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                return Err(self.at(
+                    span.clone(),
+                    format!("key `{key}` does not apply to {what} (it takes {takes})"),
+                ));
             }
         }
         Ok(())

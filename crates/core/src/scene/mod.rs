@@ -3,8 +3,12 @@
 //! `docs/scene-format.md`) or assembled in code with `SceneBuilder`.
 
 mod builder;
+mod elements;
+mod format;
 mod hit;
 pub mod load;
+mod obj;
+mod transform;
 pub mod ray_stats;
 
 pub use builder::{LightDesc, SceneBuilder, ShapeGeometry, TriangleMesh};

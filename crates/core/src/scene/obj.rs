@@ -14,34 +14,69 @@ pub fn load_obj(ctx: &Ctx, file: &S<String>) -> Result<TriangleMesh, SceneError>
     let shown = path.display();
     let text = match std::fs::read_to_string(&path) {
         Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(ctx.at(file.span(), format!("mesh file `{}` not found (looked for {shown})", file.get_ref()))),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(ctx.at(
+                file.span(),
+                format!(
+                    "mesh file `{}` not found (looked for {shown})",
+                    file.get_ref()
+                ),
+            ))
+        }
         Err(e) => return Err(ctx.at(file.span(), format!("cannot read mesh file {shown}: {e}"))),
     };
     let bad = |msg: String| ctx.at(file.span(), format!("malformed OBJ file {shown}: {msg}"));
     if let Some((line, what)) = precheck(&text) {
         return Err(bad(format!("line {line}: {what}")));
     }
-    let opts = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
-    let parsed = std::panic::catch_unwind(|| tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| Err(tobj::LoadError::OpenFileFailed)));
+    // Which fields exist depends on tobj's features, hence the struct update.
+    #[allow(clippy::needless_update)]
+    let opts = tobj::LoadOptions {
+        single_index: true,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let parsed = std::panic::catch_unwind(|| {
+        tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| {
+            Err(tobj::LoadError::OpenFileFailed)
+        })
+    });
     let models = match parsed {
         Ok(Ok((models, _materials))) => models,
         Ok(Err(e)) => return Err(bad(e.to_string())),
         Err(_) => return Err(bad("the OBJ reader failed on it".into())),
     };
-    let mut mesh = TriangleMesh { normals: Some(Vec::new()), ..Default::default() };
+    let mut mesh = TriangleMesh {
+        normals: Some(Vec::new()),
+        ..Default::default()
+    };
     for m in &models {
         let m = &m.mesh;
         let base = mesh.positions.len() as u32;
-        let p: Vec<Vec3> = m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
+        let p: Vec<Vec3> = m
+            .positions
+            .chunks_exact(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect();
         if m.normals.len() == m.positions.len() {
             if let Some(ns) = &mut mesh.normals {
-                ns.extend(m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+                ns.extend(
+                    m.normals
+                        .chunks_exact(3)
+                        .map(|c| Vec3::new(c[0], c[1], c[2])),
+                );
             }
         } else {
             mesh.normals = None;
         }
         mesh.positions.extend(p);
-        mesh.indices.extend(m.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
+        mesh.indices.extend(
+            m.indices
+                .chunks_exact(3)
+                .map(|t| [base + t[0], base + t[1], base + t[2]]),
+        );
     }
     if mesh.indices.is_empty() {
         return Err(bad("it has no faces".into()));
@@ -49,7 +84,11 @@ pub fn load_obj(ctx: &Ctx, file: &S<String>) -> Result<TriangleMesh, SceneError>
     if mesh.positions.iter().any(|p| !p.is_finite()) {
         return Err(bad("a vertex position is NaN or infinite".into()));
     }
-    if mesh.normals.as_ref().is_some_and(|ns| ns.iter().any(|n| !n.is_finite())) {
+    if mesh
+        .normals
+        .as_ref()
+        .is_some_and(|ns| ns.iter().any(|n| !n.is_finite()))
+    {
         return Err(bad("a vertex normal is NaN or infinite".into()));
     }
     Ok(mesh)
@@ -62,7 +101,9 @@ fn precheck(text: &str) -> Option<(usize, String)> {
         let mut words = line.split_whitespace();
         let key = words.next().unwrap_or("");
         let args: Vec<&str> = words.collect();
-        let floats = |min: usize, max: usize| args.len() >= min && args.len() <= max && args.iter().all(|w| w.parse::<f32>().is_ok());
+        let floats = |min: usize, max: usize| {
+            args.len() >= min && args.len() <= max && args.iter().all(|w| w.parse::<f32>().is_ok())
+        };
         let problem = match key {
             "v" if !floats(3, 7) => Some("a vertex needs 3 numbers".to_string()),
             "vn" if !floats(3, 3) => Some("a normal needs 3 numbers".to_string()),
@@ -92,12 +133,22 @@ fn face_problem(args: &[&str], nv: i64, nt: i64, nn: i64) -> Option<String> {
             if part.is_empty() && k > 0 {
                 continue;
             }
-            let Some(&count) = [nv, nt, nn].get(k) else { return Some(format!("`{a}` has too many `/`")) };
-            let Ok(idx) = part.parse::<i64>() else { return Some(format!("`{part}` is not an index")) };
-            let ok = if idx > 0 { idx <= count } else { idx < 0 && -idx <= count };
+            let Some(&count) = [nv, nt, nn].get(k) else {
+                return Some(format!("`{a}` has too many `/`"));
+            };
+            let Ok(idx) = part.parse::<i64>() else {
+                return Some(format!("`{part}` is not an index"));
+            };
+            let ok = if idx > 0 {
+                idx <= count
+            } else {
+                idx < 0 && -idx <= count
+            };
             if !ok {
                 let what = ["vertex", "texture coordinate", "normal"][k];
-                return Some(format!("{what} index {idx} is out of range (1..={count} defined so far)"));
+                return Some(format!(
+                    "{what} index {idx} is out of range (1..={count} defined so far)"
+                ));
             }
         }
     }

@@ -9,21 +9,37 @@ use glam::{DMat3, DMat4, DVec3, Mat4};
 
 /// The shape's object-to-world matrix (identity when it gives no transform keys), with the span a
 /// degenerate-transform error should point at (`to_world` or `scale`, else the shape's `type`).
-pub fn shape_matrix(ctx: &Ctx, def: &ShapeDef) -> Result<(Mat4, std::ops::Range<usize>), SceneError> {
+pub fn shape_matrix(
+    ctx: &Ctx,
+    def: &ShapeDef,
+) -> Result<(Mat4, std::ops::Range<usize>), SceneError> {
     if let Some(m) = &def.to_world {
-        let trs = [def.translate.as_ref().map(S::span), def.rotate.as_ref().map(S::span), def.scale.as_ref().map(S::span)];
+        let trs = [
+            def.translate.as_ref().map(S::span),
+            def.rotate.as_ref().map(S::span),
+            def.scale.as_ref().map(S::span),
+        ];
         if let Some(span) = trs.into_iter().flatten().next() {
-            return Err(ctx.at(span, "give either `to_world` or `translate`/`rotate`/`scale`, not both"));
+            return Err(ctx.at(
+                span,
+                "give either `to_world` or `translate`/`rotate`/`scale`, not both",
+            ));
         }
         let rows = m.get_ref();
         if rows.iter().flatten().any(|v| !v.is_finite()) {
             return Err(ctx.at(m.span(), "`to_world` has a NaN or infinite entry"));
         }
         if rows[3] != [0.0, 0.0, 0.0, 1.0] {
-            return Err(ctx.at(m.span(), "`to_world` must be affine: its last row must be [0, 0, 0, 1]"));
+            return Err(ctx.at(
+                m.span(),
+                "`to_world` must be affine: its last row must be [0, 0, 0, 1]",
+            ));
         }
         // Rows as written, acting on column vectors (Mitsuba's convention).
-        return Ok((DMat4::from_cols_array_2d(rows).transpose().as_mat4(), m.span()));
+        return Ok((
+            DMat4::from_cols_array_2d(rows).transpose().as_mat4(),
+            m.span(),
+        ));
     }
     let mut m = DMat4::IDENTITY;
     let mut span = def.kind.span();
@@ -59,7 +75,11 @@ pub fn shape_matrix(ctx: &Ctx, def: &ShapeDef) -> Result<(Mat4, std::ops::Range<
 /// Rodrigues' rotation about a unit axis, counter-clockwise by `deg` degrees.
 fn rotation(a: DVec3, deg: f64) -> DMat3 {
     let (s, c) = sin_cos_deg(deg);
-    let k = DMat3::from_cols(DVec3::new(0.0, a.z, -a.y), DVec3::new(-a.z, 0.0, a.x), DVec3::new(a.y, -a.x, 0.0));
+    let k = DMat3::from_cols(
+        DVec3::new(0.0, a.z, -a.y),
+        DVec3::new(-a.z, 0.0, a.x),
+        DVec3::new(a.y, -a.x, 0.0),
+    );
     DMat3::IDENTITY * c + k * s + outer(a, a) * (1.0 - c)
 }
 
@@ -78,7 +98,10 @@ fn sin_cos_deg(deg: f64) -> (f64, f64) {
 
 /// Rejects transforms that squash a quad to zero area (only the quad's own plane matters).
 pub fn check_quad(ctx: &Ctx, m: &Mat4, span: std::ops::Range<usize>) -> Result<(), SceneError> {
-    let (u, v) = (m.x_axis.truncate().as_dvec3(), m.y_axis.truncate().as_dvec3());
+    let (u, v) = (
+        m.x_axis.truncate().as_dvec3(),
+        m.y_axis.truncate().as_dvec3(),
+    );
     let area = u.cross(v).length();
     if !(area > 1e-9 * u.length() * v.length()) || !(area > 0.0) {
         return Err(ctx.at(span, "degenerate transform: the quad has zero area"));
@@ -87,12 +110,20 @@ pub fn check_quad(ctx: &Ctx, m: &Mat4, span: std::ops::Range<usize>) -> Result<(
 }
 
 /// Rejects transforms that flatten a solid (a cube or a mesh) onto a plane, line or point.
-pub fn check_solid(ctx: &Ctx, m: &Mat4, span: std::ops::Range<usize>, what: &str) -> Result<(), SceneError> {
+pub fn check_solid(
+    ctx: &Ctx,
+    m: &Mat4,
+    span: std::ops::Range<usize>,
+    what: &str,
+) -> Result<(), SceneError> {
     let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.truncate().as_dvec3());
     let det = DMat3::from_cols(cols[0], cols[1], cols[2]).determinant();
     let scale = cols[0].length() * cols[1].length() * cols[2].length();
     if !(det.abs() > 1e-9 * scale) || !(scale > 0.0) {
-        return Err(ctx.at(span, format!("degenerate transform: it flattens the {what} (determinant {det:.3e})")));
+        return Err(ctx.at(
+            span,
+            format!("degenerate transform: it flattens the {what} (determinant {det:.3e})"),
+        ));
     }
     Ok(())
 }

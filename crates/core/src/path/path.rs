@@ -1,0 +1,224 @@
+//! A complete path x̄ = x0 … xk (x0 on a light, xk the camera: Veach's order) and, from scratch,
+//! its measurement contribution f(x̄) and its density p_s(x̄) under every technique s.
+
+use super::scatter::{connectable, delta_tolerance, scatter, Scatter};
+use super::vertex::{geometry, PathVertex, VertexKind};
+use crate::bsdf::TransportMode;
+use crate::light::Light;
+use crate::math::Color;
+use crate::scene::Scene;
+use glam::DVec3;
+
+/// A full path, light end first. Interior vertices are `Surface`s.
+#[derive(Clone, Debug)]
+pub struct Path {
+    pub vertices: Vec<PathVertex>,
+}
+
+/// Per-vertex densities of a path, from which every p_s follows (Veach 1997, ch. 10: p_s is the
+/// product of the light subpath's densities of x0 … x_{s−1} and the camera subpath's of x_s … xk).
+#[derive(Clone, Debug)]
+pub struct Densities {
+    /// `light[i]`: density of x_i when the light subpath generates it, given x0 … x_{i−1}.
+    /// `light[0]` = pmf · pdf_le position (solid angle pdf_le direction at infinity);
+    /// `light[k]` = 0, since no walk hits a pinhole.
+    pub light: Vec<f64>,
+    /// `camera[i]`: density of x_i when the camera subpath generates it, given x_{i+1} … xk.
+    /// `camera[k]` = 1 (pinhole); `camera[0]` = 0 for a light with a delta position.
+    pub camera: Vec<f64>,
+    /// Density of x0 when next-event estimation from x1 chooses it (technique s = 1 only):
+    /// pmf · pdf_li converted to area at x0 (solid angle at infinity, pmf for a point light).
+    pub nee: f64,
+    /// `connectable[i]`: a connection edge may end at x_i (not a delta surface).
+    pub connectable: Vec<bool>,
+}
+
+impl Densities {
+    /// Number of segments k.
+    pub fn k(&self) -> usize {
+        self.light.len() - 1
+    }
+
+    /// Whether technique s can produce the path at all, judged by structure only: s = k+1 needs
+    /// a camera a walk can hit (never, with a pinhole); 1 ≤ s ≤ k connects x_{s−1} with x_s,
+    /// which must both be connectable. (s = 0 with a point light is excluded by `camera[0]` = 0.)
+    pub fn valid(&self, s: usize) -> bool {
+        let k = self.k();
+        s <= k && (s == 0 || (self.connectable[s - 1] && self.connectable[s]))
+    }
+
+    /// The density of the light subpath x0 … x_{s−1} alone.
+    pub fn light_prefix(&self, s: usize) -> f64 {
+        match s {
+            0 => 1.0,
+            1 => self.nee,
+            _ => self.light[..s].iter().product(),
+        }
+    }
+
+    /// p_s(x̄) (Russian roulette excluded).
+    pub fn technique(&self, s: usize) -> f64 {
+        if !self.valid(s) {
+            return 0.0;
+        }
+        self.light_prefix(s) * self.camera[s..].iter().product::<f64>()
+    }
+
+    /// p_s for s = 0 … k+1.
+    pub fn all(&self) -> Vec<f64> {
+        (0..=self.k() + 1).map(|s| self.technique(s)).collect()
+    }
+}
+
+impl Path {
+    /// Panics unless x0 is a light, xk the camera and the rest surfaces (a programming error).
+    pub fn new(vertices: Vec<PathVertex>) -> Path {
+        let n = vertices.len();
+        assert!(n >= 2, "a path needs a light and a camera vertex");
+        assert!(matches!(vertices[0].kind, VertexKind::Light { .. }), "x0 must be a light vertex");
+        assert!(matches!(vertices[n - 1].kind, VertexKind::Camera), "xk must be the camera");
+        assert!(vertices[1..n - 1].iter().all(|v| matches!(v.kind, VertexKind::Surface { .. })), "interior vertices must be surfaces");
+        Path { vertices }
+    }
+
+    /// Joins a light subpath (x0 first) and a camera subpath (camera first, as it was walked).
+    pub fn from_subpaths(light: &[PathVertex], camera: &[PathVertex]) -> Path {
+        Path::new(light.iter().chain(camera.iter().rev()).copied().collect())
+    }
+
+    /// Number of segments k (vertices x0 … xk).
+    pub fn k(&self) -> usize {
+        self.vertices.len() - 1
+    }
+
+    /// Scattering at x_i with `wo` towards x_from and `wi` towards x_to.
+    fn scatter_at(&self, scene: &Scene, i: usize, from: usize, to: usize, mode: TransportMode) -> Scatter {
+        let v = &self.vertices;
+        let tol = delta_tolerance(&v[i], &v[from], &v[to]);
+        scatter(scene, &v[i], v[i].dir_to(&v[from]), v[i].dir_to(&v[to]), mode, tol)
+    }
+
+    fn light<'a>(&self, scene: &'a Scene) -> &'a Light {
+        match self.vertices[0].kind {
+            VertexKind::Light { light, .. } => &scene.lights[light as usize],
+            _ => unreachable!("Path::new checks x0"),
+        }
+    }
+
+    /// Veach's measurement contribution (1997, ch. 8):
+    /// f(x̄) = Le(x0→x1) G(x0↔x1) ∏_{i=1}^{k−1} fs(x_{i−1}→x_i→x_{i+1}) G(x_i↔x_{i+1}) · We(x_{k−1}→x_k),
+    /// with visibility NOT included (the caller traced or will test the segments).
+    ///
+    /// fs is `f_cos / |ng·wi|` in radiance mode (bsdf/mod.rs). In importance mode the material
+    /// returns the adjoint and the shading-normal correction moves the |ns|/|ng| ratio to the other
+    /// side, so for every non-delta BSDF the factor is the same number: both equal
+    /// f · |ns·ω_L| / |ng·ω_L| with ω_L towards the light end — which is f itself when ns = ng.
+    /// Where ns ≠ ng that ratio is part of the integrand every technique estimates (Veach 1997,
+    /// ch. 5); the `path_space` tests hold both modes to it.
+    ///
+    /// Delta vertices contribute their delta-stripped lobe value (see `scatter`), stripped of the
+    /// Dirac in the direction towards the light, as a camera walk samples it. That is the
+    /// convention of every technique that samples the vertex from the camera side; see
+    /// `contribution_for` for the others. At a point light Le is the intensity and G has no
+    /// cosine at x0; at infinity Le is the radiance along x0.p.
+    /// The result is f64: per-segment factors scale as 1/length², which underflows f32 for long
+    /// paths in scenes measured in kilometres.
+    pub fn contribution(&self, scene: &Scene) -> DVec3 {
+        self.contribution_for(scene, 0)
+    }
+
+    /// f(x̄) with each delta vertex stripped in the measure in which technique s samples it:
+    /// vertices x_i with i < s are sampled by the light subpath, which draws the direction towards
+    /// the camera (importance mode). For mirrors and every non-delta BSDF this equals
+    /// `contribution` exactly; at a refraction the two strippings differ by the solid-angle
+    /// Jacobian dω_C/dω_L = η_L² cos θ_L / (η_C² cos θ_C) (Veach 1997, §5.2, the η² asymmetry of
+    /// refraction), so f/p_s must pair each p_s with its own stripping, as `estimate` does.
+    pub fn contribution_for(&self, scene: &Scene, s: usize) -> DVec3 {
+        let v = &self.vertices;
+        let k = self.k();
+        let x0 = &v[0];
+        let le = match self.light(scene) {
+            Light::Point(p) => p.intensity,
+            l if x0.is_infinite() => l.escaped(x0.p),
+            l => l.emitted(x0.ng, x0.dir_to(&v[1])),
+        };
+        let mut f = le.as_dvec3() * geometry(x0, &v[1]) as f64;
+        for i in 1..k {
+            let fs = if i < s {
+                self.scatter_at(scene, i, i - 1, i + 1, TransportMode::Importance).f
+            } else {
+                self.scatter_at(scene, i, i + 1, i - 1, TransportMode::Radiance).f
+            };
+            f *= fs.as_dvec3() * geometry(&v[i], &v[i + 1]) as f64;
+        }
+        f * scene.camera.importance(v[k].dir_to(&v[k - 1])) as f64
+    }
+
+    /// The per-vertex densities of both walks (see `Densities`).
+    pub fn densities(&self, scene: &Scene) -> Densities {
+        let v = &self.vertices;
+        let k = self.k();
+        let (x0, x1) = (&v[0], &v[1]);
+        let VertexKind::Light { light: li, .. } = x0.kind else { unreachable!("Path::new checks x0") };
+        let light = self.light(scene);
+        let pmf = scene.light_sampler.pmf(li as usize) as f64;
+
+        // Light subpath: x0 from pdf_le, x1 from its direction, then BSDFs in importance mode.
+        let mut pl = vec![0.0f64; k + 1];
+        let d01 = x0.dir_to(x1);
+        let (pos, dir) = light.pdf_le(x0.ng, d01, scene.bounding_sphere);
+        pl[0] = pmf * if x0.is_infinite() { dir } else { pos } as f64;
+        if k >= 2 {
+            pl[1] = x0.convert_density(if x0.is_infinite() { pos } else { dir }, x1) as f64;
+        }
+        for i in 2..k {
+            let pdf_w = self.scatter_at(scene, i - 1, i - 2, i, TransportMode::Importance).pdf_w;
+            pl[i] = v[i - 1].convert_density(pdf_w, &v[i]) as f64;
+        }
+
+        // Next-event estimation of x0 from x1.
+        let nee = if light.delta_position() {
+            pmf
+        } else {
+            let pdf_w = light.pdf_li(x1.p, x1.dir_to(x0), x0.p, x0.ng);
+            pmf * x1.convert_density(pdf_w, x0) as f64
+        };
+
+        // Camera subpath: the pinhole, x_{k−1} from the film-wide direction pdf, then BSDFs.
+        let mut pc = vec![0.0f64; k + 1];
+        pc[k] = 1.0;
+        let pdf_dir = scene.camera.pdf_dir(v[k].dir_to(&v[k - 1]));
+        pc[k - 1] = v[k].convert_density(pdf_dir, &v[k - 1]) as f64;
+        for i in (0..k.saturating_sub(1)).rev() {
+            let pdf_w = self.scatter_at(scene, i + 1, i + 2, i, TransportMode::Radiance).pdf_w;
+            pc[i] = v[i + 1].convert_density(pdf_w, &v[i]) as f64;
+        }
+        if light.delta_position() {
+            pc[0] = 0.0;
+        }
+
+        let conn = v.iter().map(|x| connectable(scene, x)).collect();
+        Densities { light: pl, camera: pc, nee, connectable: conn }
+    }
+
+    /// p_s(x̄): the density of generating this path with s vertices from the light and
+    /// t = k+1−s from the camera (Russian roulette excluded). s ranges over 0 … k+1.
+    pub fn pdf(&self, scene: &Scene, s: usize) -> f64 {
+        self.densities(scene).technique(s)
+    }
+
+    /// p_s(x̄) for every s = 0 … k+1.
+    pub fn pdfs(&self, scene: &Scene) -> Vec<f64> {
+        self.densities(scene).all()
+    }
+
+    /// The unweighted per-pixel estimate of technique s: f(x̄) / (N · p_s(x̄)), N the pixel count
+    /// (see the module docs for why N); zero when the technique cannot produce the path.
+    pub fn estimate(&self, scene: &Scene, s: usize) -> Color {
+        let p = self.pdf(scene, s);
+        if p <= 0.0 {
+            return Color::ZERO;
+        }
+        (self.contribution_for(scene, s) / (scene.camera.pixel_count() as f64 * p)).as_vec3()
+    }
+}

@@ -1,0 +1,90 @@
+//! The BSDF factor and the directional density at one surface vertex of a fixed path, including
+//! delta lobes, which `Material::eval`/`pdf` report as zero.
+//!
+//! Delta vertices are represented delta-stripped (Veach 1997, ch. 8, on paths through specular surfaces): a
+//! mirror's f = R δ(ω − ω_r) / |cos θ| and its sampling density p = 1 · δ(ω − ω_r) share the same
+//! Dirac, so we keep the lobe value (f_cos of the lobe) and the lobe's selection probability. Their
+//! ratio is exactly the sample weight, and no technique ever connects at such a vertex (its
+//! density of being reached by a connection is zero), so the Diracs never have to be compared.
+
+use crate::bsdf::TransportMode;
+use crate::math::{Color, Vec2, Vec3};
+use crate::path::vertex::{PathVertex, VertexKind};
+use crate::scene::Scene;
+
+/// Two unit directions closer than this (chord length, ≈ angle in radians) are the same delta
+/// lobe, on top of what the positions' rounding errors allow (`delta_tolerance`): f32 direction
+/// arithmetic alone is good to a few 1e-7, and no two distinct lobes of a smooth surface come
+/// this close.
+pub const DELTA_MATCH_TOL: f32 = 1e-4;
+
+/// Bound on the angle between the direction a walk sampled from `a` and the one rebuilt from the
+/// stored positions of `a` and `b`: each position is within its `p_err` box of the exact point
+/// (the walk's ray started on the offset origin, which is as close), so the chord is at most
+/// (|err_a| + |err_b|) / distance. Zero towards infinity.
+pub fn direction_error(a: &PathVertex, b: &PathVertex) -> f32 {
+    if a.is_infinite() || b.is_infinite() {
+        return 0.0;
+    }
+    (a.p_err.length() + b.p_err.length()) / (b.p - a.p).length()
+}
+
+/// The match tolerance at a delta vertex `v` between neighbours `a` and `b`: both directions
+/// may be off by their error bound (twice, for safety), plus `DELTA_MATCH_TOL`.
+pub fn delta_tolerance(v: &PathVertex, a: &PathVertex, b: &PathVertex) -> f32 {
+    DELTA_MATCH_TOL + 2.0 * (direction_error(v, a) + direction_error(v, b))
+}
+
+/// Lobe-choice variates tried to find which delta lobe produced `wi`: every material here picks
+/// its lobe by comparing `u_lobe` with a cumulative probability, so the extremes reach the first
+/// and the last lobe (reflection and transmission of a dielectric) and the middle any third one.
+const LOBE_PROBES: [f32; 3] = [0.0, 0.5, 1.0 - f32::EPSILON];
+
+/// Factor and density of scattering at a surface vertex `v` between `wo` (towards where the walk
+/// came from) and `wi` (where it goes), both unit and pointing away from `v`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Scatter {
+    /// f_cos / |ng·wi|: the BSDF factor of f(x̄) (bsdf/mod.rs conventions), delta-stripped.
+    pub f: Color,
+    /// Solid-angle density of sampling `wi` given `wo`; for a delta lobe its selection probability.
+    pub pdf_w: f32,
+}
+
+/// Evaluates the vertex's material. `v` must be a `Surface` vertex; anything else scatters nothing.
+/// A delta lobe matches `wi` when the lobe's direction is within `tol` (see `delta_tolerance`).
+pub fn scatter(scene: &Scene, v: &PathVertex, wo: Vec3, wi: Vec3, mode: TransportMode, tol: f32) -> Scatter {
+    let VertexKind::Surface { material } = v.kind else {
+        return Scatter::default();
+    };
+    let m = scene.material(material);
+    let sf = crate::bsdf::ShadingFrame::new(v.ng, v.ns);
+    let cos_g = v.ng.dot(wi).abs();
+    if cos_g == 0.0 {
+        return Scatter::default();
+    }
+    if !m.is_delta() {
+        let e = m.eval(&sf, wo, wi, mode);
+        return Scatter { f: e.f_cos / cos_g, pdf_w: e.pdf_w };
+    }
+    let mut found: Option<Scatter> = None;
+    for u_lobe in LOBE_PROBES {
+        if let Some(s) = m.sample(&sf, wo, u_lobe, Vec2::splat(0.5), mode) {
+            if s.delta && (s.wi - wi).length() < tol {
+                // weight = f_cos / pdf for the lobe, so weight · pdf is the lobe's f_cos.
+                found = Some(Scatter { f: s.weight * s.pdf_w / cos_g, pdf_w: s.pdf_w });
+                break;
+            }
+        }
+    }
+    found.unwrap_or_default()
+}
+
+/// True when a connection (a deterministic edge between two subpaths) may end at `v`: never at a
+/// delta surface; always at the camera and at lights (none of ours is delta in direction).
+pub fn connectable(scene: &Scene, v: &PathVertex) -> bool {
+    match v.kind {
+        VertexKind::Surface { material } => !scene.material(material).is_delta(),
+        VertexKind::Light { light, .. } => !scene.lights[light as usize].delta_direction(),
+        VertexKind::Camera => true,
+    }
+}

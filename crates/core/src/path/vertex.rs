@@ -1,0 +1,187 @@
+//! One vertex of a light or camera subpath. The constructors here are the only place where a vertex
+//! is born from a sampled direction, so they are the only place that turns the walk's density into
+//! the stored area-measure `pdf_fwd` (through [`PathVertex::convert_density`], which calls the named
+//! conversions of `crate::measure`).
+
+use crate::camera::Camera;
+use crate::light::{Light, LightLeSample, LightLiSample};
+use crate::math::{Color, Vec3};
+use crate::measure;
+use crate::scene::{Scene, SurfaceHit};
+
+/// What a vertex lies on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VertexKind {
+    /// The pinhole. `ng` = `ns` = the viewing axis, so G(x_{k−1} ↔ x_k) carries the camera's cos θ
+    /// that `Camera::importance` (N / (A cos⁴θ)) expects.
+    Camera,
+    /// A light endpoint (x0 of a full path). With `infinite` (sun, environment) the vertex sits at
+    /// infinity: `p` is the unit direction from the scene towards the light, densities of this
+    /// vertex are solid angle and G(x0 ↔ x1) = |cos θ1|. A point light has `ng` = `ns` = 0:
+    /// it has no surface, so G carries no cosine at it.
+    Light { light: u32, infinite: bool },
+    /// A scattering surface.
+    Surface { material: u32 },
+}
+
+/// A path vertex (pbrt-v4's `Vertex` without the union): `Copy`, integrator-independent.
+///
+/// **Invariant:** `pdf_fwd` and `pdf_rev` are area measure, except at a vertex at infinity (solid
+/// angle) and at a delta position (point light, pinhole: discrete, 1 when chosen).
+#[derive(Clone, Copy, Debug)]
+pub struct PathVertex {
+    pub kind: VertexKind,
+    /// Position, or the unit direction towards a light at infinity.
+    pub p: Vec3,
+    /// Rounding-error bound of `p` (zero for endpoints, whose rays the lights already offset).
+    pub p_err: Vec3,
+    pub ng: Vec3,
+    pub ns: Vec3,
+    /// Throughput of the subpath up to and including this vertex (pbrt's β): for a light vertex
+    /// Le / pdf_fwd, for the camera 1, then multiplied by each sample's f_cos / pdf_w.
+    pub beta: Color,
+    /// Density with which the walk that created this vertex chose it.
+    pub pdf_fwd: f32,
+    /// Density of choosing it by a walk in the opposite direction (set by the integrator, 0 here).
+    pub pdf_rev: f32,
+    /// The vertex scattered (or will scatter) through a delta lobe: it cannot be connected to.
+    /// Integrators set it from `BsdfSample::delta`; the from-scratch `Path` code asks the material.
+    pub delta: bool,
+}
+
+impl PathVertex {
+    fn endpoint(kind: VertexKind, p: Vec3, n: Vec3, beta: Color, pdf_fwd: f32) -> PathVertex {
+        PathVertex { kind, p, p_err: Vec3::ZERO, ng: n, ns: n, beta, pdf_fwd, pdf_rev: 0.0, delta: false }
+    }
+
+    /// The pinhole: a delta position, so its density is the discrete 1.
+    pub fn camera(camera: &Camera, beta: Color) -> PathVertex {
+        PathVertex::endpoint(VertexKind::Camera, camera.eye, camera.forward(), beta, 1.0)
+    }
+
+    /// A surface the walk reached from `prev` with density `pdf` — solid angle at `prev`, except
+    /// when `prev` is a light at infinity, where it is the density on the disk perpendicular to
+    /// the ray (`LightLeSample::pdf_pos`).
+    pub fn surface(hit: &SurfaceHit, beta: Color, pdf: f32, prev: &PathVertex) -> PathVertex {
+        let mut v = PathVertex {
+            kind: VertexKind::Surface { material: hit.material },
+            p: hit.p,
+            p_err: hit.p_err,
+            ng: hit.ng,
+            ns: hit.ns,
+            beta,
+            pdf_fwd: 0.0,
+            pdf_rev: 0.0,
+            delta: false,
+        };
+        v.pdf_fwd = prev.convert_density(pdf, &v);
+        v
+    }
+
+    /// The same surface as a light endpoint x0 (a camera walk hit an emitter: technique s = 0).
+    /// `None` when the surface does not emit.
+    pub fn as_light_endpoint(&self, hit: &SurfaceHit) -> Option<PathVertex> {
+        let light = hit.light?;
+        Some(PathVertex { kind: VertexKind::Light { light, infinite: false }, delta: false, ..*self })
+    }
+
+    /// A camera walk left the scene in direction `dir` towards light `light` at infinity, chosen
+    /// with solid-angle density `pdf_w`: the density stays solid angle.
+    pub fn light_escaped(light: u32, dir: Vec3, beta: Color, pdf_w: f32) -> PathVertex {
+        PathVertex::endpoint(VertexKind::Light { light, infinite: true }, dir, -dir, beta, pdf_w)
+    }
+
+    /// x0 of a light subpath from `Light::sample_le` after choosing the light with `pmf`.
+    /// `pdf_fwd` = pmf · pdf_pos (area; 1 for a point light), or pmf · pdf_dir (solid angle) at
+    /// infinity, where the position on the disk belongs to x1; `beta` = Le / pdf_fwd.
+    pub fn light_emitted(scene: &Scene, light: u32, s: &LightLeSample, pmf: f32) -> PathVertex {
+        let l = &scene.lights[light as usize];
+        if l.is_infinite() {
+            let pdf = pmf * s.pdf_dir;
+            let kind = VertexKind::Light { light, infinite: true };
+            return PathVertex::endpoint(kind, -s.ray.d, s.ray.d, s.radiance / pdf, pdf);
+        }
+        let pdf = pmf * s.pdf_pos;
+        let n = if l.delta_position() { Vec3::ZERO } else { s.n };
+        PathVertex::endpoint(VertexKind::Light { light, infinite: false }, s.ray.o, n, s.radiance / pdf, pdf)
+    }
+
+    /// x0 chosen by next-event estimation from `from` (`Light::sample_li`, light chosen with `pmf`):
+    /// `pdf_fwd` = pmf · pdf_li converted to area at x0 (solid angle at infinity, discrete 1 for a
+    /// point light). `beta` = Le / pdf_fwd (for a point light Le is the intensity).
+    pub fn light_sampled(scene: &Scene, light: u32, s: &LightLiSample, pmf: f32, from: &PathVertex) -> PathVertex {
+        let l = &scene.lights[light as usize];
+        let infinite = l.is_infinite();
+        let kind = VertexKind::Light { light, infinite };
+        let (p, n, le) = match l {
+            Light::Point(pl) => (s.p, Vec3::ZERO, pl.intensity),
+            _ if infinite => (s.wi, -s.wi, s.radiance),
+            _ => (s.p, s.n, s.radiance),
+        };
+        let mut v = PathVertex::endpoint(kind, p, n, Color::ZERO, 0.0);
+        v.pdf_fwd = if s.delta { pmf } else { pmf * from.convert_density(s.pdf_w, &v) };
+        v.beta = if v.pdf_fwd > 0.0 { le / v.pdf_fwd } else { Color::ZERO };
+        v
+    }
+
+    /// True for a light vertex at infinity.
+    #[inline]
+    pub fn is_infinite(&self) -> bool {
+        matches!(self.kind, VertexKind::Light { infinite: true, .. })
+    }
+
+    /// True when the vertex has a surface (a normal) whose cosine enters G and area conversions.
+    #[inline]
+    pub fn on_surface(&self) -> bool {
+        self.ng != Vec3::ZERO
+    }
+
+    /// Unit direction from this vertex towards `to` (either may be at infinity).
+    #[inline]
+    pub fn dir_to(&self, to: &PathVertex) -> Vec3 {
+        if to.is_infinite() {
+            to.p
+        } else if self.is_infinite() {
+            -self.p
+        } else {
+            (to.p - self.p).normalize()
+        }
+    }
+
+    /// pbrt's `ConvertDensity`: a density with which this vertex chose the direction towards
+    /// `next` (solid angle; for a vertex at infinity, the perpendicular-disk density) turned into
+    /// the measure `next` is stored in. A vertex at infinity keeps solid angle.
+    pub fn convert_density(&self, pdf: f32, next: &PathVertex) -> f32 {
+        if next.is_infinite() {
+            return pdf;
+        }
+        let n = if next.on_surface() { next.ng } else { self.dir_to(next) };
+        if self.is_infinite() {
+            return measure::perpendicular_to_area(pdf, -self.p, n);
+        }
+        measure::solid_angle_to_area(pdf, self.p, next.p, n)
+    }
+}
+
+/// Veach's geometry term G(a ↔ b) between two path vertices, visibility excluded: the cosine at
+/// each end that has a surface (the camera's is its viewing axis), over the squared distance;
+/// with one end at infinity only the other end's cosine remains.
+pub fn geometry(a: &PathVertex, b: &PathVertex) -> f32 {
+    let cos_at = |v: &PathVertex, w: Vec3| if v.on_surface() { v.ng.dot(w).abs() } else { 1.0 };
+    if a.is_infinite() {
+        return cos_at(b, a.p);
+    }
+    if b.is_infinite() {
+        return cos_at(a, b.p);
+    }
+    if a.on_surface() && b.on_surface() {
+        return measure::geometry_term(a.p, a.ng, b.p, b.ng);
+    }
+    let d = b.p - a.p;
+    let d2 = d.length_squared();
+    if d2 == 0.0 {
+        return 0.0;
+    }
+    let w = d / d2.sqrt();
+    cos_at(a, w) * cos_at(b, w) / d2
+}

@@ -1,0 +1,632 @@
+//! Sampling tests of every material in `bsdf::test_registry()`: χ² of the sampled directions
+//! against the claimed pdf, consistency of sample / eval / pdf, reciprocity, energy, and the
+//! specifics of glass and mirrors. Seeds are fixed; thresholds come from the test statistics.
+
+use lt_core::bsdf::{test_registry, BsdfSample, Material, ShadingFrame, TransportMode};
+use lt_core::math::{gamma, Frame, Vec3};
+use lt_core::sampling::{sample_uniform_sphere, Sampler, UNIFORM_SPHERE_PDF};
+use lt_core::testing::chi2::{self, Chi2Test, SphereGrid};
+use lt_core::testing::{binomial_z, rounding_bound, sidak, MeanEstimate, DIRECTION_ROUNDING};
+
+/// Family-wise significance of the χ² tests of this file.
+const ALPHA: f64 = 0.01;
+/// z-score beyond which a binomial or mean test rejects (two-sided p ≈ 6e-5).
+const Z_MAX: f64 = 4.0;
+const MODES: [TransportMode; 2] = [TransportMode::Radiance, TransportMode::Importance];
+
+/// A tilted frame so that every test also exercises the world ↔ local rotations.
+fn flat_frame() -> ShadingFrame {
+    let n = Vec3::new(0.3, -0.5, 0.8).normalize();
+    ShadingFrame::new(n, n)
+}
+
+/// Shading normal tilted away from the geometric one (interpolated normals).
+fn bumped_frame() -> ShadingFrame {
+    let ng = Vec3::new(0.3, -0.5, 0.8).normalize();
+    let ns = (ng + Vec3::new(0.25, 0.1, 0.0)).normalize();
+    ShadingFrame::new(ng, ns)
+}
+
+fn local_dir(cos: f32, phi: f32) -> Vec3 {
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)
+}
+
+/// Outgoing directions in the shading frame: normal, oblique, grazing, and from below.
+fn wo_cases() -> Vec<(f32, Vec3)> {
+    [
+        (1.0, 0.0),
+        (0.8, 0.7),
+        (0.3, 2.0),
+        (0.05, 4.0),
+        (-0.6, 1.3),
+        (-0.05, 5.5),
+    ]
+    .iter()
+    .map(|&(c, p)| (c, local_dir(c, p)))
+    .collect()
+}
+
+fn mode_name(m: TransportMode) -> &'static str {
+    match m {
+        TransportMode::Radiance => "radiance",
+        TransportMode::Importance => "importance",
+    }
+}
+
+/// GGX α of a glossy material (the lobe test centres its bins on the mirror direction).
+fn roughness(m: &Material) -> Option<f32> {
+    match m {
+        Material::Glossy(g) => Some(g.roughness),
+        _ => None,
+    }
+}
+
+#[test]
+fn sampled_directions_follow_the_pdf_chi2() {
+    let sf = flat_frame();
+    let n = sf.ns();
+    let mut outcomes = Vec::new();
+    let mut seed = 1u64;
+    for (name, m) in test_registry() {
+        if m.is_delta() {
+            continue;
+        }
+        for (cos, wo_l) in wo_cases() {
+            let wo = sf.frame.to_world(wo_l);
+            for mode in MODES {
+                seed += 1;
+                let cfg = Chi2Test {
+                    samples: 1_000_000,
+                    seed,
+                };
+                let label = format!("{name} cosθo={cos} {}", mode_name(mode));
+                let sample = |s: &mut Sampler| {
+                    let u_lobe = s.next_f32();
+                    m.sample(&sf, wo, u_lobe, s.next_2d(), mode).map(|b| b.wi)
+                };
+                let pdf = |w: Vec3| m.pdf(&sf, wo, w);
+                // Whole sphere, rings uniform in cos θ around the normal, horizon on a ring edge.
+                let grid = SphereGrid::sphere(Frame::from_z(n), 40, 80);
+                outcomes.push(chi2::run(
+                    &format!("{label} sphere"),
+                    cfg,
+                    &grid,
+                    sample,
+                    pdf,
+                ));
+                // Cap around the mirror direction with rings of equal angle, to resolve peaks;
+                // it stays above the horizon, where the pdf is smooth.
+                if let Some(alpha) = roughness(&m) {
+                    let r = 2.0 * wo.dot(n) * n - wo;
+                    let elevation = wo.dot(n).abs().asin();
+                    let half_angle = (0.9 * elevation).min(10.0 * alpha) as f64;
+                    let grid =
+                        SphereGrid::cap(Frame::from_z(r), 1.0 - half_angle.cos(), 30, 40, 2.0);
+                    let cfg = Chi2Test {
+                        samples: 1_000_000,
+                        seed: seed + 1_000,
+                    };
+                    outcomes.push(chi2::run(&format!("{label} lobe"), cfg, &grid, sample, pdf));
+                }
+            }
+        }
+    }
+    let level = sidak(ALPHA, outcomes.len());
+    let mut failures = Vec::new();
+    for o in &outcomes {
+        eprintln!(
+            "{}",
+            o.summary().replace("χ²", &format!("{:<36} χ²", o.name))
+        );
+        failures.extend(o.check(level).err());
+        failures.extend(o.check_mass().err());
+    }
+    let worst = outcomes
+        .iter()
+        .map(|o| o.p_value)
+        .fold(f64::INFINITY, f64::min);
+    eprintln!(
+        "{} χ² tests, per-test level {level:.2e}, smallest p = {worst:.4}",
+        outcomes.len()
+    );
+    assert!(
+        failures.is_empty(),
+        "{} failures (level {level:.2e}):\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+/// Sum of how much `f(wo, wi)` may move when either direction is perturbed by rounding.
+fn pair_bound(f: impl Fn(Vec3, Vec3) -> f64, wo: Vec3, wi: Vec3) -> f64 {
+    rounding_bound(|w| f(wo, w), wi, DIRECTION_ROUNDING)
+        + rounding_bound(|w| f(w, wi), wo, DIRECTION_ROUNDING)
+}
+
+#[test]
+fn sample_weight_and_pdfs_agree_with_eval() {
+    let mut failures = Vec::new();
+    for sf in [flat_frame(), bumped_frame()] {
+        for (name, m) in test_registry() {
+            for (cos, wo_l) in wo_cases() {
+                let wo = sf.frame.to_world(wo_l);
+                let mut s = Sampler::new(7, cos.to_bits() as u64, 0);
+                let label = format!("{name} cosθo={cos} ns·ng={:.3}", sf.ns().dot(sf.ng));
+                for _ in 0..4000 {
+                    let (u_lobe, u) = (s.next_f32(), s.next_2d());
+                    let r = m.sample(&sf, wo, u_lobe, u, TransportMode::Radiance);
+                    let i = m.sample(&sf, wo, u_lobe, u, TransportMode::Importance);
+                    let (Some(r), Some(i)) = (r, i) else { continue };
+                    if let Err(e) = check_sample(&m, &sf, wo, &r)
+                        .and_then(|_| check_adjoint(&m, &sf, wo, &r, &i))
+                    {
+                        failures.push(format!("{label}: {e}"));
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// A radiance-mode sample against eval and pdf.
+fn check_sample(m: &Material, sf: &ShadingFrame, wo: Vec3, b: &BsdfSample) -> Result<(), String> {
+    let mode = TransportMode::Radiance;
+    let wi = b.wi;
+    if !((wi.length() - 1.0).abs() <= 2.0 * DIRECTION_ROUNDING)
+        || !b.weight.is_finite()
+        || b.weight.min_element() < 0.0
+    {
+        return Err(format!("bad sample {b:?}"));
+    }
+    let e = m.eval(sf, wo, wi, mode);
+    if b.delta != m.is_delta() {
+        return Err(format!(
+            "delta flag {} on a material with is_delta {}",
+            b.delta,
+            m.is_delta()
+        ));
+    }
+    if b.delta {
+        // Delta lobes: eval and pdf are zero, the pdfs are lobe probabilities.
+        let ok = e.f_cos == Vec3::ZERO
+            && m.pdf(sf, wo, wi) == 0.0
+            && b.pdf_w > 0.0
+            && b.pdf_w <= 1.0
+            && b.pdf_rev_w > 0.0
+            && b.pdf_rev_w <= 1.0;
+        return if ok {
+            Ok(())
+        } else {
+            Err(format!("delta sample {b:?} eval {e:?}"))
+        };
+    }
+    let pdf = |o: Vec3, i: Vec3| m.pdf(sf, o, i) as f64;
+    let tol_pdf = pair_bound(pdf, wo, wi);
+    if (b.pdf_w as f64 - pdf(wo, wi)).abs() > tol_pdf {
+        return Err(format!(
+            "sample pdf {} vs pdf() {} (tol {tol_pdf:.2e})",
+            b.pdf_w,
+            pdf(wo, wi)
+        ));
+    }
+    let tol_rev = pair_bound(|o, i| pdf(i, o), wo, wi);
+    if (b.pdf_rev_w as f64 - pdf(wi, wo)).abs() > tol_rev {
+        return Err(format!(
+            "sample pdf_rev {} vs pdf(wi→wo) {} (tol {tol_rev:.2e})",
+            b.pdf_rev_w,
+            pdf(wi, wo)
+        ));
+    }
+    if e.pdf_w != m.pdf(sf, wo, wi) || e.pdf_rev_w != m.pdf(sf, wi, wo) {
+        return Err(format!(
+            "eval pdfs {e:?} vs pdf() {} / {}",
+            pdf(wo, wi),
+            pdf(wi, wo)
+        ));
+    }
+    for c in 0..3 {
+        let ratio = |o: Vec3, i: Vec3| {
+            let e = m.eval(sf, o, i, mode);
+            e.f_cos[c] as f64 / e.pdf_w as f64
+        };
+        let tol = pair_bound(ratio, wo, wi);
+        if (b.weight[c] as f64 - ratio(wo, wi)).abs() > tol {
+            return Err(format!(
+                "weight[{c}] {} vs f_cos/pdf {} (tol {tol:.2e})",
+                b.weight[c],
+                ratio(wo, wi)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The importance-mode sample of the same variates: same direction and pdfs, and its weight and
+/// f_cos differ from radiance mode by Veach's factor |ns·wo||ng·wi| / (|ns·wi||ng·wo|), in both
+/// `sample` and `eval`. (Comparing importance weights with eval directly is ill-conditioned near
+/// the shading horizon, where the factor is ~1/cos θi and the material's own G1 ~cos θi.)
+fn check_adjoint(
+    m: &Material,
+    sf: &ShadingFrame,
+    wo: Vec3,
+    r: &BsdfSample,
+    i: &BsdfSample,
+) -> Result<(), String> {
+    if i.wi != r.wi || i.pdf_w != r.pdf_w || i.pdf_rev_w != r.pdf_rev_w || i.delta != r.delta {
+        return Err(format!(
+            "importance sample {i:?} differs from radiance {r:?} beyond its weight"
+        ));
+    }
+    let wi = r.wi;
+    let (ns, ng) = (sf.ns(), sf.ng);
+    let factor = |w_o: Vec3, w_i: Vec3| {
+        (w_o.dot(ns).abs() * w_i.dot(ng).abs() / (w_i.dot(ns).abs() * w_o.dot(ng).abs())) as f64
+    };
+    // Glass scales radiance (not importance) by 1/η² on refraction; undo it before comparing.
+    let glass_scale = match m {
+        Material::Dielectric(d) if wi.dot(ng) * wo.dot(ng) < 0.0 => {
+            let eta = if wo.dot(ng) > 0.0 { d.ior } else { 1.0 / d.ior } as f64;
+            eta * eta
+        }
+        _ => 1.0,
+    };
+    let tol = gamma(8) as f64 + pair_bound(factor, wo, wi) / factor(wo, wi);
+    let expect = factor(wo, wi) * glass_scale;
+    let got = i.weight.x as f64 / r.weight.x as f64;
+    if (got / expect - 1.0).abs() > tol {
+        return Err(format!(
+            "importance/radiance weight {got} vs {expect} (tol {tol:.1e})"
+        ));
+    }
+    if !m.is_delta() {
+        let (ei, er) = (
+            m.eval(sf, wo, wi, TransportMode::Importance),
+            m.eval(sf, wo, wi, TransportMode::Radiance),
+        );
+        let got = ei.f_cos.x as f64 / er.f_cos.x as f64;
+        if er.f_cos.x > 0.0 && (got / factor(wo, wi) - 1.0).abs() > tol {
+            return Err(format!(
+                "importance/radiance f_cos {got} vs {} (tol {tol:.1e})",
+                factor(wo, wi)
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn non_delta_materials_are_reciprocal() {
+    // Radiance mode with ns = ng: f(wo, wi) = f_cos / |cos θi| must equal f(wi, wo). Each side
+    // carries two roundings (× cos in eval, ÷ cos here), hence a relative γ(4).
+    let sf = flat_frame();
+    let mut s = Sampler::new(11, 0, 0);
+    for (name, m) in test_registry() {
+        if m.is_delta() {
+            continue;
+        }
+        let f = |o: Vec3, i: Vec3| {
+            m.eval(&sf, o, i, TransportMode::Radiance).f_cos / sf.frame.to_local(i).z.abs()
+        };
+        for k in 0..20_000 {
+            let wo = sample_uniform_sphere(s.next_2d());
+            let mut wi = sample_uniform_sphere(s.next_2d());
+            // Bias towards the mirror direction so narrow lobes are non-zero too.
+            if k % 2 == 0 {
+                wi = (2.0 * wo.dot(sf.ns()) * sf.ns() - wo + 0.1 * wi).normalize();
+            }
+            let (a, b) = (f(wo, wi), f(wi, wo));
+            let tol = gamma(4) * a.max(b);
+            assert!(
+                a.is_finite() && (a - b).abs().max_element() <= tol.max_element(),
+                "{name}: f(wo,wi) = {a} but f(wi,wo) = {b} for wo {wo} wi {wi}"
+            );
+        }
+    }
+}
+
+#[test]
+fn energy_is_conserved_and_diffuse_returns_its_albedo() {
+    let sf = flat_frame();
+    let n = 200_000;
+    let mut report = Vec::new();
+    for (name, m) in test_registry() {
+        for (cos, wo_l) in wo_cases() {
+            let wo = sf.frame.to_world(wo_l);
+            for mode in MODES {
+                // Radiance is not conserved across refraction (it scales by 1/η²); only the
+                // adjoint (importance) direction of glass integrates to ≤ 1.
+                let refracts_radiance =
+                    matches!(m, Material::Dielectric(_)) && mode == TransportMode::Radiance;
+                let mut s = Sampler::new(13, cos.to_bits() as u64, mode as u64);
+                let mut by_sampling = [MeanEstimate::default(); 3];
+                let mut by_uniform = [MeanEstimate::default(); 3];
+                for _ in 0..n {
+                    let u_lobe = s.next_f32();
+                    let w = m
+                        .sample(&sf, wo, u_lobe, s.next_2d(), mode)
+                        .map_or(Vec3::ZERO, |b| b.weight);
+                    let wi = sample_uniform_sphere(s.next_2d());
+                    let f = m.eval(&sf, wo, wi, mode).f_cos / UNIFORM_SPHERE_PDF;
+                    for c in 0..3 {
+                        by_sampling[c].add(w[c] as f64);
+                        by_uniform[c].add(f[c] as f64);
+                    }
+                }
+                let label = format!("{name} cosθo={cos} {}", mode_name(mode));
+                for c in 0..3 {
+                    let (a, b) = (by_sampling[c], by_uniform[c]);
+                    if !refracts_radiance && (a.mean() - 1.0) > Z_MAX * a.std_error() {
+                        report.push(format!(
+                            "{label}[{c}]: ∫f_cos = {:.5} ± {:.1e} exceeds 1",
+                            a.mean(),
+                            a.std_error()
+                        ));
+                    }
+                    if !m.is_delta() {
+                        // Two independent unbiased estimates of the same albedo.
+                        let z = (a.mean() - b.mean())
+                            / (a.std_error().powi(2) + b.std_error().powi(2)).sqrt();
+                        if !(z.abs() < Z_MAX) {
+                            report.push(format!("{label}[{c}]: sampled albedo {:.5} vs uniform {:.5} ± {:.1e}: z = {z:.2}", a.mean(), b.mean(), b.std_error()));
+                        }
+                    }
+                    if let Material::Diffuse(d) = &m {
+                        let z = (b.mean() - d.albedo[c] as f64) / b.std_error();
+                        if !(z.abs() < Z_MAX) {
+                            report.push(format!(
+                                "{label}[{c}]: albedo {:.5} ± {:.1e} vs {}: z = {z:.2}",
+                                b.mean(),
+                                b.std_error(),
+                                d.albedo[c]
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(report.is_empty(), "{}", report.join("\n"));
+}
+
+/// Reference Fresnel reflectance in f64, in the angle form (independent of the f32 code):
+/// rs = −sin(θi−θt)/sin(θi+θt), rp = tan(θi−θt)/tan(θi+θt); `eta` = η_t/η_i.
+fn fresnel_reference(cos_i: f64, eta: f64) -> f64 {
+    let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
+    let sin_t = sin_i / eta;
+    if sin_t >= 1.0 {
+        return 1.0;
+    }
+    if sin_i < 1e-6 {
+        return ((eta - 1.0) / (eta + 1.0)).powi(2);
+    }
+    let (ti, tt) = (sin_i.asin(), sin_t.asin());
+    let rs = -(ti - tt).sin() / (ti + tt).sin();
+    let rp = (ti - tt).tan() / (ti + tt).tan();
+    0.5 * (rs * rs + rp * rp)
+}
+
+fn glasses() -> Vec<(&'static str, f32)> {
+    test_registry()
+        .into_iter()
+        .filter_map(|(name, m)| match m {
+            Material::Dielectric(d) => Some((name, d.ior)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Largest u_lobe a `Sampler` produces.
+const U_MAX: f32 = 1.0 - 1.0 / (1u32 << 24) as f32;
+
+#[test]
+fn glass_follows_fresnel_and_snell() {
+    let sf = flat_frame();
+    let n = sf.ns();
+    let mut worst_z = 0.0f64;
+    for (name, ior) in glasses() {
+        let m = Material::Dielectric(lt_core::bsdf::Dielectric { ior });
+        for (cos, wo_l) in wo_cases() {
+            let wo = sf.frame.to_world(wo_l);
+            // η = η_t/η_i of the path wo → wi: entering the inside when wo is outside.
+            let eta = if cos > 0.0 {
+                ior as f64
+            } else {
+                1.0 / ior as f64
+            };
+            let cos_i = cos.abs() as f64;
+            let f_ref = fresnel_reference(cos_i, eta);
+            let tir = f_ref == 1.0;
+            let label = format!("{name} cosθo={cos}");
+            let on_wo_side = |w: Vec3| w.dot(n) * wo.dot(n) > 0.0;
+
+            // F + T = 1, and F matches the reference up to what rounding of cos θ allows.
+            let r = m
+                .sample(&sf, wo, 0.0, Default::default(), TransportMode::Radiance)
+                .unwrap();
+            assert!(
+                on_wo_side(r.wi) && r.delta,
+                "{label}: u_lobe = 0 must reflect"
+            );
+            let d = DIRECTION_ROUNDING as f64;
+            let tol_f = (fresnel_reference(cos_i * (1.0 - d), eta) - f_ref)
+                .abs()
+                .max((fresnel_reference((cos_i * (1.0 + d)).min(1.0), eta) - f_ref).abs())
+                + 16.0 * f32::EPSILON as f64;
+            assert!(
+                (r.pdf_w as f64 - f_ref).abs() <= tol_f,
+                "{label}: F = {} vs reference {f_ref} (tol {tol_f:.1e})",
+                r.pdf_w
+            );
+            let t = m
+                .sample(&sf, wo, U_MAX, Default::default(), TransportMode::Radiance)
+                .unwrap();
+            if tir {
+                assert!(
+                    on_wo_side(t.wi) && t.pdf_w == 1.0,
+                    "{label}: total internal reflection expected"
+                );
+            } else {
+                assert!(!on_wo_side(t.wi), "{label}: u_lobe → 1 must refract");
+                assert!(
+                    (r.pdf_w + t.pdf_w - 1.0).abs() <= f32::EPSILON,
+                    "{label}: F + T = {}",
+                    r.pdf_w + t.pdf_w
+                );
+                assert_eq!(
+                    t.pdf_rev_w, t.pdf_w,
+                    "{label}: reverse refraction has the same 1 − F"
+                );
+            }
+
+            // Exact mirror direction for reflection; Snell's law and the plane of incidence for
+            // refraction. sin θ = |n × w| carries the directions' rounding, once per side.
+            let mirror = 2.0 * wo.dot(n) * n - wo;
+            assert!(
+                (r.wi - mirror).length() <= 2.0 * DIRECTION_ROUNDING,
+                "{label}: reflection {} vs {mirror}",
+                r.wi
+            );
+            if !tir {
+                let (sin_i, sin_t) = (n.cross(wo).length() as f64, n.cross(t.wi).length() as f64);
+                let tol = (eta + 1.0) * d;
+                assert!(
+                    (eta * sin_t - sin_i).abs() <= tol,
+                    "{label}: Snell η sinθt = {} vs sinθi = {sin_i}",
+                    eta * sin_t
+                );
+                let (po, pi) = (wo - wo.dot(n) * n, t.wi - t.wi.dot(n) * n);
+                if po.length() > 1e-3 {
+                    assert!(
+                        (po.normalize().dot(pi.normalize()) + 1.0).abs()
+                            <= 4.0 * DIRECTION_ROUNDING,
+                        "{label}: refraction leaves the plane of incidence"
+                    );
+                }
+            }
+
+            // Radiance vs importance differ by exactly η² on refraction, not at all on reflection.
+            for u in [0.0, U_MAX] {
+                let a = m
+                    .sample(&sf, wo, u, Default::default(), TransportMode::Radiance)
+                    .unwrap();
+                let b = m
+                    .sample(&sf, wo, u, Default::default(), TransportMode::Importance)
+                    .unwrap();
+                let expect = if on_wo_side(a.wi) { 1.0 } else { eta * eta };
+                let ratio = b.weight.x as f64 / a.weight.x as f64;
+                assert!(
+                    (ratio / expect - 1.0).abs() <= gamma(4) as f64,
+                    "{label} u={u}: importance/radiance = {ratio}, expected {expect}"
+                );
+                assert_eq!(b.weight.x, 1.0, "{label}: importance weight of glass is 1");
+            }
+
+            // The frequency of reflection is F (binomial z-test).
+            if !tir {
+                let trials = 100_000u64;
+                let mut s = Sampler::new(17, cos.to_bits() as u64, ior.to_bits() as u64);
+                let k = (0..trials)
+                    .filter(|_| {
+                        on_wo_side(
+                            m.sample(&sf, wo, s.next_f32(), s.next_2d(), TransportMode::Radiance)
+                                .unwrap()
+                                .wi,
+                        )
+                    })
+                    .count();
+                let z = binomial_z(k as u64, trials, f_ref);
+                worst_z = worst_z.max(z.abs());
+                assert!(
+                    z.abs() < Z_MAX,
+                    "{label}: reflected {k}/{trials}, F = {f_ref}: z = {z:.2}"
+                );
+            }
+        }
+    }
+    eprintln!("worst |z| of reflection frequency vs F: {worst_z:.2}");
+}
+
+#[test]
+fn glass_reflects_totally_beyond_the_critical_angle() {
+    let sf = flat_frame();
+    for (name, ior) in glasses() {
+        let m = Material::Dielectric(lt_core::bsdf::Dielectric { ior });
+        // From the denser side the relative IOR is < 1 and sin θc = η.
+        let (side, eta) = if ior > 1.0 {
+            (-1.0f32, 1.0 / ior)
+        } else {
+            (1.0, ior)
+        };
+        for (factor, expect_tir) in [(1.01f32, true), (0.99, false)] {
+            let sin = (eta * factor).min(1.0);
+            let wo = sf
+                .frame
+                .to_world(Vec3::new(sin, 0.0, side * (1.0 - sin * sin).sqrt()));
+            let mut s = Sampler::new(19, ior.to_bits() as u64, 0);
+            let mut refracted = 0;
+            for _ in 0..2000 {
+                let b = m
+                    .sample(&sf, wo, s.next_f32(), s.next_2d(), TransportMode::Radiance)
+                    .unwrap();
+                if b.wi.dot(sf.ns()) * wo.dot(sf.ns()) < 0.0 {
+                    refracted += 1;
+                } else if expect_tir {
+                    assert!(
+                        b.pdf_w == 1.0 && b.weight == Vec3::ONE,
+                        "{name}: TIR sample {b:?}"
+                    );
+                }
+            }
+            assert_eq!(
+                refracted == 0,
+                expect_tir,
+                "{name}: sinθ = {factor}·sinθc refracted {refracted}/2000"
+            );
+            let t = m
+                .sample(&sf, wo, U_MAX, Default::default(), TransportMode::Radiance)
+                .unwrap();
+            assert_eq!(
+                t.wi.dot(sf.ns()) * wo.dot(sf.ns()) > 0.0,
+                expect_tir,
+                "{name}: u_lobe → 1 at {factor}·sinθc"
+            );
+        }
+    }
+}
+
+#[test]
+fn mirror_reflects_exactly() {
+    for sf in [flat_frame(), bumped_frame()] {
+        let n = sf.ns();
+        let (_, m) = test_registry()
+            .into_iter()
+            .find(|(k, _)| *k == "mirror")
+            .unwrap();
+        let Material::Mirror(mirror) = &m else {
+            unreachable!()
+        };
+        for (cos, wo_l) in wo_cases() {
+            let wo = sf.frame.to_world(wo_l);
+            let Some(b) = m.sample(&sf, wo, 0.5, Default::default(), TransportMode::Radiance)
+            else {
+                // Only a shading normal tilted away from ng may reject (light leak guard).
+                assert!(sf.ns() != sf.ng, "mirror rejected cosθo={cos} with ns = ng");
+                continue;
+            };
+            let r = 2.0 * wo.dot(n) * n - wo;
+            assert!(
+                (b.wi - r).length() <= 2.0 * DIRECTION_ROUNDING,
+                "cosθo={cos}: {} vs {r}",
+                b.wi
+            );
+            assert!(b.delta && b.pdf_w == 1.0 && b.pdf_rev_w == 1.0);
+            assert_eq!(
+                b.weight, mirror.reflectance,
+                "radiance weight is the reflectance"
+            );
+        }
+    }
+}

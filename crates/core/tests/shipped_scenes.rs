@@ -1,0 +1,397 @@
+//! Every scene in `scenes/` loads, and each is what its comments say it is.
+
+use lt_core::bsdf::Material;
+use lt_core::geometry::Ray;
+use lt_core::light::{Light, SunLight};
+use lt_core::math::{Color, Vec3, PI};
+use lt_core::scene::{load_scene, ShapeGeometry};
+use lt_core::Scene;
+use std::path::PathBuf;
+
+const SCENES: [&str; 7] = [
+    "cornell-box",
+    "cornell-small-light",
+    "cornell-glass-light",
+    "sun-room",
+    "caustic-sds",
+    "veach-mis",
+    "veach-door",
+];
+
+fn scenes_dir() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"))
+}
+
+fn load(name: &str) -> Scene {
+    let path = scenes_dir().join(format!("{name}.toml"));
+    load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Σ over area lights of area × emission: the emitted power is π times this.
+fn area_times_emission(s: &Scene) -> Color {
+    s.lights
+        .iter()
+        .filter_map(|l| {
+            if let Light::Area(a) = l {
+                Some(a.area * a.emission)
+            } else {
+                None
+            }
+        })
+        .sum()
+}
+
+fn close(a: f32, b: f32, rel: f32) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs())
+}
+
+/// Normal of the first triangle of a mesh shape (quads: the quad's normal).
+fn mesh_normal(s: &Scene, shape: u32) -> Vec3 {
+    let ShapeGeometry::Mesh(m) = &s.shapes[shape as usize].geometry else {
+        panic!("shape {shape} is not a mesh")
+    };
+    let [a, b, c] = m.triangle(0);
+    (b - a).cross(c - a).normalize()
+}
+
+fn mesh_center(s: &Scene, shape: u32) -> Vec3 {
+    let ShapeGeometry::Mesh(m) = &s.shapes[shape as usize].geometry else {
+        panic!("shape {shape} is not a mesh")
+    };
+    m.positions.iter().copied().sum::<Vec3>() / m.positions.len() as f32
+}
+
+/// Directions over the whole sphere (a Fibonacci lattice), for watertightness checks.
+fn sphere_directions(n: usize) -> impl Iterator<Item = Vec3> {
+    let golden = PI * (3.0 - 5f32.sqrt());
+    (0..n).map(move |i| {
+        let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+        let r = (1.0 - z * z).sqrt();
+        let phi = golden * i as f32;
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    })
+}
+
+#[test]
+fn every_scene_loads() {
+    let mut found: Vec<String> = std::fs::read_dir(scenes_dir())
+        .unwrap()
+        .filter_map(|e| {
+            e.ok()?
+                .path()
+                .file_name()?
+                .to_str()?
+                .strip_suffix(".toml")
+                .map(str::to_string)
+        })
+        .collect();
+    found.sort();
+    for name in SCENES {
+        assert!(
+            found.iter().any(|f| f == name),
+            "scenes/{name}.toml is missing"
+        );
+    }
+    for name in &found {
+        let s = load(name);
+        assert!(!s.lights.is_empty(), "{name} has no light");
+        assert!(
+            s.camera.width <= 256 && s.camera.height <= 256,
+            "{name} is larger than 256²"
+        );
+        assert_eq!(s.settings.max_depth, 8, "{name}");
+    }
+}
+
+#[test]
+fn area_lights_face_the_scene() {
+    for name in SCENES {
+        let s = load(name);
+        let center = s.bounding_sphere.0;
+        for l in &s.lights {
+            if let Light::Area(a) = l {
+                if let ShapeGeometry::Mesh(_) = s.shapes[a.shape as usize].geometry {
+                    let n = mesh_normal(&s, a.shape);
+                    assert!(
+                        n.dot(center - mesh_center(&s, a.shape)) > 0.0,
+                        "{name}: light {} faces away from the scene",
+                        a.shape
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn cornell_box_has_mitsubas_numbers() {
+    let s = load("cornell-box");
+    assert_eq!(s.shapes.len(), 8);
+    assert_eq!(s.lights.len(), 1);
+    let Light::Area(light) = &s.lights[0] else {
+        panic!("the light is not an area light")
+    };
+    // to_world columns of the light rectangle: 0.23 x and 0.19 along z, so 0.46 x 0.38.
+    assert!(
+        close(light.area, 0.46 * 0.38, 1e-6),
+        "light area {}",
+        light.area
+    );
+    assert_eq!(light.emission, Vec3::new(18.387, 13.9873, 6.75357));
+    let n = mesh_normal(&s, light.shape);
+    assert!(
+        (n - Vec3::new(0.0, -1.0, 0.0)).length() < 1e-6,
+        "light normal {n}"
+    );
+    assert!((mesh_center(&s, light.shape) - Vec3::new(0.0, 0.99, 0.01)).length() < 1e-6);
+    assert!((s.camera.eye - Vec3::new(0.0, 0.0, 3.9)).length() < 1e-6);
+    assert!((s.camera.forward() - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
+    assert_eq!((s.camera.width, s.camera.height), (256, 256));
+    let Material::Diffuse(white) = s.material(s.shapes[light.shape as usize].material) else {
+        panic!("the light is not white diffuse")
+    };
+    assert_eq!(white.albedo, Vec3::new(0.885809, 0.698859, 0.666422));
+    // The red wall (x = -1) is on the image's left, the green one on its right.
+    let red = s.camera.project(Vec3::new(-0.99, 0.0, 0.0)).unwrap().raster;
+    let green = s.camera.project(Vec3::new(0.99, 0.0, 0.0)).unwrap().raster;
+    assert!(
+        red.x < 128.0 && green.x > 128.0,
+        "red at {red}, green at {green}"
+    );
+    let red_hit = s
+        .intersect(&s.camera.generate_ray(lt_core::Vec2::new(5.5, 128.5)))
+        .unwrap();
+    let Material::Diffuse(d) = s.material(red_hit.material) else {
+        panic!()
+    };
+    assert_eq!(
+        d.albedo,
+        Vec3::new(0.570068, 0.0430135, 0.0443706),
+        "the left edge shows the red wall"
+    );
+}
+
+#[test]
+fn cornell_small_light_has_the_same_power() {
+    let big = load("cornell-box");
+    let small = load("cornell-small-light");
+    let (pb, ps) = (area_times_emission(&big), area_times_emission(&small));
+    for k in 0..3 {
+        assert!(close(pb[k], ps[k], 1e-5), "{pb} vs {ps}");
+    }
+    let Light::Area(l) = &small.lights[0] else {
+        panic!()
+    };
+    assert!(close(l.area, 0.46 * 0.38 / 25.0, 1e-5));
+}
+
+#[test]
+fn cornell_glass_light_is_a_sphere_in_a_glass_shell() {
+    let s = load("cornell-glass-light");
+    assert_eq!(s.lights.len(), 1, "the sphere is the only light");
+    let Light::Area(l) = &s.lights[0] else {
+        panic!()
+    };
+    let ShapeGeometry::Sphere { center, radius } = s.shapes[l.shape as usize].geometry else {
+        panic!("the light is not a sphere")
+    };
+    let shells: Vec<_> = s
+        .shapes
+        .iter()
+        .filter(|sh| matches!(s.material(sh.material), Material::Dielectric(d) if d.ior == 1.5))
+        .map(|sh| match sh.geometry {
+            ShapeGeometry::Sphere {
+                center: c,
+                radius: r,
+            } => (c, r, sh.flip_normals),
+            _ => panic!("glass that is not a sphere"),
+        })
+        .collect();
+    assert_eq!(shells.len(), 2);
+    for &(c, r, flipped) in &shells {
+        assert_eq!(c, center, "the shell is concentric with the light");
+        assert!(r > radius);
+        assert_eq!(flipped, r < 0.2, "only the inner surface is flipped");
+    }
+    // Same emitted power as cornell-box (within the rounding of the radiance in the file).
+    let (pg, pb) = (
+        area_times_emission(&s),
+        area_times_emission(&load("cornell-box")),
+    );
+    for k in 0..3 {
+        assert!(close(pg[k], pb[k], 1e-4), "{pg} vs {pb}");
+    }
+}
+
+#[test]
+fn sun_room_is_lit_by_the_sun_alone() {
+    let s = load("sun-room");
+    assert_eq!(s.lights.len(), 1);
+    let Light::Sun(sun) = &s.lights[0] else {
+        panic!("the light is not a sun")
+    };
+    assert_eq!(sun.solid_angle, 6.87e-5);
+    let expect = SunLight::radiance_from_irradiance(Color::new(5.0, 4.7, 4.2), 6.87e-5);
+    assert!((sun.radiance - expect).length() <= 1e-6 * expect.length());
+    assert!(
+        s.shapes.iter().all(|sh| sh.light.is_none()),
+        "no emissive shapes"
+    );
+    // The sunlit patch on the floor is in view and lit: sun -> window -> floor.
+    let patch = Vec3::new(0.8, 0.0, -0.45);
+    assert!(s.camera.project(patch).is_some());
+    assert!(s.visible_between(s.camera.eye, patch + Vec3::new(0.0, 1e-3, 0.0)));
+    let to_sun = patch + sun.direction * 10.0;
+    assert!(
+        s.visible_between(patch + Vec3::new(0.0, 1e-3, 0.0), to_sun),
+        "the patch sees the sun"
+    );
+}
+
+#[test]
+fn sun_room_is_closed_but_for_the_window() {
+    let s = load("sun-room");
+    let middle = Vec3::new(0.0, 1.25, 0.0);
+    for (i, _) in s.shapes.iter().enumerate() {
+        let i = i as u32;
+        assert!(
+            mesh_normal(&s, i).dot(middle - mesh_center(&s, i)) > 0.0,
+            "wall {i} faces out of the room"
+        );
+    }
+    for eye in [
+        s.camera.eye,
+        Vec3::new(0.0, 1.25, 0.0),
+        Vec3::new(1.9, 0.1, 2.9),
+    ] {
+        for d in sphere_directions(20000) {
+            if s.intersect(&Ray::new(eye, d)).is_some() {
+                continue;
+            }
+            // An escaping ray must leave through the window: x = 2, y 1..2, z -0.75..0.75.
+            assert!(d.x > 0.0, "ray {d} from {eye} escapes through a crack");
+            let p = eye + d * ((2.0 - eye.x) / d.x);
+            assert!(
+                (1.0..=2.0).contains(&p.y) && (-0.75..=0.75).contains(&p.z),
+                "ray {d} from {eye} escapes at {p}"
+            );
+        }
+    }
+}
+
+#[test]
+fn caustic_is_seen_only_in_the_mirror() {
+    let s = load("caustic-sds");
+    let caustic = Vec3::new(0.8, 0.0, 0.0);
+    assert!(
+        s.camera.project(caustic).is_none(),
+        "the caustic must be out of the direct view"
+    );
+    // Through the mirror (z = -2.5) its image is at z = -5: the camera ray there hits the mirror,
+    // and the reflected ray reaches the caustic unobstructed.
+    let image = Vec3::new(caustic.x, caustic.y, -5.0 - caustic.z);
+    assert!(
+        s.camera.project(image).is_some(),
+        "the caustic's mirror image is in frame"
+    );
+    let d = (image - s.camera.eye).normalize();
+    let hit = s
+        .intersect(&Ray::new(s.camera.eye, d))
+        .expect("the camera ray hits the mirror");
+    assert!(matches!(s.material(hit.material), Material::Mirror(_)));
+    assert!((hit.p.z + 2.5).abs() < 1e-4);
+    assert!(s.visible_between(
+        hit.p + Vec3::new(0.0, 0.0, 1e-3),
+        caustic + Vec3::new(0.0, 1e-3, 0.0)
+    ));
+    let glass = s
+        .shapes
+        .iter()
+        .filter(|sh| matches!(s.material(sh.material), Material::Dielectric(_)))
+        .count();
+    assert_eq!(glass, 1);
+}
+
+#[test]
+fn veach_mis_lights_have_equal_power() {
+    let s = load("veach-mis");
+    let mut radii = Vec::new();
+    for l in &s.lights {
+        let Light::Area(a) = l else { panic!() };
+        let ShapeGeometry::Sphere { center, radius } = s.shapes[a.shape as usize].geometry else {
+            panic!()
+        };
+        if center.y == 0.0 {
+            radii.push(radius);
+            assert!(
+                close(a.emission.x * radius * radius, 1.0, 2e-4),
+                "L r² = {}",
+                a.emission.x * radius * radius
+            );
+            assert!(
+                s.camera.project(center).is_some(),
+                "light at {center} is out of frame"
+            );
+        }
+    }
+    assert_eq!(radii, vec![0.0333, 0.1, 0.3, 0.9]);
+    let rough: Vec<f32> = s
+        .materials
+        .iter()
+        .filter_map(|m| {
+            if let Material::Glossy(g) = m {
+                Some(g.roughness)
+            } else {
+                None
+            }
+        })
+        .collect();
+    assert_eq!(rough.len(), 4);
+}
+
+#[test]
+fn veach_door_light_reaches_the_dark_room_only_by_bouncing() {
+    let s = load("veach-door");
+    assert_eq!(s.lights.len(), 1);
+    let Light::Area(lamp) = &s.lights[0] else {
+        panic!()
+    };
+    let lc = mesh_center(&s, lamp.shape);
+    assert!(lc.x > 0.0, "the lamp is in the far room");
+    assert!(s.camera.eye.x < 0.0, "the camera is in the dark room");
+    // Closed: every ray from the camera hits something.
+    for d in sphere_directions(20000) {
+        assert!(
+            s.intersect(&Ray::new(s.camera.eye, d)).is_some(),
+            "ray {d} escapes"
+        );
+    }
+    // No straight line joins the lamp to the dark room, but the door is open (the far room's
+    // walls are visible from the dark room through the gap).
+    let mut through_gap = 0;
+    for i in 0..9 {
+        for j in 0..9 {
+            let l = lc + Vec3::new(-0.45 + 0.1125 * i as f32, -0.01, -0.45 + 0.1125 * j as f32);
+            for x in [-3.9f32, -3.0, -2.0, -1.0, -0.2] {
+                for y in [0.05f32, 0.5, 1.0, 1.5, 2.0, 2.45] {
+                    for z in [-2.4f32, -1.5, -0.5, 0.3, 0.6, 1.0, 1.5, 2.4] {
+                        assert!(
+                            !s.visible_between(l, Vec3::new(x, y, z)),
+                            "lamp point {l} sees ({x}, {y}, {z})"
+                        );
+                    }
+                }
+            }
+        }
+    }
+    // The gap opens sideways (the door's free edge is in the dark room), so it joins the far
+    // room's north side (z > 0.5) to the dark room's south side (z < 0.5).
+    for i in 0..40 {
+        for j in 0..40 {
+            let a = Vec3::new(-3.9 + 0.085 * i as f32, 1.0, -2.4);
+            let b = Vec3::new(0.5 + 0.085 * j as f32, 1.0, 2.4);
+            through_gap += s.visible_between(a, b) as usize;
+        }
+    }
+    assert!(through_gap > 0, "no line of sight through the door gap");
+}
