@@ -4,7 +4,7 @@
 use glam::DVec3;
 use lt_core::bsdf::TransportMode;
 use lt_core::math::{Color, Vec2, Vec3};
-use lt_core::measure::{geometry_term, solid_angle_to_area};
+use lt_core::measure::solid_angle_to_area;
 use lt_core::path::{Path, PathVertex};
 use lt_core::sampling::Sampler;
 use lt_core::Scene;
@@ -16,7 +16,10 @@ pub struct Made {
     pub s: usize,
     /// Product of the area-measure densities the walk used (Russian roulette aside).
     pub pdf: f64,
-    /// Product of the measurement-contribution factors the walk met (Le, G, fs, We).
+    /// Product of the measurement-contribution factors the walk met, grouped as a walk sees them:
+    /// Le or We times the cosine it leaves with, then per vertex cos/d² on arrival and f_cos
+    /// (the sample's weight · pdf) on leaving. Same product as Le·G·∏fs·G·We, but each vertex's
+    /// outgoing cosine is the sampled direction's, as in the walk's throughput.
     pub f: DVec3,
     /// The estimator's own value, f/(N p) computed from sample weights: Le · β for the camera
     /// techniques, the splat for light tracing.
@@ -36,19 +39,18 @@ pub fn camera_walk(scene: &Scene, rng: &mut Sampler, raster: Option<Vec2>, max_k
     let mut ray = cam.generate_ray(raster);
     let mut verts = vec![PathVertex::camera(cam, Color::ONE)];
     let mut pdf_w = cam.pdf_dir(ray.d);
-    // The pinhole's discrete 1; We times the camera's cosine (G's camera end) comes below.
+    // The pinhole's discrete 1; We times the camera's cosine (G's camera end).
     let mut pdf = 1.0f64;
-    let mut f = DVec3::splat(cam.importance(ray.d) as f64);
+    let mut f = DVec3::splat((cam.importance(ray.d) * cam.forward().dot(ray.d)) as f64);
     let mut beta = DVec3::ONE;
-    for k in 1..=max_k {
+    for _ in 0..max_k {
         let prev = *verts.last().unwrap();
         let Some(hit) = scene.intersect(&ray) else {
             // Escaped: every light at infinity is an x0 in solid angle, G = |cos| at prev.
             for &li in &scene.infinite_lights {
                 let x0 = PathVertex::light_escaped(li, ray.d, beta.as_vec3(), pdf_w);
                 let le = scene.lights[li as usize].escaped(ray.d).as_dvec3();
-                let g = prev.ng.dot(ray.d).abs() as f64;
-                out(Made { path: Path::from_subpaths(&[x0], &verts), s: 0, pdf: pdf * pdf_w as f64, f: f * g * le, estimate: beta * le });
+                out(Made { path: Path::from_subpaths(&[x0], &verts), s: 0, pdf: pdf * pdf_w as f64, f: f * le, estimate: beta * le });
             }
             return;
         };
@@ -56,12 +58,7 @@ pub fn camera_walk(scene: &Scene, rng: &mut Sampler, raster: Option<Vec2>, max_k
         let pa = solid_angle_to_area(pdf_w, prev.p, hit.p, hit.ng);
         assert_eq!(v.pdf_fwd, pa, "the vertex stores the density the walk used");
         pdf *= pa as f64;
-        let g = if k == 1 {
-            cam.forward().dot(ray.d) * hit.ng.dot(ray.d).abs() / (hit.p - prev.p).length_squared()
-        } else {
-            geometry_term(prev.p, prev.ng, hit.p, hit.ng)
-        };
-        f *= g as f64;
+        f *= solid_angle_to_area(1.0, prev.p, hit.p, hit.ng) as f64;
         if let Some(x0) = v.as_light_endpoint(&hit) {
             let le = scene.lights[hit.light.unwrap() as usize].emitted(hit.ng, -ray.d).as_dvec3();
             out(Made { path: Path::from_subpaths(&[x0], &verts), s: 0, pdf, f: f * le, estimate: beta * le });
@@ -76,8 +73,7 @@ pub fn camera_walk(scene: &Scene, rng: &mut Sampler, raster: Option<Vec2>, max_k
             nee(scene, rng, &hit, &camera_sub, wo, pdf, f, beta, out);
         }
         let Some(bs) = m.sample(&sf, wo, rng.next_f32(), uv(rng), TransportMode::Radiance) else { return };
-        let fs = bs.weight * bs.pdf_w / hit.ng.dot(bs.wi).abs();
-        f *= fs.as_dvec3();
+        f *= (bs.weight * bs.pdf_w).as_dvec3();
         beta *= bs.weight.as_dvec3();
         pdf_w = bs.pdf_w;
         let mut v = v;
@@ -94,18 +90,18 @@ fn nee(scene: &Scene, rng: &mut Sampler, hit: &lt_core::scene::SurfaceHit, sub: 
     let Some(ls) = light.sample_li(hit.p, uv(rng)) else { return };
     let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, sub.last().unwrap());
     let e = scene.material(hit.material).eval(&hit.shading_frame(), wo, ls.wi, TransportMode::Radiance);
+    // Density of x0 and the arrival factor at it (cos/d², 1/d² at a point, 1 at infinity).
     let (pa, g) = if ls.delta {
-        (1.0, hit.ng.dot(ls.wi).abs() / (ls.p - hit.p).length_squared())
+        (1.0, 1.0 / (ls.p - hit.p).length_squared())
     } else if light.is_infinite() {
-        (ls.pdf_w, hit.ng.dot(ls.wi).abs())
+        (ls.pdf_w, 1.0)
     } else {
-        (solid_angle_to_area(ls.pdf_w, hit.p, ls.p, ls.n), geometry_term(hit.p, hit.ng, ls.p, ls.n))
+        (solid_angle_to_area(ls.pdf_w, hit.p, ls.p, ls.n), solid_angle_to_area(1.0, hit.p, ls.p, ls.n))
     };
     // A point light's LightLiSample radiance is I/d²: Le·G needs the intensity I and G with 1/d².
     let le = if ls.delta { ls.radiance * (ls.p - hit.p).length_squared() } else { ls.radiance };
-    let fs = e.f_cos / hit.ng.dot(ls.wi).abs();
     let est = beta * (e.f_cos * ls.radiance).as_dvec3() / (pmf * ls.pdf_w) as f64;
-    let f = f * (fs * le).as_dvec3() * g as f64;
+    let f = f * (e.f_cos * le).as_dvec3() * g as f64;
     out(Made { path: Path::from_subpaths(&[x0], sub), s: 1, pdf: pdf * (pmf * pa) as f64, f, estimate: est });
 }
 
@@ -119,7 +115,7 @@ pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
     let infinite = light.is_infinite();
     let mut verts = vec![x0];
     let mut pdf = (pmf * if infinite { le.pdf_dir } else { le.pdf_pos }) as f64;
-    let mut f = le.radiance.as_dvec3();
+    let mut f = le.radiance.as_dvec3() * if infinite || light.delta_position() { 1.0 } else { le.n.dot(le.ray.d).abs() as f64 };
     let mut beta = le.radiance.as_dvec3() * if infinite { 1.0 } else { le.n.dot(le.ray.d).abs() as f64 } / (pmf * le.pdf_pos * le.pdf_dir) as f64;
     let mut pdf_w = if infinite { le.pdf_pos } else { le.pdf_dir };
     let mut ray = le.ray;
@@ -130,11 +126,8 @@ pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
         let v = PathVertex::surface(&hit, beta.as_vec3(), pdf_w, &prev);
         let (pa, g) = if k == 1 && infinite {
             (pdf_w * hit.ng.dot(ray.d).abs(), hit.ng.dot(ray.d).abs())
-        } else if k == 1 && light.delta_position() {
-            let d2 = (hit.p - prev.p).length_squared();
-            (solid_angle_to_area(pdf_w, prev.p, hit.p, hit.ng), hit.ng.dot(ray.d).abs() / d2)
         } else {
-            (solid_angle_to_area(pdf_w, prev.p, hit.p, hit.ng), geometry_term(prev.p, prev.ng, hit.p, hit.ng))
+            (solid_angle_to_area(pdf_w, prev.p, hit.p, hit.ng), solid_angle_to_area(1.0, prev.p, hit.p, hit.ng))
         };
         pdf *= pa as f64;
         f *= g as f64;
@@ -144,16 +137,16 @@ pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
         if let (false, Some(proj)) = (m.is_delta(), cam.project(hit.p)) {
             let e = m.eval(&sf, wo, -proj.dir, TransportMode::Importance);
             let cos_c = cam.forward().dot(proj.dir);
-            let g_c = cos_c * hit.ng.dot(proj.dir).abs() / (proj.distance * proj.distance);
-            let fc = f * (e.f_cos / hit.ng.dot(proj.dir).abs()).as_dvec3() * (g_c * proj.importance) as f64;
-            let splat = beta * e.f_cos.as_dvec3() * (proj.importance * cos_c / (proj.distance * proj.distance)) as f64 / cam.pixel_count() as f64;
+            let arrive = (proj.importance * cos_c / (proj.distance * proj.distance)) as f64;
+            let fc = f * e.f_cos.as_dvec3() * arrive;
+            let splat = beta * e.f_cos.as_dvec3() * arrive / cam.pixel_count() as f64;
             let mut sub = verts.clone();
             sub.push(v);
             let path = Path::from_subpaths(&sub, &[PathVertex::camera(cam, Color::ONE)]);
             out(Made { path, s: k + 1, pdf, f: fc, estimate: splat });
         }
         let Some(bs) = m.sample(&sf, wo, rng.next_f32(), uv(rng), TransportMode::Importance) else { return };
-        f *= (bs.weight * bs.pdf_w / hit.ng.dot(bs.wi).abs()).as_dvec3();
+        f *= (bs.weight * bs.pdf_w).as_dvec3();
         beta *= bs.weight.as_dvec3();
         pdf_w = bs.pdf_w;
         let mut v = v;
