@@ -2,16 +2,23 @@
 //! agreement per 8×8 block within a Šidák-corrected z threshold checks NEE, light pdfs and MIS
 //! weights against the plain estimator.
 
-use lt_estimators::agreement::agreement;
+use lt_estimators::agreement::agreement_t;
 use lt_integrators::IntegratorParams;
 use lt_tests::{render_blocks, shipped_scene};
 
 fn agree(scene_name: &str, passes_pt: u32, passes_bsdf: u32) {
     let scene = shipped_scene(scene_name, Some((64, 64)));
     let (r1, a) = render_blocks(&scene, "pt", IntegratorParams::default(), passes_pt, 11, 8);
-    let (r2, b) = render_blocks(&scene, "pt-bsdf", IntegratorParams::default(), passes_bsdf, 12, 8);
+    let (r2, b) = render_blocks(
+        &scene,
+        "pt-bsdf",
+        IntegratorParams::default(),
+        passes_bsdf,
+        12,
+        8,
+    );
     assert_eq!(r1.invalid_samples + r2.invalid_samples, 0);
-    let result = agreement(&a, &b, 1e-3);
+    let result = agreement_t(&a, &b, 1e-3);
     assert!(result.passed(), "{scene_name}: pt vs pt-bsdf: {result}");
 }
 

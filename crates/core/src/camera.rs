@@ -47,7 +47,15 @@ pub struct Projection {
 
 impl Camera {
     /// Fails with a description when the view is degenerate.
-    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_deg: f32, fov_axis: FovAxis, width: u32, height: u32) -> Result<Camera, String> {
+    pub fn look_at(
+        eye: Vec3,
+        target: Vec3,
+        up: Vec3,
+        fov_deg: f32,
+        fov_axis: FovAxis,
+        width: u32,
+        height: u32,
+    ) -> Result<Camera, String> {
         let forward = target - eye;
         if !(forward.length() > 0.0) {
             return Err("camera eye and target coincide".into());
@@ -58,7 +66,9 @@ impl Camera {
             return Err("camera up is parallel to the viewing direction".into());
         }
         if !(fov_deg > 0.0 && fov_deg < 180.0) {
-            return Err(format!("camera fov {fov_deg} must lie strictly between 0 and 180 degrees"));
+            return Err(format!(
+                "camera fov {fov_deg} must lie strictly between 0 and 180 degrees"
+            ));
         }
         if width == 0 || height == 0 {
             return Err("camera resolution must be at least 1×1".into());
@@ -73,10 +83,18 @@ impl Camera {
             FovAxis::Smaller => width <= height,
             FovAxis::Larger => width >= height,
         };
-        let tan_half = if along_x { Vec2::new(t, t / aspect) } else { Vec2::new(t * aspect, t) };
+        let tan_half = if along_x {
+            Vec2::new(t, t / aspect)
+        } else {
+            Vec2::new(t * aspect, t)
+        };
         Ok(Camera {
             eye,
-            frame: Frame { x: right, y: true_up, z: forward },
+            frame: Frame {
+                x: right,
+                y: true_up,
+                z: forward,
+            },
             width,
             height,
             tan_half,
@@ -112,7 +130,10 @@ impl Camera {
 
     /// The primary ray through a raster position (pixel (i, j) covers [i, i+1) × [j, j+1)).
     pub fn generate_ray(&self, raster: Vec2) -> Ray {
-        let ndc = Vec2::new(2.0 * raster.x / self.width as f32 - 1.0, 1.0 - 2.0 * raster.y / self.height as f32);
+        let ndc = Vec2::new(
+            2.0 * raster.x / self.width as f32 - 1.0,
+            1.0 - 2.0 * raster.y / self.height as f32,
+        );
         let local = Vec3::new(ndc.x * self.tan_half.x, ndc.y * self.tan_half.y, 1.0);
         Ray::new(self.eye, self.frame.to_world(local).normalize())
     }
@@ -125,8 +146,15 @@ impl Camera {
         }
         let x = l.x / (l.z * self.tan_half.x);
         let y = l.y / (l.z * self.tan_half.y);
-        let raster = Vec2::new((x + 1.0) * 0.5 * self.width as f32, (1.0 - y) * 0.5 * self.height as f32);
-        (raster.x >= 0.0 && raster.y >= 0.0 && raster.x < self.width as f32 && raster.y < self.height as f32).then_some(raster)
+        let raster = Vec2::new(
+            (x + 1.0) * 0.5 * self.width as f32,
+            (1.0 - y) * 0.5 * self.height as f32,
+        );
+        (raster.x >= 0.0
+            && raster.y >= 0.0
+            && raster.x < self.width as f32
+            && raster.y < self.height as f32)
+            .then_some(raster)
     }
 
     /// We(ω) per pixel for a unit direction from the eye; zero off the film.
@@ -157,7 +185,12 @@ impl Camera {
         }
         let dir = to / distance;
         let raster = self.raster_of(dir)?;
-        Some(Projection { raster, dir, distance, importance: self.importance(dir) })
+        Some(Projection {
+            raster,
+            dir,
+            distance,
+            importance: self.importance(dir),
+        })
     }
 }
 
@@ -166,13 +199,26 @@ mod tests {
     use super::*;
 
     fn cam() -> Camera {
-        Camera::look_at(Vec3::new(0.0, 0.0, 3.9), Vec3::ZERO, Vec3::Y, 39.3077, FovAxis::X, 64, 48).unwrap()
+        Camera::look_at(
+            Vec3::new(0.0, 0.0, 3.9),
+            Vec3::ZERO,
+            Vec3::Y,
+            39.3077,
+            FovAxis::X,
+            64,
+            48,
+        )
+        .unwrap()
     }
 
     #[test]
     fn projection_inverts_ray_generation() {
         let c = cam();
-        for r in [Vec2::new(0.5, 0.5), Vec2::new(63.2, 1.7), Vec2::new(31.9, 47.1)] {
+        for r in [
+            Vec2::new(0.5, 0.5),
+            Vec2::new(63.2, 1.7),
+            Vec2::new(31.9, 47.1),
+        ] {
             let ray = c.generate_ray(r);
             let back = c.project(ray.at(2.5)).unwrap().raster;
             assert!((back - r).length() < 1e-3, "{r} -> {back}");
@@ -194,7 +240,10 @@ mod tests {
         let mut total = 0.0f64;
         for j in 0..n {
             for i in 0..n {
-                let r = Vec2::new((i as f32 + 0.5) / n as f32 * 64.0, (j as f32 + 0.5) / n as f32 * 48.0);
+                let r = Vec2::new(
+                    (i as f32 + 0.5) / n as f32 * 64.0,
+                    (j as f32 + 0.5) / n as f32 * 48.0,
+                );
                 let d = c.generate_ray(r).d;
                 let cos = d.dot(c.forward()) as f64;
                 let da = c.plane_area as f64 / (n * n) as f64;

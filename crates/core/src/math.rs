@@ -67,10 +67,18 @@ mod tests {
 
     #[test]
     fn frame_is_orthonormal_for_awkward_normals() {
-        for n in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(1e-7, -1e-7, -1.0).normalize(), Vec3::new(0.3, -0.8, 0.1).normalize()] {
+        for n in [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::X,
+            Vec3::new(1e-7, -1e-7, -1.0).normalize(),
+            Vec3::new(0.3, -0.8, 0.1).normalize(),
+        ] {
             let f = Frame::from_z(n);
             assert!((f.x.length() - 1.0).abs() < 1e-5 && (f.y.length() - 1.0).abs() < 1e-5);
-            assert!(f.x.dot(f.y).abs() < 1e-5 && f.x.dot(f.z).abs() < 1e-5 && f.y.dot(f.z).abs() < 1e-5);
+            assert!(
+                f.x.dot(f.y).abs() < 1e-5 && f.x.dot(f.z).abs() < 1e-5 && f.y.dot(f.z).abs() < 1e-5
+            );
             let v = Vec3::new(0.2, -0.5, 0.7);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
         }

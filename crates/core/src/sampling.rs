@@ -23,7 +23,9 @@ impl Sampler {
     pub fn new(seed: u64, item: u64, pass: u64) -> Sampler {
         let state = mix64(seed ^ mix64(item.wrapping_add(0x9e3779b97f4a7c15)));
         let stream = mix64(pass ^ mix64(seed.wrapping_add(item.rotate_left(32))));
-        Sampler { rng: Pcg32::new(state, stream) }
+        Sampler {
+            rng: Pcg32::new(state, stream),
+        }
     }
 
     /// Uniform in [0, 1), never 1.
@@ -129,7 +131,11 @@ impl Distribution1D {
         let total_f64: f64 = weights.iter().map(|&w| w as f64).sum();
         let total = total_f64 as f32;
         if total_f64 <= 0.0 {
-            return Distribution1D { cdf: vec![], pmf: vec![0.0; weights.len()], total: 0.0 };
+            return Distribution1D {
+                cdf: vec![],
+                pmf: vec![0.0; weights.len()],
+                total: 0.0,
+            };
         }
         let mut acc = 0.0f64;
         let mut cdf = Vec::with_capacity(weights.len());
@@ -138,7 +144,10 @@ impl Distribution1D {
             cdf.push((acc / total_f64) as f32);
         }
         *cdf.last_mut().unwrap() = 1.0;
-        let pmf = weights.iter().map(|&w| (w as f64 / total_f64) as f32).collect();
+        let pmf = weights
+            .iter()
+            .map(|&w| (w as f64 / total_f64) as f32)
+            .collect();
         Distribution1D { cdf, pmf, total }
     }
 
@@ -152,10 +161,17 @@ impl Distribution1D {
 
     /// Returns (index, pmf, u remapped to [0,1) within the chosen bin).
     pub fn sample(&self, u: f32) -> (usize, f32, f32) {
-        let i = self.cdf.partition_point(|&c| c <= u).min(self.cdf.len() - 1);
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .min(self.cdf.len() - 1);
         let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
         let p = self.pmf[i];
-        let remapped = if p > 0.0 { ((u - lo) / (self.cdf[i] - lo)).clamp(0.0, 1.0 - f32::EPSILON) } else { 0.0 };
+        let remapped = if p > 0.0 {
+            ((u - lo) / (self.cdf[i] - lo)).clamp(0.0, 1.0 - f32::EPSILON)
+        } else {
+            0.0
+        };
         (i, p, remapped)
     }
 
@@ -171,18 +187,24 @@ mod tests {
 
     #[test]
     fn streams_are_deterministic_and_distinct() {
-        let a: Vec<f32> = (0..4).map({
-            let mut s = Sampler::new(7, 3, 1);
-            move |_| s.next_f32()
-        }).collect();
-        let b: Vec<f32> = (0..4).map({
-            let mut s = Sampler::new(7, 3, 1);
-            move |_| s.next_f32()
-        }).collect();
-        let c: Vec<f32> = (0..4).map({
-            let mut s = Sampler::new(7, 3, 2);
-            move |_| s.next_f32()
-        }).collect();
+        let a: Vec<f32> = (0..4)
+            .map({
+                let mut s = Sampler::new(7, 3, 1);
+                move |_| s.next_f32()
+            })
+            .collect();
+        let b: Vec<f32> = (0..4)
+            .map({
+                let mut s = Sampler::new(7, 3, 1);
+                move |_| s.next_f32()
+            })
+            .collect();
+        let c: Vec<f32> = (0..4)
+            .map({
+                let mut s = Sampler::new(7, 3, 2);
+                move |_| s.next_f32()
+            })
+            .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
     }

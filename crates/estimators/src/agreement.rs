@@ -45,7 +45,10 @@ impl Agreement {
 /// Two-sided |z| threshold keeping the family-wise false-alarm rate at `alpha` over `tests`
 /// independent tests (Šidák): each test runs at 1 − (1 − alpha)^(1/tests).
 pub fn sidak_threshold(alpha: f64, tests: usize) -> f64 {
-    assert!(alpha > 0.0 && alpha < 1.0, "false-alarm rate must be in (0, 1), got {alpha}");
+    assert!(
+        alpha > 0.0 && alpha < 1.0,
+        "false-alarm rate must be in (0, 1), got {alpha}"
+    );
     // expm1/ln_1p keep the per-test rate accurate when it is tiny.
     let per_test = -(((-alpha).ln_1p()) / tests.max(1) as f64).exp_m1();
     -Normal::standard().inverse_cdf(per_test / 2.0)
@@ -63,15 +66,32 @@ pub fn agreement(a: &BlockEstimate, b: &BlockEstimate, false_alarm_rate: f64) ->
         b.blocks_y
     );
     let z = (0..a.regions())
-        .map(|i| [0, 1, 2].map(|c| z_score(a.mean[i][c] - b.mean[i][c], a.std_error[i][c].hypot(b.std_error[i][c]))))
+        .map(|i| {
+            [0, 1, 2].map(|c| {
+                z_score(
+                    a.mean[i][c] - b.mean[i][c],
+                    a.std_error[i][c].hypot(b.std_error[i][c]),
+                )
+            })
+        })
         .collect();
     summarize(z, a.blocks_x, false_alarm_rate)
 }
 
 /// One estimate against a reference taken as exact (block means, e.g. from [`crate::block_means`]).
-pub fn agreement_with_reference(a: &BlockEstimate, reference: &[[f64; 3]], false_alarm_rate: f64) -> Agreement {
-    assert_eq!(a.regions(), reference.len(), "agreement_with_reference: region counts differ");
-    let z = (0..a.regions()).map(|i| [0, 1, 2].map(|c| z_score(a.mean[i][c] - reference[i][c], a.std_error[i][c]))).collect();
+pub fn agreement_with_reference(
+    a: &BlockEstimate,
+    reference: &[[f64; 3]],
+    false_alarm_rate: f64,
+) -> Agreement {
+    assert_eq!(
+        a.regions(),
+        reference.len(),
+        "agreement_with_reference: region counts differ"
+    );
+    let z = (0..a.regions())
+        .map(|i| [0, 1, 2].map(|c| z_score(a.mean[i][c] - reference[i][c], a.std_error[i][c])))
+        .collect();
     summarize(z, a.blocks_x, false_alarm_rate)
 }
 
@@ -80,14 +100,20 @@ pub fn agreement_with_reference(a: &BlockEstimate, reference: &[[f64; 3]], false
 /// the same tail probability, so the stated false-alarm rate holds for any pass count ≥ 2.
 pub fn agreement_t(a: &RunningBlocks, b: &RunningBlocks, false_alarm_rate: f64) -> Agreement {
     let (ea, eb) = (a.estimate(), b.estimate());
-    assert!((ea.blocks_x, ea.blocks_y) == (eb.blocks_x, eb.blocks_y), "agreement_t: block grids differ");
+    assert!(
+        (ea.blocks_x, ea.blocks_y) == (eb.blocks_x, eb.blocks_y),
+        "agreement_t: block grids differ"
+    );
     let (da, db) = (a.count() as f64 - 1.0, b.count() as f64 - 1.0);
     let z = (0..ea.regions())
         .map(|i| {
             [0, 1, 2].map(|c| {
                 let (sa, sb) = (ea.std_error[i][c].powi(2), eb.std_error[i][c].powi(2));
                 let dof = (sa + sb).powi(2) / (sa * sa / da + sb * sb / db);
-                t_to_z(z_score(ea.mean[i][c] - eb.mean[i][c], (sa + sb).sqrt()), dof)
+                t_to_z(
+                    z_score(ea.mean[i][c] - eb.mean[i][c], (sa + sb).sqrt()),
+                    dof,
+                )
             })
         })
         .collect();
@@ -95,11 +121,28 @@ pub fn agreement_t(a: &RunningBlocks, b: &RunningBlocks, false_alarm_rate: f64) 
 }
 
 /// [`agreement_with_reference`] with the same t-to-z mapping as [`agreement_t`] (dof n − 1).
-pub fn agreement_with_reference_t(a: &RunningBlocks, reference: &[[f64; 3]], false_alarm_rate: f64) -> Agreement {
+pub fn agreement_with_reference_t(
+    a: &RunningBlocks,
+    reference: &[[f64; 3]],
+    false_alarm_rate: f64,
+) -> Agreement {
     let e = a.estimate();
-    assert_eq!(e.regions(), reference.len(), "agreement_with_reference_t: region counts differ");
+    assert_eq!(
+        e.regions(),
+        reference.len(),
+        "agreement_with_reference_t: region counts differ"
+    );
     let dof = a.count() as f64 - 1.0;
-    let z = (0..e.regions()).map(|i| [0, 1, 2].map(|c| t_to_z(z_score(e.mean[i][c] - reference[i][c], e.std_error[i][c]), dof))).collect();
+    let z = (0..e.regions())
+        .map(|i| {
+            [0, 1, 2].map(|c| {
+                t_to_z(
+                    z_score(e.mean[i][c] - reference[i][c], e.std_error[i][c]),
+                    dof,
+                )
+            })
+        })
+        .collect();
     summarize(z, e.blocks_x, false_alarm_rate)
 }
 
@@ -157,7 +200,10 @@ fn summarize(z: Vec<[f64; 3]>, blocks_x: usize, false_alarm_rate: f64) -> Agreem
 
 impl fmt::Display for Agreement {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (bx, by) = (self.worst_region % self.blocks_x, self.worst_region / self.blocks_x);
+        let (bx, by) = (
+            self.worst_region % self.blocks_x,
+            self.worst_region / self.blocks_x,
+        );
         write!(
             f,
             "{}: max |z| {:.3} at region {} (block {bx},{by}) channel {}, threshold {:.3} \
@@ -195,8 +241,16 @@ mod tests {
     }
 
     fn estimate_with_known_se(rng: &mut Rng, truth: &[[f64; 3]], se: f64) -> BlockEstimate {
-        let mean = truth.iter().map(|t| t.map(|v| v + se * rng.normal())).collect();
-        BlockEstimate { blocks_x: 8, blocks_y: truth.len() / 8, mean, std_error: vec![[se; 3]; truth.len()] }
+        let mean = truth
+            .iter()
+            .map(|t| t.map(|v| v + se * rng.normal()))
+            .collect();
+        BlockEstimate {
+            blocks_x: 8,
+            blocks_y: truth.len() / 8,
+            mean,
+            std_error: vec![[se; 3]; truth.len()],
+        }
     }
 
     // With exact standard errors, z is exactly normal, so the family-wise false-alarm rate must be
@@ -222,12 +276,26 @@ mod tests {
     // degrees of freedom (2(n−1) for equal variances). The observed rate must match that
     // prediction, and stay within 1.5× the stated rate at n = 64.
     /// Two accumulators of the same noisy image; `skewed` adds an exponential channel.
-    fn null_pair(rng: &mut Rng, w: usize, h: usize, block: usize, n: [usize; 2], skewed: bool) -> [RunningBlocks; 2] {
-        let mut est = [RunningBlocks::new(w, h, block), RunningBlocks::new(w, h, block)];
+    fn null_pair(
+        rng: &mut Rng,
+        w: usize,
+        h: usize,
+        block: usize,
+        n: [usize; 2],
+        skewed: bool,
+    ) -> [RunningBlocks; 2] {
+        let mut est = [
+            RunningBlocks::new(w, h, block),
+            RunningBlocks::new(w, h, block),
+        ];
         for (e, n) in est.iter_mut().zip(n) {
             for _ in 0..n {
                 e.add(&Image::from_fn(w, h, |x, _| {
-                    let third = if skewed { 2.0 * rng.exp() } else { 2.0 + 3.0 * rng.normal() };
+                    let third = if skewed {
+                        2.0 * rng.exp()
+                    } else {
+                        2.0 + 3.0 * rng.normal()
+                    };
                     [x as f64 + rng.normal(), rng.uniform(), third]
                 }));
             }
@@ -319,12 +387,20 @@ mod tests {
 
     #[test]
     fn zero_errors_and_nan() {
-        let e = |m: f64, s: f64| BlockEstimate { blocks_x: 1, blocks_y: 1, mean: vec![[m; 3]], std_error: vec![[s; 3]] };
+        let e = |m: f64, s: f64| BlockEstimate {
+            blocks_x: 1,
+            blocks_y: 1,
+            mean: vec![[m; 3]],
+            std_error: vec![[s; 3]],
+        };
         assert!(agreement(&e(1.0, 0.0), &e(1.0, 0.0), 0.01).passed());
         let r = agreement(&e(1.0, 0.0), &e(2.0, 0.0), 0.01);
         assert!(!r.passed() && r.max_abs_z.is_infinite());
         assert!(!agreement(&e(1.0, f64::NAN), &e(1.0, 0.1), 0.01).passed());
         let s = agreement(&e(1.0, 0.1), &e(1.2, 0.0), 0.01).to_string();
-        assert!(s.contains("max |z| 2.000") && s.contains("threshold"), "{s}");
+        assert!(
+            s.contains("max |z| 2.000") && s.contains("threshold"),
+            "{s}"
+        );
     }
 }

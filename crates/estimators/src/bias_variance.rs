@@ -30,13 +30,20 @@ impl Interval {
 
 impl std::fmt::Display for Interval {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{:.6e} [{:.6e}, {:.6e}]", self.estimate, self.lo, self.hi)
+        write!(
+            f,
+            "{:.6e} [{:.6e}, {:.6e}]",
+            self.estimate, self.lo, self.hi
+        )
     }
 }
 
 /// Two-sided Student t quantile t_{dof, 1−(1−confidence)/2}.
 pub fn t_quantile(confidence: f64, dof: f64) -> f64 {
-    assert!(confidence > 0.0 && confidence < 1.0, "confidence must be in (0, 1), got {confidence}");
+    assert!(
+        confidence > 0.0 && confidence < 1.0,
+        "confidence must be in (0, 1), got {confidence}"
+    );
     let p = 0.5 + confidence / 2.0;
     if dof > 1e4 {
         // statrs' inversion loses accuracy above ~1e4 dof and stalls for huge ones; the Cornish–Fisher
@@ -45,27 +52,45 @@ pub fn t_quantile(confidence: f64, dof: f64) -> f64 {
         let (z3, z5) = (z.powi(3), z.powi(5));
         return z + (z3 + z) / (4.0 * dof) + (5.0 * z5 + 16.0 * z3 + 3.0 * z) / (96.0 * dof * dof);
     }
-    StudentsT::new(0.0, 1.0, dof).expect("dof > 0").inverse_cdf(p)
+    StudentsT::new(0.0, 1.0, dof)
+        .expect("dof > 0")
+        .inverse_cdf(p)
 }
 
 /// χ² interval for a variance estimate `s2` with `dof` degrees of freedom.
 pub fn variance_interval(s2: f64, dof: f64, confidence: f64) -> Interval {
     let chi = ChiSquared::new(dof).expect("dof > 0");
     let a = (1.0 - confidence) / 2.0;
-    Interval { estimate: s2, lo: dof * s2 / chi.inverse_cdf(1.0 - a), hi: dof * s2 / chi.inverse_cdf(a) }
+    Interval {
+        estimate: s2,
+        lo: dof * s2 / chi.inverse_cdf(1.0 - a),
+        hi: dof * s2 / chi.inverse_cdf(a),
+    }
 }
 
 /// t interval for a mean from its estimate, standard error and degrees of freedom.
 pub fn mean_interval(mean: f64, std_error: f64, dof: f64, confidence: f64) -> Interval {
     let h = t_quantile(confidence, dof) * std_error;
-    Interval { estimate: mean, lo: mean - h, hi: mean + h }
+    Interval {
+        estimate: mean,
+        lo: mean - h,
+        hi: mean + h,
+    }
 }
 
 /// The interval of b² for b in `bias` (same coverage: squaring maps the event b ∈ CI onto it).
 fn squared(bias: Interval, estimate: f64) -> Interval {
     let (a, b) = (bias.lo * bias.lo, bias.hi * bias.hi);
-    let lo = if bias.lo <= 0.0 && bias.hi >= 0.0 { 0.0 } else { a.min(b) };
-    Interval { estimate, lo, hi: a.max(b) }
+    let lo = if bias.lo <= 0.0 && bias.hi >= 0.0 {
+        0.0
+    } else {
+        a.min(b)
+    };
+    Interval {
+        estimate,
+        lo,
+        hi: a.max(b),
+    }
 }
 
 /// Scalar decomposition: one number per run (a pixel, a block, an integral).
@@ -99,11 +124,18 @@ impl BiasVariance {
         let dof = (k - 1) as f64;
         let (m, s2, se) = (s.mean(), s.sample_variance(), s.std_error());
         let mean = mean_interval(m, se, dof, confidence);
-        let shift = |i: Interval| Interval { estimate: i.estimate - reference, lo: i.lo - reference, hi: i.hi - reference };
+        let shift = |i: Interval| Interval {
+            estimate: i.estimate - reference,
+            lo: i.lo - reference,
+            hi: i.hi - reference,
+        };
         let bias = shift(mean);
         let b2 = bias.estimate * bias.estimate - s2 / k as f64;
         let half = 1.0 - (1.0 - confidence) / 2.0;
-        let (b2w, vw) = (squared(shift(mean_interval(m, se, dof, half)), b2), variance_interval(s2, dof, half));
+        let (b2w, vw) = (
+            squared(shift(mean_interval(m, se, dof, half)), b2),
+            variance_interval(s2, dof, half),
+        );
         BiasVariance {
             runs: k,
             confidence,
@@ -112,7 +144,11 @@ impl BiasVariance {
             bias,
             bias2: squared(bias, b2),
             variance: variance_interval(s2, dof, confidence),
-            mse: Interval { estimate: b2 + s2, lo: b2w.lo + vw.lo, hi: b2w.hi + vw.hi },
+            mse: Interval {
+                estimate: b2 + s2,
+                lo: b2w.lo + vw.lo,
+                hi: b2w.hi + vw.hi,
+            },
         }
     }
 }
@@ -134,8 +170,14 @@ impl ImageBiasVariance {
     /// Needs at least three runs (the jackknife drops one and still needs a variance).
     pub fn from_runs(runs: &[Image], reference: &Image, confidence: f64) -> ImageBiasVariance {
         let k = runs.len();
-        assert!(k >= 3, "image bias/variance needs at least three runs, got {k}");
-        assert!(runs.iter().all(|r| r.same_size(reference)), "image bias/variance: sizes differ");
+        assert!(
+            k >= 3,
+            "image bias/variance needs at least three runs, got {k}"
+        );
+        assert!(
+            runs.iter().all(|r| r.same_size(reference)),
+            "image bias/variance: sizes differ"
+        );
         let n = (reference.data.len() * 3) as f64;
         let kf = k as f64;
         // Full-sample sums and, per left-out run j, the delete-one sums.
@@ -145,7 +187,9 @@ impl ImageBiasVariance {
         let mut xs = vec![0.0; k];
         for (p, r) in reference.data.iter().enumerate() {
             for c in 0..3 {
-                xs.iter_mut().zip(runs).for_each(|(x, run)| *x = run.data[p][c]);
+                xs.iter_mut()
+                    .zip(runs)
+                    .for_each(|(x, run)| *x = run.data[p][c]);
                 let s = RunningStat::from_slice(&xs);
                 let (m, m2) = (s.mean(), s.sample_variance() * (kf - 1.0));
                 b2 += (m - r[c]).powi(2) - m2 / ((kf - 1.0) * kf);
@@ -206,16 +250,28 @@ mod tests {
             let sums: Vec<f64> = (0..k).map(|_| sum_f(&mut rng, n)).collect();
             let plain: Vec<f64> = sums.iter().map(|s| s / n as f64).collect();
             let shrunk: Vec<f64> = sums.iter().map(|s| s / (n + 1) as f64).collect();
-            let (u, b) = (BiasVariance::from_runs(&plain, I, conf), BiasVariance::from_runs(&shrunk, I, conf));
+            let (u, b) = (
+                BiasVariance::from_runs(&plain, I, conf),
+                BiasVariance::from_runs(&shrunk, I, conf),
+            );
             let expect = -I / (n + 1) as f64;
-            println!("N={n:4}: unbiased bias {}, biased bias {} (closed form {expect:.6e})", u.bias, b.bias);
+            println!(
+                "N={n:4}: unbiased bias {}, biased bias {} (closed form {expect:.6e})",
+                u.bias, b.bias
+            );
             assert!(u.bias.contains(0.0), "N={n}: {}", u.bias);
             assert!(b.bias.contains(expect), "N={n}: {} vs {expect}", b.bias);
             // Variances: Var f/N and Var f·N/(N+1)².
             assert!(u.variance.contains(VAR_F / n as f64));
-            assert!(b.variance.contains(VAR_F * n as f64 / ((n + 1) * (n + 1)) as f64));
+            assert!(b
+                .variance
+                .contains(VAR_F * n as f64 / ((n + 1) * (n + 1)) as f64));
             if n <= 64 {
-                assert!(!b.bias.contains(0.0), "N={n}: bias not resolved: {}", b.bias);
+                assert!(
+                    !b.bias.contains(0.0),
+                    "N={n}: bias not resolved: {}",
+                    b.bias
+                );
             }
             if let Some(prev) = last_biased {
                 // Consistency: the whole interval of |bias| moved toward zero.
@@ -238,9 +294,14 @@ mod tests {
     fn fixed_bias_is_detected() {
         let mut rng = Rng::new(77);
         let (n, k, bias) = (32, 500, 0.05);
-        let runs: Vec<f64> = (0..k).map(|_| sum_f(&mut rng, n) / n as f64 + bias).collect();
+        let runs: Vec<f64> = (0..k)
+            .map(|_| sum_f(&mut rng, n) / n as f64 + bias)
+            .collect();
         let bv = BiasVariance::from_runs(&runs, I, 0.999);
-        println!("fixed bias {bias}: {}, bias² {}, mse {}", bv.bias, bv.bias2, bv.mse);
+        println!(
+            "fixed bias {bias}: {}, bias² {}, mse {}",
+            bv.bias, bv.bias2, bv.mse
+        );
         assert!(!bv.bias.contains(0.0) && bv.bias.contains(bias));
         assert!(bv.bias2.lo > 0.0 && bv.bias2.contains(bias * bias));
         assert!(bv.mse.contains(bias * bias + VAR_F / n as f64));
@@ -283,10 +344,21 @@ mod tests {
         let (w, h, k, sigma, bias) = (16, 16, 40, 0.2, 0.1);
         let reference = Image::from_fn(w, h, |x, y| [x as f64, y as f64, 1.0]);
         let runs: Vec<Image> = (0..k)
-            .map(|_| Image { width: w, height: h, data: reference.data.iter().map(|r| r.map(|v| v + bias + sigma * rng.normal())).collect() })
+            .map(|_| Image {
+                width: w,
+                height: h,
+                data: reference
+                    .data
+                    .iter()
+                    .map(|r| r.map(|v| v + bias + sigma * rng.normal()))
+                    .collect(),
+            })
             .collect();
         let d = ImageBiasVariance::from_runs(&runs, &reference, 0.999);
-        println!("image: bias2 {}, variance {}, mse {}", d.bias2, d.variance, d.mse);
+        println!(
+            "image: bias2 {}, variance {}, mse {}",
+            d.bias2, d.variance, d.mse
+        );
         assert!(d.bias2.contains(bias * bias) && d.bias2.lo > 0.0);
         assert!(d.variance.contains(sigma * sigma));
         assert!(d.mse.contains(bias * bias + sigma * sigma));

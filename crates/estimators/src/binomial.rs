@@ -31,20 +31,42 @@ impl BinomialTest {
 
 /// Tests `successes` out of `trials` against success probability `p`.
 pub fn binomial_test(successes: u64, trials: u64, p: f64) -> BinomialTest {
-    assert!(successes <= trials && trials > 0, "binomial_test: {successes} of {trials}");
+    assert!(
+        successes <= trials && trials > 0,
+        "binomial_test: {successes} of {trials}"
+    );
     assert!((0.0..=1.0).contains(&p), "binomial_test: p = {p}");
     let d = Binomial::new(p, trials).expect("valid binomial");
     let p_lower = d.cdf(successes);
-    let p_upper = if successes == 0 { 1.0 } else { d.sf(successes - 1) };
-    BinomialTest { successes, trials, p, p_lower, p_upper, p_value: (2.0 * p_lower.min(p_upper)).min(1.0) }
+    let p_upper = if successes == 0 {
+        1.0
+    } else {
+        d.sf(successes - 1)
+    };
+    BinomialTest {
+        successes,
+        trials,
+        p,
+        p_lower,
+        p_upper,
+        p_value: (2.0 * p_lower.min(p_upper)).min(1.0),
+    }
 }
 
 /// Clopper–Pearson (exact, conservative) interval for a proportion.
 pub fn clopper_pearson(successes: u64, trials: u64, confidence: f64) -> (f64, f64) {
     let a = (1.0 - confidence) / 2.0;
     let (k, n) = (successes as f64, trials as f64);
-    let lo = if successes == 0 { 0.0 } else { Beta::new(k, n - k + 1.0).unwrap().inverse_cdf(a) };
-    let hi = if successes == trials { 1.0 } else { Beta::new(k + 1.0, n - k).unwrap().inverse_cdf(1.0 - a) };
+    let lo = if successes == 0 {
+        0.0
+    } else {
+        Beta::new(k, n - k + 1.0).unwrap().inverse_cdf(a)
+    };
+    let hi = if successes == trials {
+        1.0
+    } else {
+        Beta::new(k + 1.0, n - k).unwrap().inverse_cdf(1.0 - a)
+    };
     (lo, hi)
 }
 
@@ -81,7 +103,10 @@ mod tests {
             let t = binomial_test(k, n, p);
             let lower: f64 = (0..=k).map(pmf).sum();
             let upper: f64 = (k..=n).map(pmf).sum();
-            assert!((t.p_lower - lower).abs() < 1e-12 && (t.p_upper - upper).abs() < 1e-12, "k={k}");
+            assert!(
+                (t.p_lower - lower).abs() < 1e-12 && (t.p_upper - upper).abs() < 1e-12,
+                "k={k}"
+            );
         }
         assert!(binomial_test(0, 100, 0.5).rejects(1e-20));
         assert!(!binomial_test(50, 100, 0.5).rejects(0.5));

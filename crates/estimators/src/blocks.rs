@@ -42,7 +42,12 @@ impl RunningBlocks {
     pub fn new(width: usize, height: usize, block: usize) -> Self {
         assert!(block > 0, "block size must be positive");
         let acc = RunningImage::new(width.div_ceil(block), height.div_ceil(block));
-        RunningBlocks { width, height, block, acc }
+        RunningBlocks {
+            width,
+            height,
+            block,
+            acc,
+        }
     }
 
     pub fn add(&mut self, pass: &Image) {
@@ -103,8 +108,15 @@ impl BlockEstimate {
     /// renderer). Assumes pixel errors are independent — true when each pixel is sampled on its
     /// own (path tracing), false for splatting estimators; for those use [`RunningBlocks`].
     pub fn from_pixel_estimates(mean: &Image, std_error: &Image, block: usize) -> BlockEstimate {
-        assert!(mean.same_size(std_error), "mean and standard-error images differ in size");
-        let var = Image { width: mean.width, height: mean.height, data: std_error.data.iter().map(|s| s.map(|v| v * v)).collect() };
+        assert!(
+            mean.same_size(std_error),
+            "mean and standard-error images differ in size"
+        );
+        let var = Image {
+            width: mean.width,
+            height: mean.height,
+            data: std_error.data.iter().map(|s| s.map(|v| v * v)).collect(),
+        };
         let (m, v) = (block_means(mean, block), block_means(&var, block));
         let std_error = (0..m.data.len())
             .map(|i| {
@@ -115,7 +127,12 @@ impl BlockEstimate {
                 v.data[i].map(|v| (v / (w * h) as f64).sqrt())
             })
             .collect();
-        BlockEstimate { blocks_x: m.width, blocks_y: m.height, mean: m.data, std_error }
+        BlockEstimate {
+            blocks_x: m.width,
+            blocks_y: m.height,
+            mean: m.data,
+            std_error,
+        }
     }
 }
 
@@ -144,7 +161,9 @@ mod tests {
         let mut rb = RunningBlocks::new(w, h, block);
         for _ in 0..n {
             let offs: Vec<f64> = (0..4).map(|_| rng.normal()).collect();
-            rb.add(&Image::from_fn(w, h, |x, y| [offs[(y / block) * 2 + x / block] + 10.0; 3]));
+            rb.add(&Image::from_fn(w, h, |x, y| {
+                [offs[(y / block) * 2 + x / block] + 10.0; 3]
+            }));
         }
         let e = rb.estimate();
         let expect = 1.0 / (n as f64).sqrt();
@@ -158,18 +177,34 @@ mod tests {
     #[test]
     fn blocks_merge_equals_sequential() {
         let mut rng = Rng::new(5);
-        let passes: Vec<Image> = (0..20).map(|_| Image::from_fn(7, 5, |_, _| [rng.normal(), rng.uniform(), rng.exp()])).collect();
-        let (mut all, mut a, mut b) = (RunningBlocks::new(7, 5, 3), RunningBlocks::new(7, 5, 3), RunningBlocks::new(7, 5, 3));
+        let passes: Vec<Image> = (0..20)
+            .map(|_| Image::from_fn(7, 5, |_, _| [rng.normal(), rng.uniform(), rng.exp()]))
+            .collect();
+        let (mut all, mut a, mut b) = (
+            RunningBlocks::new(7, 5, 3),
+            RunningBlocks::new(7, 5, 3),
+            RunningBlocks::new(7, 5, 3),
+        );
         for (i, p) in passes.iter().enumerate() {
             all.add(p);
-            if i % 3 == 0 { a.add(p) } else { b.add(p) }
+            if i % 3 == 0 {
+                a.add(p)
+            } else {
+                b.add(p)
+            }
         }
         a.merge(&b);
         let (x, y) = (a.estimate(), all.estimate());
         // Rounding bound as in running.rs: n·eps·|x|max for means, ·|d|max/(n-1) for variances.
         let n = passes.len() as f64;
-        let xmax = passes.iter().flat_map(|p| p.data.iter().flatten()).fold(0.0f64, |m, v| m.max(v.abs()));
-        let (tol_m, tol_v) = (8.0 * n * f64::EPSILON * xmax, 8.0 * n * f64::EPSILON * xmax * 2.0 * xmax / (n - 1.0));
+        let xmax = passes
+            .iter()
+            .flat_map(|p| p.data.iter().flatten())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let (tol_m, tol_v) = (
+            8.0 * n * f64::EPSILON * xmax,
+            8.0 * n * f64::EPSILON * xmax * 2.0 * xmax / (n - 1.0),
+        );
         for i in 0..x.mean.len() {
             for c in 0..3 {
                 assert!((x.mean[i][c] - y.mean[i][c]).abs() <= tol_m);

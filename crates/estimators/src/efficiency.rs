@@ -13,7 +13,11 @@ pub fn efficiency(mse: f64, seconds: f64) -> f64 {
 /// by time first. None when the curve never gets down to `target`, or was already below it at
 /// the first measurement (the crossing is not bracketed; see [`time_to_mse_extrapolated`]).
 pub fn time_to_mse(curve: &[(f64, f64)], target: f64) -> Option<f64> {
-    let mut pts: Vec<(f64, f64)> = curve.iter().copied().filter(|(t, m)| *t > 0.0 && *m > 0.0).collect();
+    let mut pts: Vec<(f64, f64)> = curve
+        .iter()
+        .copied()
+        .filter(|(t, m)| *t > 0.0 && *m > 0.0)
+        .collect();
     pts.sort_by(|a, b| a.0.total_cmp(&b.0));
     let first = pts.first()?;
     if first.1 == target {

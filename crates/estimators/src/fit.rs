@@ -35,11 +35,17 @@ impl LineFit {
 /// Ordinary least squares y = intercept + slope·x. Needs ≥ 3 points and distinct x.
 pub fn fit_line(xs: &[f64], ys: &[f64], confidence: f64) -> Result<LineFit, String> {
     if xs.len() != ys.len() {
-        return Err(format!("fit_line: {} x values but {} y values", xs.len(), ys.len()));
+        return Err(format!(
+            "fit_line: {} x values but {} y values",
+            xs.len(),
+            ys.len()
+        ));
     }
     let n = xs.len();
     if n < 3 {
-        return Err(format!("fit_line: need at least 3 points for a slope interval, got {n}"));
+        return Err(format!(
+            "fit_line: need at least 3 points for a slope interval, got {n}"
+        ));
     }
     if let Some(v) = xs.iter().chain(ys).find(|v| !v.is_finite()) {
         return Err(format!("fit_line: non-finite value {v}"));
@@ -57,7 +63,11 @@ pub fn fit_line(xs: &[f64], ys: &[f64], confidence: f64) -> Result<LineFit, Stri
     }
     let slope = sxy / sxx;
     let intercept = my - slope * mx;
-    let ssr: f64 = xs.iter().zip(ys).map(|(x, y)| (y - intercept - slope * x).powi(2)).sum();
+    let ssr: f64 = xs
+        .iter()
+        .zip(ys)
+        .map(|(x, y)| (y - intercept - slope * x).powi(2))
+        .sum();
     let residual_std = (ssr / (nf - 2.0)).sqrt();
     let se = residual_std / sxx.sqrt();
     let h = t_quantile(confidence, nf - 2.0) * se;
@@ -65,7 +75,11 @@ pub fn fit_line(xs: &[f64], ys: &[f64], confidence: f64) -> Result<LineFit, Stri
         slope,
         intercept,
         slope_std_error: se,
-        slope_ci: Interval { estimate: slope, lo: slope - h, hi: slope + h },
+        slope_ci: Interval {
+            estimate: slope,
+            lo: slope - h,
+            hi: slope + h,
+        },
         confidence,
         points: n,
         residual_std,
@@ -97,7 +111,10 @@ mod tests {
         let xs = [1.0, 2.0, 4.0, 8.0];
         let ys: Vec<f64> = xs.iter().map(|x: &f64| 3.0 * x.powf(-1.5)).collect();
         let f = fit_log_log(&xs, &ys, 0.95).unwrap();
-        assert!((f.slope + 1.5).abs() < 1e-12 && (f.power_law(16.0) - 3.0 * 16f64.powf(-1.5)).abs() < 1e-12);
+        assert!(
+            (f.slope + 1.5).abs() < 1e-12
+                && (f.power_law(16.0) - 3.0 * 16f64.powf(-1.5)).abs() < 1e-12
+        );
         assert!(f.slope_ci.half_width() < 1e-12);
         assert!(fit_log_log(&[1.0, 2.0, 0.0], &[1.0, 1.0, 1.0], 0.95).is_err());
         assert!(fit_line(&[1.0, 1.0, 1.0], &[1.0, 2.0, 3.0], 0.95).is_err());
@@ -111,7 +128,10 @@ mod tests {
         let xs: Vec<f64> = (0..6).map(|i| i as f64).collect();
         let hits = (0..trials)
             .filter(|_| {
-                let ys: Vec<f64> = xs.iter().map(|x| 1.0 - 0.7 * x + 0.3 * rng.normal()).collect();
+                let ys: Vec<f64> = xs
+                    .iter()
+                    .map(|x| 1.0 - 0.7 * x + 0.3 * rng.normal())
+                    .collect();
                 fit_line(&xs, &ys, conf).unwrap().slope_ci.contains(-0.7)
             })
             .count() as u64;
@@ -124,8 +144,13 @@ mod tests {
     fn variance_slope(rng: &mut Rng, est: impl Fn(&mut Rng, usize) -> f64) -> LineFit {
         let k = 400;
         let ns: Vec<f64> = (2..=10).map(|e| (1u32 << e) as f64).collect();
-        let vars: Vec<f64> =
-            ns.iter().map(|&n| RunningStat::from_slice(&(0..k).map(|_| est(rng, n as usize)).collect::<Vec<_>>()).sample_variance()).collect();
+        let vars: Vec<f64> = ns
+            .iter()
+            .map(|&n| {
+                RunningStat::from_slice(&(0..k).map(|_| est(rng, n as usize)).collect::<Vec<_>>())
+                    .sample_variance()
+            })
+            .collect();
         fit_log_log(&ns, &vars, 0.999).unwrap()
     }
 
@@ -134,8 +159,15 @@ mod tests {
     #[test]
     fn progressive_estimator_slopes() {
         let mut rng = Rng::new(99);
-        let plain = variance_slope(&mut rng, |r, n| (0..n).map(|_| 3.0 * r.uniform().powi(2)).sum::<f64>() / n as f64);
-        let jitter = variance_slope(&mut rng, |r, n| (0..n).map(|i| (i as f64 + r.uniform()) / n as f64).sum::<f64>() / n as f64);
+        let plain = variance_slope(&mut rng, |r, n| {
+            (0..n).map(|_| 3.0 * r.uniform().powi(2)).sum::<f64>() / n as f64
+        });
+        let jitter = variance_slope(&mut rng, |r, n| {
+            (0..n)
+                .map(|i| (i as f64 + r.uniform()) / n as f64)
+                .sum::<f64>()
+                / n as f64
+        });
         println!("plain MC variance slope {} (expect -1)", plain.slope_ci);
         println!("jittered variance slope {} (expect -3)", jitter.slope_ci);
         assert!(plain.slope_ci.contains(-1.0), "{}", plain.slope_ci);

@@ -10,17 +10,29 @@ pub struct Image {
 
 impl Image {
     pub fn new(width: usize, height: usize) -> Image {
-        Image { width, height, data: vec![[0.0; 3]; width * height] }
+        Image {
+            width,
+            height,
+            data: vec![[0.0; 3]; width * height],
+        }
     }
 
-    pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> [f64; 3]) -> Image {
+    pub fn from_fn(
+        width: usize,
+        height: usize,
+        mut f: impl FnMut(usize, usize) -> [f64; 3],
+    ) -> Image {
         let mut data = Vec::with_capacity(width * height);
         for y in 0..height {
             for x in 0..width {
                 data.push(f(x, y));
             }
         }
-        Image { width, height, data }
+        Image {
+            width,
+            height,
+            data,
+        }
     }
 
     #[inline]

@@ -15,7 +15,10 @@ pub mod running;
 #[cfg(test)]
 mod test_rng;
 
-pub use agreement::{agreement, agreement_t, agreement_with_reference, agreement_with_reference_t, sidak_threshold, Agreement};
+pub use agreement::{
+    agreement, agreement_t, agreement_with_reference, agreement_with_reference_t, sidak_threshold,
+    Agreement,
+};
 pub use bias_variance::{BiasVariance, ImageBiasVariance, Interval};
 pub use binomial::{binomial_test, BinomialTest};
 pub use blocks::{block_means, BlockEstimate, RunningBlocks};

@@ -76,10 +76,21 @@ pub fn image_metrics(img: &Image, reference: &Image) -> ImageMetrics {
         }
     }
     let n = img.data.len().max(1) as f64;
-    let channel = |s: [f64; 3], m: f64| ChannelMetrics { mse: s[0] / n, rel_mse: s[1] / n, rmse: (s[0] / n).sqrt(), mae: s[2] / n, max_abs: m };
+    let channel = |s: [f64; 3], m: f64| ChannelMetrics {
+        mse: s[0] / n,
+        rel_mse: s[1] / n,
+        rmse: (s[0] / n).sqrt(),
+        mae: s[2] / n,
+        max_abs: m,
+    };
     let channels = [0, 1, 2].map(|c| channel(sums[c], max[c]));
     let tot = [0, 1, 2].map(|k| (sums[0][k] + sums[1][k] + sums[2][k]) / 3.0);
-    ImageMetrics { channels, overall: channel(tot, max_all), max_at, nonfinite_pixels: nonfinite }
+    ImageMetrics {
+        channels,
+        overall: channel(tot, max_all),
+        max_at,
+        nonfinite_pixels: nonfinite,
+    }
 }
 
 #[cfg(test)]
@@ -89,8 +100,16 @@ mod tests {
     // A 2×1 image with hand-computed answers.
     #[test]
     fn hand_computed() {
-        let r = Image { width: 2, height: 1, data: vec![[1.0, 0.0, 2.0], [0.0, 0.0, 2.0]] };
-        let v = Image { width: 2, height: 1, data: vec![[1.5, 0.0, 2.0], [-1.0, 0.0, 5.0]] };
+        let r = Image {
+            width: 2,
+            height: 1,
+            data: vec![[1.0, 0.0, 2.0], [0.0, 0.0, 2.0]],
+        };
+        let v = Image {
+            width: 2,
+            height: 1,
+            data: vec![[1.5, 0.0, 2.0], [-1.0, 0.0, 5.0]],
+        };
         let m = image_metrics(&v, &r);
         let red = m.channels[0];
         assert_eq!(red.mse, (0.25 + 1.0) / 2.0);
@@ -113,7 +132,9 @@ mod tests {
         v.data[1][2] = f64::NAN;
         let m = image_metrics(&v, &r);
         assert_eq!(m.nonfinite_pixels, 1);
-        assert!(m.overall.mse.is_nan() && m.overall.max_abs.is_nan() && m.channels[2].max_abs.is_nan());
+        assert!(
+            m.overall.mse.is_nan() && m.overall.max_abs.is_nan() && m.channels[2].max_abs.is_nan()
+        );
         assert_eq!(m.max_at, (1, 0, 2));
     }
 }

@@ -84,7 +84,13 @@ pub struct RunningImage {
 impl RunningImage {
     pub fn new(width: usize, height: usize) -> Self {
         let z = vec![[0.0; 3]; width * height];
-        RunningImage { width, height, n: 0, mean: z.clone(), m2: z }
+        RunningImage {
+            width,
+            height,
+            n: 0,
+            mean: z.clone(),
+            m2: z,
+        }
     }
 
     pub fn add(&mut self, pass: &Image) {
@@ -119,8 +125,14 @@ impl RunningImage {
         let n = self.n;
         for i in 0..self.mean.len() {
             for c in 0..3 {
-                let (_, m, m2) =
-                    chan(n, self.mean[i][c], self.m2[i][c], other.n, other.mean[i][c], other.m2[i][c]);
+                let (_, m, m2) = chan(
+                    n,
+                    self.mean[i][c],
+                    self.m2[i][c],
+                    other.n,
+                    other.mean[i][c],
+                    other.m2[i][c],
+                );
                 self.mean[i][c] = m;
                 self.m2[i][c] = m2;
             }
@@ -141,24 +153,44 @@ impl RunningImage {
     }
 
     pub fn mean(&self) -> Image {
-        Image { width: self.width, height: self.height, data: self.mean.clone() }
+        Image {
+            width: self.width,
+            height: self.height,
+            data: self.mean.clone(),
+        }
     }
 
     /// Unbiased per-pixel variance of one pass; NaN below two passes.
     pub fn sample_variance(&self) -> Image {
-        let k = if self.n < 2 { f64::NAN } else { 1.0 / (self.n - 1) as f64 };
+        let k = if self.n < 2 {
+            f64::NAN
+        } else {
+            1.0 / (self.n - 1) as f64
+        };
         self.map_m2(|m2| m2 * k)
     }
 
     /// Per-pixel standard error of the mean, sqrt(sample_variance / count).
     pub fn std_error(&self) -> Image {
-        let k = if self.n < 2 { f64::NAN } else { 1.0 / ((self.n - 1) as f64 * self.n as f64) };
+        let k = if self.n < 2 {
+            f64::NAN
+        } else {
+            1.0 / ((self.n - 1) as f64 * self.n as f64)
+        };
         self.map_m2(|m2| (m2 * k).sqrt())
     }
 
     fn map_m2(&self, f: impl Fn(f64) -> f64) -> Image {
-        let data = self.m2.iter().map(|m| [f(m[0]), f(m[1]), f(m[2])]).collect();
-        Image { width: self.width, height: self.height, data }
+        let data = self
+            .m2
+            .iter()
+            .map(|m| [f(m[0]), f(m[1]), f(m[2])])
+            .collect();
+        Image {
+            width: self.width,
+            height: self.height,
+            data,
+        }
     }
 }
 
@@ -177,7 +209,10 @@ mod tests {
     // Two-pass textbook variance, the reference Welford must reproduce.
     fn two_pass(xs: &[f64]) -> (f64, f64) {
         let m = xs.iter().sum::<f64>() / xs.len() as f64;
-        (m, xs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (xs.len() - 1) as f64)
+        (
+            m,
+            xs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (xs.len() - 1) as f64,
+        )
     }
 
     #[test]
@@ -191,9 +226,17 @@ mod tests {
         let n = xs.len() as f64;
         let xmax = xs.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let dmax = xs.iter().fold(0.0f64, |a, x| a.max((x - m).abs()));
-        assert!((s.mean() - m).abs() <= 4.0 * n * f64::EPSILON * xmax, "{} vs {m}", s.mean());
+        assert!(
+            (s.mean() - m).abs() <= 4.0 * n * f64::EPSILON * xmax,
+            "{} vs {m}",
+            s.mean()
+        );
         let tol_v = 4.0 * n * f64::EPSILON * xmax * dmax / (n - 1.0);
-        assert!((s.sample_variance() - v).abs() <= tol_v, "{} vs {v}", s.sample_variance());
+        assert!(
+            (s.sample_variance() - v).abs() <= tol_v,
+            "{} vs {v}",
+            s.sample_variance()
+        );
         // And it is not vacuous: the bound is far below the variance itself.
         assert!(tol_v < 1e-3 * v);
     }
@@ -205,9 +248,20 @@ mod tests {
         let mut seq = RunningImage::new(4, 3);
         passes.iter().for_each(|p| seq.add(p));
         // Uneven split into three parts, including merging into and from an empty accumulator.
-        let mut parts = [RunningImage::new(4, 3), RunningImage::new(4, 3), RunningImage::new(4, 3)];
+        let mut parts = [
+            RunningImage::new(4, 3),
+            RunningImage::new(4, 3),
+            RunningImage::new(4, 3),
+        ];
         for (i, p) in passes.iter().enumerate() {
-            parts[if i < 5 { 0 } else if i < 30 { 1 } else { 2 }].add(p);
+            parts[if i < 5 {
+                0
+            } else if i < 30 {
+                1
+            } else {
+                2
+            }]
+            .add(p);
         }
         let mut merged = RunningImage::new(4, 3);
         for p in &parts {
@@ -223,11 +277,18 @@ mod tests {
                 // Same rounding bound as welford_matches_two_pass, doubled: both sides err.
                 let xs: Vec<f64> = passes.iter().map(|p| p.data[i][c]).collect();
                 let xmax = xs.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-                let dmax = xs.iter().fold(0.0f64, |m, x| m.max((x - mb.data[i][c]).abs()));
+                let dmax = xs
+                    .iter()
+                    .fold(0.0f64, |m, x| m.max((x - mb.data[i][c]).abs()));
                 let tol_m = 8.0 * n * f64::EPSILON * xmax;
                 let tol_v = 8.0 * n * f64::EPSILON * xmax * dmax / (n - 1.0);
                 assert!((ma.data[i][c] - mb.data[i][c]).abs() <= tol_m);
-                assert!((a.data[i][c] - b.data[i][c]).abs() <= tol_v, "{} vs {}", a.data[i][c], b.data[i][c]);
+                assert!(
+                    (a.data[i][c] - b.data[i][c]).abs() <= tol_v,
+                    "{} vs {}",
+                    a.data[i][c],
+                    b.data[i][c]
+                );
             }
         }
     }
@@ -248,7 +309,11 @@ mod tests {
     fn std_error_is_sqrt_var_over_n() {
         let mut r = RunningImage::new(1, 1);
         for v in [1.0, 2.0, 4.0] {
-            r.add(&Image { width: 1, height: 1, data: vec![[v, 0.0, -v]] });
+            r.add(&Image {
+                width: 1,
+                height: 1,
+                data: vec![[v, 0.0, -v]],
+            });
         }
         // Hand-computed: mean 7/3, s² = 7/3.
         let v = r.sample_variance().data[0];

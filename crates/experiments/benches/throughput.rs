@@ -8,7 +8,9 @@ use lt_integrators::{make_integrator, IntegratorParams};
 use std::path::Path;
 
 fn scene(name: &str) -> lt_core::Scene {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(format!("{name}.toml"));
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(format!("{name}.toml"));
     load_scene(&p).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -18,7 +20,9 @@ fn traversal(c: &mut Criterion) {
         let s = scene(name);
         let rays = incoherent_rays(&s, 100_000, 1);
         g.throughput(Throughput::Elements(rays.len() as u64));
-        g.bench_function(name, |b| b.iter(|| rays.iter().filter(|r| s.intersect(r).is_some()).count()));
+        g.bench_function(name, |b| {
+            b.iter(|| rays.iter().filter(|r| s.intersect(r).is_some()).count())
+        });
     }
     g.finish();
 }

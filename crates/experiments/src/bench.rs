@@ -60,9 +60,25 @@ pub struct IntegratorRate {
 }
 
 /// Runs `passes` passes of `integrator` on `threads` threads and counts the rays they trace.
-pub fn integrator_rate(scene: &Scene, integrator: &str, max_depth: Option<u32>, passes: u32, threads: usize) -> Result<IntegratorRate, String> {
-    let integ = make_integrator(integrator, scene, &IntegratorParams { max_depth, rr_depth: None })?;
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
+pub fn integrator_rate(
+    scene: &Scene,
+    integrator: &str,
+    max_depth: Option<u32>,
+    passes: u32,
+    threads: usize,
+) -> Result<IntegratorRate, String> {
+    let integ = make_integrator(
+        integrator,
+        scene,
+        &IntegratorParams {
+            max_depth,
+            rr_depth: None,
+        },
+    )?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?;
     pool.broadcast(|_| lt_core::scene::ray_stats::take());
     let start = Instant::now();
     for pass in 0..passes {
@@ -70,7 +86,9 @@ pub fn integrator_rate(scene: &Scene, integrator: &str, max_depth: Option<u32>, 
     }
     let secs = start.elapsed().as_secs_f64();
     let counts = pool.broadcast(|_| lt_core::scene::ray_stats::take());
-    let (closest, shadow) = counts.iter().fold((0u64, 0u64), |a, c| (a.0 + c.0, a.1 + c.1));
+    let (closest, shadow) = counts
+        .iter()
+        .fold((0u64, 0u64), |a, c| (a.0 + c.0, a.1 + c.1));
     let samples = passes as f64 * scene.camera.pixel_count() as f64;
     Ok(IntegratorRate {
         spp_per_second: passes as f64 / secs,

@@ -1,6 +1,8 @@
 //! `lt bench`: raw traversal and integrator throughput as a Markdown table (results/bench.md).
 
-use crate::bench::{closest_hit_rate, incoherent_rays, integrator_rate, peak_memory_mib, shadow_rate};
+use crate::bench::{
+    closest_hit_rate, incoherent_rays, integrator_rate, peak_memory_mib, shadow_rate,
+};
 use clap::Args;
 use lt_core::scene::load_scene;
 use std::fmt::Write;
@@ -28,11 +30,25 @@ pub struct BenchArgs {
 }
 
 pub fn run(args: &BenchArgs) -> Result<String, String> {
-    let threads = if args.threads == 0 { std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1) } else { args.threads };
+    let threads = if args.threads == 0 {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    } else {
+        args.threads
+    };
     let mut out = String::new();
     let cmd: Vec<String> = std::env::args().collect();
     writeln!(out, "Command: `{}`  ", cmd.join(" ")).unwrap();
-    writeln!(out, "Machine: {} hardware threads; integrators on {threads} thread(s), max depth {}.\n", std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1), args.max_depth).unwrap();
+    writeln!(
+        out,
+        "Machine: {} hardware threads; integrators on {threads} thread(s), max depth {}.\n",
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1),
+        args.max_depth
+    )
+    .unwrap();
     writeln!(out, "| scene | primitives | closest hit Mrays/s (1 thread) | hit fraction | shadow Mrays/s (1 thread) |").unwrap();
     writeln!(out, "|---|---:|---:|---:|---:|").unwrap();
     let mut scenes = Vec::new();
@@ -41,8 +57,20 @@ pub fn run(args: &BenchArgs) -> Result<String, String> {
         let rays = incoherent_rays(&scene, 200_000, 1);
         let (rate, hit) = closest_hit_rate(&scene, &rays, 5);
         let shadow = shadow_rate(&scene, &rays, 5);
-        let name = path.file_stem().unwrap_or_default().to_string_lossy().to_string();
-        writeln!(out, "| {name} | {} | {:.2} | {:.2} | {:.2} |", scene.primitive_count(), rate / 1e6, hit, shadow / 1e6).unwrap();
+        let name = path
+            .file_stem()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
+        writeln!(
+            out,
+            "| {name} | {} | {:.2} | {:.2} | {:.2} |",
+            scene.primitive_count(),
+            rate / 1e6,
+            hit,
+            shadow / 1e6
+        )
+        .unwrap();
         scenes.push((name, scene, rate));
     }
     writeln!(out, "\n| scene | integrator | resolution | spp/s | Msamples/s | Mrays/s (all threads) | rays/s per thread vs raw closest hit | closest + shadow rays per sample |").unwrap();

@@ -8,15 +8,24 @@ use std::path::{Path, PathBuf};
 
 /// A temporary path next to `path` (same directory, so the final rename stays atomic).
 fn temp_sibling(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
     path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
 }
 
 /// Runs `write` on a temporary sibling of `path`, then renames it over `path`. On error the
 /// temporary file is removed and `path` is left untouched.
-pub fn write_atomic_with(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), String> {
     let tmp = temp_sibling(path);
-    let result = write(&tmp).and_then(|()| fs::rename(&tmp, path).map_err(|e| format!("cannot move {} to {}: {e}", tmp.display(), path.display())));
+    let result = write(&tmp).and_then(|()| {
+        fs::rename(&tmp, path)
+            .map_err(|e| format!("cannot move {} to {}: {e}", tmp.display(), path.display()))
+    });
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
     }
@@ -26,8 +35,11 @@ pub fn write_atomic_with(path: &Path, write: impl FnOnce(&Path) -> Result<(), St
 /// Writes `bytes` to `path` atomically (temp file in the same directory, synced, renamed).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
     write_atomic_with(path, |tmp| {
-        let mut f = fs::File::create(tmp).map_err(|e| format!("cannot create {}: {e}", tmp.display()))?;
-        f.write_all(bytes).and_then(|()| f.sync_all()).map_err(|e| format!("cannot write {}: {e}", tmp.display()))
+        let mut f =
+            fs::File::create(tmp).map_err(|e| format!("cannot create {}: {e}", tmp.display()))?;
+        f.write_all(bytes)
+            .and_then(|()| f.sync_all())
+            .map_err(|e| format!("cannot write {}: {e}", tmp.display()))
     })
 }
 
@@ -36,7 +48,12 @@ pub fn read_exr_with_alpha(path: &Path) -> Result<(Image, bool), String> {
     use exr::prelude::read_first_rgba_layer_from_file;
     let img = read_first_rgba_layer_from_file(
         path,
-        |size, channels| (Image::new(size.width(), size.height()), channels.3.is_some()),
+        |size, channels| {
+            (
+                Image::new(size.width(), size.height()),
+                channels.3.is_some(),
+            )
+        },
         |(img, _): &mut (Image, bool), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
             let w = img.width;
             img.data[pos.y() * w + pos.x()] = [r as f64, g as f64, b as f64];
@@ -60,10 +77,14 @@ pub fn write_exr(path: &Path, img: &Image) -> Result<(), String> {
             let p = img.get(x, y);
             (p[0] as f32, p[1] as f32, p[2] as f32)
         });
-        exr::image::Image::from_encoded_channels((img.width, img.height), Encoding::SMALL_LOSSLESS, channels)
-            .write()
-            .to_file(tmp)
-            .map_err(|e| format!("cannot write EXR {}: {e}", path.display()))
+        exr::image::Image::from_encoded_channels(
+            (img.width, img.height),
+            Encoding::SMALL_LOSSLESS,
+            channels,
+        )
+        .write()
+        .to_file(tmp)
+        .map_err(|e| format!("cannot write EXR {}: {e}", path.display()))
     })
 }
 
@@ -80,16 +101,28 @@ pub fn srgb_encode(v: f64) -> f64 {
 /// Writes an 8-bit sRGB PNG preview (clamped, no tone mapping), atomically.
 pub fn write_png_preview(path: &Path, img: &Image) -> Result<(), String> {
     check_size(path, img)?;
-    let bytes: Vec<u8> = img.data.iter().flat_map(|p| p.map(|v| (srgb_encode(v) * 255.0).round() as u8)).collect();
-    let buf = image::RgbImage::from_raw(img.width as u32, img.height as u32, bytes).expect("buffer matches size");
+    let bytes: Vec<u8> = img
+        .data
+        .iter()
+        .flat_map(|p| p.map(|v| (srgb_encode(v) * 255.0).round() as u8))
+        .collect();
+    let buf = image::RgbImage::from_raw(img.width as u32, img.height as u32, bytes)
+        .expect("buffer matches size");
     write_atomic_with(path, |tmp| {
-        buf.save_with_format(tmp, image::ImageFormat::Png).map_err(|e| format!("cannot write PNG {}: {e}", path.display()))
+        buf.save_with_format(tmp, image::ImageFormat::Png)
+            .map_err(|e| format!("cannot write PNG {}: {e}", path.display()))
     })
 }
 
 fn check_size(path: &Path, img: &Image) -> Result<(), String> {
     if img.width == 0 || img.height == 0 || img.data.len() != img.width * img.height {
-        return Err(format!("cannot write {}: image is {}x{} with {} pixels", path.display(), img.width, img.height, img.data.len()));
+        return Err(format!(
+            "cannot write {}: image is {}x{} with {} pixels",
+            path.display(),
+            img.width,
+            img.height,
+            img.data.len()
+        ));
     }
     Ok(())
 }
@@ -106,7 +139,9 @@ mod tests {
 
     #[test]
     fn exr_round_trip_is_f32_exact() {
-        let img = Image::from_fn(5, 3, |x, y| [x as f64 * 0.1, y as f64 / 3.0, 1e-7 + x as f64 * 1e5]);
+        let img = Image::from_fn(5, 3, |x, y| {
+            [x as f64 * 0.1, y as f64 / 3.0, 1e-7 + x as f64 * 1e5]
+        });
         let path = scratch("rt.exr");
         write_exr(&path, &img).unwrap();
         let back = read_exr(&path).unwrap();
@@ -115,7 +150,11 @@ mod tests {
             assert_eq!(a.map(|v| v as f32 as f64), *b);
         }
         // No temporary file left behind.
-        let left: Vec<_> = fs::read_dir(path.parent().unwrap()).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains(".tmp-")).collect();
+        let left: Vec<_> = fs::read_dir(path.parent().unwrap())
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().starts_with(".rt.exr.tmp-"))
+            .collect();
         assert!(left.is_empty());
     }
 
@@ -123,7 +162,15 @@ mod tests {
     fn reads_half_rgba() {
         use exr::prelude::*;
         let path = scratch("half.exr");
-        write_rgba_file(&path, 4, 2, |x, y| (f16::from_f32(x as f32 * 0.5), f16::from_f32(y as f32), f16::from_f32(0.25), f16::from_f32(1.0))).unwrap();
+        write_rgba_file(&path, 4, 2, |x, y| {
+            (
+                f16::from_f32(x as f32 * 0.5),
+                f16::from_f32(y as f32),
+                f16::from_f32(0.25),
+                f16::from_f32(1.0),
+            )
+        })
+        .unwrap();
         let (img, alpha) = read_exr_with_alpha(&path).unwrap();
         assert!(alpha);
         assert_eq!(img.get(3, 1), [1.5, 1.0, 0.25]);
@@ -142,7 +189,11 @@ mod tests {
         assert!((srgb_encode(0.5) - 0.7353569830524495).abs() < 1e-12);
         assert!((srgb_encode(7.0) - 1.0).abs() <= f64::EPSILON); // clamped to 1 (1.055 − 0.055 rounds)
         let path = scratch("p.png");
-        write_png_preview(&path, &Image::from_fn(2, 1, |x, _| [x as f64 * 0.5, f64::NAN, 2.0])).unwrap();
+        write_png_preview(
+            &path,
+            &Image::from_fn(2, 1, |x, _| [x as f64 * 0.5, f64::NAN, 2.0]),
+        )
+        .unwrap();
         let back = image::open(&path).unwrap().to_rgb8();
         assert_eq!(back.get_pixel(1, 0).0, [188, 0, 255]);
     }

@@ -46,7 +46,10 @@ pub struct RenderArgs {
 
 /// Paths of everything written beside the main EXR.
 pub fn sibling(out: &Path, suffix: &str) -> PathBuf {
-    let stem = out.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
     out.with_file_name(format!("{stem}{suffix}"))
 }
 
@@ -59,7 +62,10 @@ fn write_outputs(out: &Path, acc: &lt_estimators::running::RunningImage) -> Resu
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
     let scene = load_scene(&args.scene).map_err(|e| e.to_string())?;
-    let params = IntegratorParams { max_depth: args.max_depth, rr_depth: None };
+    let params = IntegratorParams {
+        max_depth: args.max_depth,
+        rr_depth: None,
+    };
     let integrator = make_integrator(&args.integrator, &scene, &params)?;
     if args.time.is_some_and(|t| !(t > 0.0 && t.is_finite())) {
         return Err("--time must be a positive number of seconds".into());
@@ -72,7 +78,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if passes == 0 {
         return Err("--spp must be at least 1".into());
     }
-    let opts = RenderOptions { passes, time_limit: args.time.map(Duration::from_secs_f64), seed: args.seed, threads: args.threads };
+    let opts = RenderOptions {
+        passes,
+        time_limit: args.time.map(Duration::from_secs_f64),
+        seed: args.seed,
+        threads: args.threads,
+    };
 
     let interrupted = Arc::new(AtomicBool::new(false));
     {
@@ -119,7 +130,10 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         "invalid_samples": result.invalid_samples,
         "interrupted": interrupted.load(Ordering::SeqCst),
     });
-    crate::image_io::write_atomic(&sibling(&args.output, ".json"), serde_json::to_string_pretty(&record).unwrap().as_bytes())?;
+    crate::image_io::write_atomic(
+        &sibling(&args.output, ".json"),
+        serde_json::to_string_pretty(&record).unwrap().as_bytes(),
+    )?;
     if !args.quiet {
         eprintln!(
             "{}: {} spp in {:.2} s ({:.2} spp/s) -> {}",
@@ -130,7 +144,10 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             args.output.display()
         );
         if result.invalid_samples > 0 {
-            eprintln!("warning: {} invalid (NaN/Inf/negative) samples were dropped", result.invalid_samples);
+            eprintln!(
+                "warning: {} invalid (NaN/Inf/negative) samples were dropped",
+                result.invalid_samples
+            );
         }
     }
     Ok(())
@@ -140,7 +157,16 @@ fn progress_bar(args: &RenderArgs, passes: u32) -> ProgressBar {
     if args.quiet {
         return ProgressBar::hidden();
     }
-    let bar = if passes == u32::MAX { ProgressBar::new_spinner() } else { ProgressBar::new(passes as u64) };
-    bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} passes  {msg}  ETA {eta}").unwrap());
+    let bar = if passes == u32::MAX {
+        ProgressBar::new_spinner()
+    } else {
+        ProgressBar::new(passes as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} passes  {msg}  ETA {eta}",
+        )
+        .unwrap(),
+    );
     bar
 }

@@ -9,7 +9,12 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Runs `estimate(sampler, raster)` once per pixel with a box-filtered raster position and the
 /// pixel's (seed, pixel, pass) stream. Invalid estimates are replaced by zero and counted.
-pub fn pixel_pass(scene: &Scene, seed: u64, pass: u32, estimate: impl Fn(&mut Sampler, Vec2) -> Color + Sync) -> (Image, u64) {
+pub fn pixel_pass(
+    scene: &Scene,
+    seed: u64,
+    pass: u32,
+    estimate: impl Fn(&mut Sampler, Vec2) -> Color + Sync,
+) -> (Image, u64) {
     let w = scene.camera.width as usize;
     let h = scene.camera.height as usize;
     let mut img = Image::new(w, h);

@@ -33,7 +33,12 @@ pub struct Pt {
 
 /// Russian roulette: continue with probability min(max βᵢ, 0.95) and reweight. Returns false to stop.
 #[inline]
-pub(crate) fn russian_roulette(beta: &mut Color, depth: u32, rr_depth: u32, sampler: &mut Sampler) -> bool {
+pub(crate) fn russian_roulette(
+    beta: &mut Color,
+    depth: u32,
+    rr_depth: u32,
+    sampler: &mut Sampler,
+) -> bool {
     if depth < rr_depth {
         return true;
     }
@@ -47,7 +52,11 @@ pub(crate) fn russian_roulette(beta: &mut Color, depth: u32, rr_depth: u32, samp
 
 /// Radiance from every light at infinity along a ray leaving the scene, each weighted by `weight`.
 #[inline]
-pub(crate) fn escaped_radiance(scene: &Scene, dir: lt_core::Vec3, weight: impl Fn(u32) -> f32) -> Color {
+pub(crate) fn escaped_radiance(
+    scene: &Scene,
+    dir: lt_core::Vec3,
+    weight: impl Fn(u32) -> f32,
+) -> Color {
     let mut l = Color::ZERO;
     for &i in &scene.infinite_lights {
         let le = scene.lights[i as usize].escaped(dir);
@@ -60,7 +69,13 @@ pub(crate) fn escaped_radiance(scene: &Scene, dir: lt_core::Vec3, weight: impl F
 
 impl Pt {
     /// Next-event estimation at `hit`: one light chosen by power, MIS-weighted against the BSDF.
-    fn direct_light(&self, scene: &Scene, hit: &SurfaceHit, wo: lt_core::Vec3, sampler: &mut Sampler) -> Color {
+    fn direct_light(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        wo: lt_core::Vec3,
+        sampler: &mut Sampler,
+    ) -> Color {
         let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
             return Color::ZERO;
         };
@@ -77,12 +92,20 @@ impl Pt {
         if ev.f_cos == Color::ZERO {
             return Color::ZERO;
         }
-        let unoccluded = if ls.distance.is_finite() { scene.visible(hit, ls.p) } else { scene.unoccluded_towards(hit, ls.wi) };
+        let unoccluded = if ls.distance.is_finite() {
+            scene.visible(hit, ls.p)
+        } else {
+            scene.unoccluded_towards(hit, ls.wi)
+        };
         if !unoccluded {
             return Color::ZERO;
         }
         let light_pdf = pmf * ls.pdf_w;
-        let w = if ls.delta { 1.0 } else { power_heuristic(light_pdf, ev.pdf_w) };
+        let w = if ls.delta {
+            1.0
+        } else {
+            power_heuristic(light_pdf, ev.pdf_w)
+        };
         ev.f_cos * ls.radiance * (w / light_pdf)
     }
 
@@ -102,7 +125,8 @@ impl Pt {
                         if prev_delta {
                             1.0
                         } else {
-                            let light_pdf = scene.light_sampler.pmf(i as usize) * scene.lights[i as usize].pdf_li(prev_p, ray.d, ray.d, -ray.d);
+                            let light_pdf = scene.light_sampler.pmf(i as usize)
+                                * scene.lights[i as usize].pdf_li(prev_p, ray.d, ray.d, -ray.d);
                             power_heuristic(prev_pdf_w, light_pdf)
                         }
                     });
@@ -116,7 +140,8 @@ impl Pt {
                     let w = if prev_delta {
                         1.0
                     } else {
-                        let light_pdf = scene.light_sampler.pmf(li as usize) * light.pdf_li(prev_p, ray.d, hit.p, hit.ng);
+                        let light_pdf = scene.light_sampler.pmf(li as usize)
+                            * light.pdf_li(prev_p, ray.d, hit.p, hit.ng);
                         power_heuristic(prev_pdf_w, light_pdf)
                     };
                     l += beta * le * w;
@@ -131,11 +156,15 @@ impl Pt {
             }
             let u_lobe = sampler.next_f32();
             let u = sampler.next_2d();
-            let Some(bs) = material.sample(&hit.shading_frame(), wo, u_lobe, u, TransportMode::Radiance) else {
+            let Some(bs) =
+                material.sample(&hit.shading_frame(), wo, u_lobe, u, TransportMode::Radiance)
+            else {
                 break;
             };
             beta *= bs.weight;
-            if beta == Color::ZERO || !russian_roulette(&mut beta, depth, self.params.rr_depth, sampler) {
+            if beta == Color::ZERO
+                || !russian_roulette(&mut beta, depth, self.params.rr_depth, sampler)
+            {
                 break;
             }
             prev_pdf_w = bs.pdf_w;
@@ -153,6 +182,8 @@ impl Integrator for Pt {
     }
 
     fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
-        pixel_pass(scene, seed, pass, |s, raster| self.radiance(scene, raster, s))
+        pixel_pass(scene, seed, pass, |s, raster| {
+            self.radiance(scene, raster, s)
+        })
     }
 }

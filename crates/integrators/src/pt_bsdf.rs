@@ -40,11 +40,19 @@ impl PtBsdf {
             }
             let u_lobe = sampler.next_f32();
             let u = sampler.next_2d();
-            let Some(bs) = scene.material(hit.material).sample(&hit.shading_frame(), wo, u_lobe, u, TransportMode::Radiance) else {
+            let Some(bs) = scene.material(hit.material).sample(
+                &hit.shading_frame(),
+                wo,
+                u_lobe,
+                u,
+                TransportMode::Radiance,
+            ) else {
                 break;
             };
             beta *= bs.weight;
-            if beta == Color::ZERO || !russian_roulette(&mut beta, depth, self.params.rr_depth, sampler) {
+            if beta == Color::ZERO
+                || !russian_roulette(&mut beta, depth, self.params.rr_depth, sampler)
+            {
                 break;
             }
             ray = hit.spawn_ray(bs.wi);
@@ -59,6 +67,8 @@ impl Integrator for PtBsdf {
     }
 
     fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
-        pixel_pass(scene, seed, pass, |s, raster| self.radiance(scene, raster, s))
+        pixel_pass(scene, seed, pass, |s, raster| {
+            self.radiance(scene, raster, s)
+        })
     }
 }

@@ -42,7 +42,10 @@ pub fn render(
     opts: &RenderOptions,
     mut on_pass: impl FnMut(&PassReport) -> ControlFlow<()>,
 ) -> Result<RenderResult, String> {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(opts.threads).build().map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads)
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let mut acc = RunningImage::new(w, h);
     let mut invalid = 0;
@@ -54,12 +57,24 @@ pub fn render(
         invalid += bad;
         pass += 1;
         let elapsed = start.elapsed();
-        if on_pass(&PassReport { passes_done: pass, pass_image: &img, elapsed, accumulated: &acc }).is_break() {
+        if on_pass(&PassReport {
+            passes_done: pass,
+            pass_image: &img,
+            elapsed,
+            accumulated: &acc,
+        })
+        .is_break()
+        {
             break;
         }
         if opts.time_limit.is_some_and(|t| elapsed >= t) {
             break;
         }
     }
-    Ok(RenderResult { image: acc, passes: pass, elapsed: start.elapsed(), invalid_samples: invalid })
+    Ok(RenderResult {
+        image: acc,
+        passes: pass,
+        elapsed: start.elapsed(),
+        invalid_samples: invalid,
+    })
 }

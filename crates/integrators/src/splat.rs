@@ -32,12 +32,24 @@ impl Splats {
 
 /// Runs `work(item, splats)` for items 0..count in chunks of `chunk` and returns the summed image
 /// (each splat added once, scaled by `scale`) with the count of invalid splats.
-pub fn splat_pass(width: usize, height: usize, count: u64, chunk: u64, scale: f64, work: impl Fn(u64, &mut Splats) + Sync) -> (Image, u64) {
+pub fn splat_pass(
+    width: usize,
+    height: usize,
+    count: u64,
+    chunk: u64,
+    scale: f64,
+    work: impl Fn(u64, &mut Splats) + Sync,
+) -> (Image, u64) {
     let chunks = count.div_ceil(chunk.max(1));
     let recorded: Vec<Splats> = (0..chunks)
         .into_par_iter()
         .map(|c| {
-            let mut s = Splats { entries: Vec::new(), invalid: 0, width: width as u32, height: height as u32 };
+            let mut s = Splats {
+                entries: Vec::new(),
+                invalid: 0,
+                width: width as u32,
+                height: height as u32,
+            };
             for item in c * chunk..((c + 1) * chunk).min(count) {
                 work(item, &mut s);
             }
@@ -64,7 +76,10 @@ mod tests {
     use lt_core::sampling::Sampler;
 
     fn run(threads: usize) -> Image {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             splat_pass(16, 8, 10_000, 64, 1e-3, |i, sp| {
                 let mut s = Sampler::new(3, i, 0);
@@ -82,7 +97,11 @@ mod tests {
         let a = run(1);
         let b = run(2);
         let c = run(4);
-        assert!(a.data.iter().zip(&b.data).all(|(x, y)| x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())));
+        assert!(a
+            .data
+            .iter()
+            .zip(&b.data)
+            .all(|(x, y)| x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())));
         assert_eq!(b, c);
         assert!(a.data.iter().all(|p| p[0] > 0.0));
     }

@@ -19,7 +19,13 @@ impl LocalBsdf for Diffuse {
         if pdf_w == 0.0 {
             return None;
         }
-        Some(LocalSample { wi, weight: self.albedo, pdf_w, pdf_rev_w: cosine_hemisphere_pdf(wo.z.abs()), delta: false })
+        Some(LocalSample {
+            wi,
+            weight: self.albedo,
+            pdf_w,
+            pdf_rev_w: cosine_hemisphere_pdf(wo.z.abs()),
+            delta: false,
+        })
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> Color {

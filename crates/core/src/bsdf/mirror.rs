@@ -9,9 +9,21 @@ pub struct Mirror {
 }
 
 impl LocalBsdf for Mirror {
-    fn sample(&self, wo: Vec3, _u_lobe: f32, _u: Vec2, _mode: TransportMode) -> Option<LocalSample> {
+    fn sample(
+        &self,
+        wo: Vec3,
+        _u_lobe: f32,
+        _u: Vec2,
+        _mode: TransportMode,
+    ) -> Option<LocalSample> {
         let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-        Some(LocalSample { wi, weight: self.reflectance, pdf_w: 1.0, pdf_rev_w: 1.0, delta: true })
+        Some(LocalSample {
+            wi,
+            weight: self.reflectance,
+            pdf_w: 1.0,
+            pdf_rev_w: 1.0,
+            delta: true,
+        })
     }
     fn eval(&self, _wo: Vec3, _wi: Vec3, _mode: TransportMode) -> Color {
         Color::ZERO

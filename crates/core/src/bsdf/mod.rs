@@ -43,7 +43,10 @@ pub struct ShadingFrame {
 
 impl ShadingFrame {
     pub fn new(ng: Vec3, ns: Vec3) -> ShadingFrame {
-        ShadingFrame { ng, frame: Frame::from_z(ns) }
+        ShadingFrame {
+            ng,
+            frame: Frame::from_z(ns),
+        }
     }
     #[inline]
     pub fn ns(&self) -> Vec3 {
@@ -116,7 +119,14 @@ impl Material {
         self.local().is_delta()
     }
 
-    pub fn sample(&self, sf: &ShadingFrame, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
+    pub fn sample(
+        &self,
+        sf: &ShadingFrame,
+        wo: Vec3,
+        u_lobe: f32,
+        u: Vec2,
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
         let wo_l = sf.frame.to_local(wo);
         if wo_l.z == 0.0 {
             return None;
@@ -127,7 +137,13 @@ impl Material {
             return None;
         }
         let weight = s.weight * adjoint_correction(sf, wo, wi, wo_l.z, mode);
-        (s.pdf_w > 0.0 && weight.is_finite()).then_some(BsdfSample { wi, weight, pdf_w: s.pdf_w, pdf_rev_w: s.pdf_rev_w, delta: s.delta })
+        (s.pdf_w > 0.0 && weight.is_finite()).then_some(BsdfSample {
+            wi,
+            weight,
+            pdf_w: s.pdf_w,
+            pdf_rev_w: s.pdf_rev_w,
+            delta: s.delta,
+        })
     }
 
     pub fn eval(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3, mode: TransportMode) -> BsdfEval {
@@ -139,7 +155,11 @@ impl Material {
         let m = self.local();
         let f = m.eval(wo_l, wi_l, mode);
         let f_cos = f * wi_l.z.abs() * adjoint_correction(sf, wo, wi, wo_l.z, mode);
-        BsdfEval { f_cos, pdf_w: m.pdf(wo_l, wi_l), pdf_rev_w: m.pdf(wi_l, wo_l) }
+        BsdfEval {
+            f_cos,
+            pdf_w: m.pdf(wo_l, wi_l),
+            pdf_rev_w: m.pdf(wi_l, wo_l),
+        }
     }
 
     /// Solid-angle pdf of sampling wi given wo.
@@ -162,7 +182,13 @@ fn consistent_sides(sf: &ShadingFrame, wo: Vec3, wi: Vec3, cos_s_o: f32, cos_s_i
 
 /// The factor that turns f·|ns·wi| into f_cos for the given transport mode (see module docs).
 #[inline]
-fn adjoint_correction(sf: &ShadingFrame, wo: Vec3, wi: Vec3, cos_s_o: f32, mode: TransportMode) -> f32 {
+fn adjoint_correction(
+    sf: &ShadingFrame,
+    wo: Vec3,
+    wi: Vec3,
+    cos_s_o: f32,
+    mode: TransportMode,
+) -> f32 {
     match mode {
         TransportMode::Radiance => 1.0,
         TransportMode::Importance => {
@@ -181,7 +207,12 @@ fn adjoint_correction(sf: &ShadingFrame, wo: Vec3, wi: Vec3, cos_s_o: f32, mode:
 /// roughness from near-specular to very rough, and IORs seen from both sides of the interface.
 pub fn test_registry() -> Vec<(&'static str, Material)> {
     let c = Color::new(0.9, 0.6, 0.3);
-    let glossy = |roughness| Material::Glossy(Glossy { reflectance: c, roughness });
+    let glossy = |roughness| {
+        Material::Glossy(Glossy {
+            reflectance: c,
+            roughness,
+        })
+    };
     let glass = |ior| Material::Dielectric(Dielectric { ior });
     vec![
         ("diffuse", Material::Diffuse(Diffuse { albedo: c })),

@@ -15,8 +15,16 @@ use obvhs::{Boundable, BvhBuildParams};
 /// A primitive in the BVH. `shape` indexes the scene's shapes; `index` is the triangle within its mesh.
 #[derive(Clone, Copy, Debug)]
 pub enum Primitive {
-    Triangle { p: [Vec3; 3], shape: u32, index: u32 },
-    Sphere { center: Vec3, radius: f32, shape: u32 },
+    Triangle {
+        p: [Vec3; 3],
+        shape: u32,
+        index: u32,
+    },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+        shape: u32,
+    },
 }
 
 impl Primitive {
@@ -31,7 +39,9 @@ impl Primitive {
     pub fn intersect(&self, r: &ShearedRay, o: Vec3, d: Vec3, t_max: f32) -> f32 {
         match self {
             Primitive::Triangle { p, .. } => intersect_triangle(r, t_max, p).0,
-            &Primitive::Sphere { center, radius, .. } => intersect_sphere(o, d, t_max, center, radius),
+            &Primitive::Sphere { center, radius, .. } => {
+                intersect_sphere(o, d, t_max, center, radius)
+            }
         }
     }
 }
@@ -68,13 +78,27 @@ pub struct Accel {
 impl Accel {
     pub fn build(prims: Vec<Primitive>) -> Accel {
         if prims.is_empty() {
-            return Accel { bvh: CwBvh::default(), prims, bounds: (Vec3::ZERO, Vec3::ZERO) };
+            return Accel {
+                bvh: CwBvh::default(),
+                prims,
+                bounds: (Vec3::ZERO, Vec3::ZERO),
+            };
         }
         let mut build_time = Default::default();
         let bvh = build_cwbvh(&prims, BvhBuildParams::medium_build(), &mut build_time);
-        let ordered: Vec<Primitive> = bvh.primitive_indices.iter().map(|&i| prims[i as usize]).collect();
-        let total = prims.iter().fold(Aabb::empty(), |acc, p| acc.union(&p.aabb()));
-        Accel { bvh, prims: ordered, bounds: (total.min.into(), total.max.into()) }
+        let ordered: Vec<Primitive> = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| prims[i as usize])
+            .collect();
+        let total = prims
+            .iter()
+            .fold(Aabb::empty(), |acc, p| acc.union(&p.aabb()));
+        Accel {
+            bvh,
+            prims: ordered,
+            bounds: (total.min.into(), total.max.into()),
+        }
     }
 
     #[inline]
@@ -111,11 +135,16 @@ impl Accel {
         let prims = &self.prims;
         let (o, d) = (ray.o, ray.d);
         let sheared = ShearedRay::new(o, d);
-        let found = self.bvh.ray_traverse(Self::obvhs_ray(ray), &mut hit, |r, id| {
-            // Tested from the real origin; the result is reported in traversal-ray distance.
-            prims[id].intersect(&sheared, o, d, r.tmax - TRAVERSAL_BACKOFF) + TRAVERSAL_BACKOFF
-        });
-        found.then(|| PrimHit { t: hit.t - TRAVERSAL_BACKOFF, prim: hit.primitive_id })
+        let found = self
+            .bvh
+            .ray_traverse(Self::obvhs_ray(ray), &mut hit, |r, id| {
+                // Tested from the real origin; the result is reported in traversal-ray distance.
+                prims[id].intersect(&sheared, o, d, r.tmax - TRAVERSAL_BACKOFF) + TRAVERSAL_BACKOFF
+            });
+        found.then(|| PrimHit {
+            t: hit.t - TRAVERSAL_BACKOFF,
+            prim: hit.primitive_id,
+        })
     }
 
     /// True when anything blocks the ray within (0, t_max). Stops at the first blocker.
@@ -127,7 +156,9 @@ impl Accel {
         let prims = &self.prims;
         let (o, d, t_max) = (ray.o, ray.d, ray.t_max);
         let sheared = ShearedRay::new(o, d);
-        !self.bvh.ray_traverse_miss(Self::obvhs_ray(ray), |_, id| prims[id].intersect(&sheared, o, d, t_max) + TRAVERSAL_BACKOFF)
+        !self.bvh.ray_traverse_miss(Self::obvhs_ray(ray), |_, id| {
+            prims[id].intersect(&sheared, o, d, t_max) + TRAVERSAL_BACKOFF
+        })
     }
 }
 
@@ -142,7 +173,10 @@ mod tests {
 
     fn brute_force(prims: &[Primitive], ray: &Ray) -> f32 {
         let r = ShearedRay::new(ray.o, ray.d);
-        prims.iter().map(|p| p.intersect(&r, ray.o, ray.d, ray.t_max)).fold(f32::INFINITY, f32::min)
+        prims
+            .iter()
+            .map(|p| p.intersect(&r, ray.o, ray.d, ray.t_max))
+            .fold(f32::INFINITY, f32::min)
     }
 
     /// Random triangles and spheres at scale `scale`; rays from random points and from points on
@@ -153,11 +187,19 @@ mod tests {
         for i in 0..200u32 {
             let c = (s.next_2d().extend(s.next_f32()) - 0.5) * 10.0 * scale;
             if i % 3 == 0 {
-                prims.push(Primitive::Sphere { center: c, radius: (0.3 * s.next_f32() + 0.01) * scale, shape: i });
+                prims.push(Primitive::Sphere {
+                    center: c,
+                    radius: (0.3 * s.next_f32() + 0.01) * scale,
+                    shape: i,
+                });
             } else {
                 let e1 = sample_uniform_sphere(s.next_2d()) * scale;
                 let e2 = sample_uniform_sphere(s.next_2d()) * scale;
-                prims.push(Primitive::Triangle { p: [c, c + e1, c + e2], shape: i, index: 0 });
+                prims.push(Primitive::Triangle {
+                    p: [c, c + e1, c + e2],
+                    shape: i,
+                    index: 0,
+                });
             }
         }
         let accel = Accel::build(prims.clone());
@@ -179,11 +221,21 @@ mod tests {
                 Some(h) => {
                     // Adding and removing the traversal back-off rounds t by at most an ulp each way.
                     let tol = 2.0 * f32::EPSILON * (expected + TRAVERSAL_BACKOFF);
-                    assert!((h.t - expected).abs() <= tol, "scale {scale}: {} vs {expected}", h.t);
+                    assert!(
+                        (h.t - expected).abs() <= tol,
+                        "scale {scale}: {} vs {expected}",
+                        h.t
+                    );
                     let p = accel.primitive(h.prim);
-                    assert_eq!(p.intersect(&ShearedRay::new(ray.o, ray.d), ray.o, ray.d, ray.t_max), expected);
+                    assert_eq!(
+                        p.intersect(&ShearedRay::new(ray.o, ray.d), ray.o, ray.d, ray.t_max),
+                        expected
+                    );
                 }
-                None => assert!(expected.is_infinite(), "scale {scale}: BVH missed a hit at {expected}"),
+                None => assert!(
+                    expected.is_infinite(),
+                    "scale {scale}: BVH missed a hit at {expected}"
+                ),
             }
             assert_eq!(accel.occluded(&ray), expected.is_finite());
         }

@@ -17,7 +17,11 @@ pub struct Ray {
 
 impl Ray {
     pub fn new(o: Vec3, d: Vec3) -> Ray {
-        Ray { o, d, t_max: f32::INFINITY }
+        Ray {
+            o,
+            d,
+            t_max: f32::INFINITY,
+        }
     }
     #[inline]
     pub fn at(&self, t: f32) -> Vec3 {
@@ -86,7 +90,10 @@ mod tests {
             let n = Vec3::new(0.0, 1.0, 0.0);
             let up = offset_ray_origin(p, err, n, Vec3::new(0.1, 0.9, 0.0));
             let down = offset_ray_origin(p, err, n, Vec3::new(0.1, -0.9, 0.0));
-            assert!(up.y > p.y + err.y * 0.999 && down.y < p.y - err.y * 0.999, "scale {scale}");
+            assert!(
+                up.y > p.y + err.y * 0.999 && down.y < p.y - err.y * 0.999,
+                "scale {scale}"
+            );
             // Offsets stay tiny relative to the scene scale.
             assert!((up - p).length() < 1e-5 * scale);
         }

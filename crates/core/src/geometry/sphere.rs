@@ -34,7 +34,11 @@ pub fn intersect_sphere(o: Vec3, d: Vec3, t_max: f32, center: Vec3, radius: f32)
 pub fn refine_sphere_hit(p: Vec3, center: Vec3, radius: f32) -> (Vec3, Vec3) {
     let local = p - center;
     let len = local.length();
-    let local = if len > 0.0 { local * (radius / len) } else { Vec3::new(0.0, 0.0, radius) };
+    let local = if len > 0.0 {
+        local * (radius / len)
+    } else {
+        Vec3::new(0.0, 0.0, radius)
+    };
     let p = center + local;
     let err = (local.abs() + center.abs()) * gamma(6);
     (p, err)

@@ -16,14 +16,28 @@ pub struct ShearedRay {
 impl ShearedRay {
     pub fn new(o: Vec3, d: Vec3) -> ShearedRay {
         let a = d.abs();
-        let kz = if a.x > a.y { if a.x > a.z { 0 } else { 2 } } else if a.y > a.z { 1 } else { 2 };
+        let kz = if a.x > a.y {
+            if a.x > a.z {
+                0
+            } else {
+                2
+            }
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         // Keep the winding: swapping x and y mirrors the shear when the dominant axis is negative.
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        ShearedRay { o, k: [kx, ky, kz], s: Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]) }
+        ShearedRay {
+            o,
+            k: [kx, ky, kz],
+            s: Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]),
+        }
     }
 }
 
@@ -57,7 +71,11 @@ pub fn intersect_triangle(r: &ShearedRay, t_max: f32, p: &[Vec3; 3]) -> (f32, [f
     }
     let t_scaled = u * (r.s.z * a[kz]) + v * (r.s.z * b[kz]) + w * (r.s.z * c[kz]);
     // Compare t against (0, t_max) before dividing, with the sign of det folded in.
-    let hit = if det < 0.0 { t_scaled < 0.0 && t_scaled > t_max * det } else { t_scaled > 0.0 && t_scaled < t_max * det };
+    let hit = if det < 0.0 {
+        t_scaled < 0.0 && t_scaled > t_max * det
+    } else {
+        t_scaled > 0.0 && t_scaled < t_max * det
+    };
     if !hit {
         return MISS;
     }
@@ -73,7 +91,12 @@ mod tests {
     #[test]
     fn rays_through_a_shared_edge_never_slip_between_the_triangles() {
         // A quad split along its diagonal; rays aimed exactly at points of the diagonal.
-        let q = [Vec3::new(-1.0, -1.0, 0.3), Vec3::new(1.0, -1.0, 0.3), Vec3::new(1.0, 1.0, 0.3), Vec3::new(-1.0, 1.0, 0.3)];
+        let q = [
+            Vec3::new(-1.0, -1.0, 0.3),
+            Vec3::new(1.0, -1.0, 0.3),
+            Vec3::new(1.0, 1.0, 0.3),
+            Vec3::new(-1.0, 1.0, 0.3),
+        ];
         let (t1, t2) = ([q[0], q[1], q[2]], [q[0], q[2], q[3]]);
         let mut s = Sampler::new(5, 0, 0);
         for _ in 0..20_000 {
@@ -81,20 +104,37 @@ mod tests {
             let o = target + sample_uniform_sphere(s.next_2d()) * (0.1 + 10.0 * s.next_f32());
             let d = (target - o).normalize();
             let r = ShearedRay::new(o, d);
-            let hit = intersect_triangle(&r, f32::INFINITY, &t1).0.is_finite() || intersect_triangle(&r, f32::INFINITY, &t2).0.is_finite();
-            assert!(hit, "ray from {o} towards {target} slipped through the diagonal");
+            let hit = intersect_triangle(&r, f32::INFINITY, &t1).0.is_finite()
+                || intersect_triangle(&r, f32::INFINITY, &t2).0.is_finite();
+            assert!(
+                hit,
+                "ray from {o} towards {target} slipped through the diagonal"
+            );
         }
     }
 
     #[test]
     fn barycentrics_reconstruct_the_hit_point() {
-        let p = [Vec3::new(0.0, 0.0, 2.0), Vec3::new(1.0, 0.0, 2.0), Vec3::new(0.0, 1.0, 2.5)];
+        let p = [
+            Vec3::new(0.0, 0.0, 2.0),
+            Vec3::new(1.0, 0.0, 2.0),
+            Vec3::new(0.0, 1.0, 2.5),
+        ];
         let o = Vec3::new(0.2, 0.3, -1.0);
         let d = (Vec3::new(0.25, 0.25, 2.125) - o).normalize();
         let (t, b) = intersect_triangle(&ShearedRay::new(o, d), f32::INFINITY, &p);
         let from_b = b[0] * p[0] + b[1] * p[1] + b[2] * p[2];
-        assert!((o + d * t - from_b).length() < 1e-5 && (from_b - Vec3::new(0.25, 0.25, 2.125)).length() < 1e-5);
-        assert!(intersect_triangle(&ShearedRay::new(o, d), t * 0.999, &p).0.is_infinite());
-        assert!(intersect_triangle(&ShearedRay::new(o, -d), f32::INFINITY, &p).0.is_infinite());
+        assert!(
+            (o + d * t - from_b).length() < 1e-5
+                && (from_b - Vec3::new(0.25, 0.25, 2.125)).length() < 1e-5
+        );
+        assert!(intersect_triangle(&ShearedRay::new(o, d), t * 0.999, &p)
+            .0
+            .is_infinite());
+        assert!(
+            intersect_triangle(&ShearedRay::new(o, -d), f32::INFINITY, &p)
+                .0
+                .is_infinite()
+        );
     }
 }

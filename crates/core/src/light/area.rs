@@ -7,15 +7,21 @@ use super::{LightLeSample, LightLiSample};
 use crate::geometry::{offset_ray_origin, Ray};
 use crate::math::{gamma, luminance, Color, Frame, Vec2, Vec3, PI};
 use crate::sampling::{
-    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere, sample_uniform_triangle, uniform_cone_pdf,
-    Distribution1D,
+    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere,
+    sample_uniform_triangle, uniform_cone_pdf, Distribution1D,
 };
 use crate::scene::ShapeGeometry;
 
 #[derive(Clone, Debug)]
 enum Emitter {
-    Triangles { tris: Vec<[Vec3; 3]>, pick: Distribution1D },
-    Sphere { center: Vec3, radius: f32 },
+    Triangles {
+        tris: Vec<[Vec3; 3]>,
+        pick: Distribution1D,
+    },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
 }
 
 #[derive(Clone, Debug)]
@@ -28,17 +34,37 @@ pub struct AreaLight {
 }
 
 impl AreaLight {
-    pub fn new(shape: u32, geometry: &ShapeGeometry, emission: Color, flip_normals: bool) -> AreaLight {
+    pub fn new(
+        shape: u32,
+        geometry: &ShapeGeometry,
+        emission: Color,
+        flip_normals: bool,
+    ) -> AreaLight {
         let (emitter, area) = match geometry {
             ShapeGeometry::Mesh(m) => {
                 let tris: Vec<[Vec3; 3]> = (0..m.indices.len()).map(|i| m.triangle(i)).collect();
                 let areas: Vec<f32> = (0..m.indices.len()).map(|i| m.triangle_area(i)).collect();
                 let total: f64 = areas.iter().map(|&a| a as f64).sum();
-                (Emitter::Triangles { tris, pick: Distribution1D::new(&areas) }, total as f32)
+                (
+                    Emitter::Triangles {
+                        tris,
+                        pick: Distribution1D::new(&areas),
+                    },
+                    total as f32,
+                )
             }
-            &ShapeGeometry::Sphere { center, radius } => (Emitter::Sphere { center, radius }, 4.0 * PI * radius * radius),
+            &ShapeGeometry::Sphere { center, radius } => (
+                Emitter::Sphere { center, radius },
+                4.0 * PI * radius * radius,
+            ),
         };
-        AreaLight { shape, emission, area, flip: flip_normals, emitter }
+        AreaLight {
+            shape,
+            emission,
+            area,
+            flip: flip_normals,
+            emitter,
+        }
     }
 
     /// A uniformly distributed point on the surface with its outward (emitting-side) normal.
@@ -50,7 +76,11 @@ impl AreaLight {
                 let (b1, b2) = sample_uniform_triangle(Vec2::new(ux, u.y));
                 let b0 = 1.0 - b1 - b2;
                 let p = b0 * a + b1 * b + b2 * c;
-                (p, (b - a).cross(c - a).normalize(), crate::geometry::ray::barycentric_error([b0, b1, b2], [a, b, c]))
+                (
+                    p,
+                    (b - a).cross(c - a).normalize(),
+                    crate::geometry::ray::barycentric_error([b0, b1, b2], [a, b, c]),
+                )
             }
             &Emitter::Sphere { center, radius } => {
                 let n = sample_uniform_sphere(u);
@@ -104,10 +134,25 @@ impl AreaLight {
             return None;
         }
         let pdf_w = d2 / (cos_l * self.area);
-        Some(LightLiSample { wi, p: lp, n, distance, radiance: self.emitted(n, -wi), pdf_w, delta: false })
+        Some(LightLiSample {
+            wi,
+            p: lp,
+            n,
+            distance,
+            radiance: self.emitted(n, -wi),
+            pdf_w,
+            delta: false,
+        })
     }
 
-    fn sample_sphere_cone(&self, p: Vec3, center: Vec3, radius: f32, h: f32, u: Vec2) -> Option<LightLiSample> {
+    fn sample_sphere_cone(
+        &self,
+        p: Vec3,
+        center: Vec3,
+        radius: f32,
+        h: f32,
+        u: Vec2,
+    ) -> Option<LightLiSample> {
         let axis = center - p;
         let dc = axis.length();
         let frame = Frame::from_z(axis / dc);
@@ -124,7 +169,15 @@ impl AreaLight {
             n = -n;
         }
         let distance = (lp - p).length();
-        Some(LightLiSample { wi, p: lp, n, distance, radiance: self.emitted(n, -wi), pdf_w: uniform_cone_pdf(h), delta: false })
+        Some(LightLiSample {
+            wi,
+            p: lp,
+            n,
+            distance,
+            radiance: self.emitted(n, -wi),
+            pdf_w: uniform_cone_pdf(h),
+            delta: false,
+        })
     }
 
     pub fn pdf_li(&self, p: Vec3, wi: Vec3, light_p: Vec3, light_n: Vec3) -> f32 {
@@ -150,7 +203,13 @@ impl AreaLight {
         }
         let d = Frame::from_z(n).to_world(local);
         let ray = Ray::new(offset_ray_origin(p, err, n, d), d);
-        Some(LightLeSample { ray, n, radiance: self.emission, pdf_pos: 1.0 / self.area, pdf_dir })
+        Some(LightLeSample {
+            ray,
+            n,
+            radiance: self.emission,
+            pdf_pos: 1.0 / self.area,
+            pdf_dir,
+        })
     }
 
     pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {

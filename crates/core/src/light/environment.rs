@@ -13,13 +13,27 @@ pub struct EnvironmentLight {
 impl EnvironmentLight {
     pub fn sample_li(&self, u: Vec2) -> Option<LightLiSample> {
         let wi = sample_uniform_sphere(u);
-        Some(LightLiSample { wi, p: wi, n: -wi, distance: f32::INFINITY, radiance: self.radiance, pdf_w: UNIFORM_SPHERE_PDF, delta: false })
+        Some(LightLiSample {
+            wi,
+            p: wi,
+            n: -wi,
+            distance: f32::INFINITY,
+            radiance: self.radiance,
+            pdf_w: UNIFORM_SPHERE_PDF,
+            delta: false,
+        })
     }
 
     pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2, bounds: (Vec3, f32)) -> LightLeSample {
         let d = -sample_uniform_sphere(u_dir);
         let ray = ray_from_bounding_disk(d, u_pos, bounds);
-        LightLeSample { ray, n: d, radiance: self.radiance, pdf_pos: disk_pdf(bounds), pdf_dir: UNIFORM_SPHERE_PDF }
+        LightLeSample {
+            ray,
+            n: d,
+            radiance: self.radiance,
+            pdf_pos: disk_pdf(bounds),
+            pdf_dir: UNIFORM_SPHERE_PDF,
+        }
     }
 }
 

@@ -63,15 +63,32 @@ pub enum Light {
 }
 
 impl Light {
-    pub fn area(shape: u32, geometry: &ShapeGeometry, emission: Color, flip_normals: bool) -> Light {
+    pub fn area(
+        shape: u32,
+        geometry: &ShapeGeometry,
+        emission: Color,
+        flip_normals: bool,
+    ) -> Light {
         Light::Area(AreaLight::new(shape, geometry, emission, flip_normals))
     }
 
     pub fn from_desc(desc: &LightDesc) -> Light {
         match *desc {
-            LightDesc::Point { position, intensity } => Light::Point(PointLight { position, intensity }),
-            LightDesc::Sun { direction, solid_angle, radiance } => Light::Sun(SunLight::new(direction, solid_angle, radiance)),
-            LightDesc::Environment { radiance } => Light::Environment(EnvironmentLight { radiance }),
+            LightDesc::Point {
+                position,
+                intensity,
+            } => Light::Point(PointLight {
+                position,
+                intensity,
+            }),
+            LightDesc::Sun {
+                direction,
+                solid_angle,
+                radiance,
+            } => Light::Sun(SunLight::new(direction, solid_angle, radiance)),
+            LightDesc::Environment { radiance } => {
+                Light::Environment(EnvironmentLight { radiance })
+            }
         }
     }
 
@@ -126,7 +143,12 @@ impl Light {
         }
     }
 
-    pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2, bounds: (Vec3, f32)) -> Option<LightLeSample> {
+    pub fn sample_le(
+        &self,
+        u_pos: Vec2,
+        u_dir: Vec2,
+        bounds: (Vec3, f32),
+    ) -> Option<LightLeSample> {
         match self {
             Light::Area(l) => l.sample_le(u_pos, u_dir),
             Light::Point(l) => Some(l.sample_le(u_dir)),
@@ -166,7 +188,9 @@ pub struct LightSampler {
 impl LightSampler {
     pub fn new(lights: &[Light], bounds: (Vec3, f32)) -> LightSampler {
         let w: Vec<f32> = lights.iter().map(|l| l.power(bounds).max(0.0)).collect();
-        LightSampler { dist: Distribution1D::new(&w) }
+        LightSampler {
+            dist: Distribution1D::new(&w),
+        }
     }
 
     /// (light index, its selection probability, u reused within the choice) or None without lights.

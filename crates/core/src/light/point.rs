@@ -20,11 +20,25 @@ impl PointLight {
         }
         let distance = d2.sqrt();
         let wi = to / distance;
-        Some(LightLiSample { wi, p: self.position, n: -wi, distance, radiance: self.intensity / d2, pdf_w: 1.0, delta: true })
+        Some(LightLiSample {
+            wi,
+            p: self.position,
+            n: -wi,
+            distance,
+            radiance: self.intensity / d2,
+            pdf_w: 1.0,
+            delta: true,
+        })
     }
 
     pub fn sample_le(&self, u_dir: Vec2) -> LightLeSample {
         let d = sample_uniform_sphere(u_dir);
-        LightLeSample { ray: Ray::new(self.position, d), n: d, radiance: self.intensity, pdf_pos: 1.0, pdf_dir: UNIFORM_SPHERE_PDF }
+        LightLeSample {
+            ray: Ray::new(self.position, d),
+            n: d,
+            radiance: self.intensity,
+            pdf_pos: 1.0,
+            pdf_dir: UNIFORM_SPHERE_PDF,
+        }
     }
 }

@@ -20,7 +20,13 @@ pub struct SunLight {
 impl SunLight {
     pub fn new(direction: Vec3, solid_angle: f32, radiance: Color) -> SunLight {
         let direction = direction.normalize();
-        SunLight { direction, solid_angle, radiance, frame: Frame::from_z(direction), one_minus_cos_max: solid_angle / (2.0 * PI) }
+        SunLight {
+            direction,
+            solid_angle,
+            radiance,
+            frame: Frame::from_z(direction),
+            one_minus_cos_max: solid_angle / (2.0 * PI),
+        }
     }
 
     /// Radiance that gives `irradiance` on a surface facing the sun: E = L · π sin²θmax.
@@ -48,7 +54,13 @@ impl SunLight {
     fn sample_dir(&self, u: Vec2) -> Vec3 {
         let mut ux = u.x;
         loop {
-            let w = self.frame.to_world(sample_uniform_cone(Vec2::new(ux, u.y), self.one_minus_cos_max)).normalize();
+            let w = self
+                .frame
+                .to_world(sample_uniform_cone(
+                    Vec2::new(ux, u.y),
+                    self.one_minus_cos_max,
+                ))
+                .normalize();
             if self.in_cone(w) || ux == 0.0 {
                 return w;
             }
@@ -58,7 +70,15 @@ impl SunLight {
 
     pub fn sample_li(&self, u: Vec2) -> Option<LightLiSample> {
         let wi = self.sample_dir(u);
-        Some(LightLiSample { wi, p: wi, n: -wi, distance: f32::INFINITY, radiance: self.radiance, pdf_w: uniform_cone_pdf(self.one_minus_cos_max), delta: false })
+        Some(LightLiSample {
+            wi,
+            p: wi,
+            n: -wi,
+            distance: f32::INFINITY,
+            radiance: self.radiance,
+            pdf_w: uniform_cone_pdf(self.one_minus_cos_max),
+            delta: false,
+        })
     }
 
     pub fn pdf_li(&self, wi: Vec3) -> f32 {
@@ -80,7 +100,13 @@ impl SunLight {
     pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2, bounds: (Vec3, f32)) -> LightLeSample {
         let to_sun = self.sample_dir(u_dir);
         let d = -to_sun;
-        LightLeSample { ray: ray_from_bounding_disk(d, u_pos, bounds), n: d, radiance: self.radiance, pdf_pos: disk_pdf(bounds), pdf_dir: uniform_cone_pdf(self.one_minus_cos_max) }
+        LightLeSample {
+            ray: ray_from_bounding_disk(d, u_pos, bounds),
+            n: d,
+            radiance: self.radiance,
+            pdf_pos: disk_pdf(bounds),
+            pdf_dir: uniform_cone_pdf(self.one_minus_cos_max),
+        }
     }
 
     /// `dir` is the direction light travels (away from the sun).

@@ -18,7 +18,11 @@
 //!   are f64 so long paths in large scenes do not underflow.
 //! - **Delta scattering.** f and p of a delta lobe are stored delta-stripped (lobe value, lobe
 //!   probability; see `scatter`), so f/p is the sample weight, and any technique whose connection
-//!   edge ends at a delta vertex has p_s = 0.
+//!   edge ends at a delta vertex has p_s = 0. A refraction's Dirac lives in the solid angle of the
+//!   direction its walk sampled, so its stripped value depends on the side that sampled it:
+//!   `contribution` strips as the camera walk does, `contribution_for(s)` as technique s does,
+//!   and every f/p_s pairs the two of technique s (they differ only at refractions on the light
+//!   subpath, by η² and a cosine ratio; see `mis` for what this means for the weights).
 //! - **Image normalisation.** `Camera::importance` is per pixel, We = N / (A cos⁴θ) with N the
 //!   pixel count, while `Camera::pdf_dir` is film-wide, 1 / (A cos³θ). A camera sample whose
 //!   raster position is uniform in its pixel has the direction density N · pdf_dir, and a light

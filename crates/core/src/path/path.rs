@@ -75,9 +75,20 @@ impl Path {
     pub fn new(vertices: Vec<PathVertex>) -> Path {
         let n = vertices.len();
         assert!(n >= 2, "a path needs a light and a camera vertex");
-        assert!(matches!(vertices[0].kind, VertexKind::Light { .. }), "x0 must be a light vertex");
-        assert!(matches!(vertices[n - 1].kind, VertexKind::Camera), "xk must be the camera");
-        assert!(vertices[1..n - 1].iter().all(|v| matches!(v.kind, VertexKind::Surface { .. })), "interior vertices must be surfaces");
+        assert!(
+            matches!(vertices[0].kind, VertexKind::Light { .. }),
+            "x0 must be a light vertex"
+        );
+        assert!(
+            matches!(vertices[n - 1].kind, VertexKind::Camera),
+            "xk must be the camera"
+        );
+        assert!(
+            vertices[1..n - 1]
+                .iter()
+                .all(|v| matches!(v.kind, VertexKind::Surface { .. })),
+            "interior vertices must be surfaces"
+        );
         Path { vertices }
     }
 
@@ -92,10 +103,24 @@ impl Path {
     }
 
     /// Scattering at x_i with `wo` towards x_from and `wi` towards x_to.
-    fn scatter_at(&self, scene: &Scene, i: usize, from: usize, to: usize, mode: TransportMode) -> Scatter {
+    fn scatter_at(
+        &self,
+        scene: &Scene,
+        i: usize,
+        from: usize,
+        to: usize,
+        mode: TransportMode,
+    ) -> Scatter {
         let v = &self.vertices;
         let tol = delta_tolerance(&v[i], &v[from], &v[to]);
-        scatter(scene, &v[i], v[i].dir_to(&v[from]), v[i].dir_to(&v[to]), mode, tol)
+        scatter(
+            scene,
+            &v[i],
+            v[i].dir_to(&v[from]),
+            v[i].dir_to(&v[to]),
+            mode,
+            tol,
+        )
     }
 
     fn light<'a>(&self, scene: &'a Scene) -> &'a Light {
@@ -145,9 +170,11 @@ impl Path {
         let mut f = le.as_dvec3() * geometry(x0, &v[1]) as f64;
         for i in 1..k {
             let fs = if i < s {
-                self.scatter_at(scene, i, i - 1, i + 1, TransportMode::Importance).f
+                self.scatter_at(scene, i, i - 1, i + 1, TransportMode::Importance)
+                    .f
             } else {
-                self.scatter_at(scene, i, i + 1, i - 1, TransportMode::Radiance).f
+                self.scatter_at(scene, i, i + 1, i - 1, TransportMode::Radiance)
+                    .f
             };
             f *= fs.as_dvec3() * geometry(&v[i], &v[i + 1]) as f64;
         }
@@ -159,7 +186,9 @@ impl Path {
         let v = &self.vertices;
         let k = self.k();
         let (x0, x1) = (&v[0], &v[1]);
-        let VertexKind::Light { light: li, .. } = x0.kind else { unreachable!("Path::new checks x0") };
+        let VertexKind::Light { light: li, .. } = x0.kind else {
+            unreachable!("Path::new checks x0")
+        };
         let light = self.light(scene);
         let pmf = scene.light_sampler.pmf(li as usize) as f64;
 
@@ -172,7 +201,9 @@ impl Path {
             pl[1] = x0.convert_density(if x0.is_infinite() { pos } else { dir }, x1) as f64;
         }
         for i in 2..k {
-            let pdf_w = self.scatter_at(scene, i - 1, i - 2, i, TransportMode::Importance).pdf_w;
+            let pdf_w = self
+                .scatter_at(scene, i - 1, i - 2, i, TransportMode::Importance)
+                .pdf_w;
             pl[i] = v[i - 1].convert_density(pdf_w, &v[i]) as f64;
         }
 
@@ -190,7 +221,9 @@ impl Path {
         let pdf_dir = scene.camera.pdf_dir(v[k].dir_to(&v[k - 1]));
         pc[k - 1] = v[k].convert_density(pdf_dir, &v[k - 1]) as f64;
         for i in (0..k.saturating_sub(1)).rev() {
-            let pdf_w = self.scatter_at(scene, i + 1, i + 2, i, TransportMode::Radiance).pdf_w;
+            let pdf_w = self
+                .scatter_at(scene, i + 1, i + 2, i, TransportMode::Radiance)
+                .pdf_w;
             pc[i] = v[i + 1].convert_density(pdf_w, &v[i]) as f64;
         }
         if light.delta_position() {
@@ -198,7 +231,12 @@ impl Path {
         }
 
         let conn = v.iter().map(|x| connectable(scene, x)).collect();
-        Densities { light: pl, camera: pc, nee, connectable: conn }
+        Densities {
+            light: pl,
+            camera: pc,
+            nee,
+            connectable: conn,
+        }
     }
 
     /// p_s(x̄): the density of generating this path with s vertices from the light and

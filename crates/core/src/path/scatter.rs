@@ -52,7 +52,14 @@ pub struct Scatter {
 
 /// Evaluates the vertex's material. `v` must be a `Surface` vertex; anything else scatters nothing.
 /// A delta lobe matches `wi` when the lobe's direction is within `tol` (see `delta_tolerance`).
-pub fn scatter(scene: &Scene, v: &PathVertex, wo: Vec3, wi: Vec3, mode: TransportMode, tol: f32) -> Scatter {
+pub fn scatter(
+    scene: &Scene,
+    v: &PathVertex,
+    wo: Vec3,
+    wi: Vec3,
+    mode: TransportMode,
+    tol: f32,
+) -> Scatter {
     let VertexKind::Surface { material } = v.kind else {
         return Scatter::default();
     };
@@ -64,14 +71,20 @@ pub fn scatter(scene: &Scene, v: &PathVertex, wo: Vec3, wi: Vec3, mode: Transpor
     }
     if !m.is_delta() {
         let e = m.eval(&sf, wo, wi, mode);
-        return Scatter { f: e.f_cos / cos_g, pdf_w: e.pdf_w };
+        return Scatter {
+            f: e.f_cos / cos_g,
+            pdf_w: e.pdf_w,
+        };
     }
     let mut found: Option<Scatter> = None;
     for u_lobe in LOBE_PROBES {
         if let Some(s) = m.sample(&sf, wo, u_lobe, Vec2::splat(0.5), mode) {
             if s.delta && (s.wi - wi).length() < tol {
                 // weight = f_cos / pdf for the lobe, so weight · pdf is the lobe's f_cos.
-                found = Some(Scatter { f: s.weight * s.pdf_w / cos_g, pdf_w: s.pdf_w });
+                found = Some(Scatter {
+                    f: s.weight * s.pdf_w / cos_g,
+                    pdf_w: s.pdf_w,
+                });
                 break;
             }
         }

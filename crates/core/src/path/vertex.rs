@@ -37,8 +37,10 @@ pub struct PathVertex {
     pub p_err: Vec3,
     pub ng: Vec3,
     pub ns: Vec3,
-    /// Throughput of the subpath up to and including this vertex (pbrt's β): for a light vertex
-    /// Le / pdf_fwd, for the camera 1, then multiplied by each sample's f_cos / pdf_w.
+    /// Throughput of the subpath that created the vertex, up to and including it (pbrt's β):
+    /// a camera subpath starts at 1, a light subpath at Le / pdf_fwd of x0, and each sample
+    /// multiplies it by f_cos / pdf_w. A light endpoint reached by a camera walk
+    /// (`as_light_endpoint`, `light_escaped`) keeps the camera walk's β.
     pub beta: Color,
     /// Density with which the walk that created this vertex chose it.
     pub pdf_fwd: f32,
@@ -51,7 +53,17 @@ pub struct PathVertex {
 
 impl PathVertex {
     fn endpoint(kind: VertexKind, p: Vec3, n: Vec3, beta: Color, pdf_fwd: f32) -> PathVertex {
-        PathVertex { kind, p, p_err: Vec3::ZERO, ng: n, ns: n, beta, pdf_fwd, pdf_rev: 0.0, delta: false }
+        PathVertex {
+            kind,
+            p,
+            p_err: Vec3::ZERO,
+            ng: n,
+            ns: n,
+            beta,
+            pdf_fwd,
+            pdf_rev: 0.0,
+            delta: false,
+        }
     }
 
     /// The pinhole: a delta position, so its density is the discrete 1.
@@ -64,7 +76,9 @@ impl PathVertex {
     /// the ray (`LightLeSample::pdf_pos`).
     pub fn surface(hit: &SurfaceHit, beta: Color, pdf: f32, prev: &PathVertex) -> PathVertex {
         let mut v = PathVertex {
-            kind: VertexKind::Surface { material: hit.material },
+            kind: VertexKind::Surface {
+                material: hit.material,
+            },
             p: hit.p,
             p_err: hit.p_err,
             ng: hit.ng,
@@ -82,13 +96,29 @@ impl PathVertex {
     /// `None` when the surface does not emit.
     pub fn as_light_endpoint(&self, hit: &SurfaceHit) -> Option<PathVertex> {
         let light = hit.light?;
-        Some(PathVertex { kind: VertexKind::Light { light, infinite: false }, delta: false, ..*self })
+        Some(PathVertex {
+            kind: VertexKind::Light {
+                light,
+                infinite: false,
+            },
+            delta: false,
+            ..*self
+        })
     }
 
     /// A camera walk left the scene in direction `dir` towards light `light` at infinity, chosen
     /// with solid-angle density `pdf_w`: the density stays solid angle.
     pub fn light_escaped(light: u32, dir: Vec3, beta: Color, pdf_w: f32) -> PathVertex {
-        PathVertex::endpoint(VertexKind::Light { light, infinite: true }, dir, -dir, beta, pdf_w)
+        PathVertex::endpoint(
+            VertexKind::Light {
+                light,
+                infinite: true,
+            },
+            dir,
+            -dir,
+            beta,
+            pdf_w,
+        )
     }
 
     /// x0 of a light subpath from `Light::sample_le` after choosing the light with `pmf`.
@@ -98,18 +128,36 @@ impl PathVertex {
         let l = &scene.lights[light as usize];
         if l.is_infinite() {
             let pdf = pmf * s.pdf_dir;
-            let kind = VertexKind::Light { light, infinite: true };
+            let kind = VertexKind::Light {
+                light,
+                infinite: true,
+            };
             return PathVertex::endpoint(kind, -s.ray.d, s.ray.d, s.radiance / pdf, pdf);
         }
         let pdf = pmf * s.pdf_pos;
         let n = if l.delta_position() { Vec3::ZERO } else { s.n };
-        PathVertex::endpoint(VertexKind::Light { light, infinite: false }, s.ray.o, n, s.radiance / pdf, pdf)
+        PathVertex::endpoint(
+            VertexKind::Light {
+                light,
+                infinite: false,
+            },
+            s.ray.o,
+            n,
+            s.radiance / pdf,
+            pdf,
+        )
     }
 
     /// x0 chosen by next-event estimation from `from` (`Light::sample_li`, light chosen with `pmf`):
     /// `pdf_fwd` = pmf · pdf_li converted to area at x0 (solid angle at infinity, discrete 1 for a
     /// point light). `beta` = Le / pdf_fwd (for a point light Le is the intensity).
-    pub fn light_sampled(scene: &Scene, light: u32, s: &LightLiSample, pmf: f32, from: &PathVertex) -> PathVertex {
+    pub fn light_sampled(
+        scene: &Scene,
+        light: u32,
+        s: &LightLiSample,
+        pmf: f32,
+        from: &PathVertex,
+    ) -> PathVertex {
         let l = &scene.lights[light as usize];
         let infinite = l.is_infinite();
         let kind = VertexKind::Light { light, infinite };
@@ -119,8 +167,16 @@ impl PathVertex {
             _ => (s.p, s.n, s.radiance),
         };
         let mut v = PathVertex::endpoint(kind, p, n, Color::ZERO, 0.0);
-        v.pdf_fwd = if s.delta { pmf } else { pmf * from.convert_density(s.pdf_w, &v) };
-        v.beta = if v.pdf_fwd > 0.0 { le / v.pdf_fwd } else { Color::ZERO };
+        v.pdf_fwd = if s.delta {
+            pmf
+        } else {
+            pmf * from.convert_density(s.pdf_w, &v)
+        };
+        v.beta = if v.pdf_fwd > 0.0 {
+            le / v.pdf_fwd
+        } else {
+            Color::ZERO
+        };
         v
     }
 
@@ -155,7 +211,11 @@ impl PathVertex {
         if next.is_infinite() {
             return pdf;
         }
-        let n = if next.on_surface() { next.ng } else { self.dir_to(next) };
+        let n = if next.on_surface() {
+            next.ng
+        } else {
+            self.dir_to(next)
+        };
         if self.is_infinite() {
             return measure::perpendicular_to_area(pdf, -self.p, n);
         }
@@ -167,7 +227,13 @@ impl PathVertex {
 /// each end that has a surface (the camera's is its viewing axis), over the squared distance;
 /// with one end at infinity only the other end's cosine remains.
 pub fn geometry(a: &PathVertex, b: &PathVertex) -> f32 {
-    let cos_at = |v: &PathVertex, w: Vec3| if v.on_surface() { v.ng.dot(w).abs() } else { 1.0 };
+    let cos_at = |v: &PathVertex, w: Vec3| {
+        if v.on_surface() {
+            v.ng.dot(w).abs()
+        } else {
+            1.0
+        }
+    };
     if a.is_infinite() {
         return cos_at(b, a.p);
     }

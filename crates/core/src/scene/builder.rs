@@ -20,7 +20,11 @@ pub struct TriangleMesh {
 impl TriangleMesh {
     pub fn triangle(&self, i: usize) -> [Vec3; 3] {
         let [a, b, c] = self.indices[i];
-        [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
     }
 
     pub fn triangle_area(&self, i: usize) -> f32 {
@@ -39,7 +43,12 @@ impl TriangleMesh {
     /// An axis-aligned unit square [-1,1]² in the z = 0 plane with normal +z (Mitsuba's rectangle).
     pub fn unit_rectangle() -> TriangleMesh {
         TriangleMesh {
-            positions: vec![Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0)],
+            positions: vec![
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::new(1.0, -1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(-1.0, 1.0, 0.0),
+            ],
             normals: None,
             indices: vec![[0, 1, 2], [0, 2, 3]],
         }
@@ -51,8 +60,15 @@ impl TriangleMesh {
         let mut indices = Vec::new();
         for axis in 0..3 {
             for sign in [-1.0f32, 1.0] {
-                let n = Vec3::from_array(std::array::from_fn(|k| if k == axis { sign } else { 0.0 }));
-                let u = Vec3::from_array(std::array::from_fn(|k| if k == (axis + 1) % 3 { 1.0 } else { 0.0 }));
+                let n =
+                    Vec3::from_array(std::array::from_fn(|k| if k == axis { sign } else { 0.0 }));
+                let u = Vec3::from_array(std::array::from_fn(|k| {
+                    if k == (axis + 1) % 3 {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                }));
                 let v = n.cross(u);
                 let base = positions.len() as u32;
                 for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
@@ -62,7 +78,11 @@ impl TriangleMesh {
                 indices.push([base, base + 2, base + 3]);
             }
         }
-        TriangleMesh { positions, normals: None, indices }
+        TriangleMesh {
+            positions,
+            normals: None,
+            indices,
+        }
     }
 
     /// Applies a point transform (and its normal transform) to the mesh.
@@ -95,10 +115,19 @@ pub enum ShapeGeometry {
 /// Lights that are not shapes.
 #[derive(Clone, Debug)]
 pub enum LightDesc {
-    Point { position: Vec3, intensity: Color },
+    Point {
+        position: Vec3,
+        intensity: Color,
+    },
     /// A distant disk light. `direction` points from the scene towards the sun.
-    Sun { direction: Vec3, solid_angle: f32, radiance: Color },
-    Environment { radiance: Color },
+    Sun {
+        direction: Vec3,
+        solid_angle: f32,
+        radiance: Color,
+    },
+    Environment {
+        radiance: Color,
+    },
 }
 
 pub struct SceneBuilder {
@@ -111,7 +140,13 @@ pub struct SceneBuilder {
 
 impl SceneBuilder {
     pub fn new(camera: Camera, settings: RenderSettings) -> SceneBuilder {
-        SceneBuilder { camera, settings, materials: Vec::new(), shapes: Vec::new(), lights: Vec::new() }
+        SceneBuilder {
+            camera,
+            settings,
+            materials: Vec::new(),
+            shapes: Vec::new(),
+            lights: Vec::new(),
+        }
     }
 
     /// Returns the material's id for `add_shape`.
@@ -121,8 +156,15 @@ impl SceneBuilder {
     }
 
     /// `emission`, when given, makes the shape a one-sided area light on its normal side.
-    pub fn add_shape(&mut self, geometry: ShapeGeometry, material: u32, emission: Option<Color>, flip_normals: bool) {
-        self.shapes.push((geometry, material, emission, flip_normals));
+    pub fn add_shape(
+        &mut self,
+        geometry: ShapeGeometry,
+        material: u32,
+        emission: Option<Color>,
+        flip_normals: bool,
+    ) {
+        self.shapes
+            .push((geometry, material, emission, flip_normals));
     }
 
     pub fn add_light(&mut self, light: LightDesc) {
@@ -140,17 +182,30 @@ impl SceneBuilder {
                     for (i, _) in m.indices.iter().enumerate() {
                         let [p0, p1, p2] = m.triangle(i);
                         if m.triangle_area(i) > 0.0 {
-                            prims.push(Primitive::Triangle { p: [p0, p1, p2], shape: shape_id, index: i as u32 });
+                            prims.push(Primitive::Triangle {
+                                p: [p0, p1, p2],
+                                shape: shape_id,
+                                index: i as u32,
+                            });
                         }
                     }
                 }
-                &ShapeGeometry::Sphere { center, radius } => prims.push(Primitive::Sphere { center, radius, shape: shape_id }),
+                &ShapeGeometry::Sphere { center, radius } => prims.push(Primitive::Sphere {
+                    center,
+                    radius,
+                    shape: shape_id,
+                }),
             }
             let light = emission.map(|e| {
                 lights.push(Light::area(shape_id, &geometry, e, flip_normals));
                 (lights.len() - 1) as u32
             });
-            shapes.push(Shape { geometry, material, light, flip_normals });
+            shapes.push(Shape {
+                geometry,
+                material,
+                light,
+                flip_normals,
+            });
         }
         let accel = Accel::build(prims);
         let (lo, hi) = accel.bounds();

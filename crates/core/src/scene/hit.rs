@@ -29,14 +29,20 @@ impl SurfaceHit {
         let prim = *scene.accel.primitive(h.prim);
         let shape = &scene.shapes[prim.shape() as usize];
         let (p, p_err, mut ng, mut ns) = match prim {
-            Primitive::Triangle { p: [p0, p1, p2], index, .. } => {
+            Primitive::Triangle {
+                p: [p0, p1, p2],
+                index,
+                ..
+            } => {
                 let sheared = ShearedRay::new(ray.o, ray.d);
                 let (_, [b0, b1, b2]) = intersect_triangle(&sheared, f32::INFINITY, &[p0, p1, p2]);
                 let p = b0 * p0 + b1 * p1 + b2 * p2;
                 let err = barycentric_error([b0, b1, b2], [p0, p1, p2]);
                 let ng = (p1 - p0).cross(p2 - p0).normalize();
                 let ns = match &shape.geometry {
-                    ShapeGeometry::Mesh(m) => m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng),
+                    ShapeGeometry::Mesh(m) => {
+                        m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng)
+                    }
                     ShapeGeometry::Sphere { .. } => ng,
                 };
                 (p, err, ng, ns)
@@ -55,7 +61,16 @@ impl SurfaceHit {
         if ns.dot(ng) < 0.0 {
             ns = -ns;
         }
-        SurfaceHit { p, p_err, ng, ns, t: h.t, shape: prim.shape(), material: shape.material, light: shape.light }
+        SurfaceHit {
+            p,
+            p_err,
+            ng,
+            ns,
+            t: h.t,
+            shape: prim.shape(),
+            material: shape.material,
+            light: shape.light,
+        }
     }
 
     #[inline]
@@ -75,6 +90,10 @@ impl SurfaceHit {
         let o = offset_ray_origin(self.p, self.p_err, self.ng, to - self.p);
         let d = to - o;
         let len = d.length();
-        Ray { o, d: d / len, t_max: len * (1.0 - SHADOW_EPSILON) }
+        Ray {
+            o,
+            d: d / len,
+            t_max: len * (1.0 - SHADOW_EPSILON),
+        }
     }
 }

@@ -8,8 +8,8 @@ mod format;
 mod hit;
 pub mod load;
 mod obj;
-mod transform;
 pub mod ray_stats;
+mod transform;
 
 pub use builder::{LightDesc, SceneBuilder, ShapeGeometry, TriangleMesh};
 pub use hit::SurfaceHit;
@@ -35,7 +35,11 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings { max_depth: 8, rr_depth: 5, spp: 64 }
+        RenderSettings {
+            max_depth: 8,
+            rr_depth: 5,
+            spp: 64,
+        }
     }
 }
 
@@ -94,7 +98,11 @@ impl Scene {
         if !(len > 0.0) {
             return true;
         }
-        let ray = Ray { o: a, d: d / len, t_max: len * (1.0 - SHADOW_EPSILON) };
+        let ray = Ray {
+            o: a,
+            d: d / len,
+            t_max: len * (1.0 - SHADOW_EPSILON),
+        };
         ray_stats::count_shadow();
         !self.accel.occluded(&ray)
     }

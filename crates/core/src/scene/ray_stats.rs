@@ -21,5 +21,8 @@ pub(crate) fn count_shadow() {
 
 /// (closest-hit rays, shadow rays) traced on this thread since the last call; resets them.
 pub fn take() -> (u64, u64) {
-    (CLOSEST.with(|c| c.replace(0)), SHADOW.with(|c| c.replace(0)))
+    (
+        CLOSEST.with(|c| c.replace(0)),
+        SHADOW.with(|c| c.replace(0)),
+    )
 }

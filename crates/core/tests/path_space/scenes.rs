@@ -14,12 +14,14 @@ pub fn quad(c: Vec3, u: Vec3, v: Vec3) -> ShapeGeometry {
 }
 
 fn diffuse(b: &mut SceneBuilder, albedo: f32) -> u32 {
-    b.add_material(Material::Diffuse(Diffuse { albedo: Color::splat(albedo) }))
+    b.add_material(Material::Diffuse(Diffuse {
+        albedo: Color::splat(albedo),
+    }))
 }
 
 /// Variations of the Cornell-like box.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Box {
+pub struct BoxConfig {
     /// Tilts the floor's shading normals away from its geometric normal (differently at each
     /// corner), so radiance and importance transport differ.
     pub bumpy_floor: bool,
@@ -30,35 +32,93 @@ pub struct Box {
 
 /// A Cornell-like box [-1,1]³ open towards +z: diffuse walls, a quad light under the ceiling, a
 /// dimmer one on the back wall (so light selection pmfs are not 1) and a mirror block.
-pub fn cornell(cfg: Box) -> Scene {
-    let cam = Camera::look_at(Vec3::new(0.0, 0.0, 3.9), Vec3::ZERO, Vec3::Y, 39.3, FovAxis::X, 32, 24).unwrap();
+pub fn cornell(cfg: BoxConfig) -> Scene {
+    let cam = Camera::look_at(
+        Vec3::new(0.0, 0.0, 3.9),
+        Vec3::ZERO,
+        Vec3::Y,
+        39.3,
+        FovAxis::X,
+        32,
+        24,
+    )
+    .unwrap();
     let mut b = SceneBuilder::new(cam, RenderSettings::default());
     let white = diffuse(&mut b, 0.7);
-    let red = b.add_material(Material::Diffuse(Diffuse { albedo: Color::new(0.6, 0.1, 0.1) }));
+    let red = b.add_material(Material::Diffuse(Diffuse {
+        albedo: Color::new(0.6, 0.1, 0.1),
+    }));
     let black = diffuse(&mut b, 0.0);
-    let mirror = b.add_material(Material::Mirror(Mirror { reflectance: Color::splat(0.9) }));
+    let mirror = b.add_material(Material::Mirror(Mirror {
+        reflectance: Color::splat(0.9),
+    }));
     let (x, y, z) = (Vec3::X, Vec3::Y, Vec3::Z);
     let mut floor = quad(-y, z, x); // normal +y
     if let (true, ShapeGeometry::Mesh(m)) = (cfg.bumpy_floor, &mut floor) {
-        let tilt = [Vec3::new(0.4, 1.0, 0.1), Vec3::new(-0.3, 1.0, 0.3), Vec3::new(0.1, 1.0, -0.5), Vec3::new(0.0, 1.0, 0.2)];
+        let tilt = [
+            Vec3::new(0.4, 1.0, 0.1),
+            Vec3::new(-0.3, 1.0, 0.3),
+            Vec3::new(0.1, 1.0, -0.5),
+            Vec3::new(0.0, 1.0, 0.2),
+        ];
         m.normals = Some(tilt.iter().map(|n| n.normalize()).collect());
     }
     b.add_shape(floor, white, None, false);
     b.add_shape(quad(y, x, z), white, None, false); // ceiling, normal −y
-    let back = if cfg.glass_and_glossy { b.add_material(Material::Glossy(Glossy { reflectance: Color::new(0.8, 0.7, 0.5), roughness: 0.3 })) } else { white };
+    let back = if cfg.glass_and_glossy {
+        b.add_material(Material::Glossy(Glossy {
+            reflectance: Color::new(0.8, 0.7, 0.5),
+            roughness: 0.3,
+        }))
+    } else {
+        white
+    };
     b.add_shape(quad(-z, x, y), back, None, false); // back, normal +z
     if cfg.glass_and_glossy {
         let glass = b.add_material(Material::Dielectric(Dielectric { ior: 1.5 }));
-        b.add_shape(ShapeGeometry::Sphere { center: Vec3::new(-0.4, -0.6, 0.2), radius: 0.35 }, glass, None, false);
-        let cube = Mat4::from_translation(Vec3::new(-0.45, 0.35, -0.4)) * Mat4::from_rotation_x(0.6) * Mat4::from_rotation_y(0.7) * Mat4::from_scale(Vec3::splat(0.2));
-        b.add_shape(ShapeGeometry::Mesh(TriangleMesh::unit_cube().transformed(&cube)), glass, None, false);
+        b.add_shape(
+            ShapeGeometry::Sphere {
+                center: Vec3::new(-0.4, -0.6, 0.2),
+                radius: 0.35,
+            },
+            glass,
+            None,
+            false,
+        );
+        let cube = Mat4::from_translation(Vec3::new(-0.45, 0.35, -0.4))
+            * Mat4::from_rotation_x(0.6)
+            * Mat4::from_rotation_y(0.7)
+            * Mat4::from_scale(Vec3::splat(0.2));
+        b.add_shape(
+            ShapeGeometry::Mesh(TriangleMesh::unit_cube().transformed(&cube)),
+            glass,
+            None,
+            false,
+        );
     }
     b.add_shape(quad(-x, y, z), red, None, false); // left, normal +x
     b.add_shape(quad(x, z, y), white, None, false); // right, normal −x
-    b.add_shape(quad(Vec3::new(0.0, 0.99, 0.0), 0.3 * x, 0.3 * z), black, Some(Color::splat(12.0)), false);
-    b.add_shape(quad(Vec3::new(-0.5, 0.5, -0.99), 0.2 * x, 0.1 * y), black, Some(Color::new(3.0, 5.0, 8.0)), false);
-    let block = Mat4::from_translation(Vec3::new(0.35, -0.6, -0.3)) * Mat4::from_rotation_y(0.4) * Mat4::from_scale(Vec3::splat(0.35));
-    b.add_shape(ShapeGeometry::Mesh(TriangleMesh::unit_cube().transformed(&block)), mirror, None, false);
+    b.add_shape(
+        quad(Vec3::new(0.0, 0.99, 0.0), 0.3 * x, 0.3 * z),
+        black,
+        Some(Color::splat(12.0)),
+        false,
+    );
+    b.add_shape(
+        quad(Vec3::new(-0.5, 0.5, -0.99), 0.2 * x, 0.1 * y),
+        black,
+        Some(Color::new(3.0, 5.0, 8.0)),
+        false,
+    );
+    let block = Mat4::from_translation(Vec3::new(0.35, -0.6, -0.3))
+        * Mat4::from_rotation_y(0.4)
+        * Mat4::from_scale(Vec3::splat(0.35));
+    b.add_shape(
+        ShapeGeometry::Mesh(TriangleMesh::unit_cube().transformed(&block)),
+        mirror,
+        None,
+        false,
+    );
     b.build()
 }
 
@@ -70,27 +130,54 @@ pub enum PlaneLight {
     /// A point light at height 1 above the origin.
     Point { intensity: f32 },
     /// A sun towards `dir` of solid angle `omega`.
-    Sun { dir: Vec3, omega: f32, radiance: f32 },
+    Sun {
+        dir: Vec3,
+        omega: f32,
+        radiance: f32,
+    },
 }
 
 pub const PLANE_ALBEDO: f32 = 0.5;
 
 /// A diffuse square (half-size 2, normal +y, through the origin) seen by a camera from above.
 pub fn plane(light: PlaneLight) -> Scene {
-    let cam = Camera::look_at(Vec3::new(0.0, 0.6, 2.5), Vec3::ZERO, Vec3::Y, 40.0, FovAxis::X, 32, 24).unwrap();
+    let cam = Camera::look_at(
+        Vec3::new(0.0, 0.6, 2.5),
+        Vec3::ZERO,
+        Vec3::Y,
+        40.0,
+        FovAxis::X,
+        32,
+        24,
+    )
+    .unwrap();
     let mut b = SceneBuilder::new(cam, RenderSettings::default());
     let white = diffuse(&mut b, PLANE_ALBEDO);
     let black = diffuse(&mut b, 0.0);
-    b.add_shape(quad(Vec3::ZERO, 2.0 * Vec3::Z, 2.0 * Vec3::X), white, None, false);
+    b.add_shape(
+        quad(Vec3::ZERO, 2.0 * Vec3::Z, 2.0 * Vec3::X),
+        white,
+        None,
+        false,
+    );
     match light {
         PlaneLight::Quad { half, le } => {
             let g = quad(Vec3::Y, half * Vec3::X, half * Vec3::Z);
             b.add_shape(g, black, Some(Color::splat(le)), false);
         }
-        PlaneLight::Point { intensity } => b.add_light(LightDesc::Point { position: Vec3::Y, intensity: Color::splat(intensity) }),
-        PlaneLight::Sun { dir, omega, radiance } => {
-            b.add_light(LightDesc::Sun { direction: dir, solid_angle: omega, radiance: Color::splat(radiance) })
-        }
+        PlaneLight::Point { intensity } => b.add_light(LightDesc::Point {
+            position: Vec3::Y,
+            intensity: Color::splat(intensity),
+        }),
+        PlaneLight::Sun {
+            dir,
+            omega,
+            radiance,
+        } => b.add_light(LightDesc::Sun {
+            direction: dir,
+            solid_angle: omega,
+            radiance: Color::splat(radiance),
+        }),
     }
     b.build()
 }
@@ -103,7 +190,8 @@ pub fn plane_irradiance(light: PlaneLight, x: Vec3) -> f64 {
     match light {
         PlaneLight::Quad { half, le } => {
             let h = half as f64;
-            let corners = [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(a, c)| glam::DVec3::new(a, 1.0, c) - x.as_dvec3());
+            let corners = [(-h, -h), (h, -h), (h, h), (-h, h)]
+                .map(|(a, c)| glam::DVec3::new(a, 1.0, c) - x.as_dvec3());
             let mut sum = 0.0;
             for i in 0..4 {
                 let (a, b) = (corners[i].normalize(), corners[(i + 1) % 4].normalize());
@@ -115,9 +203,17 @@ pub fn plane_irradiance(light: PlaneLight, x: Vec3) -> f64 {
             let d = Vec3::Y.as_dvec3() - x.as_dvec3();
             intensity as f64 * n.dot(d).max(0.0) / d.length().powi(3)
         }
-        PlaneLight::Sun { dir, omega, radiance } => {
+        PlaneLight::Sun {
+            dir,
+            omega,
+            radiance,
+        } => {
             let h = omega as f64 / (2.0 * std::f64::consts::PI);
-            radiance as f64 * std::f64::consts::PI * h * (2.0 - h) * n.dot(dir.normalize().as_dvec3())
+            radiance as f64
+                * std::f64::consts::PI
+                * h
+                * (2.0 - h)
+                * n.dot(dir.normalize().as_dvec3())
         }
     }
 }

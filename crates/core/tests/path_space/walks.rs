@@ -30,12 +30,19 @@ fn uv(s: &mut Sampler) -> Vec2 {
     s.next_2d()
 }
 
-/// One camera walk of at most `max_k` segments through `raster` (uniform over the film when
-/// `None`): reports s = 0 when it hits a light and s = 1 (next-event estimation) at every
+/// One camera walk through `raster` (uniform over the film when `None`) that reports paths of at
+/// most `max_k` segments: s = 0 when it hits a light and s = 1 (next-event estimation) at every
 /// non-delta surface vertex.
-pub fn camera_walk(scene: &Scene, rng: &mut Sampler, raster: Option<Vec2>, max_k: usize, out: &mut dyn FnMut(Made)) {
+pub fn camera_walk(
+    scene: &Scene,
+    rng: &mut Sampler,
+    raster: Option<Vec2>,
+    max_k: usize,
+    out: &mut dyn FnMut(Made),
+) {
     let cam = &scene.camera;
-    let raster = raster.unwrap_or_else(|| rng.next_2d() * Vec2::new(cam.width as f32, cam.height as f32));
+    let raster =
+        raster.unwrap_or_else(|| rng.next_2d() * Vec2::new(cam.width as f32, cam.height as f32));
     let mut ray = cam.generate_ray(raster);
     let mut verts = vec![PathVertex::camera(cam, Color::ONE)];
     let mut pdf_w = cam.pdf_dir(ray.d);
@@ -43,14 +50,20 @@ pub fn camera_walk(scene: &Scene, rng: &mut Sampler, raster: Option<Vec2>, max_k
     let mut pdf = 1.0f64;
     let mut f = DVec3::splat((cam.importance(ray.d) * cam.forward().dot(ray.d)) as f64);
     let mut beta = DVec3::ONE;
-    for _ in 0..max_k {
+    for k in 1..=max_k {
         let prev = *verts.last().unwrap();
         let Some(hit) = scene.intersect(&ray) else {
             // Escaped: every light at infinity is an x0 in solid angle, G = |cos| at prev.
             for &li in &scene.infinite_lights {
                 let x0 = PathVertex::light_escaped(li, ray.d, beta.as_vec3(), pdf_w);
                 let le = scene.lights[li as usize].escaped(ray.d).as_dvec3();
-                out(Made { path: Path::from_subpaths(&[x0], &verts), s: 0, pdf: pdf * pdf_w as f64, f: f * le, estimate: beta * le });
+                out(Made {
+                    path: Path::from_subpaths(&[x0], &verts),
+                    s: 0,
+                    pdf: pdf * pdf_w as f64,
+                    f: f * le,
+                    estimate: beta * le,
+                });
             }
             return;
         };
@@ -60,8 +73,16 @@ pub fn camera_walk(scene: &Scene, rng: &mut Sampler, raster: Option<Vec2>, max_k
         pdf *= pa as f64;
         f *= solid_angle_to_area(1.0, prev.p, hit.p, hit.ng) as f64;
         if let Some(x0) = v.as_light_endpoint(&hit) {
-            let le = scene.lights[hit.light.unwrap() as usize].emitted(hit.ng, -ray.d).as_dvec3();
-            out(Made { path: Path::from_subpaths(&[x0], &verts), s: 0, pdf, f: f * le, estimate: beta * le });
+            let le = scene.lights[hit.light.unwrap() as usize]
+                .emitted(hit.ng, -ray.d)
+                .as_dvec3();
+            out(Made {
+                path: Path::from_subpaths(&[x0], &verts),
+                s: 0,
+                pdf,
+                f: f * le,
+                estimate: beta * le,
+            });
             return; // lights are black: the walk ends
         }
         let m = scene.material(hit.material);
@@ -69,10 +90,12 @@ pub fn camera_walk(scene: &Scene, rng: &mut Sampler, raster: Option<Vec2>, max_k
         let wo = -ray.d;
         let mut camera_sub = verts.clone();
         camera_sub.push(v);
-        if !m.is_delta() {
+        if !m.is_delta() && k < max_k {
             nee(scene, rng, &hit, &camera_sub, wo, pdf, f, beta, out);
         }
-        let Some(bs) = m.sample(&sf, wo, rng.next_f32(), uv(rng), TransportMode::Radiance) else { return };
+        let Some(bs) = m.sample(&sf, wo, rng.next_f32(), uv(rng), TransportMode::Radiance) else {
+            return;
+        };
         f *= (bs.weight * bs.pdf_w).as_dvec3();
         beta *= bs.weight.as_dvec3();
         pdf_w = bs.pdf_w;
@@ -84,50 +107,100 @@ pub fn camera_walk(scene: &Scene, rng: &mut Sampler, raster: Option<Vec2>, max_k
 }
 
 #[allow(clippy::too_many_arguments)]
-fn nee(scene: &Scene, rng: &mut Sampler, hit: &lt_core::scene::SurfaceHit, sub: &[PathVertex], wo: Vec3, pdf: f64, f: DVec3, beta: DVec3, out: &mut dyn FnMut(Made)) {
-    let Some((li, pmf, _)) = scene.light_sampler.sample(rng.next_f32()) else { return };
+fn nee(
+    scene: &Scene,
+    rng: &mut Sampler,
+    hit: &lt_core::scene::SurfaceHit,
+    sub: &[PathVertex],
+    wo: Vec3,
+    pdf: f64,
+    f: DVec3,
+    beta: DVec3,
+    out: &mut dyn FnMut(Made),
+) {
+    let Some((li, pmf, _)) = scene.light_sampler.sample(rng.next_f32()) else {
+        return;
+    };
     let light = &scene.lights[li];
-    let Some(ls) = light.sample_li(hit.p, uv(rng)) else { return };
+    let Some(ls) = light.sample_li(hit.p, uv(rng)) else {
+        return;
+    };
     let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, sub.last().unwrap());
-    let e = scene.material(hit.material).eval(&hit.shading_frame(), wo, ls.wi, TransportMode::Radiance);
+    let e =
+        scene
+            .material(hit.material)
+            .eval(&hit.shading_frame(), wo, ls.wi, TransportMode::Radiance);
     // Density of x0 and the arrival factor at it (cos/d², 1/d² at a point, 1 at infinity).
     let (pa, g) = if ls.delta {
         (1.0, 1.0 / (ls.p - hit.p).length_squared())
     } else if light.is_infinite() {
         (ls.pdf_w, 1.0)
     } else {
-        (solid_angle_to_area(ls.pdf_w, hit.p, ls.p, ls.n), solid_angle_to_area(1.0, hit.p, ls.p, ls.n))
+        (
+            solid_angle_to_area(ls.pdf_w, hit.p, ls.p, ls.n),
+            solid_angle_to_area(1.0, hit.p, ls.p, ls.n),
+        )
     };
     // A point light's LightLiSample radiance is I/d²: Le·G needs the intensity I and G with 1/d².
-    let le = if ls.delta { ls.radiance * (ls.p - hit.p).length_squared() } else { ls.radiance };
+    let le = if ls.delta {
+        ls.radiance * (ls.p - hit.p).length_squared()
+    } else {
+        ls.radiance
+    };
     let est = beta * (e.f_cos * ls.radiance).as_dvec3() / (pmf * ls.pdf_w) as f64;
     let f = f * (e.f_cos * le).as_dvec3() * g as f64;
-    out(Made { path: Path::from_subpaths(&[x0], sub), s: 1, pdf: pdf * (pmf * pa) as f64, f, estimate: est });
+    out(Made {
+        path: Path::from_subpaths(&[x0], sub),
+        s: 1,
+        pdf: pdf * (pmf * pa) as f64,
+        f,
+        estimate: est,
+    });
 }
 
 /// One light walk of at most `max_k` segments, connected to the camera (t = 1, s = k) at every
 /// non-delta surface vertex that projects onto the film. Visibility is not tested (f excludes it).
 pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn FnMut(Made)) {
-    let Some((li, pmf, _)) = scene.light_sampler.sample(rng.next_f32()) else { return };
+    let Some((li, pmf, _)) = scene.light_sampler.sample(rng.next_f32()) else {
+        return;
+    };
     let light = &scene.lights[li];
-    let Some(le) = light.sample_le(uv(rng), uv(rng), scene.bounding_sphere) else { return };
+    let Some(le) = light.sample_le(uv(rng), uv(rng), scene.bounding_sphere) else {
+        return;
+    };
     let x0 = PathVertex::light_emitted(scene, li as u32, &le, pmf);
     let infinite = light.is_infinite();
     let mut verts = vec![x0];
     let mut pdf = (pmf * if infinite { le.pdf_dir } else { le.pdf_pos }) as f64;
-    let mut f = le.radiance.as_dvec3() * if infinite || light.delta_position() { 1.0 } else { le.n.dot(le.ray.d).abs() as f64 };
-    let mut beta = le.radiance.as_dvec3() * if infinite { 1.0 } else { le.n.dot(le.ray.d).abs() as f64 } / (pmf * le.pdf_pos * le.pdf_dir) as f64;
+    let mut f = le.radiance.as_dvec3()
+        * if infinite || light.delta_position() {
+            1.0
+        } else {
+            le.n.dot(le.ray.d).abs() as f64
+        };
+    let mut beta = le.radiance.as_dvec3()
+        * if infinite {
+            1.0
+        } else {
+            le.n.dot(le.ray.d).abs() as f64
+        }
+        / (pmf * le.pdf_pos * le.pdf_dir) as f64;
     let mut pdf_w = if infinite { le.pdf_pos } else { le.pdf_dir };
     let mut ray = le.ray;
     let cam = &scene.camera;
     for k in 1..max_k {
-        let Some(hit) = scene.intersect(&ray) else { return };
+        let Some(hit) = scene.intersect(&ray) else {
+            return;
+        };
         let prev = *verts.last().unwrap();
         let v = PathVertex::surface(&hit, beta.as_vec3(), pdf_w, &prev);
         let (pa, g) = if k == 1 && infinite {
             (pdf_w * hit.ng.dot(ray.d).abs(), hit.ng.dot(ray.d).abs())
         } else {
-            (solid_angle_to_area(pdf_w, prev.p, hit.p, hit.ng), solid_angle_to_area(1.0, prev.p, hit.p, hit.ng))
+            (
+                solid_angle_to_area(pdf_w, prev.p, hit.p, hit.ng),
+                solid_angle_to_area(1.0, prev.p, hit.p, hit.ng),
+            )
         };
         pdf *= pa as f64;
         f *= g as f64;
@@ -143,9 +216,17 @@ pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
             let mut sub = verts.clone();
             sub.push(v);
             let path = Path::from_subpaths(&sub, &[PathVertex::camera(cam, Color::ONE)]);
-            out(Made { path, s: k + 1, pdf, f: fc, estimate: splat });
+            out(Made {
+                path,
+                s: k + 1,
+                pdf,
+                f: fc,
+                estimate: splat,
+            });
         }
-        let Some(bs) = m.sample(&sf, wo, rng.next_f32(), uv(rng), TransportMode::Importance) else { return };
+        let Some(bs) = m.sample(&sf, wo, rng.next_f32(), uv(rng), TransportMode::Importance) else {
+            return;
+        };
         f *= (bs.weight * bs.pdf_w).as_dvec3();
         beta *= bs.weight.as_dvec3();
         pdf_w = bs.pdf_w;
