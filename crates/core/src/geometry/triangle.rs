@@ -3,7 +3,7 @@
 //! 2-D edge functions are then evaluated exactly enough that a ray through a shared edge or vertex
 //! hits at least one of the triangles sharing it (Möller–Trumbore lets such rays slip through).
 
-use crate::math::Vec3;
+use crate::math::{gamma, Vec3};
 
 /// The per-ray part of the test, computed once and reused for every triangle the ray meets.
 #[derive(Clone, Copy, Debug)]
@@ -69,7 +69,8 @@ pub fn intersect_triangle(r: &ShearedRay, t_max: f32, p: &[Vec3; 3]) -> (f32, [f
     if det == 0.0 || !det.is_finite() {
         return MISS;
     }
-    let t_scaled = u * (r.s.z * a[kz]) + v * (r.s.z * b[kz]) + w * (r.s.z * c[kz]);
+    let (az, bz, cz) = (r.s.z * a[kz], r.s.z * b[kz], r.s.z * c[kz]);
+    let t_scaled = u * az + v * bz + w * cz;
     // Compare t against (0, t_max) before dividing, with the sign of det folded in.
     let hit = if det < 0.0 {
         t_scaled < 0.0 && t_scaled > t_max * det
@@ -80,7 +81,23 @@ pub fn intersect_triangle(r: &ShearedRay, t_max: f32, p: &[Vec3; 3]) -> (f32, [f
         return MISS;
     }
     let inv = 1.0 / det;
-    (t_scaled * inv, [u * inv, v * inv, w * inv])
+    let t = t_scaled * inv;
+    // A ray leaving a surface point that lies exactly on the plane (zero error bound, so zero
+    // offset) would otherwise re-hit it at a rounding-sized t. Reject t within the conservative
+    // rounding bound of the computation above (pbrt-v4 §6.8.7, after Woop et al.).
+    let max_z = az.abs().max(bz.abs()).max(cz.abs());
+    let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+    let max_y = ay.abs().max(by.abs()).max(cy.abs());
+    let delta_z = gamma(3) * max_z;
+    let delta_x = gamma(5) * (max_x + max_z);
+    let delta_y = gamma(5) * (max_y + max_z);
+    let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    let max_e = u.abs().max(v.abs()).max(w.abs());
+    let delta_t = 3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv.abs();
+    if t <= delta_t {
+        return MISS;
+    }
+    (t, [u * inv, v * inv, w * inv])
 }
 
 #[cfg(test)]
@@ -110,6 +127,24 @@ mod tests {
                 hit,
                 "ray from {o} towards {target} slipped through the diagonal"
             );
+        }
+    }
+
+    #[test]
+    fn rays_leaving_a_triangle_on_a_coordinate_plane_do_not_rehit_it() {
+        // On y = 0 the hit point is exact, its error bound is zero and so is the origin offset.
+        let p = [
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        ];
+        let mut s = Sampler::new(9, 0, 0);
+        for _ in 0..20_000 {
+            let o = Vec3::new(s.next_f32() - 0.5, 0.0, s.next_f32() - 0.5) * 0.8;
+            let mut d = sample_uniform_sphere(s.next_2d());
+            d.y = d.y.abs();
+            let t = intersect_triangle(&ShearedRay::new(o, d), f32::INFINITY, &p).0;
+            assert!(t.is_infinite(), "re-hit at t = {t} from {o} along {d}");
         }
     }
 
