@@ -1,6 +1,7 @@
-//! One obvhs compressed-wide BVH over every primitive in the scene: triangles and analytic spheres
-//! live in the same tree, so a scene without spheres pays nothing for them and vice versa.
+//! One obvhs compressed-wide BVH over every primitive in the scene: triangles, parallelograms and
+//! analytic spheres live in the same tree, so a scene pays only for the kinds it has.
 
+use super::quad::Parallelogram;
 use super::ray::Ray;
 use super::sphere::intersect_sphere;
 use super::triangle::{intersect_triangle, ShearedRay};
@@ -20,6 +21,12 @@ pub enum Primitive {
         shape: u32,
         index: u32,
     },
+    /// Triangles `index` and `index + 1` of a mesh that form a parallelogram.
+    Quad {
+        q: Parallelogram,
+        shape: u32,
+        index: u32,
+    },
     Sphere {
         center: Vec3,
         radius: f32,
@@ -30,7 +37,9 @@ pub enum Primitive {
 impl Primitive {
     pub fn shape(&self) -> u32 {
         match *self {
-            Primitive::Triangle { shape, .. } | Primitive::Sphere { shape, .. } => shape,
+            Primitive::Triangle { shape, .. }
+            | Primitive::Quad { shape, .. }
+            | Primitive::Sphere { shape, .. } => shape,
         }
     }
 
@@ -39,6 +48,7 @@ impl Primitive {
     pub fn intersect(&self, r: &ShearedRay, o: Vec3, d: Vec3, t_max: f32) -> f32 {
         match self {
             Primitive::Triangle { p, .. } => intersect_triangle(r, t_max, p).0,
+            Primitive::Quad { q, .. } => q.intersect(o, d, t_max).0,
             &Primitive::Sphere { center, radius, .. } => {
                 intersect_sphere(o, d, t_max, center, radius)
             }
@@ -52,6 +62,13 @@ impl Boundable for Primitive {
             Primitive::Triangle { p, .. } => {
                 let [a, b, c] = p.map(Vec3A::from);
                 Aabb::new(a.min(b).min(c), a.max(b).max(c))
+            }
+            Primitive::Quad { q, .. } => {
+                let c = [q.p0, q.p0 + q.e1, q.p0 + q.e2, q.p0 + q.e1 + q.e2].map(Vec3A::from);
+                Aabb::new(
+                    c[0].min(c[1]).min(c[2]).min(c[3]),
+                    c[0].max(c[1]).max(c[2]).max(c[3]),
+                )
             }
             Primitive::Sphere { center, radius, .. } => {
                 let c = Vec3A::from(center);
@@ -195,11 +212,20 @@ mod tests {
             } else {
                 let e1 = sample_uniform_sphere(s.next_2d()) * scale;
                 let e2 = sample_uniform_sphere(s.next_2d()) * scale;
-                prims.push(Primitive::Triangle {
-                    p: [c, c + e1, c + e2],
-                    shape: i,
-                    index: 0,
-                });
+                if i % 3 == 1 {
+                    prims.push(Primitive::Triangle {
+                        p: [c, c + e1, c + e2],
+                        shape: i,
+                        index: 0,
+                    });
+                } else {
+                    let q = crate::geometry::quad::Parallelogram::new(c, e1, e2);
+                    prims.push(Primitive::Quad {
+                        q,
+                        shape: i,
+                        index: 0,
+                    });
+                }
             }
         }
         let accel = Accel::build(prims.clone());
@@ -209,6 +235,7 @@ mod tests {
             } else {
                 match prims[k % prims.len()] {
                     Primitive::Triangle { p, .. } => 0.4 * p[0] + 0.3 * p[1] + 0.3 * p[2],
+                    Primitive::Quad { q, .. } => q.p0 + 0.3 * q.e1 + 0.6 * q.e2,
                     Primitive::Sphere { center, radius, .. } => center + Vec3::X * radius * 1.001,
                 }
             };

@@ -1,6 +1,7 @@
 //! Rays, primitives and the acceleration structure.
 
 pub mod accel;
+pub mod quad;
 pub mod ray;
 pub mod sphere;
 pub mod triangle;

@@ -76,21 +76,49 @@ pub fn scatter(
             pdf_w: e.pdf_w,
         };
     }
-    let mut found: Option<Scatter> = None;
-    for u_lobe in LOBE_PROBES {
+    // The lobe whose direction is closest to `wi`, and how far the nearest other lobe is.
+    let mut best: Option<(f32, Scatter, Vec3)> = None;
+    let mut candidates = [None; LOBE_PROBES.len()];
+    for (slot, u_lobe) in candidates.iter_mut().zip(LOBE_PROBES) {
         if let Some(s) = m.sample(&sf, wo, u_lobe, Vec2::splat(0.5), mode) {
-            if s.delta && (s.wi - wi).length() < tol {
+            if s.delta {
+                let dist = (s.wi - wi).length();
                 // weight = f_cos / pdf for the lobe, so weight · pdf is the lobe's f_cos.
-                found = Some(Scatter {
+                let sc = Scatter {
                     f: s.weight * s.pdf_w / cos_g,
                     pdf_w: s.pdf_w,
-                });
-                break;
+                };
+                *slot = Some(s.wi);
+                if best.is_none_or(|b| dist < b.0) {
+                    best = Some((dist, sc, s.wi));
+                }
             }
         }
     }
-    found.unwrap_or_default()
+    let Some((dist, sc, dir)) = best else {
+        return Scatter::default();
+    };
+    let other = candidates
+        .iter()
+        .flatten()
+        .filter(|w| (**w - dir).length() > tol)
+        .map(|w| (*w - wi).length())
+        .fold(f32::INFINITY, f32::min);
+    // Refraction near grazing exit magnifies the positions' angular error by η·cos θt / cos θi,
+    // beyond `tol`; the match still stands when it is unambiguous (the other lobe is far further
+    // away) and the direction is within MAGNIFIED_TOL of the lobe.
+    if dist < tol || (dist < UNAMBIGUOUS_RATIO * other && dist < MAGNIFIED_TOL) {
+        sc
+    } else {
+        Scatter::default()
+    }
 }
+
+/// Largest mismatch (chord) accepted for an unambiguous lobe: 20× magnification of 5e-4.
+const MAGNIFIED_TOL: f32 = 1e-2;
+
+/// A lobe closer to `wi` than this fraction of the distance to any other lobe is the one taken.
+const UNAMBIGUOUS_RATIO: f32 = 0.05;
 
 /// True when a connection (a deterministic edge between two subpaths) may end at `v`: never at a
 /// delta surface; always at the camera and at lights (none of ours is delta in direction).

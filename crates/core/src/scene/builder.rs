@@ -4,6 +4,7 @@
 use super::{RenderSettings, Scene, Shape};
 use crate::bsdf::Material;
 use crate::camera::Camera;
+use crate::geometry::quad::Parallelogram;
 use crate::geometry::{Accel, Primitive};
 use crate::light::{Light, LightSampler};
 use crate::math::{Color, Vec3};
@@ -130,6 +131,33 @@ pub enum LightDesc {
     },
 }
 
+/// Triangles of a mesh as BVH primitives; consecutive pairs that split a parallelogram (quads,
+/// cube faces, quads triangulated from OBJ) become one analytic parallelogram.
+fn push_mesh_primitives(m: &TriangleMesh, shape: u32, prims: &mut Vec<Primitive>) {
+    let mut i = 0;
+    while i < m.indices.len() {
+        if i + 1 < m.indices.len() && m.triangle_area(i) > 0.0 && m.triangle_area(i + 1) > 0.0 {
+            if let Some(q) = Parallelogram::from_triangle_pair(m.triangle(i), m.triangle(i + 1)) {
+                prims.push(Primitive::Quad {
+                    q,
+                    shape,
+                    index: i as u32,
+                });
+                i += 2;
+                continue;
+            }
+        }
+        if m.triangle_area(i) > 0.0 {
+            prims.push(Primitive::Triangle {
+                p: m.triangle(i),
+                shape,
+                index: i as u32,
+            });
+        }
+        i += 1;
+    }
+}
+
 pub struct SceneBuilder {
     camera: Camera,
     settings: RenderSettings,
@@ -178,18 +206,7 @@ impl SceneBuilder {
         for (geometry, material, emission, flip_normals) in self.shapes {
             let shape_id = shapes.len() as u32;
             match &geometry {
-                ShapeGeometry::Mesh(m) => {
-                    for (i, _) in m.indices.iter().enumerate() {
-                        let [p0, p1, p2] = m.triangle(i);
-                        if m.triangle_area(i) > 0.0 {
-                            prims.push(Primitive::Triangle {
-                                p: [p0, p1, p2],
-                                shape: shape_id,
-                                index: i as u32,
-                            });
-                        }
-                    }
-                }
+                ShapeGeometry::Mesh(m) => push_mesh_primitives(m, shape_id, &mut prims),
                 &ShapeGeometry::Sphere { center, radius } => prims.push(Primitive::Sphere {
                     center,
                     radius,

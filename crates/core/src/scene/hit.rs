@@ -6,7 +6,7 @@ use crate::geometry::ray::barycentric_error;
 use crate::geometry::sphere::refine_sphere_hit;
 use crate::geometry::triangle::{intersect_triangle, ShearedRay};
 use crate::geometry::{offset_ray_origin, PrimHit, Primitive, Ray, SHADOW_EPSILON};
-use crate::math::Vec3;
+use crate::math::{gamma, Vec3};
 
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceHit {
@@ -43,6 +43,28 @@ impl SurfaceHit {
                     ShapeGeometry::Mesh(m) => {
                         m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng)
                     }
+                    ShapeGeometry::Sphere { .. } => ng,
+                };
+                (p, err, ng, ns)
+            }
+            Primitive::Quad { q, index, .. } => {
+                let (t, u, v) = q.intersect(ray.o, ray.d, f32::INFINITY);
+                let p = q.p0 + u * q.e1 + v * q.e2;
+                // Rounding of the plane point from (u, v), plus how far (u, v) may sit from the
+                // ray's exact crossing (the rounding of o + t·d − p0 they were computed from).
+                let crossing = (ray.o.abs() + (ray.d * t).abs() + q.p0.abs()) * gamma(6);
+                let err = (q.p0.abs() + (u * q.e1).abs() + (v * q.e2).abs()) * gamma(5) + crossing;
+                let ng = q.e1.cross(q.e2).normalize();
+                // Which of the two source triangles holds (u, v), with its barycentrics.
+                let (tri, b) = if u >= v {
+                    (index, [1.0 - u, u - v, v])
+                } else {
+                    (index + 1, [1.0 - v, u, v - u])
+                };
+                let ns = match &shape.geometry {
+                    ShapeGeometry::Mesh(m) => m
+                        .shading_normal(tri as usize, b[0], b[1], b[2])
+                        .unwrap_or(ng),
                     ShapeGeometry::Sphere { .. } => ng,
                 };
                 (p, err, ng, ns)
