@@ -67,6 +67,31 @@ pub(crate) fn escaped_radiance(
     l
 }
 
+/// Continues a camera path at `hit` by sampling its BSDF: multiplies the throughput by the sample
+/// weight and plays Russian roulette. `None` ends the path.
+#[inline]
+pub(crate) fn continue_path(
+    scene: &Scene,
+    hit: &SurfaceHit,
+    wo: lt_core::Vec3,
+    beta: &mut Color,
+    depth: u32,
+    rr_depth: u32,
+    sampler: &mut Sampler,
+) -> Option<lt_core::bsdf::BsdfSample> {
+    let u_lobe = sampler.next_f32();
+    let u = sampler.next_2d();
+    let bs = scene.material(hit.material).sample(
+        &hit.shading_frame(),
+        wo,
+        u_lobe,
+        u,
+        TransportMode::Radiance,
+    )?;
+    *beta *= bs.weight;
+    (*beta != Color::ZERO && russian_roulette(beta, depth, rr_depth, sampler)).then_some(bs)
+}
+
 impl Pt {
     /// Next-event estimation at `hit`: one light chosen by power, MIS-weighted against the BSDF.
     fn direct_light(
@@ -154,19 +179,17 @@ impl Pt {
             if !material.is_delta() {
                 l += beta * self.direct_light(scene, &hit, wo, sampler);
             }
-            let u_lobe = sampler.next_f32();
-            let u = sampler.next_2d();
-            let Some(bs) =
-                material.sample(&hit.shading_frame(), wo, u_lobe, u, TransportMode::Radiance)
-            else {
+            let Some(bs) = continue_path(
+                scene,
+                &hit,
+                wo,
+                &mut beta,
+                depth,
+                self.params.rr_depth,
+                sampler,
+            ) else {
                 break;
             };
-            beta *= bs.weight;
-            if beta == Color::ZERO
-                || !russian_roulette(&mut beta, depth, self.params.rr_depth, sampler)
-            {
-                break;
-            }
             prev_pdf_w = bs.pdf_w;
             prev_delta = bs.delta;
             prev_p = hit.p;

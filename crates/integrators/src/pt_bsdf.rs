@@ -9,9 +9,8 @@
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 
 use crate::pixel::pixel_pass;
-use crate::pt::{escaped_radiance, russian_roulette, PtParams};
+use crate::pt::{continue_path, escaped_radiance, PtParams};
 use crate::Integrator;
-use lt_core::bsdf::TransportMode;
 use lt_core::math::Color;
 use lt_core::sampling::Sampler;
 use lt_core::{Scene, Vec2};
@@ -38,23 +37,17 @@ impl PtBsdf {
             if depth == self.params.max_depth {
                 break;
             }
-            let u_lobe = sampler.next_f32();
-            let u = sampler.next_2d();
-            let Some(bs) = scene.material(hit.material).sample(
-                &hit.shading_frame(),
+            let Some(bs) = continue_path(
+                scene,
+                &hit,
                 wo,
-                u_lobe,
-                u,
-                TransportMode::Radiance,
+                &mut beta,
+                depth,
+                self.params.rr_depth,
+                sampler,
             ) else {
                 break;
             };
-            beta *= bs.weight;
-            if beta == Color::ZERO
-                || !russian_roulette(&mut beta, depth, self.params.rr_depth, sampler)
-            {
-                break;
-            }
             ray = hit.spawn_ray(bs.wi);
         }
         l
