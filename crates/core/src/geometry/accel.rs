@@ -90,6 +90,8 @@ pub struct Accel {
     /// Primitives in BVH order, so traversal ids index this directly.
     prims: Vec<Primitive>,
     bounds: (Vec3, Vec3),
+    /// Whether any primitive is a triangle: only triangles need the per-ray shear.
+    has_triangles: bool,
 }
 
 impl Accel {
@@ -99,6 +101,7 @@ impl Accel {
                 bvh: CwBvh::default(),
                 prims,
                 bounds: (Vec3::ZERO, Vec3::ZERO),
+                has_triangles: false,
             };
         }
         let mut build_time = Default::default();
@@ -111,10 +114,24 @@ impl Accel {
         let total = prims
             .iter()
             .fold(Aabb::empty(), |acc, p| acc.union(&p.aabb()));
+        let has_triangles = prims
+            .iter()
+            .any(|p| matches!(p, Primitive::Triangle { .. }));
         Accel {
+            has_triangles,
             bvh,
             prims: ordered,
             bounds: (total.min.into(), total.max.into()),
+        }
+    }
+
+    /// The triangle test's per-ray setup, skipped (never read) in scenes without triangles.
+    #[inline]
+    fn sheared(&self, o: Vec3, d: Vec3) -> ShearedRay {
+        if self.has_triangles {
+            ShearedRay::new(o, d)
+        } else {
+            ShearedRay::UNUSED
         }
     }
 
@@ -151,7 +168,7 @@ impl Accel {
         let mut hit = RayHit::none();
         let prims = &self.prims;
         let (o, d) = (ray.o, ray.d);
-        let sheared = ShearedRay::new(o, d);
+        let sheared = self.sheared(o, d);
         let found = self
             .bvh
             .ray_traverse(Self::obvhs_ray(ray), &mut hit, |r, id| {
@@ -172,7 +189,7 @@ impl Accel {
         }
         let prims = &self.prims;
         let (o, d, t_max) = (ray.o, ray.d, ray.t_max);
-        let sheared = ShearedRay::new(o, d);
+        let sheared = self.sheared(o, d);
         !self.bvh.ray_traverse_miss(Self::obvhs_ray(ray), |_, id| {
             prims[id].intersect(&sheared, o, d, t_max) + TRAVERSAL_BACKOFF
         })

@@ -14,6 +14,13 @@ pub struct ShearedRay {
 }
 
 impl ShearedRay {
+    /// Placeholder for rays that will meet no triangle.
+    pub const UNUSED: ShearedRay = ShearedRay {
+        o: Vec3::ZERO,
+        k: [0, 1, 2],
+        s: Vec3::ZERO,
+    };
+
     pub fn new(o: Vec3, d: Vec3) -> ShearedRay {
         let a = d.abs();
         let kz = if a.x > a.y {

@@ -4,18 +4,27 @@
 //! uniformly by area from inside.
 
 use super::{LightLeSample, LightLiSample};
+use crate::geometry::quad::Parallelogram;
 use crate::geometry::{offset_ray_origin, Ray};
 use crate::math::{gamma, luminance, Color, Frame, Vec2, Vec3, PI};
 use crate::sampling::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere,
     sample_uniform_triangle, uniform_cone_pdf, Distribution1D,
 };
-use crate::scene::ShapeGeometry;
+use crate::scene::{ShapeGeometry, TriangleMesh};
+
+/// A piece of an emitting mesh: a triangle, or a pair of triangles forming a parallelogram
+/// (sampled with two uniform variates, no square root; same uniform area density).
+#[derive(Clone, Debug)]
+enum Piece {
+    Triangle([Vec3; 3]),
+    Parallelogram(Parallelogram),
+}
 
 #[derive(Clone, Debug)]
 enum Emitter {
     Triangles {
-        tris: Vec<[Vec3; 3]>,
+        pieces: Vec<Piece>,
         pick: Distribution1D,
     },
     Sphere {
@@ -33,6 +42,27 @@ pub struct AreaLight {
     emitter: Emitter,
 }
 
+/// The mesh's triangles as sampling pieces (parallelogram pairs merged, as the BVH does) with
+/// their areas.
+fn mesh_pieces(m: &TriangleMesh) -> (Vec<Piece>, Vec<f32>) {
+    let (mut pieces, mut areas) = (Vec::new(), Vec::new());
+    let mut i = 0;
+    while i < m.indices.len() {
+        if i + 1 < m.indices.len() {
+            if let Some(q) = Parallelogram::from_triangle_pair(m.triangle(i), m.triangle(i + 1)) {
+                areas.push(m.triangle_area(i) + m.triangle_area(i + 1));
+                pieces.push(Piece::Parallelogram(q));
+                i += 2;
+                continue;
+            }
+        }
+        areas.push(m.triangle_area(i));
+        pieces.push(Piece::Triangle(m.triangle(i)));
+        i += 1;
+    }
+    (pieces, areas)
+}
+
 impl AreaLight {
     pub fn new(
         shape: u32,
@@ -42,12 +72,11 @@ impl AreaLight {
     ) -> AreaLight {
         let (emitter, area) = match geometry {
             ShapeGeometry::Mesh(m) => {
-                let tris: Vec<[Vec3; 3]> = (0..m.indices.len()).map(|i| m.triangle(i)).collect();
-                let areas: Vec<f32> = (0..m.indices.len()).map(|i| m.triangle_area(i)).collect();
+                let (pieces, areas) = mesh_pieces(m);
                 let total: f64 = areas.iter().map(|&a| a as f64).sum();
                 (
                     Emitter::Triangles {
-                        tris,
+                        pieces,
                         pick: Distribution1D::new(&areas),
                     },
                     total as f32,
@@ -70,17 +99,22 @@ impl AreaLight {
     /// A uniformly distributed point on the surface with its outward (emitting-side) normal.
     fn sample_area(&self, u: Vec2) -> (Vec3, Vec3, Vec3) {
         let (p, n, err) = match &self.emitter {
-            Emitter::Triangles { tris, pick } => {
+            Emitter::Triangles { pieces, pick } => {
                 let (i, _, ux) = pick.sample(u.x);
-                let [a, b, c] = tris[i];
-                let (b1, b2) = sample_uniform_triangle(Vec2::new(ux, u.y));
-                let b0 = 1.0 - b1 - b2;
-                let p = b0 * a + b1 * b + b2 * c;
-                (
-                    p,
-                    (b - a).cross(c - a).normalize(),
-                    crate::geometry::ray::barycentric_error([b0, b1, b2], [a, b, c]),
-                )
+                match &pieces[i] {
+                    &Piece::Triangle([a, b, c]) => {
+                        let (b1, b2) = sample_uniform_triangle(Vec2::new(ux, u.y));
+                        let b0 = 1.0 - b1 - b2;
+                        let p = b0 * a + b1 * b + b2 * c;
+                        let err = crate::geometry::ray::barycentric_error([b0, b1, b2], [a, b, c]);
+                        (p, (b - a).cross(c - a).normalize(), err)
+                    }
+                    Piece::Parallelogram(q) => {
+                        let (e1, e2) = (ux * q.e1, u.y * q.e2);
+                        let err = (q.p0.abs() + e1.abs() + e2.abs()) * gamma(3);
+                        (q.p0 + e1 + e2, q.e1.cross(q.e2).normalize(), err)
+                    }
+                }
             }
             &Emitter::Sphere { center, radius } => {
                 let n = sample_uniform_sphere(u);
