@@ -33,26 +33,6 @@ impl Ray {
 /// It is relative to the segment length, so it is the same at every scene scale.
 pub const SHADOW_EPSILON: f32 = 1e-4;
 
-#[inline]
-fn next_float_up(v: f32) -> f32 {
-    if v.is_infinite() && v > 0.0 {
-        return v;
-    }
-    let v = if v == -0.0 { 0.0 } else { v };
-    let bits = v.to_bits();
-    f32::from_bits(if v >= 0.0 { bits + 1 } else { bits - 1 })
-}
-
-#[inline]
-fn next_float_down(v: f32) -> f32 {
-    if v.is_infinite() && v < 0.0 {
-        return v;
-    }
-    let v = if v == 0.0 { -0.0 } else { v };
-    let bits = v.to_bits();
-    f32::from_bits(if v > 0.0 { bits - 1 } else { bits + 1 })
-}
-
 /// Moves `p` (with per-axis error bound `p_err`) off the surface with geometric normal `ng`, to the
 /// side that `w` points into, far enough that the new origin is provably on that side.
 pub fn offset_ray_origin(p: Vec3, p_err: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
@@ -61,16 +41,11 @@ pub fn offset_ray_origin(p: Vec3, p_err: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
     if w.dot(ng) < 0.0 {
         offset = -offset;
     }
-    let mut po = p + offset;
-    // Round away from p so the rounding of the addition cannot pull the point back into the box.
-    for i in 0..3 {
-        if offset[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
-        }
-    }
-    po
+    let po = p + offset;
+    // Push each moved coordinate at least one ulp further from p, so the rounding of the addition
+    // cannot pull the point back into the error box (a branch-free stand-in for next-float-up/down).
+    let away = Vec3::select(offset.cmpeq(Vec3::ZERO), Vec3::ZERO, offset.signum());
+    po + away * (po.abs() * f32::EPSILON + Vec3::splat(f32::MIN_POSITIVE))
 }
 
 /// Error bound of a point computed as a sum of three products b_i·p_i (triangle barycentrics).
