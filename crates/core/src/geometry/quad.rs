@@ -43,6 +43,13 @@ impl Parallelogram {
             .then(|| Parallelogram::new(p0, e1, e2))
     }
 
+    /// Parameters (u, v) of a point in the parallelogram's plane.
+    #[inline]
+    pub fn uv_at(&self, p: Vec3) -> (f32, f32) {
+        let q = p - self.p0;
+        (q.dot(self.e2.cross(self.n)), q.dot(self.n.cross(self.e1)))
+    }
+
     /// (t, u, v) of the hit in (0, t_max), or t = +∞.
     #[inline]
     pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> (f32, f32, f32) {

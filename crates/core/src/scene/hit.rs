@@ -48,7 +48,8 @@ impl SurfaceHit {
                 (p, err, ng, ns)
             }
             Primitive::Quad { q, index, .. } => {
-                let (t, u, v) = q.intersect(ray.o, ray.d, f32::INFINITY);
+                let t = h.t;
+                let (u, v) = q.uv_at(ray.at(t));
                 let p = q.p0 + u * q.e1 + v * q.e2;
                 // Rounding of the plane point from (u, v), plus how far (u, v) may sit from the
                 // ray's exact crossing (the rounding of o + t·d − p0 they were computed from).
