@@ -96,9 +96,17 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     let mut last_checkpoint = Instant::now();
     let mut checkpoint_error = None;
     let result = render(&scene, integrator.as_ref(), &opts, |r| {
-        bar.set_position(r.passes_done as u64);
+        bar.set_position(if args.time.is_some() {
+            r.elapsed.as_millis() as u64
+        } else {
+            r.passes_done as u64
+        });
         let rate = r.passes_done as f64 * pixels / r.elapsed.as_secs_f64().max(1e-9);
-        bar.set_message(format!("{:.2} Msamples/s", rate / 1e6));
+        bar.set_message(format!(
+            "{} spp, {:.2} Msamples/s",
+            r.passes_done,
+            rate / 1e6
+        ));
         if last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint {
             last_checkpoint = Instant::now();
             if let Err(e) = write_outputs(&args.output, r.accumulated) {
@@ -153,19 +161,21 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
+/// Counts passes against the pass budget, or milliseconds against the time budget when there is
+/// one (the pass count then goes in the message), so the ETA is meaningful in both modes.
 fn progress_bar(args: &RenderArgs, passes: u32) -> ProgressBar {
     if args.quiet {
         return ProgressBar::hidden();
     }
-    let bar = if passes == u32::MAX {
-        ProgressBar::new_spinner()
-    } else {
-        ProgressBar::new(passes as u64)
+    let (len, unit) = match args.time {
+        Some(t) => ((t * 1000.0) as u64, "ms"),
+        None => (passes as u64, "passes"),
     };
+    let bar = ProgressBar::new(len);
     bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} passes  {msg}  ETA {eta}",
-        )
+        ProgressStyle::with_template(&format!(
+            "[{{elapsed_precise}}] {{bar:30}} {{pos}}/{{len}} {unit}  {{msg}}  ETA {{eta}}"
+        ))
         .unwrap(),
     );
     bar
