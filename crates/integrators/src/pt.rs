@@ -14,7 +14,7 @@
 
 use crate::pixel::pixel_pass;
 use crate::Integrator;
-use lt_core::bsdf::TransportMode;
+use lt_core::bsdf::{ShadingFrame, TransportMode};
 use lt_core::math::Color;
 use lt_core::sampling::{power_heuristic, Sampler};
 use lt_core::scene::SurfaceHit;
@@ -73,6 +73,7 @@ pub(crate) fn escaped_radiance(
 pub(crate) fn continue_path(
     scene: &Scene,
     hit: &SurfaceHit,
+    sf: &ShadingFrame,
     wo: lt_core::Vec3,
     beta: &mut Color,
     depth: u32,
@@ -81,13 +82,9 @@ pub(crate) fn continue_path(
 ) -> Option<lt_core::bsdf::BsdfSample> {
     let u_lobe = sampler.next_f32();
     let u = sampler.next_2d();
-    let bs = scene.material(hit.material).sample(
-        &hit.shading_frame(),
-        wo,
-        u_lobe,
-        u,
-        TransportMode::Radiance,
-    )?;
+    let bs = scene
+        .material(hit.material)
+        .sample(sf, wo, u_lobe, u, TransportMode::Radiance)?;
     *beta *= bs.weight;
     (*beta != Color::ZERO && russian_roulette(beta, depth, rr_depth, sampler)).then_some(bs)
 }
@@ -98,6 +95,7 @@ impl Pt {
         &self,
         scene: &Scene,
         hit: &SurfaceHit,
+        sf: &ShadingFrame,
         wo: lt_core::Vec3,
         sampler: &mut Sampler,
     ) -> Color {
@@ -113,7 +111,7 @@ impl Pt {
             return Color::ZERO;
         }
         let material = scene.material(hit.material);
-        let ev = material.eval(&hit.shading_frame(), wo, ls.wi, TransportMode::Radiance);
+        let ev = material.eval(sf, wo, ls.wi, TransportMode::Radiance);
         if ev.f_cos == Color::ZERO {
             return Color::ZERO;
         }
@@ -176,12 +174,14 @@ impl Pt {
                 break;
             }
             let material = scene.material(hit.material);
+            let sf = hit.shading_frame();
             if !material.is_delta() {
-                l += beta * self.direct_light(scene, &hit, wo, sampler);
+                l += beta * self.direct_light(scene, &hit, &sf, wo, sampler);
             }
             let Some(bs) = continue_path(
                 scene,
                 &hit,
+                &sf,
                 wo,
                 &mut beta,
                 depth,

@@ -40,6 +40,7 @@ impl PtBsdf {
             let Some(bs) = continue_path(
                 scene,
                 &hit,
+                &hit.shading_frame(),
                 wo,
                 &mut beta,
                 depth,
