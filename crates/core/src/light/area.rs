@@ -239,6 +239,8 @@ impl AreaLight {
         let ray = Ray::new(offset_ray_origin(p, err, n, d), d);
         Some(LightLeSample {
             ray,
+            p,
+            p_err: err,
             n,
             radiance: self.emission,
             pdf_pos: 1.0 / self.area,

@@ -29,6 +29,8 @@ impl EnvironmentLight {
         let ray = ray_from_bounding_disk(d, u_pos, bounds);
         LightLeSample {
             ray,
+            p: ray.o,
+            p_err: Vec3::ZERO,
             n: d,
             radiance: self.radiance,
             pdf_pos: disk_pdf(bounds),

@@ -43,7 +43,12 @@ pub struct LightLiSample {
 /// A ray leaving a light.
 #[derive(Clone, Copy, Debug)]
 pub struct LightLeSample {
+    /// Starts just off the light (offset by `p_err`), ready to trace.
     pub ray: Ray,
+    /// The sampled point itself (on the bounding disk for lights at infinity) and its rounding
+    /// bound, for the path vertex that records it.
+    pub p: Vec3,
+    pub p_err: Vec3,
     /// Normal at the ray origin (for distant lights: the ray direction).
     pub n: Vec3,
     /// Emitted radiance along the ray (point lights: intensity).

@@ -35,6 +35,8 @@ impl PointLight {
         let d = sample_uniform_sphere(u_dir);
         LightLeSample {
             ray: Ray::new(self.position, d),
+            p: self.position,
+            p_err: Vec3::ZERO,
             n: d,
             radiance: self.intensity,
             pdf_pos: 1.0,

@@ -100,8 +100,11 @@ impl SunLight {
     pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2, bounds: (Vec3, f32)) -> LightLeSample {
         let to_sun = self.sample_dir(u_dir);
         let d = -to_sun;
+        let ray = ray_from_bounding_disk(d, u_pos, bounds);
         LightLeSample {
-            ray: ray_from_bounding_disk(d, u_pos, bounds),
+            ray,
+            p: ray.o,
+            p_err: Vec3::ZERO,
             n: d,
             radiance: self.radiance,
             pdf_pos: disk_pdf(bounds),

@@ -136,16 +136,18 @@ impl PathVertex {
         }
         let pdf = pmf * s.pdf_pos;
         let n = if l.delta_position() { Vec3::ZERO } else { s.n };
-        PathVertex::endpoint(
+        let mut v = PathVertex::endpoint(
             VertexKind::Light {
                 light,
                 infinite: false,
             },
-            s.ray.o,
+            s.p,
             n,
             s.radiance / pdf,
             pdf,
-        )
+        );
+        v.p_err = s.p_err;
+        v
     }
 
     /// x0 chosen by next-event estimation from `from` (`Light::sample_li`, light chosen with `pmf`):
