@@ -25,17 +25,13 @@ impl EnvironmentLight {
     }
 
     pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2, bounds: (Vec3, f32)) -> LightLeSample {
-        let d = -sample_uniform_sphere(u_dir);
-        let ray = ray_from_bounding_disk(d, u_pos, bounds);
-        LightLeSample {
-            ray,
-            p: ray.o,
-            p_err: Vec3::ZERO,
-            n: d,
-            radiance: self.radiance,
-            pdf_pos: disk_pdf(bounds),
-            pdf_dir: UNIFORM_SPHERE_PDF,
-        }
+        distant_le(
+            -sample_uniform_sphere(u_dir),
+            u_pos,
+            bounds,
+            self.radiance,
+            UNIFORM_SPHERE_PDF,
+        )
     }
 }
 
@@ -55,6 +51,27 @@ pub fn power(l: &EnvironmentLight, bounds: (Vec3, f32)) -> f32 {
 /// sphere: where rays from a light at infinity start.
 pub fn disk_pdf(bounds: (Vec3, f32)) -> f32 {
     1.0 / (PI * bounds.1 * bounds.1)
+}
+
+/// The emitted ray of a light at infinity travelling in direction `d`: its origin is uniform on
+/// the bounding disk upstream of the scene; `pdf_dir` is the light's own directional pdf.
+pub fn distant_le(
+    d: Vec3,
+    u_pos: Vec2,
+    bounds: (Vec3, f32),
+    radiance: Color,
+    pdf_dir: f32,
+) -> LightLeSample {
+    let ray = ray_from_bounding_disk(d, u_pos, bounds);
+    LightLeSample {
+        ray,
+        p: ray.o,
+        p_err: Vec3::ZERO,
+        n: d,
+        radiance,
+        pdf_pos: disk_pdf(bounds),
+        pdf_dir,
+    }
 }
 
 /// A ray travelling in direction `d` that starts on the bounding disk upstream of the scene.

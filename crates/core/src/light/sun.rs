@@ -2,7 +2,7 @@
 //! has a finite pdf and takes part in MIS like any area light. The cone is stored through
 //! 1 − cos θmax = Ω / 2π, which keeps full precision for tiny cones.
 
-use super::environment::{disk_pdf, ray_from_bounding_disk};
+use super::environment::{disk_pdf, distant_le};
 use super::{LightLeSample, LightLiSample};
 use crate::math::{luminance, Color, Frame, Vec2, Vec3, PI};
 use crate::sampling::{sample_uniform_cone, uniform_cone_pdf};
@@ -98,18 +98,14 @@ impl SunLight {
     }
 
     pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2, bounds: (Vec3, f32)) -> LightLeSample {
-        let to_sun = self.sample_dir(u_dir);
-        let d = -to_sun;
-        let ray = ray_from_bounding_disk(d, u_pos, bounds);
-        LightLeSample {
-            ray,
-            p: ray.o,
-            p_err: Vec3::ZERO,
-            n: d,
-            radiance: self.radiance,
-            pdf_pos: disk_pdf(bounds),
-            pdf_dir: uniform_cone_pdf(self.one_minus_cos_max),
-        }
+        let d = -self.sample_dir(u_dir);
+        distant_le(
+            d,
+            u_pos,
+            bounds,
+            self.radiance,
+            uniform_cone_pdf(self.one_minus_cos_max),
+        )
     }
 
     /// `dir` is the direction light travels (away from the sun).
