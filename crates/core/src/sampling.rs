@@ -18,8 +18,32 @@ fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// Which family of work items a stream belongs to. Light path i and pixel i are different items:
+/// without the domain word they would draw the same numbers, correlating the two ends of every
+/// connection that pairs them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Domain {
+    /// Camera samples, one per pixel (and streams with no other use, such as tests).
+    Camera = 0,
+    /// Light subpaths (light tracing, BDPT, photons).
+    Light = 1,
+    /// Next-event and other samples drawn apart from a subpath.
+    Aux = 2,
+}
+
+/// Items are pixel or path indices, far below 2⁵⁶: the top byte is free for the domain.
+const DOMAIN_SHIFT: u32 = 56;
+
 impl Sampler {
+    /// The stream for one item of a domain in one pass of one seeded run. Camera-domain streams
+    /// are exactly `Sampler::new`'s.
+    pub fn for_item(domain: Domain, seed: u64, item: u64, pass: u64) -> Sampler {
+        debug_assert!(item < 1 << DOMAIN_SHIFT);
+        Sampler::new(seed, item ^ ((domain as u64) << DOMAIN_SHIFT), pass)
+    }
+
     /// The stream for one work item (a pixel, or a light path) in one pass of one seeded run.
+    /// Integrators use `for_item`, which keeps domains apart.
     pub fn new(seed: u64, item: u64, pass: u64) -> Sampler {
         let state = mix64(seed ^ mix64(item.wrapping_add(0x9e3779b97f4a7c15)));
         let stream = mix64(pass ^ mix64(seed.wrapping_add(item.rotate_left(32))));
@@ -207,6 +231,30 @@ mod tests {
             .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
+    }
+
+    #[test]
+    fn domains_give_uncorrelated_streams_for_the_same_item() {
+        // Pearson correlation of the first variate of camera item i and light item i over n items:
+        // √n·r is standard normal when they are independent (identical streams give r = 1).
+        let n = 20_000u64;
+        let (mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0f64, 0.0, 0.0, 0.0, 0.0);
+        for i in 0..n {
+            let x = Sampler::for_item(Domain::Camera, 5, i, 0).next_f32() as f64;
+            let y = Sampler::for_item(Domain::Light, 5, i, 0).next_f32() as f64;
+            sx += x;
+            sy += y;
+            sxx += x * x;
+            syy += y * y;
+            sxy += x * y;
+        }
+        let nf = n as f64;
+        let cov = sxy / nf - sx * sy / (nf * nf);
+        let r = cov / ((sxx / nf - (sx / nf).powi(2)) * (syy / nf - (sy / nf).powi(2))).sqrt();
+        assert!((r * nf.sqrt()).abs() < 4.0, "r = {r}");
+        // The camera domain keeps the streams every earlier image was rendered with.
+        let a = Sampler::for_item(Domain::Camera, 5, 9, 2).next_f32();
+        assert_eq!(a, Sampler::new(5, 9, 2).next_f32());
     }
 
     #[test]

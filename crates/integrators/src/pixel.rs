@@ -1,7 +1,7 @@
 //! One pass of a pixel-based estimator: every pixel gets one camera sample from its own stream.
 
 use lt_core::math::is_valid_color;
-use lt_core::sampling::Sampler;
+use lt_core::sampling::{Domain, Sampler};
 use lt_core::{Color, Scene, Vec2};
 use lt_estimators::Image;
 use rayon::prelude::*;
@@ -22,7 +22,7 @@ pub fn pixel_pass(
     img.data.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         let mut bad = 0;
         for (x, px) in row.iter_mut().enumerate() {
-            let mut s = Sampler::new(seed, (y * w + x) as u64, pass as u64);
+            let mut s = Sampler::for_item(Domain::Camera, seed, (y * w + x) as u64, pass as u64);
             let raster = Vec2::new(x as f32 + s.next_f32(), y as f32 + s.next_f32());
             let c = estimate(&mut s, raster);
             if is_valid_color(c) {
