@@ -61,6 +61,8 @@ fn light_walks_splatted_to_the_camera_match_pk_and_f() {
     let scene = cornell(BoxConfig::default());
     let made = collect(&scene, 3, 20_000, false, 8);
     assert!(made.len() > 10_000 && made.iter().all(|m| m.s == m.path.k()));
+    // The emitter seen directly (k = 1) is technique 1 by the emitted point's density.
+    assert!(made.iter().filter(|m| m.path.k() == 1).count() > 1000);
     assert!(made
         .iter()
         .any(|m| m.path.vertices.iter().any(|v| is_mirror(&scene, v))));

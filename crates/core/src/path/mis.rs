@@ -1,9 +1,16 @@
 //! Multiple importance sampling weights over the techniques s = 0 … k+1 of one path (Veach &
-//! Guibas 1995; Veach 1997, ch. 9 and 10). Pure functions of the densities: they copy, never
+//! Guibas 1995; Veach 1997, ch. 9 and 10). Pure functions of the densities: they read, never
 //! mutate vertices (Tungsten's `misWeight`, not pbrt's scoped assignments).
 //!
-//! No sample-count factor n_s appears: with one light subpath per camera sample, every technique
-//! is taken once per camera sample, so all n_s are equal (see the module docs of `path`).
+//! Every weight is computed from a [`Chain`]: the per-vertex densities of the path in both walk
+//! directions. `Path::densities` fills one from scratch (the oracle); BDPT and VCM fill one from
+//! their subpaths' stored `pdf_fwd`/`pdf_rev`, patching the entries at the connection. Both then
+//! run the same arithmetic here, so a disagreement between them is a disagreement about densities.
+//!
+//! **Sample counts.** The heuristics weigh n_s·p_s, n_s being how many samples technique s takes
+//! per pass (Veach 1997, eq. 9.13). Every technique with a camera subpath (t ≥ 2) is taken once
+//! per camera sample; light tracing (t = 1) once per light subpath, and a pass may trace M light
+//! subpaths for its N camera samples. Only the ratio matters: `Chain::light_tracing_ratio` = M/N.
 //!
 //! The densities are delta-stripped (`path::scatter`). For mirrors and every non-delta vertex the
 //! stripped p_s are the true densities in one common measure, so these are exactly the balance and
@@ -12,18 +19,217 @@
 //! stripped p_s then differ from common-measure densities by the Jacobian η_L² cos θ_L /
 //! (η_C² cos θ_C) per such refraction. The weights still sum to one and vanish where p_s = 0, so
 //! every estimator stays unbiased; they are just not the exact heuristic there (nor are pbrt's,
-//! which make the same choice). Exact ones would use p̂_s = p_s · f_0 / f_s with f_s =
-//! `contribution_for(s)`.
+//! which make the same choice).
 
 use super::path::Densities;
 
-/// Balance heuristic w_s = p_s / Σ_i p_i. Zero when p_s = 0 (the technique cannot make the path).
+/// How techniques that can produce the same path share it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Heuristic {
+    /// w_s = n_s p_s / Σ n_i p_i.
+    Balance,
+    /// w_s = (n_s p_s)² / Σ (n_i p_i)² — the project default (Veach's β = 2).
+    Power,
+    /// w_s = 1 / (number of techniques with p_i > 0): unbiased, no variance reduction.
+    Uniform,
+}
+
+impl Heuristic {
+    /// The command-line names: `balance`, `power`, `none`.
+    pub fn parse(name: &str) -> Result<Heuristic, String> {
+        match name {
+            "balance" => Ok(Heuristic::Balance),
+            "power" => Ok(Heuristic::Power),
+            "none" => Ok(Heuristic::Uniform),
+            _ => Err(format!(
+                "unknown MIS heuristic '{name}' (known: balance, power, none)"
+            )),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Heuristic::Balance => "balance",
+            Heuristic::Power => "power",
+            Heuristic::Uniform => "none",
+        }
+    }
+
+    /// The weight of a technique given r_i = n_i p_i / (n_s p_s) for every technique (r_s = 1).
+    #[inline]
+    pub fn weight_from_ratios(self, r: &[f64]) -> f64 {
+        let sum: f64 = match self {
+            Heuristic::Balance => r.iter().sum(),
+            Heuristic::Power => r.iter().map(|&x| x * x).sum(),
+            Heuristic::Uniform => r.iter().filter(|&&x| x > 0.0).count() as f64,
+        };
+        let w = 1.0 / sum;
+        // An infinite ratio (a neighbour infinitely more likely) or a NaN from a zero density
+        // where the contribution is zero as well: the technique gets nothing.
+        if w.is_finite() {
+            w
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The densities of one path of k segments, x0 (light) … xk (camera), that every weight reads.
+/// `light[i]`: density of x_i when the light subpath generates it; `camera[i]`: when the camera
+/// subpath does; `nee`: of x0 chosen by next-event estimation from x1. See `Densities`.
+#[derive(Clone, Copy, Debug)]
+pub struct Chain<'a> {
+    pub light: &'a [f64],
+    pub camera: &'a [f64],
+    pub nee: f64,
+    pub connectable: &'a [bool],
+    /// Light subpaths per camera sample in a pass (M/N): n_k / n_s for s < k.
+    pub light_tracing_ratio: f64,
+}
+
+impl Chain<'_> {
+    /// Number of segments k.
+    #[inline]
+    pub fn k(&self) -> usize {
+        self.light.len() - 1
+    }
+
+    /// Whether technique s can produce the path at all, judged by structure only: s = k+1 needs
+    /// a camera a walk can hit (never, with a pinhole); 1 ≤ s ≤ k connects x_{s−1} with x_s,
+    /// which must both be connectable. (s = 0 with a point light is excluded by `camera[0]` = 0.)
+    #[inline]
+    pub fn valid(&self, s: usize) -> bool {
+        s <= self.k() && (s == 0 || (self.connectable[s - 1] && self.connectable[s]))
+    }
+
+    /// Whether technique 1 takes x0 from next-event estimation. It does whenever a camera subpath
+    /// vertex x1 exists to sample from (k ≥ 2). On a one-segment path (an emitter seen directly)
+    /// technique 1 is light tracing's x0: the emitted point, from `light[0]`, connected to the
+    /// pinhole — what a light tracer does; next-event estimation from the pinhole is not sampled
+    /// by any integrator here.
+    #[inline]
+    pub fn one_is_nee(&self) -> bool {
+        self.k() >= 2
+    }
+
+    /// The density of the light subpath x0 … x_{s−1} alone.
+    pub fn light_prefix(&self, s: usize) -> f64 {
+        match s {
+            0 => 1.0,
+            1 if self.one_is_nee() => self.nee,
+            _ => self.light[..s].iter().product(),
+        }
+    }
+
+    /// p_s(x̄) (Russian roulette excluded), zero when technique s cannot produce the path.
+    pub fn technique(&self, s: usize) -> f64 {
+        if !self.valid(s) {
+            return 0.0;
+        }
+        self.light_prefix(s) * self.camera[s..].iter().product::<f64>()
+    }
+
+    /// n_s relative to the camera-sample count: the light-tracing ratio for s = k, else 1.
+    #[inline]
+    pub fn sample_count(&self, s: usize) -> f64 {
+        if s == self.k() {
+            self.light_tracing_ratio
+        } else {
+            1.0
+        }
+    }
+
+    /// n_s·p_s for every s = 0 … k+1: what the heuristics compare.
+    pub fn effective_all(&self) -> Vec<f64> {
+        (0..=self.k() + 1)
+            .map(|s| self.sample_count(s) * self.technique(s))
+            .collect()
+    }
+
+    /// r_i = n_i p_i / (n_s p_s) for every i (p_s > 0), by Veach's recursion (1997, §10.2)
+    /// instead of products: moving x_i from the camera subpath to the light subpath gives
+    /// p_{i+1} / p_i = l_i / c_i. When technique 1 is next-event estimation it draws x0 by `nee`
+    /// instead of l_0, so the chain steps from 0 straight to 2 (ratio l_0·l_1 / (c_0·c_1)) and
+    /// p_1 hangs off a neighbour (p_1 / p_0 = nee / c_0). Every divisor is a density of p_s itself,
+    /// hence non-zero: no remap0 (pbrt) is needed, and a delta light's c_0 = 0 zeroes p_0 by
+    /// itself. Delta-stripped densities keep the chain finite through delta vertices; techniques
+    /// that connect there are zeroed at the end. `out` must hold k+2 entries.
+    pub fn relative(&self, s: usize, out: &mut [f64]) {
+        let k = self.k();
+        let (l, c) = (self.light, self.camera);
+        let r = &mut out[..k + 2];
+        r.fill(0.0);
+        r[s] = 1.0;
+        let skip = self.one_is_nee();
+        if skip && s == 1 {
+            r[0] = c[0] / self.nee;
+            r[2] = l[0] * l[1] / (self.nee * c[1]);
+        }
+        let lo = if skip && s == 1 { 2 } else { s };
+        // Up the chain: techniques lo+1 … k+1 (with next-event estimation, 0 steps to 2).
+        let mut i = lo;
+        while i <= k {
+            let (next, ratio) = if skip && i == 0 {
+                (2, l[0] * l[1] / (c[0] * c[1]))
+            } else {
+                (i + 1, l[i] / c[i])
+            };
+            r[next] = r[i] * ratio;
+            i = next;
+        }
+        // Down the chain: techniques lo−1 … 2 (… 0 without next-event estimation).
+        let bottom = if skip { 2 } else { 0 };
+        for i in (bottom..lo).rev() {
+            r[i] = r[i + 1] * c[i] / l[i];
+        }
+        if skip && s != 1 {
+            if lo >= 2 {
+                r[0] = r[2] * c[0] * c[1] / (l[0] * l[1]);
+            }
+            r[1] = if c[0] > 0.0 {
+                r[0] * self.nee / c[0]
+            } else {
+                r[2] * self.nee * c[1] / (l[0] * l[1])
+            };
+        }
+        let ns = self.sample_count(s);
+        for (i, ri) in r.iter_mut().enumerate() {
+            *ri = if self.valid(i) {
+                *ri * self.sample_count(i) / ns
+            } else {
+                0.0
+            };
+        }
+    }
+
+    /// The weight of technique s under `h`; zero when s cannot produce the path.
+    pub fn weight(&self, s: usize, h: Heuristic) -> f64 {
+        if !self.valid(s) || self.technique(s) == 0.0 {
+            return 0.0;
+        }
+        let mut r = [0.0f64; MAX_TECHNIQUES];
+        let k = self.k();
+        if k + 2 > MAX_TECHNIQUES {
+            let mut v = vec![0.0; k + 2];
+            self.relative(s, &mut v);
+            return h.weight_from_ratios(&v);
+        }
+        self.relative(s, &mut r);
+        h.weight_from_ratios(&r[..k + 2])
+    }
+}
+
+/// Paths up to this many techniques (k ≤ 62) weigh without allocating.
+const MAX_TECHNIQUES: usize = 64;
+
+/// Balance heuristic w_s = p_s / Σ_i p_i over effective densities n_i p_i. Zero when p_s = 0.
 pub fn balance_weight(pdfs: &[f64], s: usize) -> f64 {
     power_weight(pdfs, s, 1.0)
 }
 
-/// Power heuristic w_s = p_s^β / Σ_i p_i^β. Evaluated as 1 / Σ_i (p_i / p_s)^β so that densities
-/// far outside f64's range of squares (β = 2 squares area densities) cannot overflow.
+/// Power heuristic w_s = p_s^β / Σ_i p_i^β over effective densities, evaluated as
+/// 1 / Σ_i (p_i / p_s)^β so that densities far outside f64's range of squares cannot overflow.
+/// This is the brute-force oracle that `Chain::weight` must match.
 pub fn power_weight(pdfs: &[f64], s: usize, beta: f64) -> f64 {
     let ps = pdfs[s];
     if ps.is_nan() || ps <= 0.0 {
@@ -33,62 +239,32 @@ pub fn power_weight(pdfs: &[f64], s: usize, beta: f64) -> f64 {
     1.0 / sum
 }
 
-/// The ratios p_i / p_s for every i (p_s > 0), by Veach's recursion (1997, ch. 10) instead of
-/// products. With l = `Densities::light` and c = `Densities::camera`, moving x_i from the camera
-/// subpath to the light subpath gives p_{i+1} / p_i = l_i / c_i. Technique 1 draws x0 by
-/// next-event estimation instead of l_0, so the chain steps from 0 straight to 2 (ratio
-/// l_0·l_1 / (c_0·c_1)) and p_1 hangs off a neighbour (p_1 / p_0 = nee / c_0). Every divisor is a
-/// density of p_s itself, hence non-zero: no remap0 (pbrt) is needed, and a delta light's
-/// c_0 = 0 zeroes p_0 by itself. Delta-stripped densities keep the chain finite through delta
-/// vertices; techniques that connect there are zeroed at the end.
-/// This is the form BDPT and VCM evaluate incrementally; `power_weight` on `Densities::all` is
-/// the brute-force oracle it must match.
-pub fn relative_pdfs(d: &Densities, s: usize) -> Vec<f64> {
-    let k = d.k();
-    let (l, c) = (&d.light, &d.camera);
-    let mut r = vec![0.0; k + 2];
-    r[s] = 1.0;
-    if s == 1 {
-        r[0] = c[0] / d.nee;
-        r[2] = l[0] * l[1] / (d.nee * c[1]);
-    }
-    let lo = if s == 1 { 2 } else { s };
-    // Up the chain: techniques lo+1 … k+1 (from 0, the step skips 1).
-    let mut i = lo;
-    while i <= k {
-        let (next, ratio) = if i == 0 {
-            (2, l[0] * l[1] / (c[0] * c[1]))
-        } else {
-            (i + 1, l[i] / c[i])
-        };
-        r[next] = r[i] * ratio;
-        i = next;
-    }
-    // Down the chain: techniques lo−1 … 2, then 0.
-    for i in (2..lo).rev() {
-        r[i] = r[i + 1] * c[i] / l[i];
-    }
-    if lo >= 2 && s != 1 {
-        r[0] = r[2] * c[0] * c[1] / (l[0] * l[1]);
-    }
-    if s != 1 {
-        r[1] = if c[0] > 0.0 {
-            r[0] * d.nee / c[0]
-        } else {
-            r[2] * d.nee * c[1] / (l[0] * l[1])
-        };
-    }
-    for (i, ri) in r.iter_mut().enumerate() {
-        if !d.valid(i) {
-            *ri = 0.0;
+/// The oracle's weight of technique s under `h` from effective densities (`Densities::effective_all`).
+pub fn oracle_weight(pdfs: &[f64], s: usize, h: Heuristic) -> f64 {
+    match h {
+        Heuristic::Balance => power_weight(pdfs, s, 1.0),
+        Heuristic::Power => power_weight(pdfs, s, 2.0),
+        Heuristic::Uniform => {
+            if pdfs[s] > 0.0 {
+                1.0 / pdfs.iter().filter(|&&p| p > 0.0).count() as f64
+            } else {
+                0.0
+            }
         }
     }
+}
+
+/// `Chain::relative` of a from-scratch `Densities`, as a vector.
+pub fn relative_pdfs(d: &Densities, s: usize) -> Vec<f64> {
+    let mut r = vec![0.0; d.k() + 2];
+    d.chain().relative(s, &mut r);
     r
 }
 
 /// The power-heuristic weight of technique s computed from `relative_pdfs` (β = 1: balance).
 pub fn power_weight_by_ratios(d: &Densities, s: usize, beta: f64) -> f64 {
-    if !d.valid(s) || d.technique(s) == 0.0 {
+    let c = d.chain();
+    if !c.valid(s) || c.technique(s) == 0.0 {
         return 0.0;
     }
     let sum: f64 = relative_pdfs(d, s).iter().map(|&r| r.powf(beta)).sum();

@@ -8,7 +8,9 @@
 //!   the number of segments (Mitsuba's depth). Technique s takes x0 … x_{s−1} from a light
 //!   subpath and the t = k+1−s vertices x_s … xk from a camera subpath, s = 0 … k+1:
 //!   s = 0 is a camera walk hitting the light, s = 1 next-event estimation (x0 sampled towards x1
-//!   by `Light::sample_li`), s = k light tracing (x_{k−1} connected to the camera), and s = k+1
+//!   by `Light::sample_li`) when k ≥ 2, s = k light tracing (x_{k−1} connected to the camera; on a
+//!   one-segment path s = 1 = k is the emitted point x0 connected to the pinhole, not next-event
+//!   estimation from the pinhole, which nothing samples), and s = k+1
 //!   (a light walk hitting the pinhole) is impossible: p = 0. A light with a delta position (point)
 //!   cannot be hit: p_0 = 0.
 //! - **Measures.** Densities are per unit area at the vertex they choose (**Invariant**), except
@@ -29,9 +31,10 @@
 //!   path traced once per camera sample (N · spp light paths) estimates pixel j as
 //!   (1/(N·spp)) Σ f_j / p_s. So for every technique the per-pixel estimate of one sample is
 //!   **f(x̄) / (N · p_s(x̄))**, averaged over spp (`Path::estimate`; a path tracer's throughput
-//!   starts at We cos / (N pdf_dir) = 1). All techniques then take the same number of samples per
-//!   pixel and MIS needs no sample-count factor. The `path_space` test proves it by letting s = 0,
-//!   1 and 2 estimate the same pixels of an analytic scene.
+//!   starts at We cos / (N pdf_dir) = 1). With M ≠ N light subpaths per pass, light tracing
+//!   averages over M instead: f / (M · p_k), and MIS weighs technique k by n_k/n_s = M/N
+//!   (`Densities::light_tracing_ratio`, `mis`). The `path_space` test proves the normalisation by
+//!   letting s = 0, 1 and 2 estimate the same pixels of an analytic scene.
 
 pub mod mis;
 #[allow(clippy::module_inception)]
@@ -39,7 +42,7 @@ mod path;
 pub mod scatter;
 pub mod vertex;
 
-pub use mis::{balance_weight, power_weight};
+pub use mis::{balance_weight, oracle_weight, power_weight, Chain, Heuristic};
 pub use path::{Densities, Path};
 pub use scatter::{scatter, Scatter};
 pub use vertex::{geometry, PathVertex, VertexKind};

@@ -1,6 +1,7 @@
 //! A complete path x̄ = x0 … xk (x0 on a light, xk the camera: Veach's order) and, from scratch,
 //! its measurement contribution f(x̄) and its density p_s(x̄) under every technique s.
 
+use super::mis::Chain;
 use super::scatter::{connectable, delta_tolerance, scatter, Scatter};
 use super::vertex::{geometry, PathVertex, VertexKind};
 use crate::bsdf::TransportMode;
@@ -17,6 +18,7 @@ pub struct Path {
 
 /// Per-vertex densities of a path, from which every p_s follows (Veach 1997, ch. 10: p_s is the
 /// product of the light subpath's densities of x0 … x_{s−1} and the camera subpath's of x_s … xk).
+/// Owned storage for a [`Chain`], which does the arithmetic.
 #[derive(Clone, Debug)]
 pub struct Densities {
     /// `light[i]`: density of x_i when the light subpath generates it, given x0 … x_{i−1}.
@@ -26,47 +28,55 @@ pub struct Densities {
     /// `camera[i]`: density of x_i when the camera subpath generates it, given x_{i+1} … xk.
     /// `camera[k]` = 1 (pinhole); `camera[0]` = 0 for a light with a delta position.
     pub camera: Vec<f64>,
-    /// Density of x0 when next-event estimation from x1 chooses it (technique s = 1 only):
+    /// Density of x0 when next-event estimation from x1 chooses it (technique s = 1 when k ≥ 2):
     /// pmf · pdf_li converted to area at x0 (solid angle at infinity, pmf for a point light).
     pub nee: f64,
     /// `connectable[i]`: a connection edge may end at x_i (not a delta surface).
     pub connectable: Vec<bool>,
+    /// Light subpaths per camera sample in a pass (M/N, see `mis`); 1 by default.
+    pub light_tracing_ratio: f64,
 }
 
 impl Densities {
+    /// The borrowed view every weight is computed from.
+    pub fn chain(&self) -> Chain<'_> {
+        Chain {
+            light: &self.light,
+            camera: &self.camera,
+            nee: self.nee,
+            connectable: &self.connectable,
+            light_tracing_ratio: self.light_tracing_ratio,
+        }
+    }
+
     /// Number of segments k.
     pub fn k(&self) -> usize {
         self.light.len() - 1
     }
 
-    /// Whether technique s can produce the path at all, judged by structure only: s = k+1 needs
-    /// a camera a walk can hit (never, with a pinhole); 1 ≤ s ≤ k connects x_{s−1} with x_s,
-    /// which must both be connectable. (s = 0 with a point light is excluded by `camera[0]` = 0.)
+    /// See `Chain::valid`.
     pub fn valid(&self, s: usize) -> bool {
-        let k = self.k();
-        s <= k && (s == 0 || (self.connectable[s - 1] && self.connectable[s]))
+        self.chain().valid(s)
     }
 
-    /// The density of the light subpath x0 … x_{s−1} alone.
+    /// The density of the light subpath x0 … x_{s−1} alone (see `Chain::one_is_nee` for s = 1).
     pub fn light_prefix(&self, s: usize) -> f64 {
-        match s {
-            0 => 1.0,
-            1 => self.nee,
-            _ => self.light[..s].iter().product(),
-        }
+        self.chain().light_prefix(s)
     }
 
     /// p_s(x̄) (Russian roulette excluded).
     pub fn technique(&self, s: usize) -> f64 {
-        if !self.valid(s) {
-            return 0.0;
-        }
-        self.light_prefix(s) * self.camera[s..].iter().product::<f64>()
+        self.chain().technique(s)
     }
 
     /// p_s for s = 0 … k+1.
     pub fn all(&self) -> Vec<f64> {
         (0..=self.k() + 1).map(|s| self.technique(s)).collect()
+    }
+
+    /// n_s·p_s for s = 0 … k+1: the densities the heuristics compare.
+    pub fn effective_all(&self) -> Vec<f64> {
+        self.chain().effective_all()
     }
 }
 
@@ -236,6 +246,7 @@ impl Path {
             camera: pc,
             nee,
             connectable: conn,
+            light_tracing_ratio: 1.0,
         }
     }
 
@@ -250,13 +261,21 @@ impl Path {
         self.densities(scene).all()
     }
 
-    /// The unweighted per-pixel estimate of technique s: f(x̄) / (N · p_s(x̄)), N the pixel count
-    /// (see the module docs for why N); zero when the technique cannot produce the path.
+    /// The unweighted per-pixel estimate of technique s with one light subpath per camera
+    /// sample: f(x̄) / (N · p_s(x̄)), N the pixel count (see the module docs for why N); zero when
+    /// the technique cannot produce the path.
     pub fn estimate(&self, scene: &Scene, s: usize) -> Color {
+        self.estimate_with(scene, s, 1.0)
+    }
+
+    /// The same with `light_tracing_ratio` = M/N light subpaths per camera sample: light tracing
+    /// (s = k) then averages over M = ratio·N paths, f / (ratio · N · p_k).
+    pub fn estimate_with(&self, scene: &Scene, s: usize, light_tracing_ratio: f64) -> Color {
         let p = self.pdf(scene, s);
         if p <= 0.0 {
             return Color::ZERO;
         }
-        (self.contribution_for(scene, s) / (scene.camera.pixel_count() as f64 * p)).as_vec3()
+        let n = if s == self.k() { light_tracing_ratio } else { 1.0 };
+        (self.contribution_for(scene, s) / (scene.camera.pixel_count() as f64 * n * p)).as_vec3()
     }
 }

@@ -95,6 +95,17 @@ pub fn cornell(cfg: BoxConfig) -> Scene {
             None,
             false,
         );
+        // A spherical emitter in view: next-event estimation samples its visible cone, light
+        // tracing its whole area, so the two densities of x0 differ (k = 1 tells them apart).
+        b.add_shape(
+            ShapeGeometry::Sphere {
+                center: Vec3::new(0.55, 0.45, 0.2),
+                radius: 0.12,
+            },
+            white,
+            Some(Color::splat(4.0)),
+            false,
+        );
     }
     b.add_shape(quad(-x, y, z), red, None, false); // left, normal +x
     b.add_shape(quad(x, z, y), white, None, false); // right, normal −x

@@ -188,6 +188,39 @@ pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
     let mut pdf_w = if infinite { le.pdf_pos } else { le.pdf_dir };
     let mut ray = le.ray;
     let cam = &scene.camera;
+    // x0 itself connected to the pinhole: technique 1 of a one-segment path (an emitter seen
+    // directly), by the emitted point's density alone. A point light has no surface to be seen.
+    if !light.delta_position() && max_k >= 1 {
+        let towards_cam = if infinite {
+            Some((-x0.p, 1.0f32))
+        } else {
+            cam.project(le.p).map(|pr| (-pr.dir, pr.distance))
+        };
+        if let Some((d, dist)) = towards_cam {
+            let dir_from_cam = -d;
+            let imp = cam.importance(dir_from_cam);
+            let le_cam = if infinite {
+                light.escaped(dir_from_cam)
+            } else {
+                light.emitted(le.n, d)
+            };
+            if imp > 0.0 && le_cam != Color::ZERO {
+                let cos_l = if infinite { 1.0 } else { le.n.dot(d).abs() };
+                let cos_c = cam.forward().dot(dir_from_cam);
+                let g = (cos_l * cos_c / (dist * dist)) as f64;
+                let p0 = (pmf * if infinite { le.pdf_dir } else { le.pdf_pos }) as f64;
+                let fc = le_cam.as_dvec3() * g * imp as f64;
+                let path = Path::from_subpaths(&[x0], &[PathVertex::camera(cam, Color::ONE)]);
+                out(Made {
+                    path,
+                    s: 1,
+                    pdf: p0,
+                    f: fc,
+                    estimate: fc / (p0 * cam.pixel_count() as f64),
+                });
+            }
+        }
+    }
     for k in 1..max_k {
         let Some(hit) = scene.intersect(&ray) else {
             return;
