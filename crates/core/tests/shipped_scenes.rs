@@ -1,17 +1,21 @@
 //! Every scene in `scenes/` loads, and each is what its comments say it is.
 
 use lt_core::bsdf::Material;
+use lt_core::geometry::quad::Parallelogram;
 use lt_core::geometry::Ray;
 use lt_core::light::{Light, SunLight};
 use lt_core::math::{Color, Vec3, PI};
-use lt_core::scene::{load_scene, ShapeGeometry};
+use lt_core::scene::{load_scene, ShapeGeometry, SurfaceHit};
 use lt_core::Scene;
 use std::path::PathBuf;
 
-const SCENES: [&str; 7] = [
+const SCENES: [&str; 10] = [
     "cornell-box",
     "cornell-small-light",
     "cornell-glass-light",
+    "cornell-point-caustic",
+    "cornell-mesh-light",
+    "cornell-env",
     "sun-room",
     "caustic-sds",
     "veach-mis",
@@ -394,4 +398,230 @@ fn veach_door_light_reaches_the_dark_room_only_by_bouncing() {
         }
     }
     assert!(through_gap > 0, "no line of sight through the door gap");
+}
+
+/// Snell refraction of the unit direction `d` at a surface whose unit normal `n` faces against
+/// `d`; `eta` = ior of the side `d` comes from / ior of the other side. None on total reflection.
+fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let cos_i = -d.dot(n);
+    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    (k >= 0.0).then(|| (eta * d + (eta * cos_i - k.sqrt()) * n).normalize())
+}
+
+/// Follows a ray through every dielectric it meets (refraction only, no reflection) to the first
+/// non-dielectric surface.
+fn trace_through_glass(s: &Scene, origin: Vec3, mut d: Vec3) -> Option<SurfaceHit> {
+    let mut hit = s.intersect(&Ray::new(origin, d))?;
+    for _ in 0..8 {
+        let Material::Dielectric(glass) = s.material(hit.material) else {
+            return Some(hit);
+        };
+        let entering = d.dot(hit.ng) < 0.0;
+        let (n, eta) = if entering {
+            (hit.ng, 1.0 / glass.ior)
+        } else {
+            (-hit.ng, glass.ior)
+        };
+        d = refract(d, n, eta)?;
+        hit = s.intersect(&hit.spawn_ray(d))?;
+    }
+    None
+}
+
+#[test]
+fn cornell_point_caustic_focuses_the_point_light_onto_the_floor_in_view() {
+    let s = load("cornell-point-caustic");
+    assert_eq!(s.lights.len(), 1);
+    let Light::Point(light) = &s.lights[0] else {
+        panic!("the light is not a point light")
+    };
+    assert!(
+        s.shapes.iter().all(|sh| sh.light.is_none()),
+        "no emissive shapes"
+    );
+    // Power 4 pi I = cornell-box's light power pi A L.
+    let pb = PI * area_times_emission(&load("cornell-box"));
+    let pp = 4.0 * PI * light.intensity;
+    for k in 0..3 {
+        assert!(close(pp[k], pb[k], 1e-5), "{pp} vs {pb}");
+    }
+    let glass: Vec<(Vec3, f32)> = s
+        .shapes
+        .iter()
+        .filter(|sh| matches!(s.material(sh.material), Material::Dielectric(d) if d.ior == 1.5))
+        .map(|sh| match sh.geometry {
+            ShapeGeometry::Sphere { center, radius } => (center, radius),
+            _ => panic!("glass that is not a sphere"),
+        })
+        .collect();
+    assert_eq!(glass.len(), 1, "one glass ball");
+    let (c, r) = glass[0];
+    assert!(
+        light.position.y < 1.0 && light.position.y > c.y + r,
+        "the light is above the ball"
+    );
+    // The ray through the ball's centre goes straight on and lands on the floor, in view.
+    let axis = (c - light.position).normalize();
+    let focus = trace_through_glass(&s, light.position, axis)
+        .expect("the axial ray reaches a surface")
+        .p;
+    assert!(
+        (focus.y + 1.0).abs() < 1e-4,
+        "the axial ray lands at {focus}, not on the floor"
+    );
+    let lift = Vec3::new(0.0, 1e-3, 0.0);
+    for dx in [-0.1f32, 0.0, 0.1] {
+        for dz in [-0.1f32, 0.0, 0.1] {
+            let p = focus + Vec3::new(dx, 0.0, dz);
+            let proj = s.camera.project(p).expect("the caustic is in frame");
+            assert!(
+                (0.0..s.camera.width as f32).contains(&proj.raster.x)
+                    && (0.0..s.camera.height as f32).contains(&proj.raster.y)
+            );
+            assert!(
+                s.visible_between(s.camera.eye, p + lift),
+                "the camera does not see the caustic at {p}"
+            );
+        }
+    }
+    // Rays from the light spread uniformly over the cone towards the ball: most land within 0.1
+    // of the axis point, a disk 1/13 of the area of the ball's shadow (radius ~0.36).
+    let cos_max = (1.0 - r * r / (c - light.position).length_squared()).sqrt();
+    let frame = lt_core::math::Frame::from_z(axis);
+    let (mut near, mut total) = (0usize, 0usize);
+    for i in 0..64 {
+        for j in 0..64 {
+            let cos_t = 1.0 - (1.0 - cos_max) * (i as f32 + 0.5) / 64.0 * 0.95;
+            let sin_t = (1.0 - cos_t * cos_t).sqrt();
+            let phi = 2.0 * PI * (j as f32 + 0.5) / 64.0;
+            let d = frame.to_world(Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t));
+            let Some(hit) = trace_through_glass(&s, light.position, d) else {
+                continue;
+            };
+            total += 1;
+            near += ((hit.p - focus).length() < 0.1) as usize;
+        }
+    }
+    assert_eq!(
+        total,
+        64 * 64,
+        "every ray through the ball reaches a surface"
+    );
+    assert!(
+        near as f32 > 0.4 * total as f32,
+        "only {near} of {total} rays land near {focus}"
+    );
+    // The light sees most of the floor; the ball shadows the caustic's surroundings.
+    let mut lit = 0;
+    let n = 39;
+    for i in 0..n {
+        for j in 0..n {
+            let p = Vec3::new(
+                -0.95 + 1.9 * i as f32 / (n - 1) as f32,
+                -1.0,
+                -0.95 + 1.9 * j as f32 / (n - 1) as f32,
+            );
+            let seen = s.visible_between(light.position, p + lift);
+            lit += seen as usize;
+            if (p - focus).length() < 0.25 {
+                assert!(!seen, "{p} is in the ball's shadow, but the light sees it");
+            }
+        }
+    }
+    assert!(
+        lit as f32 > 0.6 * (n * n) as f32,
+        "the light sees only {lit} of {} floor points",
+        n * n
+    );
+}
+
+#[test]
+fn cornell_mesh_light_is_an_unmerged_triangle_fan_with_cornell_box_power() {
+    let s = load("cornell-mesh-light");
+    let base = load("cornell-box");
+    assert_eq!(s.lights.len(), 1);
+    let Light::Area(light) = &s.lights[0] else {
+        panic!("the light is not an area light")
+    };
+    let ShapeGeometry::Mesh(m) = &s.shapes[light.shape as usize].geometry else {
+        panic!("the light is not a mesh")
+    };
+    assert_eq!(m.indices.len(), 8, "an octagonal fan of 8 triangles");
+    for i in 0..8 {
+        let [a, b, c] = m.triangle(i);
+        let n = (b - a).cross(c - a).normalize();
+        assert!(
+            (n - Vec3::new(0.0, -1.0, 0.0)).length() < 1e-6,
+            "triangle {i} normal {n}"
+        );
+        assert!([a, b, c].iter().all(|p| (p.y - 0.99).abs() < 1e-6));
+    }
+    // No two consecutive triangles split a parallelogram, so the builder keeps all 8 (cornell-box
+    // has the same shapes with a one-quad light).
+    for i in 0..7 {
+        assert!(
+            Parallelogram::from_triangle_pair(m.triangle(i), m.triangle(i + 1)).is_none(),
+            "triangles {i} and {} form a parallelogram",
+            i + 1
+        );
+    }
+    assert_eq!(s.primitive_count(), base.primitive_count() - 1 + 8);
+    assert!(
+        close(light.area, 0.21875, 1e-6),
+        "light area {}",
+        light.area
+    );
+    assert!((mesh_center(&s, light.shape) - Vec3::new(0.0, 0.99, 0.01)).length() < 1e-6);
+    let (pm, pb) = (area_times_emission(&s), area_times_emission(&base));
+    for k in 0..3 {
+        assert!(close(pm[k], pb[k], 1e-5), "{pm} vs {pb}");
+    }
+}
+
+#[test]
+fn cornell_env_is_lit_only_through_the_open_front() {
+    let s = load("cornell-env");
+    assert_eq!(s.lights.len(), 1);
+    let Light::Environment(env) = &s.lights[0] else {
+        panic!("the light is not an environment")
+    };
+    assert_eq!(env.radiance, Vec3::ONE);
+    assert_eq!(s.infinite_lights, vec![0]);
+    assert!(
+        s.shapes.iter().all(|sh| sh.light.is_none()),
+        "no emissive shapes"
+    );
+    assert!(s.camera.eye.z > 1.0, "the camera is in front of the box");
+    for eye in [
+        Vec3::ZERO,
+        Vec3::new(0.5, 0.5, -0.5),
+        Vec3::new(-0.5, 0.0, 0.5),
+        Vec3::new(0.9, -0.9, -0.9),
+    ] {
+        assert!(
+            s.intersect(&Ray::new(eye, Vec3::new(0.0, 0.0, 1.0)))
+                .is_none(),
+            "a ray from {eye} towards +z does not escape"
+        );
+        let mut escaped = 0;
+        for d in sphere_directions(20000) {
+            if s.intersect(&Ray::new(eye, d)).is_some() {
+                continue;
+            }
+            escaped += 1;
+            // An escaping ray leaves through the front: z = 1, x and y in [-1, 1].
+            assert!(d.z > 0.0, "ray {d} from {eye} escapes through a crack");
+            let p = eye + d * ((1.0 - eye.z) / d.z);
+            assert!(
+                p.x.abs() <= 1.0 + 1e-5 && p.y.abs() <= 1.0 + 1e-5,
+                "ray {d} from {eye} escapes at {p}"
+            );
+        }
+        if eye == Vec3::ZERO {
+            // From the centre the opening is one face of the cube: 1/6 of the sphere, less what
+            // the small box hides.
+            let f = escaped as f32 / 20000.0;
+            assert!(f > 0.14 && f < 1.0 / 6.0 + 0.005, "escaping fraction {f}");
+        }
+    }
 }
