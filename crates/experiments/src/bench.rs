@@ -70,9 +70,9 @@ pub fn integrator_rate(
     let integ = make_integrator(
         integrator,
         scene,
-        &IntegratorParams {
-            max_depth,
-            rr_depth: None,
+        &match max_depth {
+            Some(d) => IntegratorParams::new().with("max_depth", d),
+            None => IntegratorParams::new(),
         },
     )?;
     let pool = rayon::ThreadPoolBuilder::new()

@@ -4,4 +4,5 @@ pub mod bench;
 pub mod bench_cmd;
 pub mod compare;
 pub mod image_io;
+pub mod integrator_args;
 pub mod render_cmd;

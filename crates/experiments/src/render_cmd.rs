@@ -5,7 +5,7 @@ use crate::image_io::{write_exr, write_png_preview};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use lt_core::scene::load_scene;
-use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
+use lt_integrators::{make_integrator, render, RenderOptions};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -30,9 +30,8 @@ pub struct RenderArgs {
     /// Worker threads (0 = one per core). The image does not depend on it.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Longest path in segments, camera ray included (overrides the scene).
-    #[arg(long)]
-    pub max_depth: Option<u32>,
+    #[command(flatten)]
+    pub integrator_args: crate::integrator_args::IntegratorArgs,
     /// Output EXR; `.png`, `.stderr.exr` and `.json` are written beside it.
     #[arg(long, short)]
     pub output: PathBuf,
@@ -62,10 +61,7 @@ fn write_outputs(out: &Path, acc: &lt_estimators::running::RunningImage) -> Resu
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
     let scene = load_scene(&args.scene).map_err(|e| e.to_string())?;
-    let params = IntegratorParams {
-        max_depth: args.max_depth,
-        rr_depth: None,
-    };
+    let params = args.integrator_args.to_params()?;
     let integrator = make_integrator(&args.integrator, &scene, &params)?;
     if args.time.is_some_and(|t| !(t > 0.0 && t.is_finite())) {
         return Err("--time must be a positive number of seconds".into());
@@ -132,7 +128,8 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         "spp": result.passes,
         "seed": args.seed,
         "threads": args.threads,
-        "max_depth": args.max_depth.unwrap_or(scene.settings.max_depth),
+        "max_depth": args.integrator_args.max_depth.unwrap_or(scene.settings.max_depth),
+        "params": params.pairs().iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>(),
         "seconds": secs,
         "spp_per_second": result.passes as f64 / secs,
         "invalid_samples": result.invalid_samples,

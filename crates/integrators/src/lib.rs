@@ -1,14 +1,18 @@
 //! Light-transport estimators over the shared path-space core. One integrator per file; each opens
 //! with a table of its parameters. `registry` maps names to constructors, `render` drives passes.
 
+pub mod params;
 pub mod pixel;
 pub mod pt;
 pub mod pt_bsdf;
+pub mod record;
 pub mod registry;
 pub mod render;
 pub mod splat;
+pub mod walk;
 
-pub use registry::{make_integrator, IntegratorParams, INTEGRATORS};
+pub use params::IntegratorParams;
+pub use registry::{make_integrator, IntegratorInfo, INTEGRATORS};
 pub use render::{render, PassReport, RenderOptions, RenderResult};
 
 use lt_core::Scene;

@@ -1,103 +1,129 @@
 //! `pt` — unidirectional path tracing with next-event estimation, combined with BSDF sampling by
-//! multiple importance sampling (power heuristic, Veach & Guibas 1995).
+//! multiple importance sampling (Veach & Guibas 1995).
 //!
 //! At every non-delta vertex one light is chosen by power and sampled towards the vertex (NEE);
 //! the BSDF-sampled continuation may hit an emitter too. Both techniques can produce the same path,
-//! so each contribution is weighted by the power heuristic over their solid-angle pdfs at the
-//! vertex. Delta lights (point) and delta BSDF lobes (mirror, glass) are reached by one technique
-//! only and get weight one.
+//! so each contribution is weighted by the heuristic over their solid-angle pdfs at the vertex.
+//! Delta lights (point) and delta BSDF lobes (mirror, glass) are reached by one technique only
+//! and get weight one. `techniques = light` or `bsdf` keeps one of the two (weight one where it
+//! is the only one left): Veach's MIS comparison on `veach-mis` is four runs of this integrator.
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
 //! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
+//! | `mis` | power/balance | power | heuristic combining NEE and BSDF sampling |
+//! | `techniques` | both/light/bsdf | both | NEE and BSDF sampling, NEE only, or BSDF sampling only |
 
+use crate::params::ParamReader;
 use crate::pixel::pixel_pass;
+use crate::record::{Completed, NoRecord, Recorder};
+use crate::walk::{continue_path, escaped_radiance};
 use crate::Integrator;
 use lt_core::bsdf::{ShadingFrame, TransportMode};
 use lt_core::math::Color;
-use lt_core::sampling::{power_heuristic, Sampler};
+use lt_core::path::{Heuristic, PathVertex};
+use lt_core::sampling::Sampler;
 use lt_core::scene::SurfaceHit;
 use lt_core::{Scene, Vec2};
 use lt_estimators::Image;
+
+/// Which of the two techniques run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Techniques {
+    Both,
+    /// Next-event estimation only (emitters hit by BSDF samples count only after delta bounces).
+    Light,
+    /// BSDF sampling only (`pt-bsdf` without sharing its code).
+    Bsdf,
+}
+
+impl Techniques {
+    fn parse(s: &str) -> Result<Techniques, String> {
+        match s {
+            "both" => Ok(Techniques::Both),
+            "light" => Ok(Techniques::Light),
+            "bsdf" => Ok(Techniques::Bsdf),
+            _ => Err(format!("unknown techniques '{s}' (known: both, light, bsdf)")),
+        }
+    }
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct PtParams {
     pub max_depth: u32,
     pub rr_depth: u32,
+    pub mis: Heuristic,
+    pub techniques: Techniques,
+}
+
+impl PtParams {
+    pub fn read(scene: &Scene, r: &ParamReader) -> Result<PtParams, String> {
+        let mis = r
+            .get_with("mis", |v| match Heuristic::parse(v)? {
+                Heuristic::Uniform => Err("pt takes power or balance".to_string()),
+                h => Ok(h),
+            })?
+            .unwrap_or(Heuristic::Power);
+        Ok(PtParams {
+            max_depth: r.get("max_depth")?.unwrap_or(scene.settings.max_depth),
+            rr_depth: r.get("rr_depth")?.unwrap_or(scene.settings.rr_depth),
+            mis,
+            techniques: r
+                .get_with("techniques", Techniques::parse)?
+                .unwrap_or(Techniques::Both),
+        })
+    }
 }
 
 pub struct Pt {
     pub params: PtParams,
 }
 
-/// Russian roulette: continue with probability min(max βᵢ, 0.95) and reweight. Returns false to stop.
-#[inline]
-pub(crate) fn russian_roulette(
-    beta: &mut Color,
-    depth: u32,
-    rr_depth: u32,
-    sampler: &mut Sampler,
-) -> bool {
-    if depth < rr_depth {
-        return true;
-    }
-    let q = beta.max_element().min(0.95);
-    if sampler.next_f32() >= q {
-        return false;
-    }
-    *beta /= q;
-    true
-}
-
-/// Radiance from every light at infinity along a ray leaving the scene, each weighted by `weight`.
-#[inline]
-pub(crate) fn escaped_radiance(
-    scene: &Scene,
-    dir: lt_core::Vec3,
-    weight: impl Fn(u32) -> f32,
-) -> Color {
-    let mut l = Color::ZERO;
-    for &i in &scene.infinite_lights {
-        let le = scene.lights[i as usize].escaped(dir);
-        if le != Color::ZERO {
-            l += le * weight(i);
+impl Pt {
+    /// The weight of technique a against b (solid-angle densities at one vertex).
+    #[inline]
+    fn weight(&self, a: f32, b: f32) -> f32 {
+        match self.params.mis {
+            Heuristic::Balance => {
+                if a.is_infinite() {
+                    1.0
+                } else if a + b > 0.0 {
+                    a / (a + b)
+                } else {
+                    0.0
+                }
+            }
+            _ => lt_core::sampling::power_heuristic(a, b),
         }
     }
-    l
-}
 
-/// Continues a camera path at `hit` by sampling its BSDF: multiplies the throughput by the sample
-/// weight and plays Russian roulette. `None` ends the path.
-#[inline]
-pub(crate) fn continue_path(
-    scene: &Scene,
-    hit: &SurfaceHit,
-    sf: &ShadingFrame,
-    wo: lt_core::Vec3,
-    beta: &mut Color,
-    depth: u32,
-    rr_depth: u32,
-    sampler: &mut Sampler,
-) -> Option<lt_core::bsdf::BsdfSample> {
-    let u_lobe = sampler.next_f32();
-    let u = sampler.next_2d();
-    let bs = scene
-        .material(hit.material)
-        .sample(sf, wo, u_lobe, u, TransportMode::Radiance)?;
-    *beta *= bs.weight;
-    (*beta != Color::ZERO && russian_roulette(beta, depth, rr_depth, sampler)).then_some(bs)
-}
+    /// The weight of a BSDF-sampled emitter hit, with `light_pdf` the NEE density of the same
+    /// direction; `(this, the NEE weight of the same path)`.
+    #[inline]
+    fn hit_weights(&self, prev_delta: bool, prev_pdf_w: f32, light_pdf: f32) -> (f32, f32) {
+        match self.params.techniques {
+            _ if prev_delta => (1.0, 0.0),
+            Techniques::Both => (
+                self.weight(prev_pdf_w, light_pdf),
+                self.weight(light_pdf, prev_pdf_w),
+            ),
+            Techniques::Light => (0.0, 1.0),
+            Techniques::Bsdf => (1.0, 0.0),
+        }
+    }
 
-impl Pt {
-    /// Next-event estimation at `hit`: one light chosen by power, MIS-weighted against the BSDF.
-    fn direct_light(
+    /// Next-event estimation at `hit`: one light chosen by power, weighted against the BSDF.
+    #[allow(clippy::too_many_arguments)]
+    fn direct_light<R: Recorder>(
         &self,
         scene: &Scene,
         hit: &SurfaceHit,
         sf: &ShadingFrame,
         wo: lt_core::Vec3,
         sampler: &mut Sampler,
+        rec: &mut R,
+        camera_path: &[PathVertex],
     ) -> Color {
         let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
             return Color::ZERO;
@@ -124,49 +150,98 @@ impl Pt {
             return Color::ZERO;
         }
         let light_pdf = pmf * ls.pdf_w;
-        let w = if ls.delta {
-            1.0
+        let (w, w_bsdf) = if ls.delta || self.params.techniques == Techniques::Light {
+            (1.0, 0.0)
         } else {
-            power_heuristic(light_pdf, ev.pdf_w)
+            (
+                self.weight(light_pdf, ev.pdf_w),
+                self.weight(ev.pdf_w, light_pdf),
+            )
         };
+        if R::ACTIVE {
+            let from = camera_path.last().expect("the vertex NEE starts from");
+            let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, from);
+            rec.completed(Completed {
+                s: 1,
+                light: &[x0],
+                camera: camera_path,
+                weight: w as f64,
+                alternatives: &[(0, w_bsdf as f64)],
+            });
+        }
         ev.f_cos * ls.radiance * (w / light_pdf)
     }
 
     pub fn radiance(&self, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> Color {
+        self.radiance_recorded(scene, raster, sampler, &mut NoRecord)
+    }
+
+    /// `radiance`, reporting every path it completes to `rec` (for `lt mis-check`).
+    pub fn radiance_recorded<R: Recorder>(
+        &self,
+        scene: &Scene,
+        raster: Vec2,
+        sampler: &mut Sampler,
+        rec: &mut R,
+    ) -> Color {
+        let nee = self.params.techniques != Techniques::Bsdf;
         let mut ray = scene.camera.generate_ray(raster);
         let mut beta = Color::ONE;
         let mut l = Color::ZERO;
         // The previous vertex's BSDF pdf (solid angle) and whether it was a delta lobe; the camera
         // counts as a delta so emitters seen directly get full weight.
-        let mut prev_pdf_w = 0.0f32;
+        let mut prev_pdf_w = scene.camera.pdf_dir(ray.d);
         let mut prev_delta = true;
         let mut prev_p = ray.o;
+        // The camera subpath so far, only kept for a recorder.
+        let mut verts: Vec<PathVertex> = Vec::new();
+        if R::ACTIVE {
+            verts.push(PathVertex::camera(&scene.camera, Color::ONE));
+        }
         for depth in 1..=self.params.max_depth {
             let Some(hit) = scene.intersect(&ray) else {
                 l += beta
                     * escaped_radiance(scene, ray.d, |i| {
-                        if prev_delta {
-                            1.0
-                        } else {
-                            let light_pdf = scene.light_sampler.pmf(i as usize)
-                                * scene.lights[i as usize].pdf_li(prev_p, ray.d, ray.d, -ray.d);
-                            power_heuristic(prev_pdf_w, light_pdf)
+                        let light_pdf = scene.light_sampler.pmf(i as usize)
+                            * scene.lights[i as usize].pdf_li(prev_p, ray.d, ray.d, -ray.d);
+                        let (w, w_nee) = self.hit_weights(prev_delta, prev_pdf_w, light_pdf);
+                        if R::ACTIVE {
+                            let x0 = PathVertex::light_escaped(i, ray.d, beta, prev_pdf_w);
+                            rec.completed(Completed {
+                                s: 0,
+                                light: &[x0],
+                                camera: &verts,
+                                weight: w as f64,
+                                alternatives: &[(1, w_nee as f64)],
+                            });
                         }
+                        w
                     });
                 break;
             };
             let wo = -ray.d;
+            if R::ACTIVE {
+                let prev = *verts.last().unwrap();
+                verts.push(PathVertex::surface(&hit, wo, beta, prev_pdf_w, &prev));
+            }
             if let Some(li) = hit.light {
                 let light = &scene.lights[li as usize];
                 let le = light.emitted(hit.ng, wo);
                 if le != Color::ZERO {
-                    let w = if prev_delta {
-                        1.0
-                    } else {
-                        let light_pdf = scene.light_sampler.pmf(li as usize)
-                            * light.pdf_li(prev_p, ray.d, hit.p, hit.ng);
-                        power_heuristic(prev_pdf_w, light_pdf)
-                    };
+                    let light_pdf = scene.light_sampler.pmf(li as usize)
+                        * light.pdf_li(prev_p, ray.d, hit.p, hit.ng);
+                    let (w, w_nee) = self.hit_weights(prev_delta, prev_pdf_w, light_pdf);
+                    if R::ACTIVE {
+                        let n = verts.len();
+                        let x0 = verts[n - 1].as_light_endpoint().unwrap();
+                        rec.completed(Completed {
+                            s: 0,
+                            light: &[x0],
+                            camera: &verts[..n - 1],
+                            weight: w as f64,
+                            alternatives: &[(1, w_nee as f64)],
+                        });
+                    }
                     l += beta * le * w;
                 }
             }
@@ -175,8 +250,8 @@ impl Pt {
             }
             let material = scene.material(hit.material);
             let sf = hit.shading_frame();
-            if !material.is_delta() {
-                l += beta * self.direct_light(scene, &hit, &sf, wo, sampler);
+            if nee && !material.is_delta() {
+                l += beta * self.direct_light(scene, &hit, &sf, wo, sampler, rec, &verts);
             }
             let Some(bs) = continue_path(
                 scene,
@@ -186,10 +261,14 @@ impl Pt {
                 &mut beta,
                 depth,
                 self.params.rr_depth,
+                TransportMode::Radiance,
                 sampler,
             ) else {
                 break;
             };
+            if R::ACTIVE {
+                verts.last_mut().unwrap().delta = bs.delta;
+            }
             prev_pdf_w = bs.pdf_w;
             prev_delta = bs.delta;
             prev_p = hit.p;

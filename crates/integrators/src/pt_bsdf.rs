@@ -8,16 +8,33 @@
 //! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 
+use crate::params::ParamReader;
 use crate::pixel::pixel_pass;
-use crate::pt::{continue_path, escaped_radiance, PtParams};
+use crate::walk::{continue_path, escaped_radiance};
 use crate::Integrator;
+use lt_core::bsdf::TransportMode;
 use lt_core::math::Color;
 use lt_core::sampling::Sampler;
 use lt_core::{Scene, Vec2};
 use lt_estimators::Image;
 
+#[derive(Clone, Copy, Debug)]
+pub struct PtBsdfParams {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+}
+
+impl PtBsdfParams {
+    pub fn read(scene: &Scene, r: &ParamReader) -> Result<PtBsdfParams, String> {
+        Ok(PtBsdfParams {
+            max_depth: r.get("max_depth")?.unwrap_or(scene.settings.max_depth),
+            rr_depth: r.get("rr_depth")?.unwrap_or(scene.settings.rr_depth),
+        })
+    }
+}
+
 pub struct PtBsdf {
-    pub params: PtParams,
+    pub params: PtBsdfParams,
 }
 
 impl PtBsdf {
@@ -45,6 +62,7 @@ impl PtBsdf {
                 &mut beta,
                 depth,
                 self.params.rr_depth,
+                TransportMode::Radiance,
                 sampler,
             ) else {
                 break;

@@ -1,59 +1,117 @@
-//! The one table from integrator names to constructors (the CLI and the experiments both use it).
+//! The one table from integrator names to constructors (the CLI, the tests and the experiments
+//! all use it). Tests that loop over `INTEGRATORS` cover a new integrator without new test code.
 
+use crate::params::{IntegratorParams, ParamReader};
 use crate::pt::{Pt, PtParams};
-use crate::pt_bsdf::PtBsdf;
+use crate::pt_bsdf::{PtBsdf, PtBsdfParams};
 use crate::Integrator;
 use lt_core::Scene;
 
-/// Command-line overrides; `None` falls back to the scene's `[render]` settings.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct IntegratorParams {
-    pub max_depth: Option<u32>,
-    pub rr_depth: Option<u32>,
+type Constructor = fn(&Scene, &ParamReader) -> Result<Box<dyn Integrator>, String>;
+
+/// What the registry knows of one integrator.
+pub struct IntegratorInfo {
+    pub name: &'static str,
+    /// One line for `lt list`.
+    pub about: &'static str,
+    /// The integrator's source file, whose opening table documents its keys.
+    pub source: &'static str,
+    pub make: Constructor,
 }
 
-type Constructor = fn(&Scene, &IntegratorParams) -> Box<dyn Integrator>;
-
-/// (name, one-line description, constructor).
-pub const INTEGRATORS: &[(&str, &str, Constructor)] = &[
-    (
-        "pt",
-        "path tracing with next-event estimation and MIS (power heuristic)",
-        |s, p| {
-            Box::new(Pt {
-                params: pt_params(s, p),
-            })
-        },
-    ),
-    (
-        "pt-bsdf",
-        "path tracing by BSDF sampling only (the cross-check of pt)",
-        |s, p| {
-            Box::new(PtBsdf {
-                params: pt_params(s, p),
-            })
-        },
-    ),
+pub const INTEGRATORS: &[IntegratorInfo] = &[
+    IntegratorInfo {
+        name: "pt",
+        about: "path tracing with next-event estimation and MIS (power heuristic)",
+        source: include_str!("pt.rs"),
+        make: |s, r| Ok(Box::new(Pt { params: PtParams::read(s, r)? })),
+    },
+    IntegratorInfo {
+        name: "pt-bsdf",
+        about: "path tracing by BSDF sampling only (the cross-check of pt)",
+        source: include_str!("pt_bsdf.rs"),
+        make: |s, r| Ok(Box::new(PtBsdf { params: PtBsdfParams::read(s, r)? })),
+    },
 ];
 
-fn pt_params(scene: &Scene, p: &IntegratorParams) -> PtParams {
-    PtParams {
-        max_depth: p.max_depth.unwrap_or(scene.settings.max_depth),
-        rr_depth: p.rr_depth.unwrap_or(scene.settings.rr_depth),
-    }
+/// The registered names, in table order.
+pub fn names() -> impl Iterator<Item = &'static str> {
+    INTEGRATORS.iter().map(|i| i.name)
 }
 
+pub fn find(name: &str) -> Result<&'static IntegratorInfo, String> {
+    INTEGRATORS.iter().find(|i| i.name == name).ok_or_else(|| {
+        let known: Vec<&str> = names().collect();
+        format!("unknown integrator '{name}' (known: {})", known.join(", "))
+    })
+}
+
+/// Builds `name` with `params`; refuses keys the integrator does not take.
 pub fn make_integrator(
     name: &str,
     scene: &Scene,
     params: &IntegratorParams,
 ) -> Result<Box<dyn Integrator>, String> {
-    INTEGRATORS
-        .iter()
-        .find(|(n, _, _)| *n == name)
-        .map(|(_, _, make)| make(scene, params))
-        .ok_or_else(|| {
-            let known: Vec<&str> = INTEGRATORS.iter().map(|(n, _, _)| *n).collect();
-            format!("unknown integrator '{name}' (known: {})", known.join(", "))
-        })
+    let info = find(name)?;
+    let reader = ParamReader::new(info.name, params);
+    let integrator = (info.make)(scene, &reader)?;
+    reader.finish()?;
+    Ok(integrator)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::documented_keys;
+    use lt_core::camera::{Camera, FovAxis};
+    use lt_core::scene::{RenderSettings, SceneBuilder};
+    use lt_core::Vec3;
+
+    fn empty_scene() -> Scene {
+        let cam = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, FovAxis::X, 4, 4).unwrap();
+        SceneBuilder::new(cam, RenderSettings::default()).build()
+    }
+
+    /// A value of a documented type: numbers, or each of the listed alternatives.
+    fn sample_values(ty: &str) -> Vec<String> {
+        match ty {
+            "u32" | "u64" => vec!["3".into()],
+            "f64" | "f32" => vec!["0.5".into()],
+            alts => alts.split('/').map(|a| a.trim().to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn every_documented_key_is_read_and_every_read_key_is_documented() {
+        let scene = empty_scene();
+        for info in INTEGRATORS {
+            let documented = documented_keys(info.source);
+            assert!(!documented.is_empty(), "{}: no key table", info.name);
+            let none = IntegratorParams::default();
+            let reader = ParamReader::new(info.name, &none);
+            (info.make)(&scene, &reader).unwrap();
+            let mut asked = reader.asked();
+            asked.sort();
+            asked.dedup();
+            let mut keys: Vec<&str> = documented.iter().map(|(k, _)| k.as_str()).collect();
+            keys.sort();
+            assert_eq!(asked, keys, "{}: keys read vs documented", info.name);
+            for (key, ty) in &documented {
+                for v in sample_values(ty) {
+                    let p = IntegratorParams::new().with(key, &v);
+                    make_integrator(info.name, &scene, &p)
+                        .unwrap_or_else(|e| panic!("{} {key}={v}: {e}", info.name));
+                }
+                let bad = IntegratorParams::new().with(key, "not-a-value");
+                assert!(
+                    make_integrator(info.name, &scene, &bad).is_err(),
+                    "{} accepts {key}=not-a-value",
+                    info.name
+                );
+            }
+            let unknown = IntegratorParams::new().with("no_such_key", 1);
+            let err = make_integrator(info.name, &scene, &unknown).err().unwrap();
+            assert!(err.contains("no_such_key"), "{err}");
+        }
+    }
 }

@@ -49,6 +49,12 @@ pub struct PathVertex {
     /// The vertex scattered (or will scatter) through a delta lobe: it cannot be connected to.
     /// Integrators set it from `BsdfSample::delta`; the from-scratch `Path` code asks the material.
     pub delta: bool,
+    /// Unit direction towards the vertex the walk came from, exactly as the walk traced it (zero
+    /// at endpoints). Connections evaluate the BSDF with it instead of rebuilding it from two f32
+    /// positions, which is ill-conditioned for short segments and sharp (small-α GGX) lobes.
+    pub wo: Vec3,
+    /// The light a surface vertex emits as, when it lies on an emitter (technique s = 0).
+    pub emitter: Option<u32>,
 }
 
 impl PathVertex {
@@ -63,6 +69,8 @@ impl PathVertex {
             pdf_fwd,
             pdf_rev: 0.0,
             delta: false,
+            wo: Vec3::ZERO,
+            emitter: None,
         }
     }
 
@@ -71,10 +79,16 @@ impl PathVertex {
         PathVertex::endpoint(VertexKind::Camera, camera.eye, camera.forward(), beta, 1.0)
     }
 
-    /// A surface the walk reached from `prev` with density `pdf` — solid angle at `prev`, except
-    /// when `prev` is a light at infinity, where it is the density on the disk perpendicular to
-    /// the ray (`LightLeSample::pdf_pos`).
-    pub fn surface(hit: &SurfaceHit, beta: Color, pdf: f32, prev: &PathVertex) -> PathVertex {
+    /// A surface the walk reached from `prev` along a ray of direction −`wo`, with density `pdf` —
+    /// solid angle at `prev`, except when `prev` is a light at infinity, where it is the density
+    /// on the disk perpendicular to the ray (`LightLeSample::pdf_pos`).
+    pub fn surface(
+        hit: &SurfaceHit,
+        wo: Vec3,
+        beta: Color,
+        pdf: f32,
+        prev: &PathVertex,
+    ) -> PathVertex {
         let mut v = PathVertex {
             kind: VertexKind::Surface {
                 material: hit.material,
@@ -87,6 +101,8 @@ impl PathVertex {
             pdf_fwd: 0.0,
             pdf_rev: 0.0,
             delta: false,
+            wo,
+            emitter: hit.light,
         };
         v.pdf_fwd = prev.convert_density(pdf, &v);
         v
@@ -94,8 +110,8 @@ impl PathVertex {
 
     /// The same surface as a light endpoint x0 (a camera walk hit an emitter: technique s = 0).
     /// `None` when the surface does not emit.
-    pub fn as_light_endpoint(&self, hit: &SurfaceHit) -> Option<PathVertex> {
-        let light = hit.light?;
+    pub fn as_light_endpoint(&self) -> Option<PathVertex> {
+        let light = self.emitter?;
         Some(PathVertex {
             kind: VertexKind::Light {
                 light,

@@ -67,12 +67,12 @@ pub fn camera_walk(
             }
             return;
         };
-        let v = PathVertex::surface(&hit, beta.as_vec3(), pdf_w, &prev);
+        let v = PathVertex::surface(&hit, -ray.d, beta.as_vec3(), pdf_w, &prev);
         let pa = solid_angle_to_area(pdf_w, prev.p, hit.p, hit.ng);
         assert_eq!(v.pdf_fwd, pa, "the vertex stores the density the walk used");
         pdf *= pa as f64;
         f *= solid_angle_to_area(1.0, prev.p, hit.p, hit.ng) as f64;
-        if let Some(x0) = v.as_light_endpoint(&hit) {
+        if let Some(x0) = v.as_light_endpoint() {
             let le = scene.lights[hit.light.unwrap() as usize]
                 .emitted(hit.ng, -ray.d)
                 .as_dvec3();
@@ -226,7 +226,7 @@ pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
             return;
         };
         let prev = *verts.last().unwrap();
-        let v = PathVertex::surface(&hit, beta.as_vec3(), pdf_w, &prev);
+        let v = PathVertex::surface(&hit, -ray.d, beta.as_vec3(), pdf_w, &prev);
         let (pa, g) = if k == 1 && infinite {
             (pdf_w * hit.ng.dot(ray.d).abs(), hit.ng.dot(ray.d).abs())
         } else {

@@ -29,8 +29,8 @@ fn main() -> ExitCode {
         Command::Compare(a) => lt_experiments::compare::run(a).map(|report| print!("{report}")),
         Command::Bench(a) => lt_experiments::bench_cmd::run(a).map(|table| print!("{table}")),
         Command::List => {
-            for (name, about, _) in lt_integrators::INTEGRATORS {
-                println!("{name:10} {about}");
+            for i in lt_integrators::INTEGRATORS {
+                println!("{:10} {}", i.name, i.about);
             }
             Ok(())
         }

@@ -1,0 +1,35 @@
+//! What an integrator can report about the paths it completes, for `lt mis-check`: the path's
+//! vertices and the MIS weight it gave the technique that made it. Rendering passes `NoRecord`,
+//! which compiles to nothing.
+
+use lt_core::path::PathVertex;
+
+/// One completed path: x0 (light end) first, xk (camera) last, as `lt_core::path::Path` wants.
+pub struct Completed<'a> {
+    /// Technique s (vertices taken from the light side) that produced it.
+    pub s: usize,
+    /// The light-side prefix x0 … x_{s−1} (for s = 0, the emitter vertex the camera walk hit).
+    pub light: &'a [PathVertex],
+    /// The camera-side prefix, camera first: x_k … x_s.
+    pub camera: &'a [PathVertex],
+    /// The weight the integrator applied.
+    pub weight: f64,
+    /// The weights the integrator's own code gives the same path under each of the other
+    /// techniques it runs, as (s, weight); empty when it computes none.
+    pub alternatives: &'a [(usize, f64)],
+}
+
+pub trait Recorder {
+    /// False for `NoRecord`: integrators skip building what only a recorder would read.
+    const ACTIVE: bool;
+    fn completed(&mut self, path: Completed);
+}
+
+/// Records nothing.
+pub struct NoRecord;
+
+impl Recorder for NoRecord {
+    const ACTIVE: bool = false;
+    #[inline]
+    fn completed(&mut self, _: Completed) {}
+}

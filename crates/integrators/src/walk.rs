@@ -1,0 +1,233 @@
+//! Walk code shared by every integrator and owned by none: Russian roulette, radiance escaping to
+//! lights at infinity, one BSDF continuation (in either transport mode), and the subpath tracer
+//! that bidirectional estimators build their camera and light subpaths with.
+//!
+//! The subpath tracer is where a bidirectional vertex is born: it creates each vertex through
+//! `PathVertex`'s constructors (which fill `pdf_fwd`, area measure) and fills the previous
+//! vertex's `pdf_rev` when it samples the next direction — `convert_density` of the reverse BSDF
+//! density (pbrt-v4's `RandomWalk`; Veach 1997, §10.2). Russian roulette reweights β but is never
+//! part of a density.
+
+use lt_core::bsdf::{BsdfSample, ShadingFrame, TransportMode};
+use lt_core::geometry::Ray;
+use lt_core::math::{Color, Vec3};
+use lt_core::path::PathVertex;
+use lt_core::sampling::Sampler;
+use lt_core::scene::SurfaceHit;
+use lt_core::{Scene, Vec2};
+
+/// Russian roulette: continue with probability min(max βᵢ, 0.95) and reweight. Returns false to stop.
+/// `depth` counts segments so far; roulette starts once it reaches `rr_depth`.
+#[inline]
+pub fn russian_roulette(beta: &mut Color, depth: u32, rr_depth: u32, sampler: &mut Sampler) -> bool {
+    if depth < rr_depth {
+        return true;
+    }
+    let q = beta.max_element().min(0.95);
+    if sampler.next_f32() >= q {
+        return false;
+    }
+    *beta /= q;
+    true
+}
+
+/// Radiance from every light at infinity along a ray leaving the scene, each weighted by `weight`.
+#[inline]
+pub fn escaped_radiance(scene: &Scene, dir: Vec3, mut weight: impl FnMut(u32) -> f32) -> Color {
+    let mut l = Color::ZERO;
+    for &i in &scene.infinite_lights {
+        let le = scene.lights[i as usize].escaped(dir);
+        if le != Color::ZERO {
+            l += le * weight(i);
+        }
+    }
+    l
+}
+
+/// Continues a walk at `hit` by sampling its BSDF in `mode`: multiplies the throughput by the
+/// sample weight and plays Russian roulette. `None` ends the walk.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn continue_path(
+    scene: &Scene,
+    hit: &SurfaceHit,
+    sf: &ShadingFrame,
+    wo: Vec3,
+    beta: &mut Color,
+    depth: u32,
+    rr_depth: u32,
+    mode: TransportMode,
+    sampler: &mut Sampler,
+) -> Option<BsdfSample> {
+    let u_lobe = sampler.next_f32();
+    let u = sampler.next_2d();
+    let bs = scene.material(hit.material).sample(sf, wo, u_lobe, u, mode)?;
+    *beta *= bs.weight;
+    (*beta != Color::ZERO && russian_roulette(beta, depth, rr_depth, sampler)).then_some(bs)
+}
+
+/// How long subpaths may grow.
+#[derive(Clone, Copy, Debug)]
+pub struct WalkLimits {
+    /// Most vertices in the subpath, its endpoint included.
+    pub max_vertices: usize,
+    pub rr_depth: u32,
+}
+
+/// A camera walk that left the scene: the radiance of lights at infinity along `dir` completes
+/// it (technique s = 0 with x0 at infinity).
+#[derive(Clone, Copy, Debug)]
+pub struct Escape {
+    pub dir: Vec3,
+    /// Throughput up to the escape.
+    pub beta: Color,
+    /// Solid-angle density with which the last vertex chose `dir`.
+    pub pdf_w: f32,
+}
+
+/// One subpath: the camera or light endpoint first, then surfaces in walk order.
+#[derive(Clone, Debug, Default)]
+pub struct Subpath {
+    pub vertices: Vec<PathVertex>,
+    /// For camera subpaths: the walk left the scene after its last vertex.
+    pub escape: Option<Escape>,
+}
+
+impl Subpath {
+    pub fn with_capacity(n: usize) -> Subpath {
+        Subpath {
+            vertices: Vec::with_capacity(n),
+            escape: None,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.vertices.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.vertices.is_empty()
+    }
+}
+
+/// Traces a camera subpath through `raster`: z0 = the pinhole, then the surfaces the walk meets
+/// (radiance mode). The primary ray's density is the film-wide `Camera::pdf_dir`, so β starts at
+/// 1 (see `lt_core::path` on image normalisation).
+pub fn camera_subpath(
+    scene: &Scene,
+    raster: Vec2,
+    sampler: &mut Sampler,
+    limits: WalkLimits,
+    out: &mut Subpath,
+) {
+    out.vertices.clear();
+    out.escape = None;
+    let ray = scene.camera.generate_ray(raster);
+    out.vertices.push(PathVertex::camera(&scene.camera, Color::ONE));
+    if limits.max_vertices < 2 {
+        return;
+    }
+    let pdf = scene.camera.pdf_dir(ray.d);
+    random_walk(scene, ray, Color::ONE, pdf, TransportMode::Radiance, sampler, limits, out);
+}
+
+/// Traces a light subpath: y0 on a light chosen by power (`Light::sample_le`), then the surfaces
+/// the emitted ray meets (importance mode). β of y0 is Le / pdf_fwd; the emitted direction's
+/// cosine and density enter β at y1.
+pub fn light_subpath(scene: &Scene, sampler: &mut Sampler, limits: WalkLimits, out: &mut Subpath) {
+    out.vertices.clear();
+    out.escape = None;
+    let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
+        return;
+    };
+    let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
+    let light = &scene.lights[li];
+    let Some(le) = light.sample_le(u_pos, u_dir, scene.bounding_sphere) else {
+        return;
+    };
+    if le.radiance == Color::ZERO || le.pdf_pos == 0.0 || le.pdf_dir == 0.0 {
+        return;
+    }
+    let y0 = PathVertex::light_emitted(scene, li as u32, &le, pmf);
+    out.vertices.push(y0);
+    if limits.max_vertices < 2 {
+        return;
+    }
+    // β at y1: Le |cos θ0| / (pmf pdf_pos pdf_dir); a light at infinity has no cosine at y0 and
+    // its perpendicular-disk density belongs to y1.
+    let cos0 = if light.is_infinite() || light.delta_position() {
+        1.0
+    } else {
+        le.n.dot(le.ray.d).abs()
+    };
+    let beta = le.radiance * (cos0 / (pmf * le.pdf_pos * le.pdf_dir));
+    let pdf = if light.is_infinite() { le.pdf_pos } else { le.pdf_dir };
+    random_walk(scene, le.ray, beta, pdf, TransportMode::Importance, sampler, limits, out);
+}
+
+/// Extends `out` (which holds at least its endpoint) along `ray`, which its last vertex sampled
+/// with density `pdf` (see `PathVertex::surface`), until the walk ends or fills `max_vertices`.
+#[allow(clippy::too_many_arguments)]
+fn random_walk(
+    scene: &Scene,
+    mut ray: Ray,
+    mut beta: Color,
+    mut pdf: f32,
+    mode: TransportMode,
+    sampler: &mut Sampler,
+    limits: WalkLimits,
+    out: &mut Subpath,
+) {
+    loop {
+        let Some(hit) = scene.intersect(&ray) else {
+            if mode == TransportMode::Radiance && !scene.infinite_lights.is_empty() {
+                out.escape = Some(Escape {
+                    dir: ray.d,
+                    beta,
+                    pdf_w: pdf,
+                });
+            }
+            return;
+        };
+        let wo = -ray.d;
+        let prev = *out.vertices.last().expect("the endpoint is pushed first");
+        let mut v = PathVertex::surface(&hit, wo, beta, pdf, &prev);
+        if out.vertices.len() + 1 >= limits.max_vertices {
+            out.vertices.push(v);
+            return;
+        }
+        let sf = hit.shading_frame();
+        let depth = out.vertices.len() as u32;
+        let Some(bs) =
+            continue_path(scene, &hit, &sf, wo, &mut beta, depth, limits.rr_depth, mode, sampler)
+        else {
+            out.vertices.push(v);
+            return;
+        };
+        v.delta = bs.delta;
+        // The reverse density of the vertex before: how a walk from the other end, arriving along
+        // bs.wi, would have chosen it.
+        let n = out.vertices.len();
+        let before = &mut out.vertices[n - 1];
+        before.pdf_rev = reverse_density(before, &v, bs.pdf_rev_w);
+        out.vertices.push(v);
+        pdf = bs.pdf_w;
+        ray = hit.spawn_ray(bs.wi);
+    }
+}
+
+/// The density of generating `target` from `from` with a solid-angle density `pdf_w` at `from`,
+/// in `target`'s measure; zero where a walk cannot land (a point light's delta position).
+#[inline]
+pub fn reverse_density(target: &PathVertex, from: &PathVertex, pdf_w: f32) -> f32 {
+    if is_point_light(target) {
+        return 0.0;
+    }
+    from.convert_density(pdf_w, target)
+}
+
+/// A light vertex without a surface (a point light): no walk can arrive at it.
+#[inline]
+pub fn is_point_light(v: &PathVertex) -> bool {
+    matches!(v.kind, lt_core::path::VertexKind::Light { infinite: false, .. }) && !v.on_surface()
+}
