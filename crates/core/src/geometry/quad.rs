@@ -43,11 +43,29 @@ impl Parallelogram {
             .then(|| Parallelogram::new(p0, e1, e2))
     }
 
+    /// Dual basis: (u, v) = (q · a1, q · a2) for q = p − p0 in the plane.
+    #[inline]
+    fn dual(&self) -> (Vec3, Vec3) {
+        (self.e2.cross(self.n), self.n.cross(self.e1))
+    }
+
     /// Parameters (u, v) of a point in the parallelogram's plane.
     #[inline]
     pub fn uv_at(&self, p: Vec3) -> (f32, f32) {
         let q = p - self.p0;
-        (q.dot(self.e2.cross(self.n)), q.dot(self.n.cross(self.e1)))
+        let (a1, a2) = self.dual();
+        (q.dot(a1), q.dot(a2))
+    }
+
+    /// The crossing of the ray's line with the plane at distance `t`, relative to p0, and a
+    /// per-axis bound on its rounding error. Everything is computed from `o − p0`, so the bound
+    /// scales with the distances involved, not with how far from the world origin the quad sits:
+    /// `o − p0` rounds once (relative error u), and `d·t − (p0 − o)` adds three more roundings.
+    #[inline]
+    fn crossing(&self, o: Vec3, d: Vec3, t: f32) -> (Vec3, Vec3) {
+        let to = self.p0 - o;
+        let q = d * t - to;
+        (q, (to.abs() + (d * t).abs()) * gamma(4))
     }
 
     /// (t, u, v) of the hit in (0, t_max), or t = +∞.
@@ -61,22 +79,46 @@ impl Parallelogram {
         if !(t > 0.0 && t < t_max) {
             return MISS;
         }
-        // Rounding bound of num: a hit this close to the origin's own plane cannot be told apart
-        // from the plane the ray left.
+        // An origin within the rounding of its coordinates of this plane (the size of any hit
+        // point's error box there) cannot be told apart from a point on it: the ray is taken to
+        // leave the plane, not to cross it (no self-hits, and no hits on a neighbour that an
+        // origin near a shared edge rounds onto the wrong side of).
         let num_err = gamma(3) * (self.p0.abs() + o.abs()).dot(self.n.abs());
         if num.abs() <= num_err {
             return MISS;
         }
-        let q = o + d * t - self.p0;
-        let a1 = self.e2.cross(self.n);
-        let a2 = self.n.cross(self.e1);
+        let (q, q_err) = self.crossing(o, d, t);
+        let (a1, a2) = self.dual();
         let (u, v) = (q.dot(a1), q.dot(a2));
-        let q_err = (o.abs() + (d * t).abs() + self.p0.abs()) * gamma(6);
-        let (eu, ev) = (q_err.dot(a1.abs()), q_err.dot(a2.abs()));
+        // Widen by the rounding of (u, v), relative to the crossing, plus a few ulps of the
+        // parameter itself for the rounding of e1, e2 and the dual basis, so that neighbours
+        // sharing an edge overlap by rounding-sized slivers instead of leaving cracks.
+        let (eu, ev) = (
+            q_err.dot(a1.abs()) + gamma(6) * (q.abs().dot(a1.abs()) + 1.0),
+            q_err.dot(a2.abs()) + gamma(6) * (q.abs().dot(a2.abs()) + 1.0),
+        );
         if u < -eu || u > 1.0 + eu || v < -ev || v > 1.0 + ev {
             return MISS;
         }
         (t, u, v)
+    }
+
+    /// The hit point at ray distance `t` (from `intersect`), its parameters and a per-axis bound
+    /// on its rounding error: the rounding of p0 + u·e1 + v·e2 (absolute, as any stored point), plus
+    /// how far (u, v) may sit from the exact crossing (relative to the distances, see `crossing`).
+    pub fn hit_point(&self, o: Vec3, d: Vec3, t: f32) -> (Vec3, Vec3, f32, f32) {
+        let (q, q_err) = self.crossing(o, d, t);
+        let (a1, a2) = self.dual();
+        let (u, v) = (q.dot(a1), q.dot(a2));
+        let p = self.p0 + u * self.e1 + v * self.e2;
+        let (eu, ev) = (
+            q_err.dot(a1.abs()) + gamma(4) * q.abs().dot(a1.abs()),
+            q_err.dot(a2.abs()) + gamma(4) * q.abs().dot(a2.abs()),
+        );
+        let err = (self.p0.abs() + (u * self.e1).abs() + (v * self.e2).abs()) * gamma(5)
+            + eu * self.e1.abs()
+            + ev * self.e2.abs();
+        (p, err, u, v)
     }
 }
 

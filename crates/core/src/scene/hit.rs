@@ -6,7 +6,7 @@ use crate::geometry::ray::barycentric_error;
 use crate::geometry::sphere::refine_sphere_hit;
 use crate::geometry::triangle::{intersect_triangle, ShearedRay};
 use crate::geometry::{offset_ray_origin, PrimHit, Primitive, Ray, SHADOW_EPSILON};
-use crate::math::{gamma, Vec3};
+use crate::math::Vec3;
 
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceHit {
@@ -48,13 +48,7 @@ impl SurfaceHit {
                 (p, err, ng, ns)
             }
             Primitive::Quad { q, index, .. } => {
-                let t = h.t;
-                let (u, v) = q.uv_at(ray.at(t));
-                let p = q.p0 + u * q.e1 + v * q.e2;
-                // Rounding of the plane point from (u, v), plus how far (u, v) may sit from the
-                // ray's exact crossing (the rounding of o + t·d − p0 they were computed from).
-                let crossing = (ray.o.abs() + (ray.d * t).abs() + q.p0.abs()) * gamma(6);
-                let err = (q.p0.abs() + (u * q.e1).abs() + (v * q.e2).abs()) * gamma(5) + crossing;
+                let (p, err, u, v) = q.hit_point(ray.o, ray.d, h.t);
                 let ng = q.e1.cross(q.e2).normalize();
                 // Which of the two source triangles holds (u, v), with its barycentrics.
                 let (tri, b) = if u >= v {

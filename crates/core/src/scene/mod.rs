@@ -1,5 +1,5 @@
 //! The scene: shapes in one BVH, materials, lights and the camera, plus the queries integrators
-//! make (closest hit, visibility). Scenes are read from TOML by `load` (format in
+//! make (closest hit; visibility in `visibility.rs`). Scenes are read from TOML by `load` (format in
 //! `docs/scene-format.md`) or assembled in code with `SceneBuilder`.
 
 mod builder;
@@ -10,6 +10,8 @@ pub mod load;
 mod obj;
 pub mod ray_stats;
 mod transform;
+mod translated;
+mod visibility;
 
 pub use builder::{LightDesc, SceneBuilder, ShapeGeometry, TriangleMesh};
 pub use hit::SurfaceHit;
@@ -17,7 +19,7 @@ pub use load::{load_scene, load_scene_str, SceneError};
 
 use crate::bsdf::Material;
 use crate::camera::Camera;
-use crate::geometry::{Accel, Ray, SHADOW_EPSILON};
+use crate::geometry::{Accel, Ray};
 use crate::light::{Light, LightSampler};
 use crate::math::Vec3;
 
@@ -75,36 +77,6 @@ impl Scene {
         ray_stats::count_closest();
         let h = self.accel.intersect(ray)?;
         Some(SurfaceHit::new(self, ray, h))
-    }
-
-    /// True when nothing blocks the segment from a surface point to a point `to` (exclusive).
-    #[inline]
-    pub fn visible(&self, from: &SurfaceHit, to: Vec3) -> bool {
-        ray_stats::count_shadow();
-        !self.accel.occluded(&from.spawn_ray_to(to))
-    }
-
-    /// True when nothing blocks the ray leaving a surface point in direction `dir` (a distant light).
-    #[inline]
-    pub fn unoccluded_towards(&self, from: &SurfaceHit, dir: Vec3) -> bool {
-        ray_stats::count_shadow();
-        !self.accel.occluded(&from.spawn_ray(dir))
-    }
-
-    /// Visibility between two arbitrary points with error bounds (used by camera connections).
-    pub fn visible_between(&self, a: Vec3, b: Vec3) -> bool {
-        let d = b - a;
-        let len = d.length();
-        if !(len > 0.0) {
-            return true;
-        }
-        let ray = Ray {
-            o: a,
-            d: d / len,
-            t_max: len * (1.0 - SHADOW_EPSILON),
-        };
-        ray_stats::count_shadow();
-        !self.accel.occluded(&ray)
     }
 
     pub fn material(&self, id: u32) -> &Material {
