@@ -1,6 +1,9 @@
 //! Light-transport estimators over the shared path-space core. One integrator per file; each opens
 //! with a table of its parameters. `registry` maps names to constructors, `render` drives passes.
 
+pub mod bdpt;
+pub mod connect;
+pub mod light;
 pub mod params;
 pub mod pixel;
 pub mod pt;

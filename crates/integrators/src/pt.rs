@@ -124,6 +124,7 @@ impl Pt {
         sampler: &mut Sampler,
         rec: &mut R,
         camera_path: &[PathVertex],
+        raster: Vec2,
     ) -> Color {
         let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
             return Color::ZERO;
@@ -166,6 +167,8 @@ impl Pt {
                 light: &[x0],
                 camera: camera_path,
                 weight: w as f64,
+                value: from.beta * ev.f_cos * ls.radiance / light_pdf,
+                raster,
                 alternatives: &[(0, w_bsdf as f64)],
             });
         }
@@ -212,6 +215,8 @@ impl Pt {
                                 light: &[x0],
                                 camera: &verts,
                                 weight: w as f64,
+                                value: beta * scene.lights[i as usize].escaped(ray.d),
+                                raster,
                                 alternatives: &[(1, w_nee as f64)],
                             });
                         }
@@ -239,6 +244,8 @@ impl Pt {
                             light: &[x0],
                             camera: &verts[..n - 1],
                             weight: w as f64,
+                            value: beta * le,
+                            raster,
                             alternatives: &[(1, w_nee as f64)],
                         });
                     }
@@ -251,7 +258,7 @@ impl Pt {
             let material = scene.material(hit.material);
             let sf = hit.shading_frame();
             if nee && !material.is_delta() {
-                l += beta * self.direct_light(scene, &hit, &sf, wo, sampler, rec, &verts);
+                l += beta * self.direct_light(scene, &hit, &sf, wo, sampler, rec, &verts, raster);
             }
             let Some(bs) = continue_path(
                 scene,

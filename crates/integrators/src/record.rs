@@ -2,6 +2,7 @@
 //! vertices and the MIS weight it gave the technique that made it. Rendering passes `NoRecord`,
 //! which compiles to nothing.
 
+use lt_core::math::{Color, Vec2};
 use lt_core::path::PathVertex;
 
 /// One completed path: x0 (light end) first, xk (camera) last, as `lt_core::path::Path` wants.
@@ -14,6 +15,11 @@ pub struct Completed<'a> {
     pub camera: &'a [PathVertex],
     /// The weight the integrator applied.
     pub weight: f64,
+    /// The unweighted contribution to the image (the weight is applied on top of it), already
+    /// normalised as the integrator adds it: per-pixel units, light tracing divided by M.
+    pub value: Color,
+    /// Where on the film it lands.
+    pub raster: Vec2,
     /// The weights the integrator's own code gives the same path under each of the other
     /// techniques it runs, as (s, weight); empty when it computes none.
     pub alternatives: &'a [(usize, f64)],

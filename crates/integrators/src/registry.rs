@@ -2,6 +2,8 @@
 //! all use it). Tests that loop over `INTEGRATORS` cover a new integrator without new test code.
 
 use crate::params::{IntegratorParams, ParamReader};
+use crate::bdpt::{Bdpt, BdptParams};
+use crate::light::{LightParams, LightTracer};
 use crate::pt::{Pt, PtParams};
 use crate::pt_bsdf::{PtBsdf, PtBsdfParams};
 use crate::Integrator;
@@ -31,6 +33,18 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "path tracing by BSDF sampling only (the cross-check of pt)",
         source: include_str!("pt_bsdf.rs"),
         make: |s, r| Ok(Box::new(PtBsdf { params: PtBsdfParams::read(s, r)? })),
+    },
+    IntegratorInfo {
+        name: "light",
+        about: "light tracing: light subpaths splatted to the camera at every vertex",
+        source: include_str!("light.rs"),
+        make: |s, r| Ok(Box::new(LightTracer { params: LightParams::read(s, r)? })),
+    },
+    IntegratorInfo {
+        name: "bdpt",
+        about: "bidirectional path tracing: every (s,t) strategy under MIS (power heuristic)",
+        source: include_str!("bdpt.rs"),
+        make: |s, r| Ok(Box::new(Bdpt { params: BdptParams::read(s, r)? })),
     },
 ];
 

@@ -18,6 +18,27 @@ pub struct Splats {
 }
 
 impl Splats {
+    /// An empty record for a film of `width` × `height` pixels.
+    pub fn new(width: u32, height: u32) -> Splats {
+        Splats {
+            entries: Vec::new(),
+            invalid: 0,
+            width,
+            height,
+        }
+    }
+
+    /// Adds `value` to pixel `index` (row-major); invalid values are dropped and counted.
+    pub fn add_to_pixel(&mut self, index: u32, value: Color) {
+        if !is_valid_color(value) {
+            self.invalid += 1;
+            return;
+        }
+        if value != Color::ZERO {
+            self.entries.push((index, value));
+        }
+    }
+
     /// Adds `value` to the pixel containing `raster`; invalid values are dropped and counted.
     pub fn add(&mut self, raster: Vec2, value: Color) {
         if !is_valid_color(value) {
@@ -40,18 +61,34 @@ pub fn splat_pass(
     scale: f64,
     work: impl Fn(u64, &mut Splats) + Sync,
 ) -> (Image, u64) {
+    let (mut img, invalid) = splat_pass_with(width, height, count, chunk, || (), |i, s, _| work(i, s));
+    if scale != 1.0 {
+        for px in &mut img.data {
+            for c in px.iter_mut() {
+                *c *= scale;
+            }
+        }
+    }
+    (img, invalid)
+}
+
+/// `splat_pass` with per-chunk scratch state made by `init` (buffers reused across a chunk's items).
+pub fn splat_pass_with<S>(
+    width: usize,
+    height: usize,
+    count: u64,
+    chunk: u64,
+    init: impl Fn() -> S + Sync,
+    work: impl Fn(u64, &mut Splats, &mut S) + Sync,
+) -> (Image, u64) {
     let chunks = count.div_ceil(chunk.max(1));
     let recorded: Vec<Splats> = (0..chunks)
         .into_par_iter()
         .map(|c| {
-            let mut s = Splats {
-                entries: Vec::new(),
-                invalid: 0,
-                width: width as u32,
-                height: height as u32,
-            };
+            let mut s = Splats::new(width as u32, height as u32);
+            let mut state = init();
             for item in c * chunk..((c + 1) * chunk).min(count) {
-                work(item, &mut s);
+                work(item, &mut s, &mut state);
             }
             s
         })
@@ -62,9 +99,9 @@ pub fn splat_pass(
         invalid += s.invalid;
         for (i, v) in s.entries {
             let px = &mut img.data[i as usize];
-            px[0] += v.x as f64 * scale;
-            px[1] += v.y as f64 * scale;
-            px[2] += v.z as f64 * scale;
+            px[0] += v.x as f64;
+            px[1] += v.y as f64;
+            px[2] += v.z as f64;
         }
     }
     (img, invalid)

@@ -1,0 +1,575 @@
+//! `bdpt` — bidirectional path tracing (Veach & Guibas 1994; Veach 1997, ch. 10): per pixel
+//! sample, one camera subpath and one light subpath, joined by every strategy (s, t) — s light
+//! vertices and t camera vertices, k = s + t − 1 ≤ `max_depth` segments — and combined by MIS.
+//!
+//! - s = 0: the camera walk hits an emitter (or escapes to a light at infinity);
+//! - s = 1: a fresh light sample towards the camera vertex (next-event estimation, as in `pt`);
+//! - t = 1: the light vertex is joined to the pinhole and splatted (light tracing; `light`);
+//! - s, t ≥ 2: a shadow ray between the two subpath ends.
+//!
+//! Weights come from the subpaths' stored densities (`pdf_fwd`, `pdf_rev`, filled by
+//! `walk::random_walk`) with the ≤ 4 entries the connection changes patched, through
+//! `lt_core::path::Chain` — the same arithmetic the from-scratch oracle runs, never a `Path`.
+//! With `light_paths` = M ≠ N, camera sample j pairs with light subpath j mod M, every light
+//! subpath is splatted once, and light tracing's weight carries n_k/n_s = M/N.
+//!
+//! | key | type | default | meaning |
+//! |---|---|---|---|
+//! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
+//! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
+//! | `mis` | power/balance/none | power | heuristic over the strategies (none: uniform weights) |
+//! | `light_paths` | u64 | the pixel count | light subpaths per pass |
+
+use crate::connect::{connect_to_camera, eval_towards};
+use crate::params::ParamReader;
+use crate::record::{Completed, NoRecord, Recorder};
+use crate::splat::{splat_pass_with, Splats};
+use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
+use crate::Integrator;
+use lt_core::bsdf::{BsdfEval, TransportMode};
+use lt_core::math::{Color, Vec2};
+use lt_core::path::scatter::connectable;
+use lt_core::path::{Chain, Heuristic, PathVertex, VertexKind};
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::Scene;
+use lt_estimators::Image;
+
+#[derive(Clone, Copy, Debug)]
+pub struct BdptParams {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub mis: Heuristic,
+    /// `None`: one light subpath per pixel.
+    pub light_paths: Option<u64>,
+}
+
+impl BdptParams {
+    pub fn read(scene: &Scene, r: &ParamReader) -> Result<BdptParams, String> {
+        let light_paths = r.get::<u64>("light_paths")?;
+        if light_paths == Some(0) {
+            return Err("bdpt: light_paths must be at least 1".into());
+        }
+        Ok(BdptParams {
+            max_depth: r.get("max_depth")?.unwrap_or(scene.settings.max_depth),
+            rr_depth: r.get("rr_depth")?.unwrap_or(scene.settings.rr_depth),
+            mis: r
+                .get_with("mis", Heuristic::parse)?
+                .unwrap_or(Heuristic::Power),
+            light_paths,
+        })
+    }
+}
+
+pub struct Bdpt {
+    pub params: BdptParams,
+}
+
+/// The two subpath prefixes one strategy joins, as the MIS weight needs them.
+#[derive(Clone, Copy)]
+pub struct Split<'a> {
+    /// x0 … x_{s−1}. For s = 1 the light sample next-event estimation drew (pdf_fwd = its NEE
+    /// density); empty for s = 0.
+    pub light: &'a [PathVertex],
+    /// x_k … x_s, camera first. For s = 0 the last entry is the light endpoint x0 (an emitter
+    /// the walk hit, or a light at infinity it escaped to), with the walk's pdf_fwd.
+    pub camera: &'a [PathVertex],
+    /// For s ≥ 2: the density of x0 under next-event estimation from x1 (`nee_density`).
+    pub light_nee: f64,
+}
+
+/// The BSDFs at the two ends of a connection towards each other, as the contribution used them:
+/// `light_end` at x_{s−1} (importance mode, s ≥ 2), `camera_end` at x_s (radiance mode, t ≥ 2).
+#[derive(Clone, Copy, Default)]
+pub struct EndEvals {
+    pub light_end: Option<BsdfEval>,
+    pub camera_end: Option<BsdfEval>,
+}
+
+/// Density of x0 when next-event estimation from x1 chooses it: pmf · pdf_li in x0's measure
+/// (area; solid angle at infinity; the pmf alone for a point light). Mirrors `Path::densities`.
+pub fn nee_density(scene: &Scene, x0: &PathVertex, x1: &PathVertex) -> f64 {
+    let VertexKind::Light { light, .. } = x0.kind else {
+        return 0.0;
+    };
+    let l = &scene.lights[light as usize];
+    let pmf = scene.light_sampler.pmf(light as usize) as f64;
+    if l.delta_position() {
+        return pmf;
+    }
+    let pdf_w = l.pdf_li(x1.p, x1.dir_to(x0), x0.p, x0.ng);
+    pmf * x1.convert_density(pdf_w, x0) as f64
+}
+
+/// (pmf · positional density of x0, density of x1 from x0's emitted direction) — the light
+/// walk's l_0 and l_1 for an x0 that the light walk did not make. Mirrors `Path::densities`.
+fn emission_densities(scene: &Scene, x0: &PathVertex, x1: Option<&PathVertex>) -> (f64, f64) {
+    let VertexKind::Light { light, .. } = x0.kind else {
+        return (0.0, 0.0);
+    };
+    let l = &scene.lights[light as usize];
+    let pmf = scene.light_sampler.pmf(light as usize) as f64;
+    let Some(x1) = x1 else {
+        // x1 is the pinhole, which no light walk hits: l_1 = l_k = 0.
+        let dir = if x0.is_infinite() { -x0.p } else { -x0.ng };
+        let (pos, d) = l.pdf_le(x0.ng, dir, scene.bounding_sphere);
+        return (pmf * if x0.is_infinite() { d } else { pos } as f64, 0.0);
+    };
+    let (pos, dir) = l.pdf_le(x0.ng, x0.dir_to(x1), scene.bounding_sphere);
+    let (first, second) = if x0.is_infinite() { (dir, pos) } else { (pos, dir) };
+    (pmf * first as f64, x0.convert_density(second, x1) as f64)
+}
+
+/// Longest path handled without allocating (segments).
+const MAX_K: usize = 62;
+
+/// The MIS weight of strategy (s, t) for the path `split` forms (Veach 1997, eq. 10.9 with the
+/// ratios of §10.2), under `h`, with `ratio` = M/N light subpaths per camera sample.
+pub fn mis_weight(
+    scene: &Scene,
+    split: Split,
+    evals: EndEvals,
+    h: Heuristic,
+    ratio: f64,
+) -> f64 {
+    let (y, z) = (split.light, split.camera);
+    let s = if z.last().is_some_and(|v| matches!(v.kind, VertexKind::Light { .. })) {
+        0
+    } else {
+        y.len()
+    };
+    let t = z.len();
+    let k = s + t - 1;
+    debug_assert!(k >= 1 && k <= MAX_K);
+    let mut light = [0.0f64; MAX_K + 1];
+    let mut camera = [0.0f64; MAX_K + 1];
+    let mut conn = [false; MAX_K + 1];
+    // x_i: light vertices below s, camera vertices from s up (for s = 0, z's last is x0).
+    let at = |i: usize| -> &PathVertex {
+        if i < s {
+            &y[i]
+        } else {
+            &z[k - i]
+        }
+    };
+    for i in 0..=k {
+        let v = at(i);
+        conn[i] = connectable(scene, v);
+        if i < s {
+            light[i] = v.pdf_fwd as f64;
+            camera[i] = v.pdf_rev as f64;
+        } else {
+            camera[i] = v.pdf_fwd as f64;
+            light[i] = v.pdf_rev as f64;
+        }
+    }
+    // The pinhole: chosen with the discrete 1, never hit by a walk.
+    camera[k] = 1.0;
+    light[k] = 0.0;
+    let mut nee = split.light_nee;
+    match (s, t) {
+        (0, _) => {
+            // The camera walk made x0; the light walk's densities of x0 and x1 are emission's.
+            let x0 = &z[t - 1];
+            let x1 = (k >= 2).then(|| &z[t - 2]);
+            let (l0, l1) = emission_densities(scene, x0, x1);
+            light[0] = l0;
+            if k >= 2 {
+                light[1] = l1;
+                nee = nee_density(scene, x0, x1.unwrap());
+            }
+        }
+        (_, 1) => {
+            // x_{k−1} = y_{s−1} joined to the pinhole.
+            let yv = &y[s - 1];
+            let cam = &z[0];
+            let dir = cam.dir_to(yv);
+            camera[k - 1] = reverse_density(yv, cam, scene.camera.pdf_dir(dir)) as f64;
+            if s >= 2 {
+                let ev = evals.light_end.expect("a surface connected to the camera");
+                camera[k - 2] = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
+            }
+        }
+        _ => {
+            let (yv, zv) = (&y[s - 1], &z[t - 1]);
+            let ev_z = evals.camera_end.expect("the camera end is a surface");
+            camera[s - 1] = reverse_density(yv, zv, ev_z.pdf_w) as f64;
+            if s + 1 < k {
+                light[s + 1] = reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64;
+            }
+            if s == 1 {
+                // x0 came from next-event estimation: its light-walk densities are emission's.
+                let (l0, l1) = emission_densities(scene, yv, Some(zv));
+                light[0] = l0;
+                light[1] = l1;
+                nee = yv.pdf_fwd as f64;
+            } else {
+                let ev_y = evals.light_end.expect("the light end is a surface");
+                light[s] = yv.convert_density(ev_y.pdf_w, zv) as f64;
+                camera[s - 2] = reverse_density(&y[s - 2], yv, ev_y.pdf_rev_w) as f64;
+            }
+        }
+    }
+    let chain = Chain {
+        light: &light[..=k],
+        camera: &camera[..=k],
+        nee,
+        connectable: &conn[..=k],
+        light_tracing_ratio: ratio,
+    };
+    chain.weight(s, h)
+}
+
+/// Per-thread buffers of one sample.
+pub struct Scratch {
+    camera: Subpath,
+    light: Subpath,
+    /// Prefix copies for strategies whose end vertex differs from the stored one (s = 0, 1).
+    prefix: Vec<PathVertex>,
+}
+
+impl Bdpt {
+    fn light_paths(&self, scene: &Scene) -> u64 {
+        self.params
+            .light_paths
+            .unwrap_or(scene.camera.pixel_count() as u64)
+    }
+
+    fn ratio(&self, scene: &Scene) -> f64 {
+        self.light_paths(scene) as f64 / scene.camera.pixel_count() as f64
+    }
+
+    fn limits(&self, camera: bool) -> WalkLimits {
+        let d = self.params.max_depth as usize;
+        WalkLimits {
+            // t ≤ k + 1 camera vertices (s = 0), s ≤ k light vertices (t = 1).
+            max_vertices: if camera { d + 1 } else { d },
+            rr_depth: self.params.rr_depth,
+        }
+    }
+
+    /// One camera sample of pixel `pixel` paired with light subpath `light_index`; splats t = 1
+    /// contributions when `splat_light` (each light subpath is splatted by exactly one sample).
+    /// Returns the pixel's own estimate (strategies t ≥ 2).
+    #[allow(clippy::too_many_arguments)]
+    fn sample<R: Recorder>(
+        &self,
+        scene: &Scene,
+        seed: u64,
+        pass: u32,
+        pixel: Option<u64>,
+        light_index: u64,
+        splat_light: bool,
+        splats: &mut Splats,
+        scratch: &mut Scratch,
+        rec: &mut R,
+    ) -> Color {
+        let cam = &scene.camera;
+        let ratio = self.ratio(scene);
+        let h = self.params.mis;
+        let max_k = self.params.max_depth as usize;
+        let mut ls = Sampler::for_item(Domain::Light, seed, light_index, pass as u64);
+        light_subpath(scene, &mut ls, self.limits(false), &mut scratch.light);
+        let y = &scratch.light.vertices;
+        let light_nee = if y.len() >= 2 {
+            nee_density(scene, &y[0], &y[1])
+        } else {
+            0.0
+        };
+
+        // t = 1: every connectable light vertex joined to the pinhole.
+        if splat_light {
+            let scale = 1.0 / self.light_paths(scene) as f32;
+            for s in 1..=y.len().min(max_k) {
+                let yv = &y[s - 1];
+                if !connectable(scene, yv) {
+                    continue;
+                }
+                let Some(c) = connect_to_camera(scene, yv) else {
+                    continue;
+                };
+                let camera_only = [PathVertex::camera(cam, Color::ONE)];
+                let split = Split {
+                    light: &y[..s],
+                    camera: &camera_only,
+                    light_nee,
+                };
+                let evals = EndEvals {
+                    light_end: c.eval,
+                    camera_end: None,
+                };
+                let w = mis_weight(scene, split, evals, h, ratio);
+                if R::ACTIVE {
+                    rec.completed(Completed {
+                        s,
+                        light: &y[..s],
+                        camera: &camera_only,
+                        weight: w,
+                        value: c.value * scale,
+                        raster: c.raster,
+                        alternatives: &[],
+                    });
+                }
+                if w > 0.0 {
+                    splats.add(c.raster, c.value * (w as f32 * scale));
+                }
+            }
+        }
+        let Some(pixel) = pixel else {
+            return Color::ZERO;
+        };
+
+        // The camera subpath through a box-filtered position in the pixel.
+        let w = cam.width as u64;
+        let mut cs = Sampler::for_item(Domain::Camera, seed, pixel, pass as u64);
+        let raster = Vec2::new(
+            (pixel % w) as f32 + cs.next_f32(),
+            (pixel / w) as f32 + cs.next_f32(),
+        );
+        camera_subpath(scene, raster, &mut cs, self.limits(true), &mut scratch.camera);
+        let z = &scratch.camera.vertices;
+        let mut l = Color::ZERO;
+        for t in 2..=z.len() {
+            let zv = &z[t - 1];
+            // s = 0: the walk hit an emitter at z_{t−1}.
+            if t - 1 <= max_k {
+                if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter) {
+                    let le = scene.lights[li as usize].emitted(x0.ng, x0.wo);
+                    if le != Color::ZERO {
+                        scratch.prefix.clear();
+                        scratch.prefix.extend_from_slice(&z[..t - 1]);
+                        scratch.prefix.push(x0);
+                        let split = Split {
+                            light: &[],
+                            camera: &scratch.prefix,
+                            light_nee: 0.0,
+                        };
+                        let wgt = mis_weight(scene, split, EndEvals::default(), h, ratio);
+                        if R::ACTIVE {
+                            rec.completed(Completed {
+                                s: 0,
+                                light: &scratch.prefix[t - 1..],
+                                camera: &scratch.prefix[..t - 1],
+                                weight: wgt,
+                                value: zv.beta * le,
+                                raster,
+                                alternatives: &[],
+                            });
+                        }
+                        l += zv.beta * le * wgt as f32;
+                    }
+                }
+            }
+            if !connectable(scene, zv) {
+                continue;
+            }
+            // s = 1: next-event estimation from z_{t−1}.
+            if t <= max_k {
+                l += self.next_event(scene, z, t, &mut cs, ratio, raster, rec);
+            }
+            // s ≥ 2: shadow rays to the light subpath's vertices.
+            for s in 2..=y.len().min(max_k + 1 - t) {
+                let yv = &y[s - 1];
+                if !connectable(scene, yv) {
+                    continue;
+                }
+                let d = yv.p - zv.p;
+                let d2 = d.length_squared();
+                if !(d2 > 0.0) {
+                    continue;
+                }
+                let dir = d / d2.sqrt();
+                let (Some(ev_y), Some(ev_z)) = (
+                    eval_towards(scene, yv, -dir, TransportMode::Importance),
+                    eval_towards(scene, zv, dir, TransportMode::Radiance),
+                ) else {
+                    continue;
+                };
+                let c = yv.beta * ev_y.f_cos * ev_z.f_cos * zv.beta / d2;
+                if c == Color::ZERO || !scene.connection_visible(yv, zv) {
+                    continue;
+                }
+                let split = Split {
+                    light: &y[..s],
+                    camera: &z[..t],
+                    light_nee,
+                };
+                let evals = EndEvals {
+                    light_end: Some(ev_y),
+                    camera_end: Some(ev_z),
+                };
+                let wgt = mis_weight(scene, split, evals, h, ratio);
+                if R::ACTIVE {
+                    rec.completed(Completed {
+                        s,
+                        light: &y[..s],
+                        camera: &z[..t],
+                        weight: wgt,
+                        value: c,
+                        raster,
+                        alternatives: &[],
+                    });
+                }
+                l += c * wgt as f32;
+            }
+        }
+        // s = 0 at infinity: the walk left the scene after its last vertex.
+        if let Some(esc) = scratch.camera.escape {
+            if z.len() <= max_k {
+                for &li in &scene.infinite_lights {
+                    let le = scene.lights[li as usize].escaped(esc.dir);
+                    if le == Color::ZERO {
+                        continue;
+                    }
+                    let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
+                    scratch.prefix.clear();
+                    scratch.prefix.extend_from_slice(z);
+                    scratch.prefix.push(x0);
+                    let split = Split {
+                        light: &[],
+                        camera: &scratch.prefix,
+                        light_nee: 0.0,
+                    };
+                    let wgt = mis_weight(scene, split, EndEvals::default(), h, ratio);
+                    if R::ACTIVE {
+                        let n = scratch.prefix.len();
+                        rec.completed(Completed {
+                            s: 0,
+                            light: &scratch.prefix[n - 1..],
+                            camera: &scratch.prefix[..n - 1],
+                            weight: wgt,
+                            value: esc.beta * le,
+                            raster,
+                            alternatives: &[],
+                        });
+                    }
+                    l += esc.beta * le * wgt as f32;
+                }
+            }
+        }
+        l
+    }
+
+    /// Strategy s = 1 at camera vertex z_{t−1}: one light chosen by power and sampled towards it.
+    #[allow(clippy::too_many_arguments)]
+    fn next_event<R: Recorder>(
+        &self,
+        scene: &Scene,
+        z: &[PathVertex],
+        t: usize,
+        sampler: &mut Sampler,
+        ratio: f64,
+        raster: Vec2,
+        rec: &mut R,
+    ) -> Color {
+        let zv = &z[t - 1];
+        let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
+            return Color::ZERO;
+        };
+        let u = sampler.next_2d();
+        let Some(ls) = scene.lights[li].sample_li(zv.p, u) else {
+            return Color::ZERO;
+        };
+        if ls.radiance == Color::ZERO || ls.pdf_w == 0.0 {
+            return Color::ZERO;
+        }
+        let Some(ev_z) = eval_towards(scene, zv, ls.wi, TransportMode::Radiance) else {
+            return Color::ZERO;
+        };
+        if ev_z.f_cos == Color::ZERO {
+            return Color::ZERO;
+        }
+        let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, zv);
+        if !scene.connection_visible(&x0, zv) {
+            return Color::ZERO;
+        }
+        let split = Split {
+            light: std::slice::from_ref(&x0),
+            camera: &z[..t],
+            light_nee: 0.0,
+        };
+        let evals = EndEvals {
+            light_end: None,
+            camera_end: Some(ev_z),
+        };
+        let w = mis_weight(scene, split, evals, self.params.mis, ratio);
+        if R::ACTIVE {
+            rec.completed(Completed {
+                s: 1,
+                light: std::slice::from_ref(&x0),
+                camera: &z[..t],
+                weight: w,
+                value: zv.beta * ev_z.f_cos * ls.radiance / (pmf * ls.pdf_w),
+                raster,
+                alternatives: &[],
+            });
+        }
+        zv.beta * ev_z.f_cos * ls.radiance * (w as f32 / (pmf * ls.pdf_w))
+    }
+
+    /// One pass with every path reported to `rec` (for `lt mis-check`), pixel by pixel on one
+    /// thread; the image is discarded.
+    pub fn record_pass<R: Recorder>(&self, scene: &Scene, seed: u64, pass: u32, rec: &mut R) {
+        let n = scene.camera.pixel_count() as u64;
+        let m = self.light_paths(scene);
+        let mut scratch = self.scratch();
+        let mut splats = Splats::new(scene.camera.width, scene.camera.height);
+        for i in 0..n.max(m) {
+            self.item(scene, seed, pass, i, &mut splats, &mut scratch, rec);
+        }
+    }
+
+    pub fn scratch(&self) -> Scratch {
+        let d = self.params.max_depth as usize;
+        Scratch {
+            camera: Subpath::with_capacity(d + 1),
+            light: Subpath::with_capacity(d),
+            prefix: Vec::with_capacity(d + 2),
+        }
+    }
+
+    /// Work item i of a pass (0 … max(N, M)−1): pixel i (when i < N) with light subpath i mod M, splatting that
+    /// light subpath when i < M; items N … M−1 (M > N) splat their light subpath only.
+    #[allow(clippy::too_many_arguments)]
+    pub fn item<R: Recorder>(
+        &self,
+        scene: &Scene,
+        seed: u64,
+        pass: u32,
+        i: u64,
+        splats: &mut Splats,
+        scratch: &mut Scratch,
+        rec: &mut R,
+    ) {
+        let n = scene.camera.pixel_count() as u64;
+        let m = self.light_paths(scene);
+        let pixel = (i < n).then_some(i);
+        let l = self.sample(scene, seed, pass, pixel, i % m, i < m, splats, scratch, rec);
+        if let Some(p) = pixel {
+            splats.add_to_pixel(p as u32, l);
+        }
+    }
+}
+
+/// Work items per splat chunk (fixed, so the image does not depend on the thread count).
+const CHUNK: u64 = 256;
+
+impl Integrator for Bdpt {
+    fn name(&self) -> &'static str {
+        "bdpt"
+    }
+
+    fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
+        let cam = &scene.camera;
+        let n = cam.pixel_count() as u64;
+        let items = n.max(self.light_paths(scene));
+        let (w, h) = (cam.width as usize, cam.height as usize);
+        splat_pass_with(
+            w,
+            h,
+            items,
+            CHUNK,
+            || self.scratch(),
+            |i, splats, scratch| self.item(scene, seed, pass, i, splats, scratch, &mut NoRecord),
+        )
+    }
+}

@@ -1,0 +1,82 @@
+//! Connections shared by the bidirectional estimators and owned by none of them: a light-subpath
+//! vertex joined to the pinhole (t = 1, light tracing), and the BSDF of a subpath vertex evaluated
+//! towards another vertex. Visibility is always `Scene::connection_visible`, which offsets both
+//! ends by their error bounds.
+
+use lt_core::bsdf::{BsdfEval, ShadingFrame, TransportMode};
+use lt_core::math::{Color, Vec2, Vec3};
+use lt_core::path::{PathVertex, VertexKind};
+use lt_core::Scene;
+
+/// A light-subpath vertex seen by the camera.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraConnection {
+    pub raster: Vec2,
+    /// Unit direction from the eye to the vertex.
+    pub dir: Vec3,
+    /// β · f_cos · We · cos θ_camera / d²: the splat before the 1/M of M light subpaths.
+    pub value: Color,
+    /// The vertex's BSDF towards the camera (importance mode); `None` at x0 on a light.
+    pub eval: Option<BsdfEval>,
+}
+
+/// The BSDF of surface vertex `v` between its stored incoming direction `v.wo` and the direction
+/// towards `to`, in `mode`. `None` for non-surfaces.
+#[inline]
+pub fn eval_towards(scene: &Scene, v: &PathVertex, wi: Vec3, mode: TransportMode) -> Option<BsdfEval> {
+    let VertexKind::Surface { material } = v.kind else {
+        return None;
+    };
+    let sf = ShadingFrame::new(v.ng, v.ns);
+    Some(scene.material(material).eval(&sf, v.wo, wi, mode))
+}
+
+/// Joins light-subpath vertex `y` (x0 on a light, or a non-delta surface) to the pinhole.
+/// `None` when it is off the film, faces away, is occluded or contributes nothing. A point light
+/// (delta position) cannot be seen and returns `None`.
+pub fn connect_to_camera(scene: &Scene, y: &PathVertex) -> Option<CameraConnection> {
+    let cam = &scene.camera;
+    let camera = PathVertex::camera(cam, Color::ONE);
+    let (dir, dist2, value, eval) = match y.kind {
+        VertexKind::Light { light, infinite } => {
+            // x0 from `Light::sample_le`: its pdf_fwd is pmf · pdf_pos (pmf · pdf_dir at infinity),
+            // and the radiance towards the camera replaces the one along the sampled ray.
+            let l = &scene.lights[light as usize];
+            if infinite {
+                // The camera looks along y.p, towards the light; there is no cosine at x0.
+                (y.p, 1.0, l.escaped(y.p) / y.pdf_fwd, None)
+            } else if !y.on_surface() {
+                return None;
+            } else {
+                let d = y.p - cam.eye;
+                let dist2 = d.length_squared();
+                let dir = d / dist2.sqrt();
+                let le = l.emitted(y.ng, -dir) * y.ng.dot(dir).abs();
+                (dir, dist2, le / y.pdf_fwd, None)
+            }
+        }
+        VertexKind::Surface { .. } => {
+            let d = y.p - cam.eye;
+            let dist2 = d.length_squared();
+            let dir = d / dist2.sqrt();
+            let ev = eval_towards(scene, y, -dir, TransportMode::Importance)?;
+            (dir, dist2, y.beta * ev.f_cos, Some(ev))
+        }
+        VertexKind::Camera => return None,
+    };
+    if value == Color::ZERO {
+        return None;
+    }
+    let raster = cam.raster_of(dir)?;
+    let we = cam.importance(dir);
+    let cos_c = cam.forward().dot(dir);
+    if !scene.connection_visible(y, &camera) {
+        return None;
+    }
+    Some(CameraConnection {
+        raster,
+        dir,
+        value: value * (we * cos_c / dist2),
+        eval,
+    })
+}

@@ -1,0 +1,88 @@
+//! `light` — light tracing (Veach 1997, §10.2 with t = 1; the seed's "splat to the image at each
+//! vertex"): light subpaths are traced in importance mode and every vertex that can be connected —
+//! x0 on an emitter included — is joined to the pinhole and splatted to the pixel it lands in.
+//!
+//! One technique only, so no MIS: each splat is β · f · We · cos θ_c / d² over the M light
+//! subpaths of the pass. It cannot render what the camera sees through a delta surface (a mirror
+//! or glass seen directly, or an emitter behind glass): the connection would end at a delta
+//! vertex, whose density of being reached is zero. A point light is never seen directly either,
+//! by any technique. Tests comparing `light` with other integrators exclude exactly those paths.
+//!
+//! | key | type | default | meaning |
+//! |---|---|---|---|
+//! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
+//! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
+//! | `light_paths` | u64 | the pixel count | light subpaths per pass |
+
+use crate::connect::connect_to_camera;
+use crate::params::ParamReader;
+use crate::splat::splat_pass;
+use crate::walk::{light_subpath, Subpath, WalkLimits};
+use crate::Integrator;
+use lt_core::path::scatter::connectable;
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::Scene;
+use lt_estimators::Image;
+
+#[derive(Clone, Copy, Debug)]
+pub struct LightParams {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    /// `None`: one light subpath per pixel.
+    pub light_paths: Option<u64>,
+}
+
+impl LightParams {
+    pub fn read(scene: &Scene, r: &ParamReader) -> Result<LightParams, String> {
+        let light_paths = r.get::<u64>("light_paths")?;
+        if light_paths == Some(0) {
+            return Err("light: light_paths must be at least 1".into());
+        }
+        Ok(LightParams {
+            max_depth: r.get("max_depth")?.unwrap_or(scene.settings.max_depth),
+            rr_depth: r.get("rr_depth")?.unwrap_or(scene.settings.rr_depth),
+            light_paths,
+        })
+    }
+}
+
+pub struct LightTracer {
+    pub params: LightParams,
+}
+
+/// Light subpaths per splat chunk: enough to amortise the chunk's bookkeeping.
+const CHUNK: u64 = 1024;
+
+impl Integrator for LightTracer {
+    fn name(&self) -> &'static str {
+        "light"
+    }
+
+    fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
+        let cam = &scene.camera;
+        let m = self
+            .params
+            .light_paths
+            .unwrap_or(cam.pixel_count() as u64);
+        let limits = WalkLimits {
+            // s light vertices and the pinhole make a path of s segments.
+            max_vertices: self.params.max_depth as usize,
+            rr_depth: self.params.rr_depth,
+        };
+        let scale = 1.0 / m as f32;
+        let (w, h) = (cam.width as usize, cam.height as usize);
+        splat_pass(w, h, m, CHUNK, 1.0, |i, splats| {
+            let mut sampler = Sampler::for_item(Domain::Light, seed, i, pass as u64);
+            let mut sub = Subpath::with_capacity(limits.max_vertices);
+            light_subpath(scene, &mut sampler, limits, &mut sub);
+            for y in &sub.vertices {
+                if !connectable(scene, y) {
+                    continue;
+                }
+                if let Some(c) = connect_to_camera(scene, y) {
+                    splats.add(c.raster, c.value * scale);
+                }
+            }
+        })
+    }
+}
