@@ -119,8 +119,8 @@ fn emission_densities(scene: &Scene, x0: &PathVertex, x1: Option<&PathVertex>) -
     (pmf * first as f64, x0.convert_density(second, x1) as f64)
 }
 
-/// Longest path handled without allocating (segments).
-const MAX_K: usize = 62;
+/// Longest path weighed without allocating (segments); longer ones use the heap.
+const STACK_K: usize = 23;
 
 /// The MIS weight of strategy (s, t) for the path `split` forms (Veach 1997, eq. 10.9 with the
 /// ratios of §10.2), under `h`, with `ratio` = M/N light subpaths per camera sample.
@@ -139,10 +139,18 @@ pub fn mis_weight(
     };
     let t = z.len();
     let k = s + t - 1;
-    debug_assert!(k >= 1 && k <= MAX_K);
-    let mut light = [0.0f64; MAX_K + 1];
-    let mut camera = [0.0f64; MAX_K + 1];
-    let mut conn = [false; MAX_K + 1];
+    debug_assert!(k >= 1);
+    let (mut light_a, mut camera_a, mut conn_a) =
+        ([0.0f64; STACK_K + 1], [0.0f64; STACK_K + 1], [false; STACK_K + 1]);
+    let (mut light_v, mut camera_v, mut conn_v) = (Vec::new(), Vec::new(), Vec::new());
+    let (light, camera, conn): (&mut [f64], &mut [f64], &mut [bool]) = if k <= STACK_K {
+        (&mut light_a, &mut camera_a, &mut conn_a)
+    } else {
+        light_v.resize(k + 1, 0.0);
+        camera_v.resize(k + 1, 0.0);
+        conn_v.resize(k + 1, false);
+        (&mut light_v, &mut camera_v, &mut conn_v)
+    };
     // x_i: light vertices below s, camera vertices from s up (for s = 0, z's last is x0).
     let at = |i: usize| -> &PathVertex {
         if i < s {

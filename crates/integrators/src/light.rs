@@ -16,7 +16,7 @@
 
 use crate::connect::connect_to_camera;
 use crate::params::ParamReader;
-use crate::splat::splat_pass;
+use crate::splat::splat_pass_with;
 use crate::walk::{light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::path::scatter::connectable;
@@ -71,10 +71,10 @@ impl Integrator for LightTracer {
         };
         let scale = 1.0 / m as f32;
         let (w, h) = (cam.width as usize, cam.height as usize);
-        splat_pass(w, h, m, CHUNK, 1.0, |i, splats| {
+        let scratch = || Subpath::with_capacity(limits.max_vertices);
+        splat_pass_with(w, h, m, CHUNK, scratch, |i, splats, sub| {
             let mut sampler = Sampler::for_item(Domain::Light, seed, i, pass as u64);
-            let mut sub = Subpath::with_capacity(limits.max_vertices);
-            light_subpath(scene, &mut sampler, limits, &mut sub);
+            light_subpath(scene, &mut sampler, limits, sub);
             for y in &sub.vertices {
                 if !connectable(scene, y) {
                     continue;

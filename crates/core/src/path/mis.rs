@@ -219,8 +219,8 @@ impl Chain<'_> {
     }
 }
 
-/// Paths up to this many techniques (k ≤ 62) weigh without allocating.
-const MAX_TECHNIQUES: usize = 64;
+/// Paths up to this many techniques (k ≤ 24) weigh without allocating.
+const MAX_TECHNIQUES: usize = 26;
 
 /// Balance heuristic w_s = p_s / Σ_i p_i over effective densities n_i p_i. Zero when p_s = 0.
 pub fn balance_weight(pdfs: &[f64], s: usize) -> f64 {
