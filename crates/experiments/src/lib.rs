@@ -6,3 +6,4 @@ pub mod compare;
 pub mod image_io;
 pub mod integrator_args;
 pub mod render_cmd;
+pub mod strategies;

@@ -2,10 +2,11 @@
 //! standard-error EXR and a JSON record of how the image was made.
 
 use crate::image_io::{write_exr, write_png_preview};
+use crate::strategies::{make_bdpt, write_pyramid, PyramidIntegrator, PyramidMeta};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use lt_core::scene::load_scene;
-use lt_integrators::{make_integrator, render, RenderOptions};
+use lt_integrators::{make_integrator, render, Integrator, RenderOptions};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -41,6 +42,14 @@ pub struct RenderArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// bdpt only: also write Veach's path pyramid into DIR — per strategy (s, t) of every length
+    /// k ≤ --strategy-length its weighted and unweighted images with standard errors, a tiled
+    /// pyramid.png, README.md and strategies.json. The main image is unchanged.
+    #[arg(long, value_name = "DIR")]
+    pub strategies: Option<PathBuf>,
+    /// Longest path length k (segments) in the pyramid written by --strategies.
+    #[arg(long, value_name = "L", default_value_t = crate::strategies::DEFAULT_LENGTH)]
+    pub strategy_length: usize,
 }
 
 /// Paths of everything written beside the main EXR.
@@ -60,9 +69,50 @@ fn write_outputs(out: &Path, acc: &lt_estimators::running::RunningImage) -> Resu
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
+    if let Some(dir) = &args.strategies {
+        if args.integrator != "bdpt" {
+            return Err(format!(
+                "--strategies {} needs -i bdpt: the per-strategy path pyramid splits bdpt's \
+                 (s, t) strategies, which '{}' does not have",
+                dir.display(),
+                args.integrator
+            ));
+        }
+        if args.strategy_length == 0 {
+            return Err("--strategy-length must be at least 1".into());
+        }
+    }
     let scene = load_scene(&args.scene).map_err(|e| e.to_string())?;
     let params = args.integrator_args.to_params()?;
-    let integrator = make_integrator(&args.integrator, &scene, &params)?;
+    let pyramid = match &args.strategies {
+        None => None,
+        Some(dir) => {
+            let bdpt = make_bdpt(&scene, &params)?;
+            let meta = PyramidMeta {
+                scene: args.scene.display().to_string(),
+                seed: args.seed,
+                max_depth: bdpt.params.max_depth,
+            };
+            let integ = PyramidIntegrator::new(&scene, bdpt, args.strategy_length);
+            Some((dir.clone(), integ, meta))
+        }
+    };
+    let plain = match pyramid {
+        None => Some(make_integrator(&args.integrator, &scene, &params)?),
+        Some(_) => None,
+    };
+    let integrator: &dyn Integrator = match (&pyramid, &plain) {
+        (Some((_, p, _)), _) => p,
+        (None, Some(i)) => i.as_ref(),
+        (None, None) => unreachable!("one of the two is built"),
+    };
+    let write_all = |acc: &lt_estimators::running::RunningImage| -> Result<(), String> {
+        write_outputs(&args.output, acc)?;
+        if let Some((dir, integ, meta)) = &pyramid {
+            integ.with_pyramid(|p| write_pyramid(dir, p, meta))?;
+        }
+        Ok(())
+    };
     if args.time.is_some_and(|t| !(t > 0.0 && t.is_finite())) {
         return Err("--time must be a positive number of seconds".into());
     }
@@ -91,7 +141,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     let pixels = scene.camera.pixel_count() as f64;
     let mut last_checkpoint = Instant::now();
     let mut checkpoint_error = None;
-    let result = render(&scene, integrator.as_ref(), &opts, |r| {
+    let result = render(&scene, integrator, &opts, |r| {
         bar.set_position(if args.time.is_some() {
             r.elapsed.as_millis() as u64
         } else {
@@ -105,7 +155,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         ));
         if last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint {
             last_checkpoint = Instant::now();
-            if let Err(e) = write_outputs(&args.output, r.accumulated) {
+            if let Err(e) = write_all(r.accumulated) {
                 checkpoint_error = Some(e);
                 return ControlFlow::Break(());
             }
@@ -120,7 +170,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if let Some(e) = checkpoint_error {
         return Err(e);
     }
-    write_outputs(&args.output, &result.image)?;
+    write_all(&result.image)?;
     let secs = result.elapsed.as_secs_f64();
     let record = serde_json::json!({
         "scene": args.scene.display().to_string(),
@@ -134,6 +184,8 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         "spp_per_second": result.passes as f64 / secs,
         "invalid_samples": result.invalid_samples,
         "interrupted": interrupted.load(Ordering::SeqCst),
+        "strategies": pyramid.as_ref().map(|(dir, _, _)| dir.display().to_string()),
+        "strategy_length": pyramid.as_ref().map(|_| args.strategy_length),
     });
     crate::image_io::write_atomic(
         &sibling(&args.output, ".json"),
