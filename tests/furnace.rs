@@ -1,18 +1,49 @@
 //! White furnace: inside a closed enclosure whose walls have albedo ρ and emit Le everywhere,
-//! radiance is Le · (1 + ρ + ρ² + …) = Le / (1 − ρ) in every direction. Both path tracers must
-//! reproduce it within 4 standard errors (Šidák-corrected over the channels), for an analytic
-//! sphere and for a triangle-mesh cube, at small and at extreme scene scales.
+//! radiance is Le · (1 + ρ + ρ² + …) = Le / (1 − ρ) in every direction. Every registered
+//! integrator (`lt_integrators::INTEGRATORS`, so a new one is covered with no new test code) must
+//! reproduce it within Šidák-corrected standard errors, for an analytic sphere and for a
+//! triangle-mesh cube, at small and at extreme scene scales. The walls are both the emitter and
+//! the reflector, so light tracing and BDPT start their light subpaths on the very surfaces they
+//! bounce on (x0 on a wall is splatted too).
 
 use lt_core::bsdf::{Diffuse, Material};
 use lt_core::camera::{Camera, FovAxis};
 use lt_core::scene::{RenderSettings, SceneBuilder, ShapeGeometry, TriangleMesh};
 use lt_core::{Color, Scene, Vec3};
 use lt_estimators::agreement::agreement_with_reference_t;
-use lt_integrators::IntegratorParams;
+use lt_integrators::{IntegratorParams, INTEGRATORS};
 use lt_tests::render_blocks;
 
 const RHO: f32 = 0.6;
 const LE: f32 = 0.5;
+
+/// Furnace cases an integrator legitimately cannot do: (integrator, case, reason). A case is
+/// "sphere" or "cube". Empty today: the furnace has no delta surface and no delta light, so every
+/// estimator of the registry can see all of it. A listed case is reported, never silently skipped.
+const EXCLUDED: &[(&str, &str, &str)] = &[];
+
+/// Furnace cases that fail because of an integrator bug, kept asserted (the case must still fail,
+/// so a fix is noticed and the entry removed): (integrator, case, scale, the bug).
+// FIXME(walk roulette): `walk::russian_roulette` continues with probability max βᵢ, and on a light
+// subpath β = Le·cos/(pmf·pdf_pos·pdf_dir) carries the light's power, which scales with the
+// emitter's area (scale²). At scale 1e-3, β ≈ 2e-5 after the first bounces: nearly every light
+// subpath stops at rr_depth and the few survivors carry weight ~1e5. Unbiased in expectation,
+// but so heavy-tailed that a finite render is low with rare fireflies: light −4.5 % (z ≈ −15 at
+// 1024 passes), bdpt −0.7 % (z ≈ −27 at 512 passes). Roulette on β relative to the subpath's
+// starting β (a unitless albedo product) would make it scale-invariant.
+const KNOWN_FAILURES: &[(&str, &str, f32, &str)] = &[
+    ("light", "sphere", 1e-3, "FIXME(walk roulette)"),
+    ("light", "cube", 1e-3, "FIXME(walk roulette)"),
+    ("bdpt", "sphere", 1e-3, "FIXME(walk roulette)"),
+    ("bdpt", "cube", 1e-3, "FIXME(walk roulette)"),
+];
+
+fn excluded(integrator: &str, case: &str) -> Option<&'static str> {
+    EXCLUDED
+        .iter()
+        .find(|(i, c, _)| *i == integrator && *c == case)
+        .map(|(_, _, why)| *why)
+}
 
 fn furnace(sphere: bool, scale: f32) -> Scene {
     let camera = Camera::look_at(
@@ -51,51 +82,102 @@ fn furnace(sphere: bool, scale: f32) -> Scene {
     b.build()
 }
 
-fn check(integrator: &str, sphere: bool, scale: f32) {
+/// Runs one furnace case; `Err` describes how it failed (a panic included).
+fn run(
+    integrator: &str,
+    params: IntegratorParams,
+    passes: u32,
+    sphere: bool,
+    scale: f32,
+) -> Result<String, String> {
+    let case = if sphere { "sphere" } else { "cube" };
+    let name = format!("{integrator} {case} scale={scale:e}");
     let scene = furnace(sphere, scale);
-    let (result, blocks) =
-        render_blocks(&scene, integrator, IntegratorParams::default(), 64, 7, 16);
-    assert_eq!(result.invalid_samples, 0);
+    let rendered = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        render_blocks(&scene, integrator, params, passes, 7, 16)
+    }));
+    let (result, blocks) = rendered.map_err(|e| {
+        let msg = e
+            .downcast_ref::<String>()
+            .cloned()
+            .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
+            .unwrap_or_default();
+        format!("{name}: panicked: {msg}")
+    })?;
+    if result.invalid_samples != 0 {
+        return Err(format!("{name}: {} invalid samples", result.invalid_samples));
+    }
     let expected = (LE / (1.0 - RHO)) as f64;
     let a = agreement_with_reference_t(&blocks, &[[expected; 3]], 1e-3);
-    let blocks = blocks.estimate();
-    assert!(
-        a.passed(),
-        "{integrator} sphere={sphere} scale={scale}: mean {:?} vs {expected}: {a}",
-        blocks.mean[0]
+    let b = blocks.estimate();
+    let (mean, se) = (b.mean[0][0], b.std_error[0][0]);
+    let summary = format!(
+        "{name}: mean {mean:.5} ± {se:.5} (ratio {:.4}) vs {expected}: {a}",
+        mean / expected
     );
+    if !a.passed() {
+        return Err(summary);
+    }
     // Non-trivial: the estimate has a real spread, so the test could detect a bias of a few %.
-    assert!(
-        blocks.std_error[0][0] > 0.0 && blocks.std_error[0][0] < 0.02 * expected,
-        "stderr {:?}",
-        blocks.std_error[0]
-    );
+    if !(se > 0.0 && se < 0.02 * expected) {
+        return Err(format!("{summary}; standard error {se} not in (0, 2 % of the answer)"));
+    }
+    Ok(summary)
+}
+
+/// Asserts one case: it must pass, or, if it is a known failure, still fail as recorded.
+fn check(integrator: &str, sphere: bool, scale: f32) {
+    let case = if sphere { "sphere" } else { "cube" };
+    if let Some(why) = excluded(integrator, case) {
+        println!("{integrator} {case} furnace: excluded ({why})");
+        return;
+    }
+    let known = KNOWN_FAILURES
+        .iter()
+        .find(|(i, c, s, _)| *i == integrator && *c == case && *s == scale)
+        .map(|(_, _, _, why)| *why);
+    match (run(integrator, IntegratorParams::default(), 64, sphere, scale), known) {
+        (Ok(summary), None) => println!("{summary}"),
+        (Err(e), None) => panic!("{e}"),
+        (Err(e), Some(why)) => println!("KNOWN FAILURE ({why}): {e}"),
+        (Ok(summary), Some(why)) => panic!(
+            "{summary}\nthis case is listed in KNOWN_FAILURES ({why}) but now passes: remove it"
+        ),
+    }
 }
 
 #[test]
-fn pt_sphere_furnace() {
-    check("pt", true, 1.0);
+fn every_integrator_sphere_furnace() {
+    for info in INTEGRATORS {
+        check(info.name, true, 1.0);
+    }
 }
 
 #[test]
-fn pt_bsdf_sphere_furnace() {
-    check("pt-bsdf", true, 1.0);
+fn every_integrator_cube_furnace() {
+    for info in INTEGRATORS {
+        check(info.name, false, 1.0);
+    }
 }
 
 #[test]
-fn pt_cube_furnace() {
-    check("pt", false, 1.0);
+fn every_integrator_furnace_is_scale_invariant() {
+    for info in INTEGRATORS {
+        for scale in [1e-3, 1e6] {
+            check(info.name, true, scale);
+            check(info.name, false, scale);
+        }
+    }
 }
 
+/// Without roulette every furnace path reaches max_depth = 64 segments, past the MIS arrays bdpt
+/// keeps on the stack (it panicked there before they spilled to the heap). Few passes: these
+/// paths are long and every one carries all (s, t) strategies, and the error is tiny anyway.
 #[test]
-fn pt_bsdf_cube_furnace() {
-    check("pt-bsdf", false, 1.0);
-}
-
-#[test]
-fn pt_furnace_is_scale_invariant() {
-    for scale in [1e-3, 1e6] {
-        check("pt", true, scale);
-        check("pt", false, scale);
+fn bdpt_furnace_without_roulette_at_64_segments() {
+    let no_roulette = IntegratorParams::new().with("rr_depth", 1000);
+    match run("bdpt", no_roulette, 4, true, 1.0) {
+        Ok(summary) => println!("{summary}"),
+        Err(e) => panic!("{e}"),
     }
 }

@@ -1,78 +1,118 @@
-//! Every shipped scene renders without NaN, infinite or negative pixels, and the same seed gives
-//! the same image bit for bit with one thread or two.
+//! Every registered integrator (`lt_integrators::INTEGRATORS`, so a new one is covered with no new
+//! test code) renders every shipped scene without NaN, infinite or negative pixels and without
+//! invalid samples, and gives the same image bit for bit with one thread or two.
 
-use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
+use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions, INTEGRATORS};
 use lt_tests::{shipped_scene, shipped_scene_names};
 use std::ops::ControlFlow;
 
+/// Why an integrator's image of a scene may legitimately be black at this test's sample count.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Black {
+    /// Zero is the exact expected value: the image must be black.
+    Exact,
+    /// Lit paths exist but are so rare that a black image is the likely outcome: either is fine.
+    Likely,
+}
+
+/// (integrator, scene, kind, reason) where a black image is right. Only the "not black" check is
+/// lifted; finiteness, non-negativity and zero invalid samples still hold everywhere.
+const BLACK: &[(&str, &str, Black, &str)] = &[
+    (
+        "pt-bsdf",
+        "cornell-point-caustic",
+        Black::Exact,
+        "its only light is a point light, which BSDF sampling never hits",
+    ),
+    (
+        "pt-bsdf",
+        "sun-room",
+        Black::Likely,
+        "its only light is the sun (6.87e-5 sr) through a window: a BSDF-sampled direction \
+         hits it on ~1e-5 of the bounces that see the window, none in 48²×16 samples",
+    ),
+    (
+        "light",
+        "caustic-sds",
+        Black::Exact,
+        "the camera sees only the mirror, a delta surface: a light vertex joined to the pinhole \
+         would have to be on it",
+    ),
+];
+
+fn black(integrator: &str, scene: &str) -> Option<(Black, &'static str)> {
+    BLACK
+        .iter()
+        .find(|(i, s, _, _)| *i == integrator && *s == scene)
+        .map(|(_, _, k, why)| (*k, *why))
+}
+
 #[test]
-fn pt_gives_finite_non_negative_pixels_on_every_shipped_scene() {
+fn every_integrator_gives_finite_non_negative_pixels_on_every_shipped_scene() {
     let names = shipped_scene_names();
     assert!(
         names.len() >= 7,
         "expected the seven shipped scenes, found {names:?}"
     );
-    for name in names {
-        let scene = shipped_scene(&name, Some((48, 48)));
-        let (result, _) =
-            lt_tests::render_blocks(&scene, "pt", IntegratorParams::default(), 16, 3, 48);
-        assert_eq!(
-            result.invalid_samples, 0,
-            "{name}: integrator produced invalid samples"
-        );
-        let mean = result.image.mean();
-        assert!(
-            mean.data
-                .iter()
-                .flatten()
-                .all(|v| v.is_finite() && *v >= 0.0),
-            "{name}: invalid pixel"
-        );
-        assert!(
-            mean.data.iter().flatten().any(|v| *v > 0.0),
-            "{name}: image is black"
-        );
+    for info in INTEGRATORS {
+        for name in &names {
+            let scene = shipped_scene(name, Some((48, 48)));
+            let (result, _) =
+                lt_tests::render_blocks(&scene, info.name, IntegratorParams::default(), 16, 3, 48);
+            let who = format!("{} on {name}", info.name);
+            assert_eq!(
+                result.invalid_samples, 0,
+                "{who}: integrator produced invalid samples"
+            );
+            let mean = result.image.mean();
+            assert!(
+                mean.data
+                    .iter()
+                    .flatten()
+                    .all(|v| v.is_finite() && *v >= 0.0),
+                "{who}: invalid pixel"
+            );
+            let lit = mean.data.iter().flatten().any(|v| *v > 0.0);
+            match black(info.name, name) {
+                None => assert!(lit, "{who}: image is black"),
+                Some((Black::Exact, why)) => {
+                    assert!(!lit, "{who}: expected black ({why}), found light")
+                }
+                Some((Black::Likely, why)) => println!("{who}: black allowed ({why}); lit: {lit}"),
+            }
+        }
     }
 }
 
 #[test]
 fn same_seed_gives_identical_images_for_one_and_two_threads() {
-    for name in ["cornell-box", "veach-mis", "cornell-glass-light"] {
-        let scene = shipped_scene(name, Some((32, 32)));
-        let integ = make_integrator("pt", &scene, &IntegratorParams::default()).unwrap();
-        let run = |threads| {
-            let opts = RenderOptions {
-                passes: 4,
-                time_limit: None,
-                seed: 99,
-                threads,
+    for info in INTEGRATORS {
+        for name in ["cornell-box", "veach-mis", "cornell-glass-light"] {
+            let who = format!("{} on {name}", info.name);
+            let scene = shipped_scene(name, Some((32, 32)));
+            let integ = make_integrator(info.name, &scene, &IntegratorParams::default()).unwrap();
+            let run = |threads, seed| {
+                let opts = RenderOptions {
+                    passes: 4,
+                    time_limit: None,
+                    seed,
+                    threads,
+                };
+                render(&scene, integ.as_ref(), &opts, |_| ControlFlow::Continue(()))
+                    .unwrap()
+                    .image
+                    .mean()
             };
-            render(&scene, integ.as_ref(), &opts, |_| ControlFlow::Continue(()))
-                .unwrap()
-                .image
-                .mean()
-        };
-        let one = run(1);
-        let two = run(2);
-        let same = one
-            .data
-            .iter()
-            .flatten()
-            .zip(two.data.iter().flatten())
-            .all(|(a, b)| a.to_bits() == b.to_bits());
-        assert!(same, "{name}: images differ between 1 and 2 threads");
-        let other_seed = {
-            let opts = RenderOptions {
-                passes: 4,
-                time_limit: None,
-                seed: 100,
-                threads: 2,
-            };
-            render(&scene, integ.as_ref(), &opts, |_| ControlFlow::Continue(()))
-                .unwrap()
-                .image
-                .mean()
-        };
-        assert_ne!(one, other_seed, "{name}: the seed must matter");
+            let one = run(1, 99);
+            let two = run(2, 99);
+            let same = one
+                .data
+                .iter()
+                .flatten()
+                .zip(two.data.iter().flatten())
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(same, "{who}: images differ between 1 and 2 threads");
+            assert_ne!(one, run(2, 100), "{who}: the seed must matter");
+        }
     }
 }
