@@ -45,7 +45,8 @@ impl Default for RenderSettings {
     }
 }
 
-/// One shape as the user described it, after transforms (world space).
+/// One shape as the user described it, after transforms, in the scene's internal coordinates
+/// (world − `Scene::origin`).
 #[derive(Clone, Debug)]
 pub struct Shape {
     pub geometry: ShapeGeometry,
@@ -57,6 +58,11 @@ pub struct Shape {
 }
 
 pub struct Scene {
+    /// The world position of the internal origin. Every position the scene holds or returns —
+    /// shapes, point lights, the camera eye, the bounding sphere, hit points, path vertices, and
+    /// the points its queries take — is internal: world − `origin`. Add it back to report a
+    /// world position. Directions are the same in both.
+    pub origin: Vec3,
     pub camera: Camera,
     pub settings: RenderSettings,
     pub materials: Vec<Material>,

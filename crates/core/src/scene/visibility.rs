@@ -245,6 +245,9 @@ mod tests {
         let wall = (p(0.0, 0.0, 0.0), ey, ez); // x = 0, normal +x
         let corner_wall = (p(0.0, 0.0, -1.0), ey, ez); // x = 0, z ∈ [−1, 0]
         let sc = scene(&[floor, wall, corner_wall]);
+        // Query points in the scene's internal coordinates (exact: Sterbenz, see `Scene::origin`).
+        let world = p;
+        let p = |x: f32, y: f32, z: f32| world(x, y, z) - sc.origin;
         let mut s = Sampler::new(5, scale.to_bits() as u64, shift.x.to_bits() as u64);
         let inside = p(0.5, 0.5, 0.5);
         let mut tested = 0;
