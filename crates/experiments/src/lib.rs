@@ -5,5 +5,6 @@ pub mod bench_cmd;
 pub mod compare;
 pub mod image_io;
 pub mod integrator_args;
+pub mod mis_check;
 pub mod render_cmd;
 pub mod strategies;

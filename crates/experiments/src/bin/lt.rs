@@ -18,6 +18,8 @@ enum Command {
     Compare(lt_experiments::compare::CompareArgs),
     /// Measure BVH and integrator throughput (results/bench.md).
     Bench(lt_experiments::bench_cmd::BenchArgs),
+    /// Check an integrator's MIS weights (pt, bdpt) against the from-scratch path-space oracle.
+    MisCheck(lt_experiments::mis_check::MisCheckArgs),
     /// List the integrators.
     List,
 }
@@ -28,6 +30,7 @@ fn main() -> ExitCode {
         Command::Render(a) => lt_experiments::render_cmd::run(a),
         Command::Compare(a) => lt_experiments::compare::run(a).map(|report| print!("{report}")),
         Command::Bench(a) => lt_experiments::bench_cmd::run(a).map(|table| print!("{table}")),
+        Command::MisCheck(a) => lt_experiments::mis_check::run(a).map(|table| print!("{table}")),
         Command::List => {
             for i in lt_integrators::INTEGRATORS {
                 println!("{:10} {}", i.name, i.about);

@@ -1,0 +1,824 @@
+//! `lt mis-check`: samples paths with an integrator's own code (through its `Recorder` hooks) and
+//! holds the MIS weights it applied to the from-scratch oracle of `lt_core::path`.
+//!
+//! Per recorded path x̄ of k segments made by technique s:
+//!
+//! - **(a) oracle.** The weight the integrator used against `oracle_weight` over the effective
+//!   densities of `Path::densities` (bdpt: every technique 0 … k+1; pt: only 0 = BSDF hit and
+//!   1 = NEE, and only 0 for k = 1). The mismatch is relative, |w − w°| / max(w, w°): the
+//!   heuristics' weights have bounded log-derivatives (|∂ ln w_s / ∂ ln p_i| ≤ β), so a relative
+//!   error ε in the walk's densities moves a weight by at most ~βε relatively, whatever its size;
+//!   an absolute measure would hide a wrong density behind a small weight. A weight that is zero
+//!   on one side only is a mismatch of 1.
+//! - **(b) partition of unity.** Σ_s' w_s' = 1 over the techniques, each by the integrator's own
+//!   code: for pt `weight + alternatives`; for bdpt `bdpt::mis_weight` replayed for every valid
+//!   technique s' on the same path split at s', its vertices' `pdf_fwd`/`pdf_rev` set from the
+//!   oracle's densities (as the walks would have set them) and its end evaluations from
+//!   `connect::eval_towards`. This exercises bdpt's patching and the chain arithmetic; (a)
+//!   exercises the densities the walks filled. Each replayed weight is also compared with the
+//!   oracle's (`replay` column).
+
+use clap::Args;
+use lt_core::bsdf::TransportMode;
+use lt_core::math::{Color, Vec2};
+use lt_core::path::{oracle_weight, Heuristic, Path, PathVertex, VertexKind};
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::Scene;
+use lt_integrators::bdpt::{mis_weight, Bdpt, BdptParams, EndEvals, Split};
+use lt_integrators::connect::eval_towards;
+use lt_integrators::pt::{Pt, PtParams, Techniques};
+use lt_integrators::record::{Completed, Recorder};
+use std::collections::BTreeSet;
+use std::fmt::{self, Write as _};
+use std::path::PathBuf;
+
+/// Default tolerance of check (a), relative (see the module docs and `lt mis-check --help`).
+pub const DEFAULT_TOLERANCE: f64 = 1e-3;
+/// Tolerance of check (b), absolute on Σ w − 1 (f64 arithmetic on consistent densities for bdpt;
+/// two complementary f32 weights for pt).
+pub const SUM_TOLERANCE: f64 = 1e-6;
+/// Stricter levels of (a) whose exceedances the table counts, for the record.
+pub const STRICT_LEVELS: [f64; 3] = [1e-4, 1e-5, 1e-6];
+
+#[derive(Args, Debug, Clone)]
+pub struct MisCheckArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Integrator whose weights are checked: pt or bdpt.
+    #[arg(long, default_value = "bdpt")]
+    pub integrator: String,
+    /// MIS heuristic: power (the integrators' default), balance, or none (bdpt only).
+    #[arg(long)]
+    pub mis: Option<String>,
+    /// Paths to check per (path length, technique); each length gets at least this many.
+    #[arg(long, default_value_t = 1000)]
+    pub paths: usize,
+    /// Longest path in segments (default: the scene's max_depth).
+    #[arg(long)]
+    pub max_depth: Option<u32>,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Film resolution (square) the passes run at.
+    #[arg(long, default_value_t = 16)]
+    pub resolution: u32,
+    /// Give up on lengths still short of `paths` after this many passes.
+    #[arg(long, default_value_t = 2000)]
+    pub max_passes: u32,
+    /// bdpt: light subpaths per pass (default: the pixel count).
+    #[arg(long)]
+    pub light_paths: Option<u64>,
+    /// Relative tolerance of the integrator's weight against the oracle's.
+    #[arg(long, default_value_t = DEFAULT_TOLERANCE)]
+    pub tolerance: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Which {
+    Pt,
+    Bdpt,
+}
+
+impl Which {
+    pub fn parse(s: &str) -> Result<Which, String> {
+        match s {
+            "pt" => Ok(Which::Pt),
+            "bdpt" => Ok(Which::Bdpt),
+            _ => Err(format!(
+                "mis-check: unknown integrator '{s}' (known: pt, bdpt)"
+            )),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Which::Pt => "pt",
+            Which::Bdpt => "bdpt",
+        }
+    }
+}
+
+/// What to sample and how to judge it.
+#[derive(Clone, Copy, Debug)]
+pub struct Options {
+    pub integrator: Which,
+    pub heuristic: Heuristic,
+    /// Paths kept per (k, s); sampling stops once every k ≤ max_depth has at least this many.
+    pub paths: usize,
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub seed: u64,
+    pub resolution: u32,
+    pub max_passes: u32,
+    pub light_paths: Option<u64>,
+    pub tolerance: f64,
+}
+
+impl Options {
+    /// Defaults for `scene`: bdpt, power, the scene's depths, 16×16, tolerance 1e-3.
+    pub fn new(scene: &Scene, integrator: Which) -> Options {
+        Options {
+            integrator,
+            heuristic: Heuristic::Power,
+            paths: 1000,
+            max_depth: scene.settings.max_depth,
+            rr_depth: scene.settings.rr_depth,
+            seed: 1,
+            resolution: 16,
+            max_passes: 2000,
+            light_paths: None,
+            tolerance: DEFAULT_TOLERANCE,
+        }
+    }
+}
+
+/// One completed path as an integrator reported it (an owned `Completed`).
+#[derive(Clone, Debug)]
+pub struct Record {
+    pub s: usize,
+    pub light: Vec<PathVertex>,
+    pub camera: Vec<PathVertex>,
+    pub weight: f64,
+    pub value: Color,
+    pub raster: Vec2,
+    pub alternatives: Vec<(usize, f64)>,
+}
+
+impl Record {
+    /// Segments k of the full path.
+    pub fn k(&self) -> usize {
+        self.light.len() + self.camera.len() - 1
+    }
+
+    pub fn path(&self) -> Path {
+        Path::from_subpaths(&self.light, &self.camera)
+    }
+}
+
+/// A `Recorder` keeping up to `quota` paths per (k, s).
+pub struct Collector {
+    pub quota: usize,
+    pub max_depth: usize,
+    /// counts[k][s].
+    counts: Vec<Vec<usize>>,
+    pub records: Vec<Record>,
+    /// Paths reported with k beyond max_depth (an integrator bug; checked as an error).
+    pub too_long: usize,
+}
+
+impl Collector {
+    pub fn new(quota: usize, max_depth: usize) -> Collector {
+        Collector {
+            quota,
+            max_depth,
+            counts: (0..=max_depth).map(|k| vec![0; k + 2]).collect(),
+            records: Vec::new(),
+            too_long: 0,
+        }
+    }
+
+    /// Paths kept of length k (all techniques).
+    pub fn of_length(&self, k: usize) -> usize {
+        self.counts[k].iter().sum()
+    }
+
+    /// Every length 1 … max_depth has at least `quota` paths.
+    pub fn full(&self) -> bool {
+        (1..=self.max_depth).all(|k| self.of_length(k) >= self.quota)
+    }
+}
+
+impl Recorder for Collector {
+    const ACTIVE: bool = true;
+
+    fn completed(&mut self, p: Completed) {
+        let k = p.light.len() + p.camera.len() - 1;
+        if k > self.max_depth || p.s > k + 1 {
+            self.too_long += 1;
+            return;
+        }
+        if self.counts[k][p.s] >= self.quota {
+            return;
+        }
+        self.counts[k][p.s] += 1;
+        self.records.push(Record {
+            s: p.s,
+            light: p.light.to_vec(),
+            camera: p.camera.to_vec(),
+            weight: p.weight,
+            value: p.value,
+            raster: p.raster,
+            alternatives: p.alternatives.to_vec(),
+        });
+    }
+}
+
+/// Sets `scene`'s film to the check's resolution (passes run over every pixel).
+pub fn prepare_scene(scene: &mut Scene, opts: &Options) {
+    scene.camera = scene
+        .camera
+        .with_resolution(opts.resolution, opts.resolution);
+}
+
+/// M/N of the run (bdpt's light-tracing ratio; 1 for pt, which has no light tracing).
+pub fn light_tracing_ratio(scene: &Scene, opts: &Options) -> f64 {
+    match opts.integrator {
+        Which::Pt => 1.0,
+        Which::Bdpt => {
+            let n = scene.camera.pixel_count() as u64;
+            opts.light_paths.unwrap_or(n) as f64 / n as f64
+        }
+    }
+}
+
+/// Runs passes of the integrator on `scene` (already at the check's resolution) until every
+/// length has its paths or `max_passes` ran. Returns the collector and the passes run.
+pub fn collect(scene: &Scene, opts: &Options) -> (Collector, u32) {
+    let mut c = Collector::new(opts.paths, opts.max_depth as usize);
+    let mut passes = 0;
+    match opts.integrator {
+        Which::Bdpt => {
+            let bdpt = Bdpt {
+                params: BdptParams {
+                    max_depth: opts.max_depth,
+                    rr_depth: opts.rr_depth,
+                    mis: opts.heuristic,
+                    light_paths: opts.light_paths,
+                },
+            };
+            while passes < opts.max_passes && !c.full() {
+                bdpt.record_pass(scene, opts.seed, passes, &mut c);
+                passes += 1;
+            }
+        }
+        Which::Pt => {
+            let pt = Pt {
+                params: PtParams {
+                    max_depth: opts.max_depth,
+                    rr_depth: opts.rr_depth,
+                    mis: opts.heuristic,
+                    techniques: Techniques::Both,
+                },
+            };
+            let w = scene.camera.width as u64;
+            let n = scene.camera.pixel_count() as u64;
+            while passes < opts.max_passes && !c.full() {
+                for i in 0..n {
+                    let mut s = Sampler::for_item(Domain::Camera, opts.seed, i, passes as u64);
+                    let raster =
+                        Vec2::new((i % w) as f32 + s.next_f32(), (i / w) as f32 + s.next_f32());
+                    pt.radiance_recorded(scene, raster, &mut s, &mut c);
+                }
+                passes += 1;
+            }
+        }
+    }
+    (c, passes)
+}
+
+/// The verdict on one path.
+#[derive(Clone, Debug)]
+pub struct PathCheck {
+    pub k: usize,
+    pub s: usize,
+    /// The oracle's weight of technique s.
+    pub oracle: f64,
+    /// Relative mismatch of the integrator's weight (check a).
+    pub mismatch: f64,
+    /// The path's condition number for (a), see `condition`.
+    pub condition: f64,
+    /// Σ of the integrator's own weights over the techniques, minus 1 (check b).
+    pub sum_error: f64,
+    /// Largest |replayed weight − oracle weight| over the techniques (bdpt; 0 for pt).
+    pub replay_error: f64,
+    /// Techniques the oracle considers valid with non-zero density.
+    pub valid: Vec<usize>,
+}
+
+/// Relative difference |a − b| / max(|a|, |b|) (0 when both are 0; NaN counts as 1).
+fn relative(a: f64, b: f64) -> f64 {
+    if a == b {
+        return 0.0;
+    }
+    let r = (a - b).abs() / a.abs().max(b.abs());
+    if r.is_nan() {
+        1.0
+    } else {
+        r
+    }
+}
+
+/// How far the oracle's densities can stray from the walk's on this path: the largest, over its
+/// segments, of the segment direction's error bound (`scatter::direction_error`: the two ends'
+/// rounding-error bounds over the length — the oracle rebuilds every direction from two f32
+/// positions, the walk used the direction it traced) over the smallest |cos| at the segment's
+/// ends that have a surface (a direction error δ moves a cosine, hence an area conversion or a
+/// cosine-shaped pdf, by up to δ·tan θ < δ / cos θ relatively).
+pub fn condition(path: &Path) -> f64 {
+    let v = &path.vertices;
+    let mut kappa = 0.0f64;
+    for i in 0..path.k() {
+        let (a, b) = (&v[i], &v[i + 1]);
+        let err = lt_core::path::scatter::direction_error(a, b) as f64;
+        if err == 0.0 {
+            continue;
+        }
+        let w = a.dir_to(b);
+        let mut cos = 1.0f32;
+        for x in [a, b] {
+            if x.on_surface() && !x.is_infinite() {
+                cos = cos.min(x.ng.dot(w).abs());
+            }
+        }
+        kappa = kappa.max(err / (cos as f64).max(f64::MIN_POSITIVE));
+    }
+    kappa
+}
+
+/// The tolerance of (a) for a path of condition `kappa`: `tolerance`, or κ when larger.
+pub fn path_tolerance(tolerance: f64, kappa: f64) -> f64 {
+    tolerance.max(kappa)
+}
+
+fn unit_towards(from: &PathVertex, to: &PathVertex) -> lt_core::Vec3 {
+    from.dir_to(to)
+}
+
+fn is_delta(scene: &Scene, v: &PathVertex) -> bool {
+    match v.kind {
+        VertexKind::Surface { material } => scene.material(material).is_delta(),
+        _ => false,
+    }
+}
+
+/// bdpt's own weight of technique `sp` for `path`, replayed through `bdpt::mis_weight` with the
+/// subpath densities a walk would have stored, taken from the oracle's `d`.
+fn replay_bdpt(
+    scene: &Scene,
+    path: &Path,
+    d: &lt_core::path::Densities,
+    sp: usize,
+    h: Heuristic,
+    ratio: f64,
+) -> f64 {
+    let v = &path.vertices;
+    let k = path.k();
+    // Light side x0 … x_{sp−1}: as the light walk stored them.
+    let mut light: Vec<PathVertex> = (0..sp)
+        .map(|i| {
+            let mut x = v[i];
+            x.pdf_fwd = d.light[i] as f32;
+            x.pdf_rev = d.camera[i] as f32;
+            x.wo = if i == 0 {
+                lt_core::Vec3::ZERO
+            } else {
+                unit_towards(&v[i], &v[i - 1])
+            };
+            x.delta = is_delta(scene, &v[i]);
+            x
+        })
+        .collect();
+    if sp == 1 && k >= 2 {
+        light[0].pdf_fwd = d.nee as f32;
+    }
+    // Camera side x_k … x_sp, camera first: as the camera walk stored them.
+    let camera: Vec<PathVertex> = (sp..=k)
+        .rev()
+        .map(|i| {
+            let mut x = v[i];
+            x.pdf_fwd = d.camera[i] as f32;
+            x.pdf_rev = d.light[i] as f32;
+            x.wo = if i == k {
+                lt_core::Vec3::ZERO
+            } else {
+                unit_towards(&v[i], &v[i + 1])
+            };
+            x.delta = is_delta(scene, &v[i]);
+            x
+        })
+        .collect();
+    let t = k + 1 - sp;
+    let light_end = (sp >= 2).then(|| {
+        eval_towards(
+            scene,
+            &light[sp - 1],
+            unit_towards(&v[sp - 1], &v[sp]),
+            TransportMode::Importance,
+        )
+    });
+    let camera_end = (sp >= 1 && t >= 2).then(|| {
+        eval_towards(
+            scene,
+            &camera[t - 1],
+            unit_towards(&v[sp], &v[sp - 1]),
+            TransportMode::Radiance,
+        )
+    });
+    let split = Split {
+        light: &light,
+        camera: &camera,
+        light_nee: d.nee,
+    };
+    let evals = EndEvals {
+        light_end: light_end.flatten(),
+        camera_end: camera_end.flatten(),
+    };
+    mis_weight(scene, split, evals, h, ratio)
+}
+
+/// The effective densities n_s·p_s of the techniques `which` runs (the others zeroed): every
+/// s = 0 … k+1 for bdpt; for pt 0 (BSDF hit) and, on paths of two segments or more, 1 (NEE).
+pub fn effective(d: &lt_core::path::Densities, which: Which) -> Vec<f64> {
+    let mut eff = d.effective_all();
+    if which == Which::Pt {
+        let keep = if d.k() >= 2 { 1 } else { 0 };
+        for e in eff.iter_mut().skip(keep + 1) {
+            *e = 0.0;
+        }
+    }
+    eff
+}
+
+/// Checks one recorded path (see the module docs).
+pub fn check_record(scene: &Scene, r: &Record, opts: &Options, ratio: f64) -> PathCheck {
+    let path = r.path();
+    let k = path.k();
+    let mut d = path.densities(scene);
+    d.light_tracing_ratio = ratio;
+    let eff = effective(&d, opts.integrator);
+    let h = opts.heuristic;
+    let valid: Vec<usize> = (0..eff.len())
+        .filter(|&s| d.valid(s) && eff[s] > 0.0)
+        .collect();
+    let oracle = oracle_weight(&eff, r.s, h);
+    let mismatch = relative(r.weight, oracle);
+    let (sum, replay_error) = match opts.integrator {
+        Which::Pt => (
+            r.weight + r.alternatives.iter().map(|a| a.1).sum::<f64>(),
+            0.0,
+        ),
+        Which::Bdpt => {
+            let mut sum = 0.0;
+            let mut worst = 0.0f64;
+            for &sp in &valid {
+                let w = replay_bdpt(scene, &path, &d, sp, h, ratio);
+                worst = worst.max((w - oracle_weight(&eff, sp, h)).abs());
+                sum += w;
+            }
+            (sum, worst)
+        }
+    };
+    let sum_error = if sum.is_nan() {
+        f64::INFINITY
+    } else {
+        sum - 1.0
+    };
+    PathCheck {
+        k,
+        s: r.s,
+        condition: condition(&path),
+        oracle,
+        mismatch,
+        sum_error,
+        replay_error,
+        valid,
+    }
+}
+
+/// One line of the table: paths of k segments.
+#[derive(Clone, Debug, Default)]
+pub struct Row {
+    pub k: usize,
+    pub paths: usize,
+    /// Techniques the recorded paths came from.
+    pub recorded: BTreeSet<usize>,
+    /// Techniques the oracle found valid (non-zero density) on any of them.
+    pub valid: BTreeSet<usize>,
+    pub max_sum_error: f64,
+    pub max_mismatch: f64,
+    /// Largest mismatch among well-conditioned paths (κ ≤ tolerance).
+    pub max_mismatch_well: f64,
+    /// Ill-conditioned paths (κ > tolerance), held to κ instead.
+    pub ill: usize,
+    pub max_abs_mismatch: f64,
+    pub max_replay_error: f64,
+    /// Paths over their tolerance of (a) (`path_tolerance`).
+    pub over: usize,
+    /// Paths over each of `STRICT_LEVELS`.
+    pub over_strict: [usize; 3],
+    /// Paths failing (b).
+    pub sum_fail: usize,
+}
+
+/// The outcome of a check.
+#[derive(Clone, Debug)]
+pub struct Report {
+    pub scene: String,
+    pub integrator: Which,
+    pub heuristic: Heuristic,
+    pub tolerance: f64,
+    pub passes: u32,
+    pub rows: Vec<Row>,
+    /// Paths the integrator reported beyond max_depth.
+    pub too_long: usize,
+    /// A few failing paths, described.
+    pub examples: Vec<String>,
+}
+
+impl Report {
+    pub fn failures(&self) -> usize {
+        self.too_long
+            + self
+                .rows
+                .iter()
+                .map(|r| r.over.max(r.sum_fail))
+                .sum::<usize>()
+    }
+
+    pub fn passed(&self) -> bool {
+        self.failures() == 0
+    }
+
+    pub fn checked(&self) -> usize {
+        self.rows.iter().map(|r| r.paths).sum()
+    }
+}
+
+fn kind_name(scene: &Scene, v: &PathVertex) -> String {
+    match v.kind {
+        VertexKind::Camera => "camera".into(),
+        VertexKind::Light { light, infinite } => {
+            let l = &scene.lights[light as usize];
+            let what = if infinite {
+                "infinite"
+            } else if l.delta_position() {
+                "point"
+            } else {
+                "area"
+            };
+            format!("light#{light}({what})")
+        }
+        VertexKind::Surface { material } => {
+            let m = scene.material(material);
+            format!(
+                "surf#{material}{}",
+                if m.is_delta() { "(delta)" } else { "" }
+            )
+        }
+    }
+}
+
+/// Describes a failing path: its vertices, the weights, the densities.
+pub fn describe(scene: &Scene, r: &Record, c: &PathCheck, opts: &Options, ratio: f64) -> String {
+    let path = r.path();
+    let kinds: Vec<String> = path.vertices.iter().map(|v| kind_name(scene, v)).collect();
+    let mut d = path.densities(scene);
+    d.light_tracing_ratio = ratio;
+    let eff = effective(&d, opts.integrator);
+    let oracle_all: Vec<String> = (0..eff.len())
+        .map(|s| format!("{:.6e}", oracle_weight(&eff, s, opts.heuristic)))
+        .collect();
+    // What the walks stored, in path order (light side: pdf_fwd = l_i, pdf_rev = c_i; camera
+    // side: pdf_fwd = c_i, pdf_rev = l_i), beside the segment lengths and end cosines.
+    let k = path.k();
+    let stored: Vec<String> = (0..=k)
+        .map(|i| {
+            let v = &path.vertices[i];
+            let (l, c) = if i < r.s {
+                (v.pdf_fwd, v.pdf_rev)
+            } else {
+                (v.pdf_rev, v.pdf_fwd)
+            };
+            format!("x{i}: l={l:e} c={c:e}")
+        })
+        .collect();
+    let segs: Vec<String> = (0..k)
+        .map(|i| {
+            let (a, b) = (&path.vertices[i], &path.vertices[i + 1]);
+            let w = a.dir_to(b);
+            let len = if a.is_infinite() || b.is_infinite() {
+                f32::INFINITY
+            } else {
+                (b.p - a.p).length()
+            };
+            format!(
+                "{i}-{}: len={len:.3e} cos=({:.3e},{:.3e}) derr={:.1e}",
+                i + 1,
+                a.ng.dot(w).abs(),
+                b.ng.dot(w).abs(),
+                lt_core::path::scatter::direction_error(a, b)
+            )
+        })
+        .collect();
+    format!(
+        "k={} s={} path=[{}] weight={:.9e} oracle={:.9e} rel={:.3e} κ={:.2e} Σw−1={:.3e} alternatives={:?}\n    \
+         eff p_s={:?}\n    oracle w_s=[{}]\n    light={:?}\n    camera={:?} nee={:e}\n    stored {}\n    segments {}",
+        c.k,
+        c.s,
+        kinds.join(" → "),
+        r.weight,
+        c.oracle,
+        c.mismatch,
+        c.condition,
+        c.sum_error,
+        r.alternatives,
+        eff,
+        oracle_all.join(", "),
+        d.light,
+        d.camera,
+        d.nee,
+        stored.join("; "),
+        segs.join("; ")
+    )
+}
+
+/// Checks every record; `records` may come from `collect` or be built by hand (tests).
+pub fn check_records(
+    scene: &Scene,
+    records: &[Record],
+    opts: &Options,
+    passes: u32,
+    too_long: usize,
+    name: &str,
+) -> Report {
+    let ratio = light_tracing_ratio(scene, opts);
+    let mut rows: Vec<Row> = (0..=opts.max_depth as usize)
+        .map(|k| Row {
+            k,
+            ..Row::default()
+        })
+        .collect();
+    let mut examples = Vec::new();
+    for r in records {
+        let c = check_record(scene, r, opts, ratio);
+        if c.k >= rows.len() {
+            rows.resize_with(c.k + 1, Row::default);
+            rows[c.k].k = c.k;
+        }
+        let row = &mut rows[c.k];
+        row.paths += 1;
+        row.recorded.insert(c.s);
+        row.valid.extend(c.valid.iter().copied());
+        row.max_sum_error = row.max_sum_error.max(c.sum_error.abs());
+        row.max_mismatch = row.max_mismatch.max(c.mismatch);
+        if c.condition <= opts.tolerance {
+            row.max_mismatch_well = row.max_mismatch_well.max(c.mismatch);
+        } else {
+            row.ill += 1;
+        }
+        row.max_abs_mismatch = row.max_abs_mismatch.max((r.weight - c.oracle).abs());
+        row.max_replay_error = row.max_replay_error.max(c.replay_error);
+        for (n, &lvl) in row.over_strict.iter_mut().zip(&STRICT_LEVELS) {
+            if c.mismatch > lvl {
+                *n += 1;
+            }
+        }
+        let over = !(c.mismatch <= path_tolerance(opts.tolerance, c.condition));
+        let sum_fail = !(c.sum_error.abs() <= SUM_TOLERANCE);
+        row.over += over as usize;
+        row.sum_fail += sum_fail as usize;
+        if (over || sum_fail) && examples.len() < 5 {
+            examples.push(describe(scene, r, &c, opts, ratio));
+        }
+    }
+    rows.retain(|r| r.k >= 1);
+    Report {
+        scene: name.to_string(),
+        integrator: opts.integrator,
+        heuristic: opts.heuristic,
+        tolerance: opts.tolerance,
+        passes,
+        rows,
+        too_long,
+        examples,
+    }
+}
+
+/// Samples and checks; `scene`'s film is set to the check's resolution first.
+pub fn check_scene(scene: &mut Scene, opts: &Options, name: &str) -> Report {
+    prepare_scene(scene, opts);
+    let (c, passes) = collect(scene, opts);
+    check_records(scene, &c.records, opts, passes, c.too_long, name)
+}
+
+fn set_string(s: &BTreeSet<usize>) -> String {
+    if s.is_empty() {
+        return "-".into();
+    }
+    s.iter()
+        .map(|x| x.to_string())
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+impl fmt::Display for Report {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        writeln!(
+            f,
+            "mis-check {} {} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ max(τ={:e}, κ); (b) |Σw−1| ≤ {:e}",
+            self.scene,
+            self.integrator.name(),
+            self.heuristic.name(),
+            self.passes,
+            self.tolerance,
+            SUM_TOLERANCE
+        )?;
+        writeln!(
+            f,
+            "{:>2} {:>6} {:>15} {:>17} {:>9} {:>5} {:>8} {:>8} {:>8} {:>5} {:>5} {:>5} {:>5} {:>5} {:>8}",
+            "k",
+            "paths",
+            "recorded s",
+            "valid s",
+            "max|Σw−1|",
+            "Σfail",
+            "max rel",
+            "rel κ≤τ",
+            "max abs",
+            "ill",
+            "over",
+            ">1e-4",
+            ">1e-5",
+            ">1e-6",
+            "replay"
+        )?;
+        for r in &self.rows {
+            writeln!(
+                f,
+                "{:>2} {:>6} {:>15} {:>17} {:>9.2e} {:>5} {:>8.2e} {:>8.2e} {:>8.2e} {:>5} {:>5} {:>5} {:>5} {:>5} {:>8.1e}",
+                r.k,
+                r.paths,
+                set_string(&r.recorded),
+                set_string(&r.valid),
+                r.max_sum_error,
+                r.sum_fail,
+                r.max_mismatch,
+                r.max_mismatch_well,
+                r.max_abs_mismatch,
+                r.ill,
+                r.over,
+                r.over_strict[0],
+                r.over_strict[1],
+                r.over_strict[2],
+                r.max_replay_error
+            )?;
+        }
+        if self.too_long > 0 {
+            writeln!(f, "{} paths reported beyond max_depth", self.too_long)?;
+        }
+        for e in &self.examples {
+            writeln!(f, "  FAIL {e}")?;
+        }
+        let verdict = if self.passed() { "ok" } else { "FAILED" };
+        writeln!(
+            f,
+            "{verdict}: {} paths checked, {} failing",
+            self.checked(),
+            self.failures()
+        )
+    }
+}
+
+/// `lt mis-check`: the report, or an error carrying it when any check fails.
+pub fn run(args: &MisCheckArgs) -> Result<String, String> {
+    let mut scene = lt_core::scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let integrator = Which::parse(&args.integrator)?;
+    let mut opts = Options::new(&scene, integrator);
+    if let Some(m) = &args.mis {
+        opts.heuristic = Heuristic::parse(m)?;
+        if integrator == Which::Pt && opts.heuristic == Heuristic::Uniform {
+            return Err("mis-check: pt takes power or balance".into());
+        }
+    }
+    if let Some(d) = args.max_depth {
+        if d == 0 {
+            return Err("mis-check: max_depth must be at least 1".into());
+        }
+        opts.max_depth = d;
+    }
+    if args.light_paths == Some(0) {
+        return Err("mis-check: light_paths must be at least 1".into());
+    }
+    if args.light_paths.is_some() && integrator == Which::Pt {
+        return Err("mis-check: --light-paths is a bdpt option".into());
+    }
+    opts.paths = args.paths;
+    opts.seed = args.seed;
+    opts.resolution = args.resolution.max(1);
+    opts.max_passes = args.max_passes;
+    opts.light_paths = args.light_paths;
+    opts.tolerance = args.tolerance;
+    let name = args.scene.display().to_string();
+    let report = check_scene(&mut scene, &opts, &name);
+    let mut out = String::new();
+    let _ = write!(out, "{report}");
+    if report.passed() {
+        Ok(out)
+    } else {
+        print!("{out}");
+        Err(format!(
+            "mis-check: {} of {} paths fail",
+            report.failures(),
+            report.checked()
+        ))
+    }
+}

@@ -1,0 +1,151 @@
+//! `lt mis-check` as a test: on every shipped scene, pt's and bdpt's MIS weights (power and
+//! balance) agree with the from-scratch oracle of `lt_core::path`, and the weights each integrator's
+//! own code gives a path's techniques sum to one. Plus proof that the check can fail.
+
+use lt_core::path::Heuristic;
+use lt_experiments::mis_check::{
+    check_records, check_scene, collect, condition, prepare_scene, Options, Report, Which,
+};
+use lt_tests::{shipped_scene, shipped_scene_names};
+
+/// Paths per (length, technique): small, so the whole file runs in seconds.
+const PATHS: usize = 150;
+
+fn options(scene: &lt_core::Scene, which: Which, h: Heuristic) -> Options {
+    let mut o = Options::new(scene, which);
+    o.heuristic = h;
+    o.paths = PATHS;
+    o.max_passes = 300;
+    o.seed = 7;
+    o
+}
+
+fn check_all(which: Which, h: Heuristic) {
+    let names = shipped_scene_names();
+    assert!(
+        names.len() >= 10,
+        "expected the shipped scenes, found {names:?}"
+    );
+    let mut failed = Vec::new();
+    for name in &names {
+        let mut scene = shipped_scene(name, None);
+        let opts = options(&scene, which, h);
+        let report = check_scene(&mut scene, &opts, name);
+        assert!(report.checked() > 0, "{name}: no paths recorded\n{report}");
+        if !report.passed() {
+            failed.push(format!("{report}"));
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+#[test]
+fn bdpt_power_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all(Which::Bdpt, Heuristic::Power);
+}
+
+#[test]
+fn bdpt_balance_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all(Which::Bdpt, Heuristic::Balance);
+}
+
+#[test]
+fn pt_power_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all(Which::Pt, Heuristic::Power);
+}
+
+#[test]
+fn pt_balance_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all(Which::Pt, Heuristic::Balance);
+}
+
+/// Records of cornell-box by `which`, with the options that made them.
+fn cornell_records(
+    which: Which,
+) -> (
+    lt_core::Scene,
+    Options,
+    Vec<lt_experiments::mis_check::Record>,
+) {
+    let mut scene = shipped_scene("cornell-box", None);
+    let mut opts = options(&scene, which, Heuristic::Power);
+    opts.paths = 50;
+    opts.max_depth = 4;
+    prepare_scene(&mut scene, &opts);
+    let (c, _) = collect(&scene, &opts);
+    (scene, opts, c.records)
+}
+
+fn check(
+    scene: &lt_core::Scene,
+    opts: &Options,
+    records: &[lt_experiments::mis_check::Record],
+) -> Report {
+    check_records(scene, records, opts, 0, 0, "cornell-box")
+}
+
+#[test]
+fn a_perturbed_weight_fails_check_a() {
+    for which in [Which::Bdpt, Which::Pt] {
+        let (scene, opts, mut records) = cornell_records(which);
+        assert!(check(&scene, &opts, &records).passed());
+        // One well-conditioned path whose weight is neither 0 nor 1, off by 1 % (10 τ).
+        let i = records
+            .iter()
+            .position(|r| r.weight > 1e-3 && r.weight < 0.999 && condition(&r.path()) < 1e-3)
+            .unwrap_or_else(|| panic!("{which:?}: no path with a weight strictly between 0 and 1"));
+        records[i].weight *= 1.01;
+        let report = check(&scene, &opts, &records);
+        assert!(!report.passed(), "{report}");
+        assert_eq!(report.failures(), 1, "{report}");
+        let row = report.rows.iter().find(|r| r.k == records[i].k()).unwrap();
+        assert_eq!(row.over, 1, "{report}");
+        // bdpt's (b) replays its own code on the oracle's densities, which the perturbation does
+        // not touch; pt's (b) sums the recorded weights, so it fails as well.
+        let sum_fail = if which == Which::Pt { 1 } else { 0 };
+        assert_eq!(row.sum_fail, sum_fail, "{report}");
+    }
+}
+
+#[test]
+fn a_perturbed_alternative_fails_check_b() {
+    let (scene, opts, mut records) = cornell_records(Which::Pt);
+    let i = records
+        .iter()
+        .position(|r| r.alternatives.iter().any(|a| a.1 > 1e-3))
+        .expect("a pt path both techniques can make");
+    records[i].alternatives[0].1 += 1e-4;
+    let report = check(&scene, &opts, &records);
+    assert!(!report.passed(), "{report}");
+    let row = report.rows.iter().find(|r| r.k == records[i].k()).unwrap();
+    assert_eq!((row.sum_fail, row.over), (1, 0), "{report}");
+}
+
+#[test]
+fn weights_judged_under_the_other_heuristic_fail() {
+    for which in [Which::Bdpt, Which::Pt] {
+        let (scene, mut opts, records) = cornell_records(which);
+        opts.heuristic = Heuristic::Balance;
+        let report = check(&scene, &opts, &records);
+        assert!(!report.passed(), "{report}");
+        // bdpt's replay uses the heuristic it is told, so (b) still holds; (a) does not.
+        assert!(report.rows.iter().all(|r| r.sum_fail == 0), "{report}");
+        assert!(report.rows.iter().any(|r| r.over > 0), "{report}");
+    }
+}
+
+#[test]
+fn a_wrong_light_tracing_ratio_fails() {
+    // bdpt run with M = 4N light paths, judged as if M = N: light tracing's weight is off.
+    let mut scene = shipped_scene("cornell-box", None);
+    let mut opts = options(&scene, Which::Bdpt, Heuristic::Power);
+    opts.paths = 50;
+    opts.max_depth = 3;
+    opts.light_paths = Some(4 * 16 * 16);
+    prepare_scene(&mut scene, &opts);
+    let (c, _) = collect(&scene, &opts);
+    assert!(check(&scene, &opts, &c.records).passed());
+    opts.light_paths = None;
+    let report = check(&scene, &opts, &c.records);
+    assert!(!report.passed(), "{report}");
+}
