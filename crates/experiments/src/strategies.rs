@@ -471,7 +471,15 @@ fn pyramid_sheet(pyr: &Pyramid, means: &[Image], exposure: f64) -> Sheet {
         let tx = x0 + tw.saturating_sub(text_w) / 2;
         draw_text(&mut img, tx, y0 + th + 4, &text, label_scale);
         if st.s == 0 {
-            draw_text(&mut img, gap, y0 + th / 2 - 7, &format!("k={}", st.k), 2);
+            // Just left of the row's first tile (`left` leaves room for it on the widest row).
+            let label_x = x0 - 3 * 6 * 2 - gap;
+            draw_text(
+                &mut img,
+                label_x,
+                y0 + th / 2 - 7,
+                &format!("k={}", st.k),
+                2,
+            );
         }
     }
     Sheet {
