@@ -10,6 +10,16 @@
 //!   error ε in the walk's densities moves a weight by at most ~βε relatively, whatever its size;
 //!   an absolute measure would hide a wrong density behind a small weight. A weight that is zero
 //!   on one side only is a mismatch of 1.
+//!
+//!   **Tolerance** max(τ, κ), τ = 1e-3 (`--tolerance`), κ = `condition(x̄)`: the largest, over
+//!   the segments, of the direction's rounding-error bound over the smaller |cos| at its ends.
+//!   The walks build densities from the directions they traced (f32), the oracle rebuilds every
+//!   direction from two f32 positions, so on a short or grazing segment the two legitimately
+//!   differ by ~κ. Measured on every shipped scene (pt and bdpt, power and balance, 1000 paths
+//!   per (k, s), 567k paths): with κ ≤ 1e-3 the largest mismatch was 5.3e-4 (glossy lobes
+//!   amplify direction errors; 372 of them exceed 1e-4, 1.3e4 exceed 1e-5); with κ > 1e-3 the
+//!   largest mismatch / κ was 0.54. A wrong density (a missing cosine, pmf, ratio or patch) is
+//!   off by far more than either on the many well-conditioned paths.
 //! - **(b) partition of unity.** Σ_s' w_s' = 1 over the techniques, each by the integrator's own
 //!   code: for pt `weight + alternatives`; for bdpt `bdpt::mis_weight` replayed for every valid
 //!   technique s' on the same path split at s', its vertices' `pdf_fwd`/`pdf_rev` set from the
@@ -17,6 +27,12 @@
 //!   `connect::eval_towards`. This exercises bdpt's patching and the chain arithmetic; (a)
 //!   exercises the densities the walks filled. Each replayed weight is also compared with the
 //!   oracle's (`replay` column).
+//!
+//! Table columns per length k: paths checked; techniques recorded and techniques the oracle found
+//! valid (non-zero density) on them; max |Σw − 1| and paths failing (b); max relative mismatch,
+//! the same over well-conditioned paths (κ ≤ τ), max absolute mismatch; ill-conditioned paths
+//! (κ > τ); paths over their tolerance; paths over 1e-4, 1e-5, 1e-6 relative; max |replayed −
+//! oracle| weight (bdpt).
 
 use clap::Args;
 use lt_core::bsdf::TransportMode;
@@ -67,7 +83,8 @@ pub struct MisCheckArgs {
     /// bdpt: light subpaths per pass (default: the pixel count).
     #[arg(long)]
     pub light_paths: Option<u64>,
-    /// Relative tolerance of the integrator's weight against the oracle's.
+    /// Relative tolerance τ of the integrator's weight against the oracle's; a path of condition κ
+    /// (segment direction error / |cos|) is held to max(τ, κ).
     #[arg(long, default_value_t = DEFAULT_TOLERANCE)]
     pub tolerance: f64,
 }
