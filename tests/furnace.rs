@@ -24,19 +24,9 @@ const EXCLUDED: &[(&str, &str, &str)] = &[];
 
 /// Furnace cases that fail because of an integrator bug, kept asserted (the case must still fail,
 /// so a fix is noticed and the entry removed): (integrator, case, scale, the bug).
-// FIXME(walk roulette): `walk::russian_roulette` continues with probability max βᵢ, and on a light
-// subpath β = Le·cos/(pmf·pdf_pos·pdf_dir) carries the light's power, which scales with the
-// emitter's area (scale²). At scale 1e-3, β ≈ 2e-5 after the first bounces: nearly every light
-// subpath stops at rr_depth and the few survivors carry weight ~1e5. Unbiased in expectation,
-// but so heavy-tailed that a finite render is low with rare fireflies: light −4.5 % (z ≈ −15 at
-// 1024 passes), bdpt −0.7 % (z ≈ −27 at 512 passes). Roulette on β relative to the subpath's
-// starting β (a unitless albedo product) would make it scale-invariant.
-const KNOWN_FAILURES: &[(&str, &str, f32, &str)] = &[
-    ("light", "sphere", 1e-3, "FIXME(walk roulette)"),
-    ("light", "cube", 1e-3, "FIXME(walk roulette)"),
-    ("bdpt", "sphere", 1e-3, "FIXME(walk roulette)"),
-    ("bdpt", "cube", 1e-3, "FIXME(walk roulette)"),
-];
+// Empty: light and bdpt were low at scale 1e-3 while Russian roulette compared a light subpath's
+// β (which carries the light's power) with 1; it now compares β with the walk's starting β.
+const KNOWN_FAILURES: &[(&str, &str, f32, &str)] = &[];
 
 fn excluded(integrator: &str, case: &str) -> Option<&'static str> {
     EXCLUDED

@@ -266,6 +266,7 @@ impl Pt {
                 &sf,
                 wo,
                 &mut beta,
+                Color::ONE,
                 depth,
                 self.params.rr_depth,
                 TransportMode::Radiance,

@@ -60,6 +60,7 @@ impl PtBsdf {
                 &hit.shading_frame(),
                 wo,
                 &mut beta,
+                Color::ONE,
                 depth,
                 self.params.rr_depth,
                 TransportMode::Radiance,

@@ -16,14 +16,24 @@ use lt_core::sampling::Sampler;
 use lt_core::scene::SurfaceHit;
 use lt_core::{Scene, Vec2};
 
-/// Russian roulette: continue with probability min(max βᵢ, 0.95) and reweight. Returns false to stop.
-/// `depth` counts segments so far; roulette starts once it reaches `rr_depth`.
+/// Russian roulette: continue with probability min(max βᵢ / max refᵢ, 0.95) and reweight.
+/// Returns false to stop. `depth` counts segments so far; roulette starts once it reaches
+/// `rr_depth`. `reference` is the walk's β at its start: 1 for camera walks, Le/pdf for light
+/// walks, whose β carries the light's power — comparing that with 1 would end almost every light
+/// walk from a small bright emitter (and keep every one from a large dim one), which is unbiased
+/// but makes the survivors' weights explode.
 #[inline]
-pub fn russian_roulette(beta: &mut Color, depth: u32, rr_depth: u32, sampler: &mut Sampler) -> bool {
+pub fn russian_roulette(
+    beta: &mut Color,
+    reference: Color,
+    depth: u32,
+    rr_depth: u32,
+    sampler: &mut Sampler,
+) -> bool {
     if depth < rr_depth {
         return true;
     }
-    let q = beta.max_element().min(0.95);
+    let q = (beta.max_element() / reference.max_element()).min(0.95);
     if sampler.next_f32() >= q {
         return false;
     }
@@ -45,7 +55,8 @@ pub fn escaped_radiance(scene: &Scene, dir: Vec3, mut weight: impl FnMut(u32) ->
 }
 
 /// Continues a walk at `hit` by sampling its BSDF in `mode`: multiplies the throughput by the
-/// sample weight and plays Russian roulette. `None` ends the walk.
+/// sample weight and plays Russian roulette relative to `rr_reference` (the walk's starting β).
+/// `None` ends the walk.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn continue_path(
@@ -54,6 +65,7 @@ pub fn continue_path(
     sf: &ShadingFrame,
     wo: Vec3,
     beta: &mut Color,
+    rr_reference: Color,
     depth: u32,
     rr_depth: u32,
     mode: TransportMode,
@@ -63,7 +75,8 @@ pub fn continue_path(
     let u = sampler.next_2d();
     let bs = scene.material(hit.material).sample(sf, wo, u_lobe, u, mode)?;
     *beta *= bs.weight;
-    (*beta != Color::ZERO && russian_roulette(beta, depth, rr_depth, sampler)).then_some(bs)
+    (*beta != Color::ZERO && russian_roulette(beta, rr_reference, depth, rr_depth, sampler))
+        .then_some(bs)
 }
 
 /// How long subpaths may grow.
@@ -178,6 +191,7 @@ fn random_walk(
     limits: WalkLimits,
     out: &mut Subpath,
 ) {
+    let rr_reference = beta;
     loop {
         let Some(hit) = scene.intersect(&ray) else {
             if mode == TransportMode::Radiance && !scene.infinite_lights.is_empty() {
@@ -199,7 +213,7 @@ fn random_walk(
         let sf = hit.shading_frame();
         let depth = out.vertices.len() as u32;
         let Some(bs) =
-            continue_path(scene, &hit, &sf, wo, &mut beta, depth, limits.rr_depth, mode, sampler)
+            continue_path(scene, &hit, &sf, wo, &mut beta, rr_reference, depth, limits.rr_depth, mode, sampler)
         else {
             out.vertices.push(v);
             return;
