@@ -343,27 +343,10 @@ impl Bdpt {
                 if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter) {
                     let le = scene.lights[li as usize].emitted(x0.ng, x0.wo);
                     if le != Color::ZERO {
-                        scratch.prefix.clear();
-                        scratch.prefix.extend_from_slice(&z[..t - 1]);
-                        scratch.prefix.push(x0);
-                        let split = Split {
-                            light: &[],
-                            camera: &scratch.prefix,
-                            light_nee: 0.0,
-                        };
-                        let wgt = mis_weight(scene, split, EndEvals::default(), h, ratio);
-                        if R::ACTIVE {
-                            rec.completed(Completed {
-                                s: 0,
-                                light: &scratch.prefix[t - 1..],
-                                camera: &scratch.prefix[..t - 1],
-                                weight: wgt,
-                                value: zv.beta * le,
-                                raster,
-                                alternatives: &[],
-                            });
-                        }
-                        l += zv.beta * le * wgt as f32;
+                        let value = zv.beta * le;
+                        l += self.emitter_reached(
+                            scene, &z[..t - 1], x0, value, raster, &mut scratch.prefix, ratio, rec,
+                        );
                     }
                 }
             }
@@ -429,32 +412,53 @@ impl Bdpt {
                         continue;
                     }
                     let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
-                    scratch.prefix.clear();
-                    scratch.prefix.extend_from_slice(z);
-                    scratch.prefix.push(x0);
-                    let split = Split {
-                        light: &[],
-                        camera: &scratch.prefix,
-                        light_nee: 0.0,
-                    };
-                    let wgt = mis_weight(scene, split, EndEvals::default(), h, ratio);
-                    if R::ACTIVE {
-                        let n = scratch.prefix.len();
-                        rec.completed(Completed {
-                            s: 0,
-                            light: &scratch.prefix[n - 1..],
-                            camera: &scratch.prefix[..n - 1],
-                            weight: wgt,
-                            value: esc.beta * le,
-                            raster,
-                            alternatives: &[],
-                        });
-                    }
-                    l += esc.beta * le * wgt as f32;
+                    let value = esc.beta * le;
+                    l += self.emitter_reached(
+                        scene, z, x0, value, raster, &mut scratch.prefix, ratio, rec,
+                    );
                 }
             }
         }
         l
+    }
+
+    /// Strategy s = 0: the camera walk `camera` (camera first) reached light endpoint `x0`
+    /// (an emitter it hit, or a light at infinity it escaped to) with unweighted contribution
+    /// `value`. Returns the weighted contribution.
+    #[allow(clippy::too_many_arguments)]
+    fn emitter_reached<R: Recorder>(
+        &self,
+        scene: &Scene,
+        camera: &[PathVertex],
+        x0: PathVertex,
+        value: Color,
+        raster: Vec2,
+        prefix: &mut Vec<PathVertex>,
+        ratio: f64,
+        rec: &mut R,
+    ) -> Color {
+        prefix.clear();
+        prefix.extend_from_slice(camera);
+        prefix.push(x0);
+        let split = Split {
+            light: &[],
+            camera: prefix,
+            light_nee: 0.0,
+        };
+        let w = mis_weight(scene, split, EndEvals::default(), self.params.mis, ratio);
+        if R::ACTIVE {
+            let n = prefix.len();
+            rec.completed(Completed {
+                s: 0,
+                light: &prefix[n - 1..],
+                camera: &prefix[..n - 1],
+                weight: w,
+                value,
+                raster,
+                alternatives: &[],
+            });
+        }
+        value * w as f32
     }
 
     /// Strategy s = 1 at camera vertex z_{t−1}: one light chosen by power and sampled towards it.
