@@ -142,12 +142,7 @@ impl Pt {
         if ev.f_cos == Color::ZERO {
             return Color::ZERO;
         }
-        let unoccluded = if ls.distance.is_finite() {
-            scene.visible(hit, ls.p)
-        } else {
-            scene.unoccluded_towards(hit, ls.wi)
-        };
-        if !unoccluded {
+        if !scene.visible_light(hit, &ls) {
             return Color::ZERO;
         }
         let light_pdf = pmf * ls.pdf_w;

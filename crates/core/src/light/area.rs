@@ -155,7 +155,7 @@ impl AreaLight {
                 return self.sample_sphere_cone(p, center, radius, h, u);
             }
         }
-        let (lp, n, _) = self.sample_area(u);
+        let (lp, n, lp_err) = self.sample_area(u);
         let to = lp - p;
         let d2 = to.length_squared();
         if !(d2 > 0.0) {
@@ -172,6 +172,7 @@ impl AreaLight {
             wi,
             p: lp,
             n,
+            p_err: lp_err,
             distance,
             radiance: self.emitted(n, -wi),
             pdf_w,
@@ -207,6 +208,8 @@ impl AreaLight {
             wi,
             p: lp,
             n,
+            // center + radius·n: the rounding of a sum of two terms (`sample_area`'s bound).
+            p_err: (lp.abs() + center.abs()) * gamma(6),
             distance,
             radiance: self.emitted(n, -wi),
             pdf_w: uniform_cone_pdf(h),

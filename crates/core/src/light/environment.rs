@@ -14,6 +14,7 @@ impl EnvironmentLight {
     pub fn sample_li(&self, u: Vec2) -> Option<LightLiSample> {
         let wi = sample_uniform_sphere(u);
         Some(LightLiSample {
+            p_err: Vec3::ZERO,
             wi,
             p: wi,
             n: -wi,

@@ -32,6 +32,9 @@ pub struct LightLiSample {
     pub p: Vec3,
     /// The light's surface normal at `p` (for distant lights, −wi).
     pub n: Vec3,
+    /// Rounding-error bound of `p` (zero for point and distant lights), so a shadow ray can stop
+    /// short of the light's surface by its real error instead of a guessed one.
+    pub p_err: Vec3,
     pub distance: f32,
     /// Radiance arriving along −wi (point lights: intensity / distance²).
     pub radiance: Color,

@@ -21,6 +21,7 @@ impl PointLight {
         let distance = d2.sqrt();
         let wi = to / distance;
         Some(LightLiSample {
+            p_err: Vec3::ZERO,
             wi,
             p: self.position,
             n: -wi,

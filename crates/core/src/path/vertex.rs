@@ -185,6 +185,7 @@ impl PathVertex {
             _ => (s.p, s.n, s.radiance),
         };
         let mut v = PathVertex::endpoint(kind, p, n, Color::ZERO, 0.0);
+        v.p_err = s.p_err;
         v.pdf_fwd = if s.delta {
             pmf
         } else {

@@ -130,6 +130,23 @@ impl Scene {
         )
     }
 
+    /// True when nothing blocks the segment from a surface point to a point next-event estimation
+    /// sampled on a light, whose own error bound and normal move that end off the light's
+    /// surface. (With a bare point instead, a target on a curved emitter seen at a grazing angle
+    /// from nearby — a sphere light from a point on its own surface — is spuriously occluded by
+    /// the emitter itself.)
+    #[inline]
+    pub fn visible_light(&self, from: &SurfaceHit, ls: &crate::light::LightLiSample) -> bool {
+        if !ls.distance.is_finite() {
+            return self.unoccluded_towards(from, ls.wi);
+        }
+        let n = if ls.delta { Vec3::ZERO } else { ls.n };
+        self.segment_unoccluded(
+            self.end(from.p, from.p_err, from.ng),
+            self.end(ls.p, ls.p_err, n),
+        )
+    }
+
     /// True when nothing blocks the ray leaving a surface point in direction `dir` (a distant light).
     #[inline]
     pub fn unoccluded_towards(&self, from: &SurfaceHit, dir: Vec3) -> bool {
