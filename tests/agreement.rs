@@ -137,7 +137,12 @@ fn over_blocks(a: &Agreement, blocks: &[usize]) -> (f64, usize, usize, f64) {
             }
         }
     }
-    (max, worst, channel, sidak_threshold(ALPHA, blocks.len() * 3))
+    (
+        max,
+        worst,
+        channel,
+        sidak_threshold(ALPHA, blocks.len() * 3),
+    )
 }
 
 fn block_name(a: &Agreement, i: usize) -> String {
@@ -155,7 +160,10 @@ fn per_depth(scene_name: &str, depths: std::ops::RangeInclusive<u32>) {
                 .iter()
                 .find(|(s, l, _)| *s == scene_name && *l == other.label)
             {
-                println!("{scene_name} max_depth={depth} {}: excluded ({why})", other.label);
+                println!(
+                    "{scene_name} max_depth={depth} {}: excluded ({why})",
+                    other.label
+                );
                 continue;
             }
             let (_, blocks) = other.render(&scene, Some(depth));
@@ -287,7 +295,10 @@ fn light_and_bdpt_agree_through_glass_on_cornell_point_caustic() {
         ["R", "G", "B"][c],
         le.mean[worst][c] / be.mean[worst][c]
     );
-    assert!(z < thr, "cornell-point-caustic: light vs bdpt disagree: {z} ≥ {thr}");
+    assert!(
+        z < thr,
+        "cornell-point-caustic: light vs bdpt disagree: {z} ≥ {thr}"
+    );
 
     // The caustic: around the projection of (0.375, −1, 0.375).
     let proj = scene

@@ -95,7 +95,10 @@ fn run(
         format!("{name}: panicked: {msg}")
     })?;
     if result.invalid_samples != 0 {
-        return Err(format!("{name}: {} invalid samples", result.invalid_samples));
+        return Err(format!(
+            "{name}: {} invalid samples",
+            result.invalid_samples
+        ));
     }
     let expected = (LE / (1.0 - RHO)) as f64;
     let a = agreement_with_reference_t(&blocks, &[[expected; 3]], 1e-3);
@@ -110,7 +113,9 @@ fn run(
     }
     // Non-trivial: the estimate has a real spread, so the test could detect a bias of a few %.
     if !(se > 0.0 && se < 0.02 * expected) {
-        return Err(format!("{summary}; standard error {se} not in (0, 2 % of the answer)"));
+        return Err(format!(
+            "{summary}; standard error {se} not in (0, 2 % of the answer)"
+        ));
     }
     Ok(summary)
 }
@@ -126,7 +131,10 @@ fn check(integrator: &str, sphere: bool, scale: f32) {
         .iter()
         .find(|(i, c, s, _)| *i == integrator && *c == case && *s == scale)
         .map(|(_, _, _, why)| *why);
-    match (run(integrator, IntegratorParams::default(), 64, sphere, scale), known) {
+    match (
+        run(integrator, IntegratorParams::default(), 64, sphere, scale),
+        known,
+    ) {
         (Ok(summary), None) => println!("{summary}"),
         (Err(e), None) => panic!("{e}"),
         (Err(e), Some(why)) => println!("KNOWN FAILURE ({why}): {e}"),

@@ -115,7 +115,11 @@ fn emission_densities(scene: &Scene, x0: &PathVertex, x1: Option<&PathVertex>) -
         return (pmf * if x0.is_infinite() { d } else { pos } as f64, 0.0);
     };
     let (pos, dir) = l.pdf_le(x0.ng, x0.dir_to(x1), scene.bounding_sphere);
-    let (first, second) = if x0.is_infinite() { (dir, pos) } else { (pos, dir) };
+    let (first, second) = if x0.is_infinite() {
+        (dir, pos)
+    } else {
+        (pos, dir)
+    };
     (pmf * first as f64, x0.convert_density(second, x1) as f64)
 }
 
@@ -124,15 +128,12 @@ const STACK_K: usize = 23;
 
 /// The MIS weight of strategy (s, t) for the path `split` forms (Veach 1997, eq. 10.9 with the
 /// ratios of §10.2), under `h`, with `ratio` = M/N light subpaths per camera sample.
-pub fn mis_weight(
-    scene: &Scene,
-    split: Split,
-    evals: EndEvals,
-    h: Heuristic,
-    ratio: f64,
-) -> f64 {
+pub fn mis_weight(scene: &Scene, split: Split, evals: EndEvals, h: Heuristic, ratio: f64) -> f64 {
     let (y, z) = (split.light, split.camera);
-    let s = if z.last().is_some_and(|v| matches!(v.kind, VertexKind::Light { .. })) {
+    let s = if z
+        .last()
+        .is_some_and(|v| matches!(v.kind, VertexKind::Light { .. }))
+    {
         0
     } else {
         y.len()
@@ -140,8 +141,11 @@ pub fn mis_weight(
     let t = z.len();
     let k = s + t - 1;
     debug_assert!(k >= 1);
-    let (mut light_a, mut camera_a, mut conn_a) =
-        ([0.0f64; STACK_K + 1], [0.0f64; STACK_K + 1], [false; STACK_K + 1]);
+    let (mut light_a, mut camera_a, mut conn_a) = (
+        [0.0f64; STACK_K + 1],
+        [0.0f64; STACK_K + 1],
+        [false; STACK_K + 1],
+    );
     let (mut light_v, mut camera_v, mut conn_v) = (Vec::new(), Vec::new(), Vec::new());
     let (light, camera, conn): (&mut [f64], &mut [f64], &mut [bool]) = if k <= STACK_K {
         (&mut light_a, &mut camera_a, &mut conn_a)
@@ -333,7 +337,13 @@ impl Bdpt {
             (pixel % w) as f32 + cs.next_f32(),
             (pixel / w) as f32 + cs.next_f32(),
         );
-        camera_subpath(scene, raster, &mut cs, self.limits(true), &mut scratch.camera);
+        camera_subpath(
+            scene,
+            raster,
+            &mut cs,
+            self.limits(true),
+            &mut scratch.camera,
+        );
         let z = &scratch.camera.vertices;
         let mut l = Color::ZERO;
         for t in 2..=z.len() {
@@ -345,7 +355,14 @@ impl Bdpt {
                     if le != Color::ZERO {
                         let value = zv.beta * le;
                         l += self.emitter_reached(
-                            scene, &z[..t - 1], x0, value, raster, &mut scratch.prefix, ratio, rec,
+                            scene,
+                            &z[..t - 1],
+                            x0,
+                            value,
+                            raster,
+                            &mut scratch.prefix,
+                            ratio,
+                            rec,
                         );
                     }
                 }
@@ -414,7 +431,14 @@ impl Bdpt {
                     let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
                     let value = esc.beta * le;
                     l += self.emitter_reached(
-                        scene, z, x0, value, raster, &mut scratch.prefix, ratio, rec,
+                        scene,
+                        z,
+                        x0,
+                        value,
+                        raster,
+                        &mut scratch.prefix,
+                        ratio,
+                        rec,
                     );
                 }
             }

@@ -23,7 +23,12 @@ pub struct CameraConnection {
 /// The BSDF of surface vertex `v` between its stored incoming direction `v.wo` and the direction
 /// towards `to`, in `mode`. `None` for non-surfaces.
 #[inline]
-pub fn eval_towards(scene: &Scene, v: &PathVertex, wi: Vec3, mode: TransportMode) -> Option<BsdfEval> {
+pub fn eval_towards(
+    scene: &Scene,
+    v: &PathVertex,
+    wi: Vec3,
+    mode: TransportMode,
+) -> Option<BsdfEval> {
     let VertexKind::Surface { material } = v.kind else {
         return None;
     };

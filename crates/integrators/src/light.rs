@@ -60,10 +60,7 @@ impl Integrator for LightTracer {
 
     fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
         let cam = &scene.camera;
-        let m = self
-            .params
-            .light_paths
-            .unwrap_or(cam.pixel_count() as u64);
+        let m = self.params.light_paths.unwrap_or(cam.pixel_count() as u64);
         let limits = WalkLimits {
             // s light vertices and the pinhole make a path of s segments.
             max_vertices: self.params.max_depth as usize,

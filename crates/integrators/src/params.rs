@@ -74,9 +74,10 @@ impl<'a> ParamReader<'a> {
         self.asked.borrow_mut().push(key);
         match self.params.value(key) {
             None => Ok(None),
-            Some(v) => v.parse().map(Some).map_err(|e| {
-                format!("{}: cannot read {key} = '{v}': {e}", self.integrator)
-            }),
+            Some(v) => v
+                .parse()
+                .map(Some)
+                .map_err(|e| format!("{}: cannot read {key} = '{v}': {e}", self.integrator)),
         }
     }
 

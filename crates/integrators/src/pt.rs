@@ -44,7 +44,9 @@ impl Techniques {
             "both" => Ok(Techniques::Both),
             "light" => Ok(Techniques::Light),
             "bsdf" => Ok(Techniques::Bsdf),
-            _ => Err(format!("unknown techniques '{s}' (known: both, light, bsdf)")),
+            _ => Err(format!(
+                "unknown techniques '{s}' (known: both, light, bsdf)"
+            )),
         }
     }
 }

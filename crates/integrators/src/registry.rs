@@ -1,9 +1,9 @@
 //! The one table from integrator names to constructors (the CLI, the tests and the experiments
 //! all use it). Tests that loop over `INTEGRATORS` cover a new integrator without new test code.
 
-use crate::params::{IntegratorParams, ParamReader};
 use crate::bdpt::{Bdpt, BdptParams};
 use crate::light::{LightParams, LightTracer};
+use crate::params::{IntegratorParams, ParamReader};
 use crate::pt::{Pt, PtParams};
 use crate::pt_bsdf::{PtBsdf, PtBsdfParams};
 use crate::Integrator;
@@ -26,25 +26,41 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "pt",
         about: "path tracing with next-event estimation and MIS (power heuristic)",
         source: include_str!("pt.rs"),
-        make: |s, r| Ok(Box::new(Pt { params: PtParams::read(s, r)? })),
+        make: |s, r| {
+            Ok(Box::new(Pt {
+                params: PtParams::read(s, r)?,
+            }))
+        },
     },
     IntegratorInfo {
         name: "pt-bsdf",
         about: "path tracing by BSDF sampling only (the cross-check of pt)",
         source: include_str!("pt_bsdf.rs"),
-        make: |s, r| Ok(Box::new(PtBsdf { params: PtBsdfParams::read(s, r)? })),
+        make: |s, r| {
+            Ok(Box::new(PtBsdf {
+                params: PtBsdfParams::read(s, r)?,
+            }))
+        },
     },
     IntegratorInfo {
         name: "light",
         about: "light tracing: light subpaths splatted to the camera at every vertex",
         source: include_str!("light.rs"),
-        make: |s, r| Ok(Box::new(LightTracer { params: LightParams::read(s, r)? })),
+        make: |s, r| {
+            Ok(Box::new(LightTracer {
+                params: LightParams::read(s, r)?,
+            }))
+        },
     },
     IntegratorInfo {
         name: "bdpt",
         about: "bidirectional path tracing: every (s,t) strategy under MIS (power heuristic)",
         source: include_str!("bdpt.rs"),
-        make: |s, r| Ok(Box::new(Bdpt { params: BdptParams::read(s, r)? })),
+        make: |s, r| {
+            Ok(Box::new(Bdpt {
+                params: BdptParams::read(s, r)?,
+            }))
+        },
     },
 ];
 

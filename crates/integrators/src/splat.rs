@@ -61,7 +61,8 @@ pub fn splat_pass(
     scale: f64,
     work: impl Fn(u64, &mut Splats) + Sync,
 ) -> (Image, u64) {
-    let (mut img, invalid) = splat_pass_with(width, height, count, chunk, || (), |i, s, _| work(i, s));
+    let (mut img, invalid) =
+        splat_pass_with(width, height, count, chunk, || (), |i, s, _| work(i, s));
     if scale != 1.0 {
         for px in &mut img.data {
             for c in px.iter_mut() {

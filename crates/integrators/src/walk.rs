@@ -73,7 +73,9 @@ pub fn continue_path(
 ) -> Option<BsdfSample> {
     let u_lobe = sampler.next_f32();
     let u = sampler.next_2d();
-    let bs = scene.material(hit.material).sample(sf, wo, u_lobe, u, mode)?;
+    let bs = scene
+        .material(hit.material)
+        .sample(sf, wo, u_lobe, u, mode)?;
     *beta *= bs.weight;
     (*beta != Color::ZERO && russian_roulette(beta, rr_reference, depth, rr_depth, sampler))
         .then_some(bs)
@@ -136,12 +138,22 @@ pub fn camera_subpath(
     out.vertices.clear();
     out.escape = None;
     let ray = scene.camera.generate_ray(raster);
-    out.vertices.push(PathVertex::camera(&scene.camera, Color::ONE));
+    out.vertices
+        .push(PathVertex::camera(&scene.camera, Color::ONE));
     if limits.max_vertices < 2 {
         return;
     }
     let pdf = scene.camera.pdf_dir(ray.d);
-    random_walk(scene, ray, Color::ONE, pdf, TransportMode::Radiance, sampler, limits, out);
+    random_walk(
+        scene,
+        ray,
+        Color::ONE,
+        pdf,
+        TransportMode::Radiance,
+        sampler,
+        limits,
+        out,
+    );
 }
 
 /// Traces a light subpath: y0 on a light chosen by power (`Light::sample_le`), then the surfaces
@@ -174,8 +186,21 @@ pub fn light_subpath(scene: &Scene, sampler: &mut Sampler, limits: WalkLimits, o
         le.n.dot(le.ray.d).abs()
     };
     let beta = le.radiance * (cos0 / (pmf * le.pdf_pos * le.pdf_dir));
-    let pdf = if light.is_infinite() { le.pdf_pos } else { le.pdf_dir };
-    random_walk(scene, le.ray, beta, pdf, TransportMode::Importance, sampler, limits, out);
+    let pdf = if light.is_infinite() {
+        le.pdf_pos
+    } else {
+        le.pdf_dir
+    };
+    random_walk(
+        scene,
+        le.ray,
+        beta,
+        pdf,
+        TransportMode::Importance,
+        sampler,
+        limits,
+        out,
+    );
 }
 
 /// Extends `out` (which holds at least its endpoint) along `ray`, which its last vertex sampled
@@ -212,9 +237,18 @@ fn random_walk(
         }
         let sf = hit.shading_frame();
         let depth = out.vertices.len() as u32;
-        let Some(bs) =
-            continue_path(scene, &hit, &sf, wo, &mut beta, rr_reference, depth, limits.rr_depth, mode, sampler)
-        else {
+        let Some(bs) = continue_path(
+            scene,
+            &hit,
+            &sf,
+            wo,
+            &mut beta,
+            rr_reference,
+            depth,
+            limits.rr_depth,
+            mode,
+            sampler,
+        ) else {
             out.vertices.push(v);
             return;
         };
@@ -243,5 +277,11 @@ pub fn reverse_density(target: &PathVertex, from: &PathVertex, pdf_w: f32) -> f3
 /// A light vertex without a surface (a point light): no walk can arrive at it.
 #[inline]
 pub fn is_point_light(v: &PathVertex) -> bool {
-    matches!(v.kind, lt_core::path::VertexKind::Light { infinite: false, .. }) && !v.on_surface()
+    matches!(
+        v.kind,
+        lt_core::path::VertexKind::Light {
+            infinite: false,
+            ..
+        }
+    ) && !v.on_surface()
 }

@@ -275,7 +275,11 @@ impl Path {
         if p <= 0.0 {
             return Color::ZERO;
         }
-        let n = if s == self.k() { light_tracing_ratio } else { 1.0 };
+        let n = if s == self.k() {
+            light_tracing_ratio
+        } else {
+            1.0
+        };
         (self.contribution_for(scene, s) / (scene.camera.pixel_count() as f64 * n * p)).as_vec3()
     }
 }
