@@ -45,17 +45,13 @@ pub struct BdptParams {
 
 impl BdptParams {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<BdptParams, String> {
-        let light_paths = r.get::<u64>("light_paths")?;
-        if light_paths == Some(0) {
-            return Err("bdpt: light_paths must be at least 1".into());
-        }
         Ok(BdptParams {
-            max_depth: r.get("max_depth")?.unwrap_or(scene.settings.max_depth),
-            rr_depth: r.get("rr_depth")?.unwrap_or(scene.settings.rr_depth),
+            max_depth: r.max_depth(scene)?,
+            rr_depth: r.rr_depth(scene)?,
             mis: r
                 .get_with("mis", Heuristic::parse)?
                 .unwrap_or(Heuristic::Power),
-            light_paths,
+            light_paths: r.light_paths()?,
         })
     }
 }

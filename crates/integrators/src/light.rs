@@ -34,14 +34,10 @@ pub struct LightParams {
 
 impl LightParams {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<LightParams, String> {
-        let light_paths = r.get::<u64>("light_paths")?;
-        if light_paths == Some(0) {
-            return Err("light: light_paths must be at least 1".into());
-        }
         Ok(LightParams {
-            max_depth: r.get("max_depth")?.unwrap_or(scene.settings.max_depth),
-            rr_depth: r.get("rr_depth")?.unwrap_or(scene.settings.rr_depth),
-            light_paths,
+            max_depth: r.max_depth(scene)?,
+            rr_depth: r.rr_depth(scene)?,
+            light_paths: r.light_paths()?,
         })
     }
 }

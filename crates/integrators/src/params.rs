@@ -96,6 +96,28 @@ impl<'a> ParamReader<'a> {
         }
     }
 
+    /// `max_depth`, defaulting to the scene's `[render] max_depth`.
+    pub fn max_depth(&self, scene: &lt_core::Scene) -> Result<u32, String> {
+        Ok(self.get("max_depth")?.unwrap_or(scene.settings.max_depth))
+    }
+
+    /// `rr_depth`, defaulting to the scene's `[render] rr_depth`.
+    pub fn rr_depth(&self, scene: &lt_core::Scene) -> Result<u32, String> {
+        Ok(self.get("rr_depth")?.unwrap_or(scene.settings.rr_depth))
+    }
+
+    /// `light_paths` (light subpaths per pass), at least 1; `None` means one per pixel.
+    pub fn light_paths(&self) -> Result<Option<u64>, String> {
+        let m = self.get::<u64>("light_paths")?;
+        if m == Some(0) {
+            return Err(format!(
+                "{}: light_paths must be at least 1",
+                self.integrator
+            ));
+        }
+        Ok(m)
+    }
+
     /// Keys asked for so far.
     pub fn asked(&self) -> Vec<&'static str> {
         self.asked.borrow().clone()

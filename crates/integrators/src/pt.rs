@@ -68,8 +68,8 @@ impl PtParams {
             })?
             .unwrap_or(Heuristic::Power);
         Ok(PtParams {
-            max_depth: r.get("max_depth")?.unwrap_or(scene.settings.max_depth),
-            rr_depth: r.get("rr_depth")?.unwrap_or(scene.settings.rr_depth),
+            max_depth: r.max_depth(scene)?,
+            rr_depth: r.rr_depth(scene)?,
             mis,
             techniques: r
                 .get_with("techniques", Techniques::parse)?

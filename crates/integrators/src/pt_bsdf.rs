@@ -27,8 +27,8 @@ pub struct PtBsdfParams {
 impl PtBsdfParams {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<PtBsdfParams, String> {
         Ok(PtBsdfParams {
-            max_depth: r.get("max_depth")?.unwrap_or(scene.settings.max_depth),
-            rr_depth: r.get("rr_depth")?.unwrap_or(scene.settings.rr_depth),
+            max_depth: r.max_depth(scene)?,
+            rr_depth: r.rr_depth(scene)?,
         })
     }
 }

@@ -51,29 +51,9 @@ impl Splats {
     }
 }
 
-/// Runs `work(item, splats)` for items 0..count in chunks of `chunk` and returns the summed image
-/// (each splat added once, scaled by `scale`) with the count of invalid splats.
-pub fn splat_pass(
-    width: usize,
-    height: usize,
-    count: u64,
-    chunk: u64,
-    scale: f64,
-    work: impl Fn(u64, &mut Splats) + Sync,
-) -> (Image, u64) {
-    let (mut img, invalid) =
-        splat_pass_with(width, height, count, chunk, || (), |i, s, _| work(i, s));
-    if scale != 1.0 {
-        for px in &mut img.data {
-            for c in px.iter_mut() {
-                *c *= scale;
-            }
-        }
-    }
-    (img, invalid)
-}
-
-/// `splat_pass` with per-chunk scratch state made by `init` (buffers reused across a chunk's items).
+/// Runs `work(item, splats, state)` for items 0..count in chunks of `chunk` and returns the summed
+/// image (each splat added once) with the count of invalid splats. Each chunk gets its own scratch
+/// state from `init` (buffers reused across the chunk's items).
 pub fn splat_pass_with<S>(
     width: usize,
     height: usize,
@@ -119,13 +99,20 @@ mod tests {
             .build()
             .unwrap();
         pool.install(|| {
-            splat_pass(16, 8, 10_000, 64, 1e-3, |i, sp| {
-                let mut s = Sampler::new(3, i, 0);
-                for _ in 0..3 {
-                    let r = Vec2::new(s.next_f32() * 16.0, s.next_f32() * 8.0);
-                    sp.add(r, Color::splat(s.next_f32() * 1e3 + 1e-3));
-                }
-            })
+            splat_pass_with(
+                16,
+                8,
+                10_000,
+                64,
+                || (),
+                |i, sp, _| {
+                    let mut s = Sampler::new(3, i, 0);
+                    for _ in 0..3 {
+                        let r = Vec2::new(s.next_f32() * 16.0, s.next_f32() * 8.0);
+                        sp.add(r, Color::splat(s.next_f32() + 1e-6));
+                    }
+                },
+            )
             .0
         })
     }
