@@ -324,31 +324,9 @@ fn relative(a: f64, b: f64) -> f64 {
     }
 }
 
-/// How far the oracle's densities can stray from the walk's on this path: the largest, over its
-/// segments, of the segment direction's error bound (`scatter::direction_error`: the two ends'
-/// rounding-error bounds over the length — the oracle rebuilds every direction from two f32
-/// positions, the walk used the direction it traced) over the smallest |cos| at the segment's
-/// ends that have a surface (a direction error δ moves a cosine, hence an area conversion or a
-/// cosine-shaped pdf, by up to δ·tan θ < δ / cos θ relatively).
+/// How far the oracle's densities can stray from the walk's on this path: `Path::condition`.
 pub fn condition(path: &Path) -> f64 {
-    let v = &path.vertices;
-    let mut kappa = 0.0f64;
-    for i in 0..path.k() {
-        let (a, b) = (&v[i], &v[i + 1]);
-        let err = lt_core::path::scatter::direction_error(a, b) as f64;
-        if err == 0.0 {
-            continue;
-        }
-        let w = a.dir_to(b);
-        let mut cos = 1.0f32;
-        for x in [a, b] {
-            if x.on_surface() && !x.is_infinite() {
-                cos = cos.min(x.ng.dot(w).abs());
-            }
-        }
-        kappa = kappa.max(err / (cos as f64).max(f64::MIN_POSITIVE));
-    }
-    kappa
+    path.condition()
 }
 
 /// The tolerance of (a) for a path of condition `kappa`: `tolerance`, or κ when larger.
