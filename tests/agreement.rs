@@ -18,8 +18,8 @@ use lt_core::camera::{Camera, FovAxis};
 use lt_core::{Scene, Vec2, Vec3};
 use lt_estimators::agreement::{agreement_t, sidak_threshold, Agreement};
 use lt_estimators::blocks::RunningBlocks;
-use lt_integrators::{IntegratorParams, RenderResult};
-use lt_tests::{render_blocks, shipped_scene};
+use lt_integrators::IntegratorParams;
+use lt_tests::{render_blocks, shipped_scene, Rendered};
 
 /// Family-wise false-alarm rate of every comparison here.
 const ALPHA: f64 = 1e-3;
@@ -47,7 +47,7 @@ impl Config {
         p
     }
 
-    fn render(&self, scene: &Scene, max_depth: Option<u32>) -> (RenderResult, RunningBlocks) {
+    fn render(&self, scene: &Scene, max_depth: Option<u32>) -> (Rendered, RunningBlocks) {
         let (r, b) = render_blocks(
             scene,
             self.integrator,
@@ -412,7 +412,7 @@ fn light_agrees_with_pt_off_axis() {
     let blocks = [corner, centre];
     let (z, worst, c, thr) = over_blocks(&a, &blocks);
     let (le, pe) = (l.estimate(), p.estimate());
-    let pixels = pr.image.mean();
+    let pixels = pr.estimate.clone();
     let cam = &scene.camera;
     for (name, i) in [("corner", corner), ("centre", centre)] {
         // The cos³ alternative: pt's pixel means times cos θ at each pixel centre, over the block.

@@ -64,7 +64,7 @@ fn every_integrator_gives_finite_non_negative_pixels_on_every_shipped_scene() {
                 result.invalid_samples, 0,
                 "{who}: integrator produced invalid samples"
             );
-            let mean = result.image.mean();
+            let mean = &result.estimate;
             assert!(
                 mean.data
                     .iter()
@@ -98,10 +98,9 @@ fn same_seed_gives_identical_images_for_one_and_two_threads() {
                     seed,
                     threads,
                 };
-                render(&scene, integ.as_ref(), &opts, |_| ControlFlow::Continue(()))
+                render(&scene, &integ, &opts, |_| ControlFlow::Continue(()))
                     .unwrap()
-                    .image
-                    .mean()
+                    .estimate
             };
             let one = run(1, 99);
             let two = run(2, 99);

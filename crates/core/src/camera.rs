@@ -133,6 +133,12 @@ impl Camera {
         self.width as usize * self.height as usize
     }
 
+    /// The side of one pixel's footprint at `distance` along the viewing axis (the square root of
+    /// a pixel's area on the plane at that distance): the unit photon radii are relative to.
+    pub fn pixel_footprint(&self, distance: f32) -> f32 {
+        distance * (self.plane_area / self.pixel_count() as f32).sqrt()
+    }
+
     pub fn forward(&self) -> Vec3 {
         self.frame.z
     }

@@ -38,7 +38,7 @@ fn path_tracing(c: &mut Criterion) {
         g.bench_function(name, |b| {
             b.iter(|| {
                 pass += 1;
-                pt.render_pass(&s, 1, pass)
+                pt.unbiased().unwrap().render_pass(&s, 1, pass)
             })
         });
     }

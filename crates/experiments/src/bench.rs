@@ -4,7 +4,7 @@
 use lt_core::geometry::Ray;
 use lt_core::sampling::{sample_uniform_sphere, Sampler};
 use lt_core::{Scene, Vec3};
-use lt_integrators::{make_integrator, IntegratorParams};
+use lt_integrators::{make_integrator, Estimator, IntegratorParams};
 use std::time::Instant;
 
 /// Incoherent rays: origins uniform in the scene's bounding box, directions uniform on the sphere.
@@ -81,8 +81,20 @@ pub fn integrator_rate(
         .map_err(|e| e.to_string())?;
     pool.broadcast(|_| lt_core::scene::ray_stats::take());
     let start = Instant::now();
-    for pass in 0..passes {
-        std::hint::black_box(pool.install(|| integ.render_pass(scene, 1, pass)));
+    match &integ {
+        Estimator::Unbiased(i) => {
+            for pass in 0..passes {
+                std::hint::black_box(pool.install(|| i.render_pass(scene, 1, pass)));
+            }
+        }
+        // A progressive run's first pass includes its set-up (a photon map, visible points).
+        Estimator::Consistent(p) => {
+            let mut run = pool.install(|| p.start(scene, 1));
+            for pass in 0..passes {
+                std::hint::black_box(pool.install(|| run.pass(pass)));
+            }
+            std::hint::black_box(pool.install(|| run.estimate()));
+        }
     }
     let secs = start.elapsed().as_secs_f64();
     let counts = pool.broadcast(|_| lt_core::scene::ray_stats::take());

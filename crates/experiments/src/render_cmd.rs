@@ -6,7 +6,8 @@ use crate::strategies::{make_bdpt, write_pyramid, PyramidIntegrator, PyramidMeta
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use lt_core::scene::load_scene;
-use lt_integrators::{make_integrator, render, Integrator, RenderOptions};
+use lt_estimators::Image;
+use lt_integrators::{make_integrator, render_runs, EstimatorRef, ProgressLog, RenderOptions};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -28,12 +29,17 @@ pub struct RenderArgs {
     pub time: Option<f64>,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Independent runs, run k seeded by seed + k: the image is their mean and OUT.stderr.exr the
+    /// standard error across them — the only error bar a consistent estimator (pm, ppm, sppm) has.
+    /// --spp and --time apply to each run.
+    #[arg(long, default_value_t = 1)]
+    pub runs: u32,
     /// Worker threads (0 = one per core). The image does not depend on it.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     #[command(flatten)]
     pub integrator_args: crate::integrator_args::IntegratorArgs,
-    /// Output EXR; `.png`, `.stderr.exr` and `.json` are written beside it.
+    /// Output EXR; `.png`, `.json` and (where there is an honest one) `.stderr.exr` beside it.
     #[arg(long, short)]
     pub output: PathBuf,
     /// Seconds between checkpoints of the partial image (an interrupted run keeps what it finished).
@@ -61,11 +67,41 @@ pub fn sibling(out: &Path, suffix: &str) -> PathBuf {
     out.with_file_name(format!("{stem}{suffix}"))
 }
 
-fn write_outputs(out: &Path, acc: &lt_estimators::running::RunningImage) -> Result<(), String> {
-    let mean = acc.mean();
-    write_exr(out, &mean)?;
-    write_png_preview(&sibling(out, ".png"), &mean)?;
-    write_exr(&sibling(out, ".stderr.exr"), &acc.std_error())
+/// Writes the image, its preview and, when there is an honest one, its standard error. Where
+/// there is none (one run of a consistent estimator) a stale `.stderr.exr` from an earlier render
+/// is removed, so no file beside the image claims an error bar it does not have.
+fn write_outputs(out: &Path, mean: &Image, std_error: Option<&Image>) -> Result<(), String> {
+    write_exr(out, mean)?;
+    write_png_preview(&sibling(out, ".png"), mean)?;
+    let se_path = sibling(out, ".stderr.exr");
+    match std_error {
+        Some(se) => write_exr(&se_path, se),
+        None => match std::fs::remove_file(&se_path) {
+            Ok(()) => Ok(()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+            Err(e) => Err(format!("cannot remove stale {}: {e}", se_path.display())),
+        },
+    }
+}
+
+/// The mean over pixels and channels of a standard-error image (NaN-free pixels only).
+fn mean_of(img: &Image) -> f64 {
+    let (sum, n) = img
+        .data
+        .iter()
+        .flatten()
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0u64), |(s, n), v| (s + v, n + 1));
+    sum / n.max(1) as f64
+}
+
+fn log_json(log: &ProgressLog) -> serde_json::Value {
+    serde_json::json!({
+        "photon_paths_per_pass": log.photon_paths,
+        "radius_scale_per_pass": log.radius_scale,
+        "mean_radius_per_pass": log.mean_radius,
+        "facts": log.facts.iter().map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone()))).collect::<serde_json::Map<_, _>>(),
+    })
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
@@ -81,6 +117,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         if args.strategy_length == 0 {
             return Err("--strategy-length must be at least 1".into());
         }
+        if args.runs != 1 {
+            return Err("--strategies takes one run: drop --runs".into());
+        }
+    }
+    if args.runs == 0 {
+        return Err("--runs must be at least 1".into());
     }
     let scene = load_scene(&args.scene).map_err(|e| e.to_string())?;
     let params = args.integrator_args.to_params()?;
@@ -101,13 +143,14 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         None => Some(make_integrator(&args.integrator, &scene, &params)?),
         Some(_) => None,
     };
-    let integrator: &dyn Integrator = match (&pyramid, &plain) {
-        (Some((_, p, _)), _) => p,
-        (None, Some(i)) => i.as_ref(),
+    let estimator: EstimatorRef = match (&pyramid, &plain) {
+        (Some((_, p, _)), _) => EstimatorRef::Unbiased(p),
+        (None, Some(i)) => i.into(),
         (None, None) => unreachable!("one of the two is built"),
     };
-    let write_all = |acc: &lt_estimators::running::RunningImage| -> Result<(), String> {
-        write_outputs(&args.output, acc)?;
+    let kind = estimator.kind();
+    let write_all = |mean: &Image, se: Option<&Image>| -> Result<(), String> {
+        write_outputs(&args.output, mean, se)?;
         if let Some((dir, integ, meta)) = &pyramid {
             integ.with_pyramid(|p| write_pyramid(dir, p, meta))?;
         }
@@ -140,48 +183,96 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     let bar = progress_bar(args, passes);
     let pixels = scene.camera.pixel_count() as f64;
     let mut last_checkpoint = Instant::now();
-    let mut checkpoint_error = None;
-    let result = render(&scene, integrator, &opts, |r| {
-        bar.set_position(if args.time.is_some() {
-            r.elapsed.as_millis() as u64
-        } else {
-            r.passes_done as u64
-        });
-        let rate = r.passes_done as f64 * pixels / r.elapsed.as_secs_f64().max(1e-9);
-        bar.set_message(format!(
-            "{} spp, {:.2} Msamples/s",
-            r.passes_done,
-            rate / 1e6
-        ));
-        if last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint {
-            last_checkpoint = Instant::now();
-            if let Err(e) = write_all(r.accumulated) {
-                checkpoint_error = Some(e);
-                return ControlFlow::Break(());
+    // Both callbacks may record a failed checkpoint.
+    let checkpoint_error = std::cell::RefCell::new(None);
+    let many = args.runs > 1;
+    let result = render_runs(
+        &scene,
+        estimator,
+        &opts,
+        args.runs,
+        |k, r| {
+            bar.set_position(if args.time.is_some() {
+                r.elapsed.as_millis() as u64
+            } else {
+                r.passes_done as u64
+            });
+            let rate = r.passes_done as f64 * pixels / r.elapsed.as_secs_f64().max(1e-9);
+            let run = if many {
+                format!("run {}/{}, ", k + 1, args.runs)
+            } else {
+                String::new()
+            };
+            bar.set_message(format!(
+                "{run}{} spp, {:.2} Msamples/s",
+                r.passes_done,
+                rate / 1e6
+            ));
+            // With several runs a checkpoint is a finished run (written by the run callback).
+            if !many && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint {
+                last_checkpoint = Instant::now();
+                if let Err(e) = write_all(&r.estimate(), r.std_error().as_ref()) {
+                    *checkpoint_error.borrow_mut() = Some(e);
+                    return ControlFlow::Break(());
+                }
             }
-        }
-        if interrupted.load(Ordering::SeqCst) {
-            ControlFlow::Break(())
-        } else {
-            ControlFlow::Continue(())
-        }
-    })?;
+            if interrupted.load(Ordering::SeqCst) {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+        |done| {
+            if many && checkpoint_error.borrow().is_none() {
+                let se = (done.runs.len() >= 2).then(|| done.across_runs.std_error());
+                if let Err(e) = write_all(&done.across_runs.mean(), se.as_ref()) {
+                    *checkpoint_error.borrow_mut() = Some(e);
+                }
+            }
+        },
+    )?;
     bar.finish_and_clear();
-    if let Some(e) = checkpoint_error {
+    if let Some(e) = checkpoint_error.into_inner() {
         return Err(e);
     }
-    write_all(&result.image)?;
+    let runs_done = result.runs.len();
+    let mean = result.across_runs.mean();
+    // Where the standard error comes from: independent runs when there are two or more, else the
+    // spread of passes for an unbiased estimator, else nowhere.
+    let across = (runs_done >= 2).then(|| result.across_runs.std_error());
+    let per_pass = result.per_pass.as_ref().map(|p| p.std_error());
+    let (se, se_source) = match (&across, &per_pass) {
+        (Some(a), _) => (Some(a), "independent runs"),
+        (None, Some(p)) => (Some(p), "spread of passes"),
+        (None, None) => (
+            None,
+            "none written: the passes of a consistent estimator are not independent; use --runs K",
+        ),
+    };
+    write_all(&mean, se)?;
     let secs = result.elapsed.as_secs_f64();
+    let total_passes: u64 = result.runs.iter().map(|r| r.passes as u64).sum();
+    let first = &result.runs[0];
     let record = serde_json::json!({
         "scene": args.scene.display().to_string(),
         "integrator": args.integrator,
-        "spp": result.passes,
+        "kind": kind.name(),
+        "spp": first.passes,
+        "runs": runs_done,
+        "run_seeds": result.runs.iter().map(|r| r.seed).collect::<Vec<_>>(),
+        "run_passes": result.runs.iter().map(|r| r.passes).collect::<Vec<_>>(),
+        "run_seconds": result.runs.iter().map(|r| r.elapsed.as_secs_f64()).collect::<Vec<_>>(),
         "seed": args.seed,
         "threads": args.threads,
         "max_depth": args.integrator_args.max_depth.unwrap_or(scene.settings.max_depth),
         "params": params.pairs().iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>(),
         "seconds": secs,
-        "spp_per_second": result.passes as f64 / secs,
+        "spp_per_second": total_passes as f64 / secs,
+        "std_error_source": se_source,
+        "mean_std_error": se.map(mean_of),
+        "mean_std_error_across_runs": across.as_ref().map(mean_of),
+        "mean_std_error_per_pass": per_pass.as_ref().map(mean_of),
+        "progress": first.log.as_ref().map(log_json),
         "invalid_samples": result.invalid_samples,
         "interrupted": interrupted.load(Ordering::SeqCst),
         "strategies": pyramid.as_ref().map(|(dir, _, _)| dir.display().to_string()),
@@ -192,12 +283,17 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         serde_json::to_string_pretty(&record).unwrap().as_bytes(),
     )?;
     if !args.quiet {
+        let runs = if many {
+            format!(" × {runs_done} runs")
+        } else {
+            String::new()
+        };
         eprintln!(
-            "{}: {} spp in {:.2} s ({:.2} spp/s) -> {}",
+            "{}: {} spp{runs} in {:.2} s ({:.2} spp/s) -> {}",
             args.integrator,
-            result.passes,
+            first.passes,
             secs,
-            result.passes as f64 / secs,
+            total_passes as f64 / secs,
             args.output.display()
         );
         if result.invalid_samples > 0 {

@@ -24,7 +24,7 @@ use lt_integrators::params::ParamReader;
 use lt_integrators::record::{Completed, Recorder};
 use lt_integrators::splat::splat_pass_with;
 use lt_integrators::{
-    render, Integrator, IntegratorParams, PassReport, RenderOptions, RenderResult,
+    render, EstimatorRef, Integrator, IntegratorParams, PassReport, RenderOptions, RenderResult,
 };
 use std::fmt::Write as _;
 use std::ops::ControlFlow;
@@ -346,7 +346,7 @@ pub fn render_pyramid(
     on_pass: impl FnMut(&PassReport) -> ControlFlow<()>,
 ) -> Result<(RenderResult, Pyramid), String> {
     let integ = PyramidIntegrator::new(scene, make_bdpt(scene, params)?, max_length);
-    let result = render(scene, &integ, opts, on_pass)?;
+    let result = render(scene, EstimatorRef::Unbiased(&integ), opts, on_pass)?;
     Ok((result, integ.into_pyramid()))
 }
 

@@ -67,7 +67,7 @@ fn strategy_images_partition_the_bdpt_image_exactly() {
             let p = pyramid_pass(&bdpt, &scene, 7, pass, l);
             assert_eq!((p.invalid, p.main_invalid), (0, 0));
             // The main image is bdpt's own, bit for bit (same items, same chunks).
-            let (reference, _) = plain.render_pass(&scene, 7, pass);
+            let (reference, _) = plain.unbiased().unwrap().render_pass(&scene, 7, pass);
             assert!(
                 p.main
                     .data
@@ -152,8 +152,8 @@ fn pt_length_two(scene: &Scene, passes: u32, block: usize) -> RunningBlocks {
     let pt1 = make_integrator("pt", scene, &depth(1)).unwrap();
     let mut blocks = RunningBlocks::new(w, h, block);
     for pass in 0..passes {
-        let (mut a, bad_a) = pt2.render_pass(scene, 21, pass);
-        let (b, bad_b) = pt1.render_pass(scene, 21, pass);
+        let (mut a, bad_a) = pt2.unbiased().unwrap().render_pass(scene, 21, pass);
+        let (b, bad_b) = pt1.unbiased().unwrap().render_pass(scene, 21, pass);
         assert_eq!(bad_a + bad_b, 0);
         for (x, y) in a.data.iter_mut().zip(&b.data) {
             for c in 0..3 {

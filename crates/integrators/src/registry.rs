@@ -4,12 +4,15 @@
 use crate::bdpt::{Bdpt, BdptParams};
 use crate::light::{LightParams, LightTracer};
 use crate::params::{IntegratorParams, ParamReader};
+use crate::pm::{Pm, PmParams};
+use crate::ppm::Ppm;
 use crate::pt::{Pt, PtParams};
 use crate::pt_bsdf::{PtBsdf, PtBsdfParams};
-use crate::Integrator;
+use crate::sppm::Sppm;
+use crate::{Estimator, Kind};
 use lt_core::Scene;
 
-type Constructor = fn(&Scene, &ParamReader) -> Result<Box<dyn Integrator>, String>;
+type Constructor = fn(&Scene, &ParamReader) -> Result<Estimator, String>;
 
 /// What the registry knows of one integrator.
 pub struct IntegratorInfo {
@@ -18,6 +21,8 @@ pub struct IntegratorInfo {
     pub about: &'static str,
     /// The integrator's source file, whose opening table documents its keys.
     pub source: &'static str,
+    /// Unbiased or consistent: where the error bars of its images come from.
+    pub kind: Kind,
     pub make: Constructor,
 }
 
@@ -25,42 +30,71 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
     IntegratorInfo {
         name: "pt",
         about: "path tracing with next-event estimation and MIS (power heuristic)",
+        kind: Kind::Unbiased,
         source: include_str!("pt.rs"),
         make: |s, r| {
-            Ok(Box::new(Pt {
+            Ok(Estimator::Unbiased(Box::new(Pt {
                 params: PtParams::read(s, r)?,
-            }))
+            })))
         },
     },
     IntegratorInfo {
         name: "pt-bsdf",
         about: "path tracing by BSDF sampling only (the cross-check of pt)",
+        kind: Kind::Unbiased,
         source: include_str!("pt_bsdf.rs"),
         make: |s, r| {
-            Ok(Box::new(PtBsdf {
+            Ok(Estimator::Unbiased(Box::new(PtBsdf {
                 params: PtBsdfParams::read(s, r)?,
-            }))
+            })))
         },
     },
     IntegratorInfo {
         name: "light",
         about: "light tracing: light subpaths splatted to the camera at every vertex",
+        kind: Kind::Unbiased,
         source: include_str!("light.rs"),
         make: |s, r| {
-            Ok(Box::new(LightTracer {
+            Ok(Estimator::Unbiased(Box::new(LightTracer {
                 params: LightParams::read(s, r)?,
-            }))
+            })))
         },
     },
     IntegratorInfo {
         name: "bdpt",
         about: "bidirectional path tracing: every (s,t) strategy under MIS (power heuristic)",
+        kind: Kind::Unbiased,
         source: include_str!("bdpt.rs"),
         make: |s, r| {
-            Ok(Box::new(Bdpt {
+            Ok(Estimator::Unbiased(Box::new(Bdpt {
                 params: BdptParams::read(s, r)?,
-            }))
+            })))
         },
+    },
+    IntegratorInfo {
+        name: "pm",
+        about: "photon mapping: one photon map per run, gathered at the first non-delta vertex",
+        kind: Kind::Consistent,
+        source: include_str!("pm.rs"),
+        make: |s, r| {
+            Ok(Estimator::Consistent(Box::new(Pm {
+                params: PmParams::read(s, r)?,
+            })))
+        },
+    },
+    IntegratorInfo {
+        name: "ppm",
+        about: "progressive photon mapping: fixed visible points, photon passes pushed into them",
+        kind: Kind::Consistent,
+        source: include_str!("ppm.rs"),
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Ppm::read(s, r)?))),
+    },
+    IntegratorInfo {
+        name: "sppm",
+        about: "stochastic progressive photon mapping: new visible points every pass",
+        kind: Kind::Consistent,
+        source: include_str!("sppm.rs"),
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Sppm::read(s, r)?))),
     },
 ];
 
@@ -81,7 +115,7 @@ pub fn make_integrator(
     name: &str,
     scene: &Scene,
     params: &IntegratorParams,
-) -> Result<Box<dyn Integrator>, String> {
+) -> Result<Estimator, String> {
     let info = find(name)?;
     let reader = ParamReader::new(info.name, params);
     let integrator = (info.make)(scene, &reader)?;
@@ -139,6 +173,9 @@ mod tests {
                     info.name
                 );
             }
+            let built = make_integrator(info.name, &scene, &none).unwrap();
+            assert_eq!(built.kind(), info.kind, "{}: registry kind", info.name);
+            assert_eq!(built.name(), info.name);
             let unknown = IntegratorParams::new().with("no_such_key", 1);
             let err = make_integrator(info.name, &scene, &unknown).err().unwrap();
             assert!(err.contains("no_such_key"), "{err}");

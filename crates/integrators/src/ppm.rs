@@ -1,0 +1,121 @@
+//! `ppm` — progressive photon mapping (Hachisuka, Ogaki & Jensen 2008): one camera pass finds a
+//! visible point per pixel (through delta bounces to the first non-delta vertex, at one jittered
+//! position in the pixel), then every pass traces a batch of photon paths and pushes each photon
+//! into the visible points whose disk holds it (`progressive`); the radii shrink pass by pass, so
+//! bias and variance both vanish as passes grow. Memory grows with the visible points (the
+//! pixels), not with the photons traced.
+//!
+//! The visible points never move, so a pixel converges to the radiance at its one point: the
+//! pixel's own integral only in expectation over runs (antialiasing and glossy blur are what
+//! `sppm` adds). Next-event estimation at the fixed point is re-sampled every pass.
+//!
+//! | key | type | default | meaning |
+//! |---|---|---|---|
+//! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
+//! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette of photon paths from this many segments on |
+//! | `photons_per_pass` | u64 | the pixel count | photon paths per pass |
+//! | `radius_px` | f32 | 2 | initial radius in pixel footprints at the visible point |
+//! | `radius_scene` | f32 | — | initial radius as a fraction of the scene's bounding-sphere diameter |
+//! | `radius` | f32 | — | initial radius in scene units (warned about when far from the pixel footprint) |
+//! | `alpha` | f64 | 2/3 | radius reduction α (see `radius`: r²ᵢ ∝ i^(α−1)) |
+//! | `radius_update` | global/local | global | Knaus & Zwicker's global schedule or Hachisuka's per-pixel update |
+//! | `kernel` | disk/epanechnikov | disk | density-estimation kernel, normalised over the disk |
+//! | `direct` | nee/photons | nee | direct light by next-event estimation or from photons |
+
+use crate::params::ParamReader;
+use crate::progressive::{ProgressiveParams, ProgressiveState};
+use crate::visible::{next_event, trace_visible_point, CameraPrefix, Direct};
+use crate::{ProgressLog, Progressive, ProgressiveRun};
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::{Scene, Vec2};
+use lt_estimators::Image;
+use rayon::prelude::*;
+
+pub struct Ppm {
+    pub params: ProgressiveParams,
+}
+
+impl Ppm {
+    pub fn read(scene: &Scene, r: &ParamReader) -> Result<Ppm, String> {
+        Ok(Ppm {
+            params: ProgressiveParams::read(scene, r, "ppm")?,
+        })
+    }
+}
+
+impl Progressive for Ppm {
+    fn name(&self) -> &'static str {
+        "ppm"
+    }
+
+    fn start<'a>(&'a self, scene: &'a Scene, seed: u64) -> Box<dyn ProgressiveRun + 'a> {
+        Box::new(PpmRun {
+            params: &self.params,
+            scene,
+            seed,
+            fixed: Vec::new(),
+            prefixes: Vec::new(),
+            state: ProgressiveState::new(scene),
+        })
+    }
+}
+
+struct PpmRun<'a> {
+    params: &'a ProgressiveParams,
+    scene: &'a Scene,
+    seed: u64,
+    /// The visible points of the camera pass (empty until pass 0).
+    fixed: Vec<CameraPrefix>,
+    /// This pass's prefixes: the fixed points with this pass's next-event estimate.
+    prefixes: Vec<CameraPrefix>,
+    state: ProgressiveState,
+}
+
+impl ProgressiveRun for PpmRun<'_> {
+    fn pass(&mut self, pass: u32) -> u64 {
+        let (scene, p, seed) = (self.scene, self.params, self.seed);
+        let w = scene.camera.width as usize;
+        if self.fixed.is_empty() {
+            // The one camera pass, from the pixels' streams of pass 0.
+            self.fixed = (0..scene.camera.pixel_count())
+                .into_par_iter()
+                .map(|j| {
+                    let mut s = Sampler::for_item(Domain::Camera, seed, j as u64, 0);
+                    let raster =
+                        Vec2::new((j % w) as f32 + s.next_f32(), (j / w) as f32 + s.next_f32());
+                    trace_visible_point(scene, raster, &mut s, p.max_depth, p.direct)
+                })
+                .collect();
+        }
+        // Next-event estimation at the fixed points, afresh each pass (the auxiliary streams).
+        self.prefixes = self
+            .fixed
+            .par_iter()
+            .enumerate()
+            .map(|(j, pre)| {
+                let mut out = *pre;
+                if pass > 0 {
+                    out.nee = lt_core::Color::ZERO;
+                    if let (Some(vp), Direct::Nee) = (&pre.vp, p.direct) {
+                        if vp.gp.segments < p.max_depth {
+                            let mut s = Sampler::for_item(Domain::Aux, seed, j as u64, pass as u64);
+                            let sf = vp.gp.sf;
+                            out.nee =
+                                vp.gp.beta * next_event(scene, &vp.hit, &sf, vp.gp.wo, &mut s);
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        self.state.pass(scene, p, seed, pass, &self.prefixes)
+    }
+
+    fn estimate(&self) -> Image {
+        self.state.estimate(self.params)
+    }
+
+    fn log(&self) -> ProgressLog {
+        self.state.log.clone()
+    }
+}

@@ -1,0 +1,283 @@
+//! Progressive photon mapping's shared machinery, owned by neither `ppm` nor `sppm`: per-pixel
+//! statistics that persist across passes, and one pass of "push" — trace a batch of photon
+//! paths, find for every photon the visible points whose radius it falls in (the core's
+//! `PointGrid` over the visible points), and add its contribution to them.
+//!
+//! Determinism: photons are pushed in parallel chunks, each writing a list of (visible point,
+//! contribution) in photon order; the lists are then applied in chunk order, so every pixel sums
+//! the same terms in the same order for any thread count.
+//!
+//! The per-pass estimate of pixel j with the global schedule is (Knaus & Zwicker 2011, eq. 7)
+//! D_i + Σ_p K_{rᵢ}(x_j − x_p) β_j f β_p / M, averaged over passes (D: emission and next-event
+//! estimation). With the local update, Hachisuka et al.'s flux τ ← (τ + Φ) r²_new / r² and the
+//! pixel's estimate is D̄ + τ / (N_e π r²), N_e the photon paths traced so far.
+
+use crate::params::ParamReader;
+use crate::photons::{trace_photons, Kernel, Photon, PhotonOptions};
+use crate::radius::{global_scale2, read_alpha, InitialRadius, Update};
+use crate::visible::{CameraPrefix, Direct};
+use crate::ProgressLog;
+use lt_core::math::{is_valid_color, Color, Vec3, PI};
+use lt_core::spatial::PointGrid;
+use lt_core::Scene;
+use lt_estimators::Image;
+use rayon::prelude::*;
+
+/// The parameters `ppm` and `sppm` share (see their key tables).
+#[derive(Clone, Copy, Debug)]
+pub struct ProgressiveParams {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    /// `None`: one photon path per pixel per pass.
+    pub photons_per_pass: Option<u64>,
+    pub radius: InitialRadius,
+    pub alpha: f64,
+    pub update: Update,
+    pub kernel: Kernel,
+    pub direct: Direct,
+}
+
+impl ProgressiveParams {
+    pub fn read(scene: &Scene, r: &ParamReader, who: &str) -> Result<ProgressiveParams, String> {
+        let m = r.get::<u64>("photons_per_pass")?;
+        if m == Some(0) {
+            return Err(format!("{who}: photons_per_pass must be at least 1"));
+        }
+        Ok(ProgressiveParams {
+            max_depth: r.max_depth(scene)?,
+            rr_depth: r.rr_depth(scene)?,
+            photons_per_pass: m,
+            radius: InitialRadius::read(r, who)?,
+            alpha: read_alpha(r, who)?,
+            update: r
+                .get_with("radius_update", Update::parse)?
+                .unwrap_or(Update::Global),
+            kernel: r.get_with("kernel", Kernel::parse)?.unwrap_or(Kernel::Disk),
+            direct: r.get_with("direct", Direct::parse)?.unwrap_or(Direct::Nee),
+        })
+    }
+
+    pub fn photon_paths(&self, scene: &Scene) -> u64 {
+        self.photons_per_pass
+            .unwrap_or(scene.camera.pixel_count() as u64)
+    }
+}
+
+/// What one pixel keeps across passes.
+#[derive(Clone, Copy, Debug, Default)]
+struct PixelState {
+    /// Σ over passes of emission + next-event estimation.
+    direct: [f64; 3],
+    /// Global schedule: Σ over passes of the photon estimate.
+    photons: [f64; 3],
+    /// Local update: r², photon count N and flux τ (Hachisuka et al. 2008). r² = 0: not yet set.
+    r2: f64,
+    n: f64,
+    tau: [f64; 3],
+}
+
+/// The state of one progressive run.
+pub struct ProgressiveState {
+    pixels: Vec<PixelState>,
+    width: usize,
+    passes: u32,
+    photon_paths: u64,
+    pub log: ProgressLog,
+}
+
+/// Photon chunk of the push: contributions are listed per chunk and applied in chunk order.
+const PUSH_CHUNK: usize = 2048;
+
+fn add(a: &mut [f64; 3], c: Color) {
+    a[0] += c.x as f64;
+    a[1] += c.y as f64;
+    a[2] += c.z as f64;
+}
+
+impl ProgressiveState {
+    pub fn new(scene: &Scene) -> ProgressiveState {
+        ProgressiveState {
+            pixels: vec![PixelState::default(); scene.camera.pixel_count()],
+            width: scene.camera.width as usize,
+            passes: 0,
+            photon_paths: 0,
+            log: ProgressLog::default(),
+        }
+    }
+
+    /// One pass over this pass's camera prefixes (one per pixel, in pixel order). Returns the
+    /// number of invalid contributions dropped.
+    pub fn pass(
+        &mut self,
+        scene: &Scene,
+        params: &ProgressiveParams,
+        seed: u64,
+        pass: u32,
+        prefixes: &[CameraPrefix],
+    ) -> u64 {
+        let mut invalid = 0;
+        let i = pass + 1; // Knaus & Zwicker count passes from 1
+        let scale2 = global_scale2(i, params.alpha);
+        // The visible points of this pass, their pixels and radii.
+        let mut pixel_of = Vec::new();
+        let mut positions = Vec::new();
+        let mut radii2 = Vec::new();
+        let (mut r_sum, mut fp_sum) = (0.0f64, 0.0f64);
+        for (j, pre) in prefixes.iter().enumerate() {
+            let d = pre.direct();
+            if is_valid_color(d) {
+                add(&mut self.pixels[j].direct, d);
+            } else {
+                invalid += 1;
+            }
+            let Some(vp) = &pre.vp else { continue };
+            let r0 = params.radius.at(scene, vp) as f64;
+            let r2 = match params.update {
+                Update::Global => r0 * r0 * scale2,
+                Update::Local => {
+                    let px = &mut self.pixels[j];
+                    if px.r2 == 0.0 {
+                        px.r2 = r0 * r0;
+                    }
+                    px.r2
+                }
+            };
+            pixel_of.push(j as u32);
+            positions.push(vp.gp.p);
+            radii2.push(r2 as f32);
+            r_sum += r2.sqrt();
+            fp_sum += vp.footprint as f64;
+        }
+        let count = positions.len().max(1) as f64;
+        self.log.mean_radius.push(r_sum / count);
+        self.log.radius_scale.push(match params.update {
+            Update::Global => scale2.sqrt(),
+            Update::Local => f64::NAN,
+        });
+        if pass == 0 {
+            if let Some(w) = params.radius.warning(fp_sum / count) {
+                self.log.facts.push(("warning".into(), w));
+            }
+        }
+
+        let paths = params.photon_paths(scene);
+        let opts = PhotonOptions {
+            max_segments: params.max_depth.saturating_sub(1),
+            rr_depth: params.rr_depth,
+            skip_direct: params.direct == Direct::Nee,
+        };
+        let batch = trace_photons(scene, seed, pass, 0, paths, opts);
+        self.photon_paths += paths;
+        self.log.photon_paths.push(paths);
+
+        // Push: each photon finds the visible points whose disk holds it.
+        let r_max = radii2.iter().fold(0.0f32, |m, &r2| m.max(r2)).sqrt();
+        let mut phi = vec![Color::ZERO; positions.len()];
+        let mut m = vec![0u32; positions.len()];
+        if r_max > 0.0 && !batch.photons.is_empty() {
+            let grid = PointGrid::build(&positions, r_max);
+            let lists: Vec<Vec<(u32, Color)>> = batch
+                .positions
+                .par_chunks(PUSH_CHUNK)
+                .zip(batch.photons.par_chunks(PUSH_CHUNK))
+                .map(|(ps, phs)| {
+                    let mut list = Vec::new();
+                    for (xp, ph) in ps.iter().zip(phs) {
+                        push_one(
+                            scene, prefixes, &pixel_of, &positions, &radii2, &grid, params, *xp,
+                            ph, r_max, &mut list,
+                        );
+                    }
+                    list
+                })
+                .collect();
+            for list in lists {
+                for (k, c) in list {
+                    phi[k as usize] += c;
+                    m[k as usize] += 1;
+                }
+            }
+        }
+
+        // Per-pixel updates.
+        for (k, &j) in pixel_of.iter().enumerate() {
+            let px = &mut self.pixels[j as usize];
+            let c = phi[k];
+            if !is_valid_color(c) {
+                invalid += 1;
+                continue;
+            }
+            match params.update {
+                Update::Global => {
+                    let r2 = radii2[k] as f64;
+                    let s = 1.0 / (paths as f64 * PI as f64 * r2);
+                    add(&mut px.photons, c * s as f32);
+                }
+                Update::Local => {
+                    let mk = m[k] as f64;
+                    if mk > 0.0 {
+                        let shrink = (px.n + params.alpha * mk) / (px.n + mk);
+                        for (t, ci) in px.tau.iter_mut().zip([c.x, c.y, c.z]) {
+                            *t = (*t + ci as f64) * shrink;
+                        }
+                        px.r2 *= shrink;
+                        px.n += params.alpha * mk;
+                    }
+                }
+            }
+        }
+        self.passes += 1;
+        invalid
+    }
+
+    /// The run's image after the passes so far.
+    pub fn estimate(&self, params: &ProgressiveParams) -> Image {
+        let h = self.pixels.len() / self.width.max(1);
+        let mut img = Image::new(self.width, h);
+        let n = self.passes.max(1) as f64;
+        let ne = self.photon_paths.max(1) as f64;
+        for (out, px) in img.data.iter_mut().zip(&self.pixels) {
+            for c in 0..3 {
+                let photons = match params.update {
+                    Update::Global => px.photons[c] / n,
+                    Update::Local if px.r2 > 0.0 => px.tau[c] / (ne * PI as f64 * px.r2),
+                    Update::Local => 0.0,
+                };
+                out[c] = px.direct[c] / n + photons;
+            }
+        }
+        img
+    }
+}
+
+/// One photon's contributions to the visible points within their radii (appended to `list`).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn push_one(
+    scene: &Scene,
+    prefixes: &[CameraPrefix],
+    pixel_of: &[u32],
+    positions: &[Vec3],
+    radii2: &[f32],
+    grid: &PointGrid,
+    params: &ProgressiveParams,
+    xp: Vec3,
+    ph: &Photon,
+    r_max: f32,
+    list: &mut Vec<(u32, Color)>,
+) {
+    grid.for_each_within(positions, xp, r_max, |k, d2| {
+        let r2 = radii2[k as usize];
+        if !(d2 <= r2) {
+            return;
+        }
+        let w = params.kernel.shape(d2, r2);
+        let vp = prefixes[pixel_of[k as usize] as usize]
+            .vp
+            .as_ref()
+            .expect("indexed points have a visible point");
+        if let Some(v) = vp.gp.photon_value(scene, ph, params.max_depth) {
+            list.push((k, vp.gp.beta * v * w));
+        }
+    });
+}
