@@ -296,6 +296,18 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             total_passes as f64 / secs,
             args.output.display()
         );
+        let mut warnings: Vec<&str> = result
+            .runs
+            .iter()
+            .filter_map(|r| r.log.as_ref())
+            .flat_map(|l| l.facts.iter())
+            .filter(|(k, _)| k == "warning")
+            .map(|(_, v)| v.as_str())
+            .collect();
+        warnings.dedup();
+        for w in warnings {
+            eprintln!("warning: {w}");
+        }
         if result.invalid_samples > 0 {
             eprintln!(
                 "warning: {} invalid (NaN/Inf/negative) samples were dropped",

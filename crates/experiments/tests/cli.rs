@@ -76,3 +76,52 @@ fn a_bad_scene_is_one_clear_error() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// One run of a consistent estimator has no honest error bar: no `.stderr.exr` is written (and
+/// a stale one is removed); `--runs 2` writes the error across the runs and says so.
+#[test]
+fn consistent_estimators_get_error_bars_only_from_runs() {
+    let dir = temp_dir("runs");
+    let out = dir.join("pm.exr");
+    let stderr = dir.join("pm.stderr.exr");
+    std::fs::write(&stderr, b"stale").unwrap();
+    let render = |extra: &[&str]| {
+        let status = lt()
+            .args([
+                "render",
+                "-i",
+                "pm",
+                "--spp",
+                "1",
+                "--photons",
+                "20000",
+                "--quiet",
+                "-o",
+            ])
+            .arg(&out)
+            .args(extra)
+            .arg(repo().join("scenes/cornell-box.toml"))
+            .status()
+            .unwrap();
+        assert!(status.success());
+        std::fs::read_to_string(dir.join("pm.json")).unwrap()
+    };
+    let one = render(&[]);
+    assert!(
+        !stderr.exists(),
+        "a stale stderr.exr survived one run of pm"
+    );
+    assert!(one.contains("\"kind\": \"consistent\""), "{one}");
+    assert!(one.contains("\"mean_std_error\": null"), "{one}");
+    let two = render(&["--runs", "2"]);
+    assert!(stderr.exists(), "--runs 2 wrote no stderr.exr");
+    assert!(
+        two.contains("\"std_error_source\": \"independent runs\""),
+        "{two}"
+    );
+    assert!(
+        two.contains("\"run_seeds\": [\n    1,\n    2\n  ]"),
+        "{two}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
