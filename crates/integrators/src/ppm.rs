@@ -3,7 +3,7 @@
 //! position in the pixel), then every pass traces a batch of photon paths and pushes each photon
 //! into the visible points whose disk holds it (`progressive`); the radii shrink pass by pass, so
 //! bias and variance both vanish as passes grow. Memory grows with the visible points (the
-//! pixels), not with the photons traced.
+//! pixels) and one pass's photons, not with all photons traced.
 //!
 //! The visible points never move, so a pixel converges to the radiance at its one point: the
 //! pixel's own integral only in expectation over runs (antialiasing and glossy blur are what

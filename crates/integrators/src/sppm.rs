@@ -1,7 +1,8 @@
 //! `sppm` — stochastic progressive photon mapping (Hachisuka & Jensen 2009): like `ppm`, but
 //! every pass traces new camera samples, so each pass has its own visible points (a new jittered
 //! position per pixel: antialiasing, and glossy and distributed effects converge) while radii and
-//! photon statistics stay per pixel. Memory grows with the pixels, not with the photons.
+//! photon statistics stay per pixel. Memory grows with the pixels and with the photons of one pass
+//! (measured: ≈ 355 bytes per pixel + 325 per photon path of a pass), not with all photons traced.
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
