@@ -219,15 +219,31 @@ impl PhotonMap {
         let mut sum = Color::ZERO;
         self.grid
             .for_each_within(&self.batch.positions, gp.p, r, |i, d2| {
-                let w = kernel.shape(d2, r2);
-                if w > 0.0 {
-                    let ph = &self.batch.photons[i as usize];
-                    if let Some(v) = gp.photon_value(scene, ph, max_depth) {
-                        sum += v * w;
-                    }
-                }
+                sum += self.weighted(scene, gp, i, d2, r2, kernel, max_depth);
             });
         sum / (PI * r2 * self.batch.paths as f32)
+    }
+
+    /// One photon's kernel-weighted value at `gp` (before 1/(π r² N)).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn weighted(
+        &self,
+        scene: &Scene,
+        gp: &GatherPoint,
+        i: u32,
+        d2: f32,
+        r2: f32,
+        kernel: Kernel,
+        max_depth: u32,
+    ) -> Color {
+        let w = kernel.shape(d2, r2);
+        if w == 0.0 {
+            return Color::ZERO;
+        }
+        let ph = &self.batch.photons[i as usize];
+        gp.photon_value(scene, ph, max_depth)
+            .map_or(Color::ZERO, |v| v * w)
     }
 
     /// The radiance estimate at `gp` from its k nearest photons (within `max_r`), the radius being
@@ -251,16 +267,9 @@ impl PhotonMap {
         if !(r2 > 0.0) {
             return Color::ZERO;
         }
-        let mut sum = Color::ZERO;
-        for &(i, d2) in scratch.iter() {
-            let w = kernel.shape(d2, r2);
-            if w > 0.0 {
-                let ph = &self.batch.photons[i as usize];
-                if let Some(v) = gp.photon_value(scene, ph, max_depth) {
-                    sum += v * w;
-                }
-            }
-        }
+        let sum = scratch.iter().fold(Color::ZERO, |s, &(i, d2)| {
+            s + self.weighted(scene, gp, i, d2, r2, kernel, max_depth)
+        });
         sum / (PI * r2 * self.batch.paths as f32)
     }
 }

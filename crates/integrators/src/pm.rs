@@ -30,6 +30,10 @@ use lt_core::Scene;
 use lt_estimators::running::RunningImage;
 use lt_estimators::Image;
 use std::cell::RefCell;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Fixed-point scale of pass 0's radius statistics.
+const FIXED: f64 = 4294967296.0;
 
 #[derive(Clone, Copy, Debug)]
 pub struct PmParams {
@@ -139,8 +143,10 @@ impl ProgressiveRun for PmRun<'_> {
         let map = self.map.as_ref().expect("built above");
         let p = &self.pm.params;
         let scene = self.scene;
-        // Pass 0 measures the radii and footprints it used (sum of r, of footprints, count).
-        let sums = std::sync::Mutex::new((0.0f64, 0.0f64, 0u64));
+        // Pass 0 measures the radii and footprints it used: sums in fixed point (2⁻³² scene
+        // units), so they are exact and order-independent without a lock per pixel.
+        let (r_fixed, fp_fixed, n_vp) = (AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0));
+        let fixed = |x: f32| (x as f64 * FIXED) as u64;
         let (img, bad) = pixel_pass(scene, self.seed, pass, |sampler, raster| {
             let prefix = trace_visible_point(scene, raster, sampler, p.max_depth, p.direct);
             let Some(vp) = prefix.vp else {
@@ -162,17 +168,17 @@ impl ProgressiveRun for PmRun<'_> {
                 }),
             };
             if pass == 0 {
-                let mut s = sums.lock().unwrap_or_else(|e| e.into_inner());
-                s.0 += r as f64;
-                s.1 += vp.footprint as f64;
-                s.2 += 1;
+                r_fixed.fetch_add(fixed(r), Ordering::Relaxed);
+                fp_fixed.fetch_add(fixed(vp.footprint), Ordering::Relaxed);
+                n_vp.fetch_add(1, Ordering::Relaxed);
             }
             prefix.direct() + vp.gp.beta * l
         });
         self.acc.add(&img);
-        let (r_sum, fp_sum, n) = sums.into_inner().unwrap_or_else(|e| e.into_inner());
+        let r_sum = r_fixed.into_inner() as f64 / FIXED;
+        let fp_sum = fp_fixed.into_inner() as f64 / FIXED;
         if pass == 0 {
-            let n = n.max(1) as f64;
+            let n = n_vp.into_inner().max(1) as f64;
             self.log.mean_radius.push(r_sum / n);
             if let Some(w) = p.radius.warning(fp_sum / n) {
                 self.log.facts.push(("warning".into(), w));
