@@ -1,0 +1,89 @@
+//! Vertex merging's techniques beside the connection techniques of [`Densities`], computed from
+//! scratch: the oracle that VCM's and BPM's recursive weights are held to.
+//!
+//! Merging at x_i (Georgiev et al. 2012, §4.1; Hachisuka et al. 2012's UPS) takes x0 … x_{i−1}
+//! and a light vertex near x_i from a light subpath and x_i … xk from a camera subpath, and accepts
+//! the pair when the two x_i lie within r. Its density is
+//!
+//!   p_VM,i = π r² · ∏_{j≤i} l_j · ∏_{j≥i} c_j,   1 ≤ i ≤ k−1, x_i not delta,
+//!
+//! with l_0 the light walk's density of x0 (never next-event estimation's: merging uses the light
+//! subpath as it was traced). A pass merges each camera subpath with all N_VM light subpaths, so
+//! relative to a connection (one per camera sample) it counts N_VM times: the heuristics compare
+//! η · ∏ l · ∏ c with η = N_VM π r² (Georgiev et al.'s η_VCM) against n_s · p_s.
+
+use super::mis::{oracle_weight, Heuristic};
+use super::path::Densities;
+
+/// Which techniques an estimator runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TechniqueSet {
+    /// Connections s ≥ 1 (next-event estimation, connections, light tracing). The camera walk
+    /// hitting a light (s = 0) is always on: it is the only technique for paths no other can make.
+    pub connections: bool,
+    /// η = N_VM π r² of merging; 0 turns merging off.
+    pub merging_eta: f64,
+}
+
+/// One technique of a path of the full VCM family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Technique {
+    /// Vertex connection (or the walks' own ends) with s light vertices.
+    Connect(usize),
+    /// Vertex merging at x_i.
+    Merge(usize),
+}
+
+impl Densities {
+    /// ∏_{j≤i} l_j · ∏_{j≥i} c_j (without π r²), or 0 where merging at x_i is impossible.
+    pub fn merging(&self, i: usize) -> f64 {
+        let k = self.k();
+        if i == 0 || i >= k || !self.connectable[i] {
+            return 0.0;
+        }
+        let l: f64 = self.light[..=i].iter().product();
+        let c: f64 = self.camera[i..].iter().product();
+        l * c
+    }
+
+    /// The effective densities the heuristics compare under `set`: n_s·p_s of the connection
+    /// techniques s = 0 … k+1 (zero for s ≥ 1 without connections), then η·p_VM,i for i = 0 … k.
+    pub fn effective_vcm(&self, set: TechniqueSet) -> (Vec<f64>, Vec<f64>) {
+        let mut vc = self.effective_all();
+        if !set.connections {
+            vc.iter_mut().skip(1).for_each(|p| *p = 0.0);
+        }
+        let vm = (0..=self.k())
+            .map(|i| set.merging_eta * self.merging(i))
+            .collect();
+        (vc, vm)
+    }
+
+    /// The weight of `technique` under `h` over every technique of `set`, by brute force over
+    /// the effective densities (`oracle_weight`).
+    pub fn vcm_weight(&self, set: TechniqueSet, technique: Technique, h: Heuristic) -> f64 {
+        let (vc, vm) = self.effective_vcm(set);
+        let index = match technique {
+            Technique::Connect(s) => s,
+            Technique::Merge(i) => vc.len() + i,
+        };
+        let all: Vec<f64> = vc.into_iter().chain(vm).collect();
+        oracle_weight(&all, index, h)
+    }
+
+    /// Every technique of `set` that can produce this path (positive effective density).
+    pub fn vcm_techniques(&self, set: TechniqueSet) -> Vec<Technique> {
+        let (vc, vm) = self.effective_vcm(set);
+        let connect = vc
+            .iter()
+            .enumerate()
+            .filter(|(_, &p)| p > 0.0)
+            .map(|(s, _)| Technique::Connect(s));
+        let merge = vm
+            .iter()
+            .enumerate()
+            .filter(|(_, &p)| p > 0.0)
+            .map(|(i, _)| Technique::Merge(i));
+        connect.chain(merge).collect()
+    }
+}
