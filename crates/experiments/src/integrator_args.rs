@@ -46,12 +46,15 @@ pub struct IntegratorArgs {
     /// Photon family: direct light by nee (default) or photons: key direct.
     #[arg(long)]
     pub direct: Option<String>,
-    /// ppm/sppm: radius reduction α in (0, 1] (default 2/3): key alpha.
+    /// ppm/sppm/vcm/bpm: radius reduction α in (0, 1] (default 2/3; vcm/bpm 0.75): key alpha.
     #[arg(long)]
     pub alpha: Option<f64>,
     /// ppm/sppm: radius schedule, global (Knaus & Zwicker, default) or local (Hachisuka): key radius_update.
     #[arg(long)]
     pub radius_update: Option<String>,
+    /// vcm: connections only, no merging — BDPT through vcm's code: key merging=false.
+    #[arg(long)]
+    pub no_merge: bool,
     /// Any integrator key, as key=value (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
@@ -94,6 +97,9 @@ impl IntegratorArgs {
             if let Some(v) = value {
                 p.set(key, v);
             }
+        }
+        if self.no_merge {
+            p.set("merging", false);
         }
         for pair in &self.set {
             p.set_pair(pair)?;

@@ -20,7 +20,7 @@
 //! | `mis` | power/balance/none | power | heuristic over the strategies (none: uniform weights) |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
 
-use crate::connect::{connect_to_camera, eval_towards};
+use crate::connect::{connect_to_camera, emission_densities, eval_towards, nee_density};
 use crate::params::ParamReader;
 use crate::record::{Completed, NoRecord, Recorder};
 use crate::splat::{splat_pass_with, Splats};
@@ -79,44 +79,6 @@ pub struct Split<'a> {
 pub struct EndEvals {
     pub light_end: Option<BsdfEval>,
     pub camera_end: Option<BsdfEval>,
-}
-
-/// Density of x0 when next-event estimation from x1 chooses it: pmf · pdf_li in x0's measure
-/// (area; solid angle at infinity; the pmf alone for a point light). Mirrors `Path::densities`.
-pub fn nee_density(scene: &Scene, x0: &PathVertex, x1: &PathVertex) -> f64 {
-    let VertexKind::Light { light, .. } = x0.kind else {
-        return 0.0;
-    };
-    let l = &scene.lights[light as usize];
-    let pmf = scene.light_sampler.pmf(light as usize) as f64;
-    if l.delta_position() {
-        return pmf;
-    }
-    let pdf_w = l.pdf_li(x1.p, x1.dir_to(x0), x0.p, x0.ng);
-    pmf * x1.convert_density(pdf_w, x0) as f64
-}
-
-/// (pmf · positional density of x0, density of x1 from x0's emitted direction) — the light
-/// walk's l_0 and l_1 for an x0 that the light walk did not make. Mirrors `Path::densities`.
-fn emission_densities(scene: &Scene, x0: &PathVertex, x1: Option<&PathVertex>) -> (f64, f64) {
-    let VertexKind::Light { light, .. } = x0.kind else {
-        return (0.0, 0.0);
-    };
-    let l = &scene.lights[light as usize];
-    let pmf = scene.light_sampler.pmf(light as usize) as f64;
-    let Some(x1) = x1 else {
-        // x1 is the pinhole, which no light walk hits: l_1 = l_k = 0.
-        let dir = if x0.is_infinite() { -x0.p } else { -x0.ng };
-        let (pos, d) = l.pdf_le(x0.ng, dir, scene.bounding_sphere);
-        return (pmf * if x0.is_infinite() { d } else { pos } as f64, 0.0);
-    };
-    let (pos, dir) = l.pdf_le(x0.ng, x0.dir_to(x1), scene.bounding_sphere);
-    let (first, second) = if x0.is_infinite() {
-        (dir, pos)
-    } else {
-        (pos, dir)
-    };
-    (pmf * first as f64, x0.convert_density(second, x1) as f64)
 }
 
 /// Longest path weighed without allocating (segments); longer ones use the heap.

@@ -2,7 +2,9 @@
 //! with a table of its parameters. `registry` maps names to constructors, `render` drives passes.
 
 pub mod bdpt;
+pub mod bpm;
 pub mod connect;
+pub mod connect_merge;
 pub mod light;
 pub mod params;
 pub mod photons;
@@ -18,6 +20,7 @@ pub mod registry;
 pub mod render;
 pub mod splat;
 pub mod sppm;
+pub mod vcm;
 pub mod visible;
 pub mod walk;
 

@@ -25,10 +25,30 @@ pub struct Completed<'a> {
     pub alternatives: &'a [(usize, f64)],
 }
 
+/// One path completed by vertex merging (`vcm`, `bpm`): a light vertex y_i found within the
+/// radius of camera vertex z_{t−1}, which stands for x_i.
+pub struct Merged<'a> {
+    /// The merging vertex x_i (1 ≤ i ≤ k − 1).
+    pub i: usize,
+    /// The light subpath y_0 … y_i, the merged light vertex last.
+    pub light: &'a [PathVertex],
+    /// The camera subpath, camera first: x_k … x_i (its last vertex is the merge point).
+    pub camera: &'a [PathVertex],
+    /// The weight the integrator applied.
+    pub weight: f64,
+    /// The unweighted contribution, normalised as added (kernel, 1/(N_VM π r²) included).
+    pub value: Color,
+    pub raster: Vec2,
+    /// The merging radius of the pass.
+    pub radius: f32,
+}
+
 pub trait Recorder {
     /// False for `NoRecord`: integrators skip building what only a recorder would read.
     const ACTIVE: bool;
     fn completed(&mut self, path: Completed);
+    /// A path made by merging; recorders of connection-only integrators ignore it.
+    fn merged(&mut self, _path: Merged) {}
 }
 
 /// Records nothing.

@@ -2,6 +2,7 @@
 //! all use it). Tests that loop over `INTEGRATORS` cover a new integrator without new test code.
 
 use crate::bdpt::{Bdpt, BdptParams};
+use crate::bpm::Bpm;
 use crate::light::{LightParams, LightTracer};
 use crate::params::{IntegratorParams, ParamReader};
 use crate::pm::{Pm, PmParams};
@@ -9,6 +10,7 @@ use crate::ppm::Ppm;
 use crate::pt::{Pt, PtParams};
 use crate::pt_bsdf::{PtBsdf, PtBsdfParams};
 use crate::sppm::Sppm;
+use crate::vcm::Vcm;
 use crate::{Estimator, Kind};
 use lt_core::Scene;
 
@@ -95,6 +97,20 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Consistent,
         source: include_str!("sppm.rs"),
         make: |s, r| Ok(Estimator::Consistent(Box::new(Sppm::read(s, r)?))),
+    },
+    IntegratorInfo {
+        name: "bpm",
+        about: "bidirectional photon mapping: merging at every camera vertex under MIS",
+        kind: Kind::Consistent,
+        source: include_str!("bpm.rs"),
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Bpm::read(s, r)?))),
+    },
+    IntegratorInfo {
+        name: "vcm",
+        about: "vertex connection and merging: bdpt's connections and merging under one MIS",
+        kind: Kind::Consistent,
+        source: include_str!("vcm.rs"),
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Vcm::read(s, r)?))),
     },
 ];
 

@@ -1,0 +1,818 @@
+//! Vertex connection and merging (Georgiev, Křivánek, Davidovič & Slusallek 2012), shared by
+//! `vcm` and `bpm` and owned by neither: one pass traces M light subpaths, indexes their
+//! non-delta vertices, then per pixel traces a camera subpath that at every vertex
+//!
+//! - **connects** as `bdpt` does — s = 0 (the walk hits a light), s = 1 (next-event
+//!   estimation), s ≥ 2 (shadow rays to light subpath j mod M), t = 1 (light subpath j splatted
+//!   to the camera) — with the same random numbers in the same order, and
+//! - **merges** with every stored light vertex within the pass's radius rᵢ (disk kernel), the
+//!   light vertex's incoming direction evaluated in the camera vertex's BSDF.
+//!
+//! All techniques share one MIS (`lt_core::path::SubpathMis`): merging at x_i counts
+//! η = M π rᵢ² times a connection (Georgiev et al. 2012, eq. 11, η_VCM). The per-vertex
+//! records (their dVCM/dVC/dVM) are formed once per subpath from the walks' stored densities, so
+//! a weight is O(1). Radii shrink as rᵢ = r₀ · i^((α−1)/2), i = 1, 2, … (Knaus & Zwicker's
+//! rate, as in SmallVCM, α = 0.75); r₀ is pixel-footprint relative by default (at the mean
+//! primary-hit distance: one radius for the whole pass, which η needs) or scene relative.
+
+use crate::connect::{connect_to_camera, emission_densities, eval_towards, nee_density};
+use crate::params::ParamReader;
+use crate::radius::InitialRadius;
+use crate::record::{Completed, Merged, NoRecord, Recorder};
+use crate::splat::{splat_pass_with, Splats};
+use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
+use crate::{ProgressLog, ProgressiveRun};
+use lt_core::bsdf::TransportMode;
+use lt_core::math::{Color, Vec2, Vec3, PI};
+use lt_core::path::scatter::connectable;
+use lt_core::path::{
+    CameraMis, Heuristic, LightMis, PathVertex, SubpathMis, TechniqueSet, VertexKind,
+};
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::spatial::PointGrid;
+use lt_core::Scene;
+use lt_estimators::Image;
+use rayon::prelude::*;
+
+/// The techniques and schedule of a VCM-family estimator.
+#[derive(Clone, Copy, Debug)]
+pub struct VcmParams {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub mis: Heuristic,
+    /// `None`: one light subpath per pixel.
+    pub light_paths: Option<u64>,
+    pub radius: InitialRadius,
+    pub alpha: f64,
+    /// Connections s ≥ 1 (bdpt's techniques); s = 0 always runs.
+    pub connections: bool,
+    pub merging: bool,
+}
+
+/// SmallVCM's radius reduction.
+pub const DEFAULT_ALPHA: f64 = 0.75;
+
+impl VcmParams {
+    /// Reads the keys common to `vcm` and `bpm`.
+    pub fn read(
+        scene: &Scene,
+        r: &ParamReader,
+        who: &str,
+        connections: bool,
+        merging: bool,
+    ) -> Result<VcmParams, String> {
+        let alpha = r.get::<f64>("alpha")?.unwrap_or(DEFAULT_ALPHA);
+        if !(alpha > 0.0 && alpha <= 1.0) {
+            return Err(format!("{who}: alpha must be in (0, 1], got {alpha}"));
+        }
+        Ok(VcmParams {
+            max_depth: r.max_depth(scene)?,
+            rr_depth: r.rr_depth(scene)?,
+            mis: r
+                .get_with("mis", Heuristic::parse)?
+                .unwrap_or(Heuristic::Power),
+            light_paths: r.light_paths()?,
+            radius: InitialRadius::read(r, who)?,
+            alpha,
+            connections,
+            merging,
+        })
+    }
+
+    pub fn light_path_count(&self, scene: &Scene) -> u64 {
+        self.light_paths
+            .unwrap_or(scene.camera.pixel_count() as u64)
+    }
+
+    /// r_i / r_0 of pass `pass` (0-based; iteration i = pass + 1).
+    pub fn radius_scale(&self, pass: u32) -> f64 {
+        ((pass + 1) as f64).powf((self.alpha - 1.0) / 2.0)
+    }
+
+    fn limits(&self, camera: bool) -> WalkLimits {
+        let d = self.max_depth as usize;
+        WalkLimits {
+            max_vertices: if camera { d + 1 } else { d },
+            rr_depth: self.rr_depth,
+        }
+    }
+}
+
+/// r₀ in scene units: footprint-relative radii use the footprint at the mean distance of primary
+/// hits over a fixed grid of pixel centres (deterministic, and one radius for the whole pass).
+pub fn initial_radius(scene: &Scene, radius: InitialRadius) -> f32 {
+    match radius {
+        InitialRadius::Pixels(k) => {
+            let cam = &scene.camera;
+            let step = (cam.width.max(cam.height) / 64).max(1);
+            let (mut sum, mut n) = (0.0f64, 0u64);
+            for y in (0..cam.height).step_by(step as usize) {
+                for x in (0..cam.width).step_by(step as usize) {
+                    let ray = cam.generate_ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                    if let Some(hit) = scene.intersect(&ray) {
+                        sum += ((hit.p - ray.o).dot(cam.forward())) as f64;
+                        n += 1;
+                    }
+                }
+            }
+            let distance = if n > 0 {
+                (sum / n as f64) as f32
+            } else {
+                scene.bounding_sphere.1
+            };
+            k * cam.pixel_footprint(distance)
+        }
+        InitialRadius::Scene(f) => f * 2.0 * scene.bounding_sphere.1,
+        InitialRadius::Absolute(r) => r,
+    }
+}
+
+/// The light subpaths of one pass, flattened, with their MIS records and the merge index.
+#[derive(Default)]
+pub struct LightPaths {
+    pub vertices: Vec<PathVertex>,
+    pub mis: Vec<LightMis>,
+    /// Path j is `vertices[starts[j]..starts[j + 1]]`.
+    pub starts: Vec<u32>,
+    /// Mergeable vertices: flat index, and segments from the light.
+    merge_vertex: Vec<(u32, u32)>,
+    merge_positions: Vec<Vec3>,
+    grid: Option<PointGrid>,
+}
+
+impl LightPaths {
+    pub fn path(&self, j: usize) -> (&[PathVertex], &[LightMis]) {
+        let (a, b) = (self.starts[j] as usize, self.starts[j + 1] as usize);
+        (&self.vertices[a..b], &self.mis[a..b])
+    }
+
+    /// Stored light vertices (for the record and memory figures).
+    pub fn merge_candidates(&self) -> usize {
+        self.merge_vertex.len()
+    }
+}
+
+/// Whether a connection technique can join `a` and `b` (both non-delta).
+#[inline]
+fn joinable(scene: &Scene, a: &PathVertex, b: &PathVertex) -> bool {
+    connectable(scene, a) && connectable(scene, b)
+}
+
+/// Light subpaths traced per parallel chunk (fixed: the order of the flat arrays, hence every
+/// sum, does not depend on the thread count).
+const LIGHT_CHUNK: u64 = 1024;
+
+/// Work items per splat chunk, as in `bdpt` (same order of floating-point sums).
+const CHUNK: u64 = 256;
+
+/// One pass of the estimator.
+pub struct PassSetup {
+    pub mis: SubpathMis,
+    pub radius: f32,
+    /// 1 / (M π r²): the density-estimation normalisation of one merge.
+    merge_norm: f32,
+    light_paths: u64,
+}
+
+pub struct Engine<'a> {
+    pub params: &'a VcmParams,
+    pub scene: &'a Scene,
+}
+
+/// Per-thread buffers of one camera sample.
+pub struct Scratch {
+    camera: Subpath,
+    records: Vec<CameraMis>,
+    prefix: Vec<PathVertex>,
+}
+
+impl<'a> Engine<'a> {
+    pub fn new(params: &'a VcmParams, scene: &'a Scene) -> Engine<'a> {
+        Engine { params, scene }
+    }
+
+    pub fn setup(&self, r0: f32, pass: u32) -> PassSetup {
+        let p = self.params;
+        let m = p.light_path_count(self.scene);
+        let n = self.scene.camera.pixel_count() as f64;
+        let radius = (r0 as f64 * p.radius_scale(pass)) as f32;
+        let eta = if p.merging {
+            m as f64 * PI as f64 * (radius as f64).powi(2)
+        } else {
+            0.0
+        };
+        let set = TechniqueSet {
+            connections: p.connections,
+            merging_eta: eta,
+        };
+        PassSetup {
+            mis: SubpathMis::new(p.mis, set, m as f64 / n),
+            radius,
+            merge_norm: (1.0 / eta) as f32,
+            light_paths: m,
+        }
+    }
+
+    /// Traces the pass's light subpaths and forms their MIS records (and the merge index).
+    pub fn trace_light_paths(&self, setup: &PassSetup, seed: u64, pass: u32) -> LightPaths {
+        let scene = self.scene;
+        let m = setup.light_paths;
+        let chunks: Vec<(Vec<PathVertex>, Vec<LightMis>, Vec<u32>)> = (0..m.div_ceil(LIGHT_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let mut sub = Subpath::with_capacity(self.params.max_depth as usize);
+                let (mut verts, mut recs, mut lens) = (Vec::new(), Vec::new(), Vec::new());
+                for j in c * LIGHT_CHUNK..((c + 1) * LIGHT_CHUNK).min(m) {
+                    let mut ls = Sampler::for_item(Domain::Light, seed, j, pass as u64);
+                    light_subpath(scene, &mut ls, self.params.limits(false), &mut sub);
+                    let start = recs.len();
+                    light_records(scene, &setup.mis, &sub.vertices, &mut recs);
+                    verts.extend_from_slice(&sub.vertices);
+                    lens.push((recs.len() - start) as u32);
+                }
+                (verts, recs, lens)
+            })
+            .collect();
+        let mut out = LightPaths {
+            starts: vec![0],
+            ..LightPaths::default()
+        };
+        for (v, r, lens) in chunks {
+            for len in lens {
+                let s = *out.starts.last().unwrap();
+                out.starts.push(s + len);
+            }
+            out.vertices.extend(v);
+            out.mis.extend(r);
+        }
+        if self.params.merging {
+            for j in 0..m as usize {
+                let (a, b) = (out.starts[j], out.starts[j + 1]);
+                for (d, idx) in (a + 1..b).enumerate() {
+                    if out.mis[idx as usize].mergeable {
+                        out.merge_vertex.push((idx, d as u32 + 1));
+                        out.merge_positions.push(out.vertices[idx as usize].p);
+                    }
+                }
+            }
+            out.grid = Some(PointGrid::build(&out.merge_positions, 2.0 * setup.radius));
+        }
+        out
+    }
+
+    pub fn scratch(&self) -> Scratch {
+        let d = self.params.max_depth as usize;
+        Scratch {
+            camera: Subpath::with_capacity(d + 1),
+            records: Vec::with_capacity(d + 1),
+            prefix: Vec::with_capacity(d + 2),
+        }
+    }
+
+    /// One pass's image: pixel estimates plus light-tracing splats. Returns (image, invalid).
+    pub fn render_pass(
+        &self,
+        setup: &PassSetup,
+        lights: &LightPaths,
+        seed: u64,
+        pass: u32,
+    ) -> (Image, u64) {
+        let cam = &self.scene.camera;
+        let n = cam.pixel_count() as u64;
+        let items = n.max(setup.light_paths);
+        splat_pass_with(
+            cam.width as usize,
+            cam.height as usize,
+            items,
+            CHUNK,
+            || self.scratch(),
+            |i, splats, scratch| {
+                self.item(setup, lights, seed, pass, i, splats, scratch, &mut NoRecord)
+            },
+        )
+    }
+
+    /// Work item i: pixel i (i < N) with light subpath i mod M, splatting light subpath i (i < M),
+    /// exactly as `bdpt` pairs them.
+    #[allow(clippy::too_many_arguments)]
+    pub fn item<R: Recorder>(
+        &self,
+        setup: &PassSetup,
+        lights: &LightPaths,
+        seed: u64,
+        pass: u32,
+        i: u64,
+        splats: &mut Splats,
+        scratch: &mut Scratch,
+        rec: &mut R,
+    ) {
+        let n = self.scene.camera.pixel_count() as u64;
+        let m = setup.light_paths;
+        let light = lights.path((i % m) as usize);
+        if i < m && self.params.connections {
+            self.splat_light_path(setup, light, splats, rec);
+        }
+        if i < n {
+            let l = self.camera_sample(setup, lights, light, seed, pass, i, scratch, rec);
+            splats.add_to_pixel(i as u32, l);
+        }
+    }
+
+    /// t = 1: every connectable vertex of one light subpath joined to the pinhole.
+    fn splat_light_path<R: Recorder>(
+        &self,
+        setup: &PassSetup,
+        (y, ly): (&[PathVertex], &[LightMis]),
+        splats: &mut Splats,
+        rec: &mut R,
+    ) {
+        let scene = self.scene;
+        let cam = &scene.camera;
+        let scale = 1.0 / setup.light_paths as f32;
+        for s in 1..=y.len().min(self.params.max_depth as usize) {
+            let yv = &y[s - 1];
+            if !connectable(scene, yv) {
+                continue;
+            }
+            let Some(c) = connect_to_camera(scene, yv) else {
+                continue;
+            };
+            let camera = PathVertex::camera(cam, Color::ONE);
+            let c_y = reverse_density(yv, &camera, cam.pdf_dir(c.dir)) as f64;
+            let w = if s == 1 {
+                setup.mis.light_tracing_origin(&ly[0], c_y)
+            } else {
+                let ev = c.eval.expect("a surface connected to the camera");
+                let c_prev = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
+                setup.mis.light_tracing(&ly[s - 1], c_y, c_prev)
+            };
+            if R::ACTIVE {
+                rec.completed(Completed {
+                    s,
+                    light: &y[..s],
+                    camera: std::slice::from_ref(&camera),
+                    weight: w,
+                    value: c.value * scale,
+                    raster: c.raster,
+                    alternatives: &[],
+                });
+            }
+            if w > 0.0 {
+                splats.add(c.raster, c.value * (w as f32 * scale));
+            }
+        }
+    }
+
+    /// The camera sample of `pixel`: every technique with t ≥ 2 (merges included).
+    #[allow(clippy::too_many_arguments)]
+    fn camera_sample<R: Recorder>(
+        &self,
+        setup: &PassSetup,
+        lights: &LightPaths,
+        (y, ly): (&[PathVertex], &[LightMis]),
+        seed: u64,
+        pass: u32,
+        pixel: u64,
+        scratch: &mut Scratch,
+        rec: &mut R,
+    ) -> Color {
+        let scene = self.scene;
+        let cam = &scene.camera;
+        let max_k = self.params.max_depth as usize;
+        let mis = &setup.mis;
+        let w = cam.width as u64;
+        let mut cs = Sampler::for_item(Domain::Camera, seed, pixel, pass as u64);
+        let raster = Vec2::new(
+            (pixel % w) as f32 + cs.next_f32(),
+            (pixel / w) as f32 + cs.next_f32(),
+        );
+        camera_subpath(
+            scene,
+            raster,
+            &mut cs,
+            self.params.limits(true),
+            &mut scratch.camera,
+        );
+        let z = &scratch.camera.vertices;
+        camera_records(scene, mis, z, &mut scratch.records);
+        let zr = &scratch.records;
+        let mut l = Color::ZERO;
+        for t in 2..=z.len() {
+            let zv = &z[t - 1];
+            // s = 0: the walk hit an emitter at z_{t−1}.
+            if t - 1 <= max_k {
+                if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter) {
+                    let le = scene.lights[li as usize].emitted(x0.ng, x0.wo);
+                    if le != Color::ZERO {
+                        let wgt = self.emitter_weight(mis, &z[..t - 1], zr, &x0, zv.pdf_fwd);
+                        let value = zv.beta * le;
+                        if R::ACTIVE {
+                            self.record_emitter(
+                                &z[..t - 1],
+                                x0,
+                                value,
+                                wgt,
+                                raster,
+                                &mut scratch.prefix,
+                                rec,
+                            );
+                        }
+                        l += value * wgt as f32;
+                    }
+                }
+            }
+            if !connectable(scene, zv) {
+                continue;
+            }
+            if self.params.connections {
+                if t <= max_k {
+                    l += self.next_event(mis, z, zr, t, &mut cs, raster, rec);
+                }
+                for s in 2..=y.len().min(max_k + 1 - t) {
+                    l += self.connect(mis, y, ly, z, zr, s, t, raster, rec);
+                }
+            }
+            if self.params.merging && t <= max_k {
+                l += self.merge(setup, lights, z, zr, t, raster, rec);
+            }
+        }
+        // s = 0 at infinity: the walk left the scene after its last vertex.
+        if let Some(esc) = scratch.camera.escape {
+            if z.len() <= max_k {
+                for &li in &scene.infinite_lights {
+                    let le = scene.lights[li as usize].escaped(esc.dir);
+                    if le == Color::ZERO {
+                        continue;
+                    }
+                    let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
+                    let wgt = self.emitter_weight(mis, z, zr, &x0, esc.pdf_w);
+                    let value = esc.beta * le;
+                    if R::ACTIVE {
+                        self.record_emitter(z, x0, value, wgt, raster, &mut scratch.prefix, rec);
+                    }
+                    l += value * wgt as f32;
+                }
+            }
+        }
+        l
+    }
+
+    /// Weight of s = 0: the camera walk `camera` (camera first, ending at x1) reached light
+    /// endpoint `x0` with density `c0`.
+    fn emitter_weight(
+        &self,
+        mis: &SubpathMis,
+        camera: &[PathVertex],
+        records: &[CameraMis],
+        x0: &PathVertex,
+        c0: f32,
+    ) -> f64 {
+        let scene = self.scene;
+        let x1 = camera.last().expect("the pinhole");
+        let vc1 = joinable(scene, x0, x1);
+        if camera.len() == 1 {
+            let (l0, _) = emission_densities(scene, x0, None);
+            return mis.emitter_seen(c0 as f64, l0, vc1);
+        }
+        let (l0, l1) = emission_densities(scene, x0, Some(x1));
+        let nee = nee_density(scene, x0, x1);
+        mis.emitter_hit(&records[camera.len() - 1], c0 as f64, l0, l1, nee, vc1)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn record_emitter<R: Recorder>(
+        &self,
+        camera: &[PathVertex],
+        x0: PathVertex,
+        value: Color,
+        weight: f64,
+        raster: Vec2,
+        prefix: &mut Vec<PathVertex>,
+        rec: &mut R,
+    ) {
+        prefix.clear();
+        prefix.extend_from_slice(camera);
+        prefix.push(x0);
+        let n = prefix.len();
+        rec.completed(Completed {
+            s: 0,
+            light: &prefix[n - 1..],
+            camera: &prefix[..n - 1],
+            weight,
+            value,
+            raster,
+            alternatives: &[],
+        });
+    }
+
+    /// s = 1 at camera vertex z_{t−1}: one light chosen by power and sampled towards it (the
+    /// random numbers `bdpt` draws, in its order).
+    #[allow(clippy::too_many_arguments)]
+    fn next_event<R: Recorder>(
+        &self,
+        mis: &SubpathMis,
+        z: &[PathVertex],
+        zr: &[CameraMis],
+        t: usize,
+        sampler: &mut Sampler,
+        raster: Vec2,
+        rec: &mut R,
+    ) -> Color {
+        let scene = self.scene;
+        let zv = &z[t - 1];
+        let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
+            return Color::ZERO;
+        };
+        let u = sampler.next_2d();
+        let Some(ls) = scene.lights[li].sample_li(zv.p, u) else {
+            return Color::ZERO;
+        };
+        if ls.radiance == Color::ZERO || ls.pdf_w == 0.0 {
+            return Color::ZERO;
+        }
+        let Some(ev_z) = eval_towards(scene, zv, ls.wi, TransportMode::Radiance) else {
+            return Color::ZERO;
+        };
+        if ev_z.f_cos == Color::ZERO {
+            return Color::ZERO;
+        }
+        let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, zv);
+        if !scene.connection_visible(&x0, zv) {
+            return Color::ZERO;
+        }
+        let c0 = reverse_density(&x0, zv, ev_z.pdf_w) as f64;
+        let (l0, l1) = emission_densities(scene, &x0, Some(zv));
+        let l2 = if t >= 3 {
+            reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64
+        } else {
+            0.0
+        };
+        let nee = x0.pdf_fwd as f64;
+        let w = mis.next_event(&zr[t - 1], &zr[t - 2], nee, c0, l0, l1, l2);
+        let value = zv.beta * ev_z.f_cos * ls.radiance / (pmf * ls.pdf_w);
+        if R::ACTIVE {
+            rec.completed(Completed {
+                s: 1,
+                light: std::slice::from_ref(&x0),
+                camera: &z[..t],
+                weight: w,
+                value,
+                raster,
+                alternatives: &[],
+            });
+        }
+        value * w as f32
+    }
+
+    /// s ≥ 2, t ≥ 2: a shadow ray from z_{t−1} to y_{s−1}.
+    #[allow(clippy::too_many_arguments)]
+    fn connect<R: Recorder>(
+        &self,
+        mis: &SubpathMis,
+        y: &[PathVertex],
+        ly: &[LightMis],
+        z: &[PathVertex],
+        zr: &[CameraMis],
+        s: usize,
+        t: usize,
+        raster: Vec2,
+        rec: &mut R,
+    ) -> Color {
+        let scene = self.scene;
+        let (yv, zv) = (&y[s - 1], &z[t - 1]);
+        if !connectable(scene, yv) {
+            return Color::ZERO;
+        }
+        let d = yv.p - zv.p;
+        let d2 = d.length_squared();
+        if !(d2 > 0.0) {
+            return Color::ZERO;
+        }
+        let dir = d / d2.sqrt();
+        let (Some(ev_y), Some(ev_z)) = (
+            eval_towards(scene, yv, -dir, TransportMode::Importance),
+            eval_towards(scene, zv, dir, TransportMode::Radiance),
+        ) else {
+            return Color::ZERO;
+        };
+        let c = yv.beta * ev_y.f_cos * ev_z.f_cos * zv.beta / d2;
+        if c == Color::ZERO || !scene.connection_visible(yv, zv) {
+            return Color::ZERO;
+        }
+        let c_y = reverse_density(yv, zv, ev_z.pdf_w) as f64;
+        let c_y_prev = reverse_density(&y[s - 2], yv, ev_y.pdf_rev_w) as f64;
+        let l_z = yv.convert_density(ev_y.pdf_w, zv) as f64;
+        let l_z_prev = if t >= 3 {
+            reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64
+        } else {
+            0.0
+        };
+        let w = mis.connection(
+            &ly[s - 1],
+            &zr[t - 1],
+            &zr[t - 2],
+            c_y,
+            c_y_prev,
+            l_z,
+            l_z_prev,
+        );
+        if R::ACTIVE {
+            rec.completed(Completed {
+                s,
+                light: &y[..s],
+                camera: &z[..t],
+                weight: w,
+                value: c,
+                raster,
+                alternatives: &[],
+            });
+        }
+        c * w as f32
+    }
+
+    /// Merges at z_{t−1} with every stored light vertex within the pass's radius (disk kernel).
+    #[allow(clippy::too_many_arguments)]
+    fn merge<R: Recorder>(
+        &self,
+        setup: &PassSetup,
+        lights: &LightPaths,
+        z: &[PathVertex],
+        zr: &[CameraMis],
+        t: usize,
+        raster: Vec2,
+        rec: &mut R,
+    ) -> Color {
+        let scene = self.scene;
+        let zv = &z[t - 1];
+        let Some(grid) = &lights.grid else {
+            return Color::ZERO;
+        };
+        let VertexKind::Surface { material } = zv.kind else {
+            return Color::ZERO;
+        };
+        let max_k = self.params.max_depth;
+        let camera_segments = (t - 1) as u32;
+        let sf = lt_core::bsdf::ShadingFrame::new(zv.ng, zv.ns);
+        let bsdf = scene.material(material);
+        let wo_side = zv.ng.dot(zv.wo);
+        let mut sum = Color::ZERO;
+        grid.for_each_within(&lights.merge_positions, zv.p, setup.radius, |e, _| {
+            let (vi, segments) = lights.merge_vertex[e as usize];
+            if segments + camera_segments > max_k {
+                return;
+            }
+            let yv = &lights.vertices[vi as usize];
+            let wi = yv.wo;
+            // The light arrived on the side the camera looks from (a thin wall lit from behind
+            // stays dark in front), and not along the photon's own surface.
+            let cos_g = yv.ng.dot(wi).abs();
+            if zv.ng.dot(wi) * wo_side <= 0.0 || !(cos_g > 0.0) {
+                return;
+            }
+            let ev = bsdf.eval(&sf, zv.wo, wi, TransportMode::Radiance);
+            if ev.f_cos == Color::ZERO {
+                return;
+            }
+            let value = zv.beta * ev.f_cos * yv.beta / cos_g;
+            let before = &lights.vertices[vi as usize - 1];
+            let c_y_prev = reverse_density(before, yv, ev.pdf_w) as f64;
+            let l_z_prev = if t >= 3 {
+                reverse_density(&z[t - 2], zv, ev.pdf_rev_w) as f64
+            } else {
+                0.0
+            };
+            let w = setup.mis.merge(
+                &lights.mis[vi as usize],
+                &zr[t - 1],
+                &zr[t - 2],
+                c_y_prev,
+                l_z_prev,
+            );
+            if R::ACTIVE {
+                let first = vi as usize - segments as usize;
+                rec.merged(Merged {
+                    i: segments as usize,
+                    light: &lights.vertices[first..=vi as usize],
+                    camera: &z[..t],
+                    weight: w,
+                    value: value * setup.merge_norm,
+                    raster,
+                    radius: setup.radius,
+                });
+            }
+            sum += value * w as f32;
+        });
+        sum * setup.merge_norm
+    }
+}
+
+/// The MIS records of a light subpath y_0 … (see `SubpathMis`), appended to `out`.
+fn light_records(scene: &Scene, mis: &SubpathMis, y: &[PathVertex], out: &mut Vec<LightMis>) {
+    let Some(y0) = y.first() else {
+        return;
+    };
+    let base = out.len();
+    out.push(mis.light_origin(y0.pdf_fwd as f64));
+    let nee_over_l0 = if y.len() >= 2 {
+        nee_density(scene, &y[0], &y[1]) / y0.pdf_fwd as f64
+    } else {
+        0.0
+    };
+    for j in 1..y.len() {
+        let c_pp = if j >= 2 { y[j - 2].pdf_rev as f64 } else { 0.0 };
+        let prev = out[base + j - 1];
+        let surface = matches!(y[j].kind, VertexKind::Surface { .. });
+        let r = mis.light_vertex(
+            j,
+            y[j].pdf_fwd as f64,
+            &prev,
+            c_pp,
+            joinable(scene, &y[j - 1], &y[j]),
+            nee_over_l0,
+            surface && connectable(scene, &y[j]) && mis.merging(),
+        );
+        out.push(r);
+    }
+}
+
+/// The MIS records of a camera subpath z_0 (pinhole) … into `out`.
+fn camera_records(scene: &Scene, mis: &SubpathMis, z: &[PathVertex], out: &mut Vec<CameraMis>) {
+    out.clear();
+    out.push(mis.camera_origin());
+    for m in 1..z.len() {
+        let surface = matches!(z[m].kind, VertexKind::Surface { .. });
+        let r = mis.camera_vertex(
+            m,
+            z[m].pdf_fwd as f64,
+            &out[m - 1],
+            z[m - 1].pdf_rev as f64,
+            joinable(scene, &z[m], &z[m - 1]),
+            surface && connectable(scene, &z[m]) && mis.merging(),
+        );
+        out.push(r);
+    }
+}
+
+/// A run's log entries of one pass.
+pub fn log_pass(log: &mut ProgressLog, setup: &PassSetup, r0: f32) {
+    log.photon_paths.push(setup.light_paths);
+    log.radius_scale.push(setup.radius as f64 / r0 as f64);
+    log.mean_radius.push(setup.radius as f64);
+    if log.facts.is_empty() {
+        log.facts
+            .push(("initial_radius".into(), format!("{r0:.6e}")));
+    }
+}
+
+/// One run of the VCM family (`vcm`, `bpm`): the mean of its iterations' images.
+pub struct Run<'a> {
+    engine: Engine<'a>,
+    seed: u64,
+    r0: f32,
+    sum: Image,
+    passes: u32,
+    log: ProgressLog,
+}
+
+impl<'a> Run<'a> {
+    pub fn new(params: &'a VcmParams, scene: &'a Scene, seed: u64) -> Run<'a> {
+        let cam = &scene.camera;
+        Run {
+            engine: Engine::new(params, scene),
+            seed,
+            r0: initial_radius(scene, params.radius),
+            sum: Image::new(cam.width as usize, cam.height as usize),
+            passes: 0,
+            log: ProgressLog::default(),
+        }
+    }
+}
+
+impl ProgressiveRun for Run<'_> {
+    fn pass(&mut self, pass: u32) -> u64 {
+        let setup = self.engine.setup(self.r0, pass);
+        let lights = self.engine.trace_light_paths(&setup, self.seed, pass);
+        let (img, invalid) = self.engine.render_pass(&setup, &lights, self.seed, pass);
+        for (a, b) in self.sum.data.iter_mut().zip(&img.data) {
+            for c in 0..3 {
+                a[c] += b[c];
+            }
+        }
+        self.passes += 1;
+        log_pass(&mut self.log, &setup, self.r0);
+        invalid
+    }
+
+    fn estimate(&self) -> Image {
+        let mut img = self.sum.clone();
+        let k = 1.0 / self.passes.max(1) as f64;
+        img.data
+            .iter_mut()
+            .for_each(|p| p.iter_mut().for_each(|c| *c *= k));
+        img
+    }
+
+    fn log(&self) -> ProgressLog {
+        self.log.clone()
+    }
+}
