@@ -6,5 +6,6 @@ pub mod compare;
 pub mod image_io;
 pub mod integrator_args;
 pub mod mis_check;
+pub mod mis_check_vcm;
 pub mod render_cmd;
 pub mod strategies;

@@ -60,7 +60,7 @@ pub const STRICT_LEVELS: [f64; 3] = [1e-4, 1e-5, 1e-6];
 pub struct MisCheckArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    /// Integrator whose weights are checked: pt or bdpt.
+    /// Integrator whose weights are checked: pt, bdpt, vcm or bpm.
     #[arg(long, default_value = "bdpt")]
     pub integrator: String,
     /// MIS heuristic: power (the integrators' default), balance, or none (bdpt only).
@@ -101,7 +101,7 @@ impl Which {
             "pt" => Ok(Which::Pt),
             "bdpt" => Ok(Which::Bdpt),
             _ => Err(format!(
-                "mis-check: unknown integrator '{s}' (known: pt, bdpt)"
+                "mis-check: unknown integrator '{s}' (known: pt, bdpt, vcm, bpm)"
             )),
         }
     }
@@ -775,6 +775,9 @@ impl fmt::Display for Report {
 
 /// `lt mis-check`: the report, or an error carrying it when any check fails.
 pub fn run(args: &MisCheckArgs) -> Result<String, String> {
+    if matches!(args.integrator.as_str(), "vcm" | "bpm") {
+        return crate::mis_check_vcm::run(args);
+    }
     let mut scene = lt_core::scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
     let integrator = Which::parse(&args.integrator)?;
     let mut opts = Options::new(&scene, integrator);

@@ -169,6 +169,8 @@ const CHUNK: u64 = 256;
 pub struct PassSetup {
     pub mis: SubpathMis,
     pub radius: f32,
+    /// η = M π r² (0 without merging).
+    pub eta: f64,
     /// 1 / (M π r²): the density-estimation normalisation of one merge.
     merge_norm: f32,
     light_paths: u64,
@@ -208,6 +210,7 @@ impl<'a> Engine<'a> {
         PassSetup {
             mis: SubpathMis::new(p.mis, set, m as f64 / n),
             radius,
+            eta,
             merge_norm: (1.0 / eta) as f32,
             light_paths: m,
         }
@@ -469,11 +472,12 @@ impl<'a> Engine<'a> {
     ) -> f64 {
         let scene = self.scene;
         let x1 = camera.last().expect("the pinhole");
-        let vc1 = joinable(scene, x0, x1);
         if camera.len() == 1 {
             let (l0, _) = emission_densities(scene, x0, None);
-            return mis.emitter_seen(c0 as f64, l0, vc1);
+            return mis.emitter_seen(c0 as f64, l0, joinable(scene, x0, x1));
         }
+        // VC(1) is next-event estimation from x1 (`Chain::valid`).
+        let vc1 = connectable(scene, x1);
         let (l0, l1) = emission_densities(scene, x0, Some(x1));
         let nee = nee_density(scene, x0, x1);
         mis.emitter_hit(&records[camera.len() - 1], c0 as f64, l0, l1, nee, vc1)
@@ -727,7 +731,12 @@ fn light_records(scene: &Scene, mis: &SubpathMis, y: &[PathVertex], out: &mut Ve
             y[j].pdf_fwd as f64,
             &prev,
             c_pp,
-            joinable(scene, &y[j - 1], &y[j]),
+            // VC(1) is next-event estimation: the light samples x0 itself (`Chain::valid`).
+            if j == 1 {
+                connectable(scene, &y[1])
+            } else {
+                joinable(scene, &y[j - 1], &y[j])
+            },
             nee_over_l0,
             surface && connectable(scene, &y[j]) && mis.merging(),
         );

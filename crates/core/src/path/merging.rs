@@ -13,7 +13,11 @@
 //! η · ∏ l · ∏ c with η = N_VM π r² (Georgiev et al.'s η_VCM) against n_s · p_s.
 
 use super::mis::{oracle_weight, Heuristic};
-use super::path::Densities;
+use super::path::{Densities, Path};
+use super::scatter::{delta_tolerance, scatter};
+use super::vertex::PathVertex;
+use crate::bsdf::TransportMode;
+use crate::scene::Scene;
 
 /// Which techniques an estimator runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,7 +30,7 @@ pub struct TechniqueSet {
 }
 
 /// One technique of a path of the full VCM family.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Technique {
     /// Vertex connection (or the walks' own ends) with s light vertices.
     Connect(usize),
@@ -35,6 +39,54 @@ pub enum Technique {
 }
 
 impl Densities {
+    /// The densities of a path completed by merging at x_i, from scratch: `light` = y_0 … y_i
+    /// (the light subpath, its merged vertex last), `camera` = z_0 … z_{t−1} (camera first, the
+    /// merging camera vertex last), i = light.len() − 1. A merge has two x_i, y_i and z: the
+    /// light side (l_0 … l_i, c_0 … c_{i−2}) is that of the path through y_i (a specular x_{i−1}
+    /// aims the light walk at y_i, not at z), the camera side (c_i … c_k, l_{i+2} …) that of the
+    /// path through z. The two densities that join them are defined as Georgiev et al. (2012)
+    /// evaluate them: z's BSDF with the light vertex's incoming direction ω_y (towards y_{i−1}) —
+    /// c_{i−1} = its density of ω_y (given the direction towards z_{t−2}), in area at y_{i−1} seen
+    /// from y_i; l_{i+1} = its density of the direction towards z_{t−2} given ω_y, in area at
+    /// z_{t−2}.
+    pub fn merged(scene: &Scene, light: &[PathVertex], camera: &[PathVertex]) -> Densities {
+        let i = light.len() - 1;
+        let t = camera.len();
+        assert!(i >= 1 && t >= 2, "a merge needs y_1 and z_1");
+        let at_light = Path::from_subpaths(light, &camera[..t - 1]).densities(scene);
+        let at_camera = Path::from_subpaths(&light[..i], camera).densities(scene);
+        let k = at_light.k();
+        let pick = |light_side: bool| if light_side { &at_light } else { &at_camera };
+        let mut d = Densities {
+            light: (0..=k).map(|j| pick(j <= i).light[j]).collect(),
+            camera: (0..=k).map(|j| pick(j + 1 < i).camera[j]).collect(),
+            nee: at_light.nee,
+            connectable: (0..=k)
+                .map(|j| pick(j < i).connectable[j] && (j != i || at_light.connectable[j]))
+                .collect(),
+            light_tracing_ratio: at_light.light_tracing_ratio,
+        };
+        let (y, yp, z, zp) = (&light[i], &light[i - 1], &camera[t - 1], &camera[t - 2]);
+        let w_y = y.dir_to(yp);
+        let w_z = z.dir_to(zp);
+        let tol = delta_tolerance(z, y, zp);
+        let towards_light = scatter(scene, z, w_z, w_y, TransportMode::Radiance, tol).pdf_w;
+        // No walk lands on a delta light: the oracle's own c_0 says so.
+        let landable = i > 1 || at_camera.camera[0] > 0.0;
+        d.camera[i - 1] = if landable {
+            y.convert_density(towards_light, yp) as f64
+        } else {
+            0.0
+        };
+        d.light[i + 1] = if i + 1 < k {
+            let towards_camera = scatter(scene, z, w_y, w_z, TransportMode::Importance, tol).pdf_w;
+            z.convert_density(towards_camera, zp) as f64
+        } else {
+            0.0
+        };
+        d
+    }
+
     /// ∏_{j≤i} l_j · ∏_{j≥i} c_j (without π r²), or 0 where merging at x_i is impossible.
     pub fn merging(&self, i: usize) -> f64 {
         let k = self.k();

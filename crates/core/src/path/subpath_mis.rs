@@ -39,8 +39,9 @@
 //! too) gives 0. `tests` hold every weight to [`Chain::weight`](super::Chain::weight) and to
 //! `Densities::vcm_weight` on random chains.
 
-use super::merging::TechniqueSet;
+use super::merging::{Technique, TechniqueSet};
 use super::mis::Heuristic;
+use super::path::Densities;
 
 /// The techniques of one pass and how they are weighed.
 #[derive(Clone, Copy, Debug)]
@@ -332,6 +333,84 @@ impl SubpathMis {
         let light = (y.own_vc + self.u(c_y_prev / y.l_prev) * y.q_prev) / self.u(self.eta * y.l);
         let camera = (z.next_vc + self.u(l_z_prev / z_prev.c) * z_prev.r) / self.u(self.eta * z.c);
         Self::weight(light + camera)
+    }
+}
+
+impl SubpathMis {
+    /// The records the integrator would build for this path, light vertices x0 … x_{k−1} and camera
+    /// vertices z_m = x_{k−m}, m = 0 … k, with the chain's densities as the stored ones.
+    fn replay_records(&self, d: &Densities) -> (Vec<LightMis>, Vec<CameraMis>) {
+        let mis = self;
+        let k = d.k();
+        let (l, c, conn) = (&d.light, &d.camera, &d.connectable);
+        let mut light = vec![mis.light_origin(l[0])];
+        for j in 1..k {
+            let c_pp = if j >= 2 { c[j - 2] } else { 0.0 };
+            let y = mis.light_vertex(
+                j,
+                l[j],
+                &light[j - 1],
+                c_pp,
+                // VC(1) is next-event estimation: the light samples x0 itself (`Chain::valid`).
+                if j == 1 {
+                    conn[1]
+                } else {
+                    conn[j - 1] && conn[j]
+                },
+                d.nee / l[0],
+                conn[j],
+            );
+            light.push(y);
+        }
+        let mut camera = vec![mis.camera_origin()];
+        for m in 1..=k {
+            let i = k - m;
+            let z = mis.camera_vertex(
+                m,
+                c[i],
+                &camera[m - 1],
+                l[i + 1],
+                conn[i] && conn[i + 1],
+                conn[i] && i >= 1,
+            );
+            camera.push(z);
+        }
+        (light, camera)
+    }
+
+    /// The weight of technique `t` by this recursion, its records built from the from-scratch
+    /// densities `d` as the walks would have stored them (`lt mis-check` replays every technique
+    /// of a recorded path this way; the tests hold it to `Densities::vcm_weight`).
+    pub fn replay(&self, d: &Densities, t: Technique) -> f64 {
+        let mis = self;
+        let k = d.k();
+        let (l, c, conn) = (&d.light, &d.camera, &d.connectable);
+        let (ly, cz) = mis.replay_records(d);
+        let at = |i: usize| if i <= k { l[i] } else { 0.0 };
+        match t {
+            Technique::Connect(0) if k == 1 => mis.emitter_seen(c[0], l[0], conn[0] && conn[1]),
+            Technique::Connect(0) => mis.emitter_hit(&cz[k - 1], c[0], l[0], l[1], d.nee, conn[1]),
+            Technique::Connect(1) if k == 1 => mis.light_tracing_origin(&ly[0], c[0]),
+            Technique::Connect(1) => {
+                mis.next_event(&cz[k - 1], &cz[k - 2], d.nee, c[0], l[0], l[1], at(2))
+            }
+            Technique::Connect(s) if s == k => mis.light_tracing(&ly[k - 1], c[k - 1], c[k - 2]),
+            Technique::Connect(s) => {
+                let t = k + 1 - s;
+                mis.connection(
+                    &ly[s - 1],
+                    &cz[t - 1],
+                    &cz[t - 2],
+                    c[s - 1],
+                    c[s - 2],
+                    l[s],
+                    at(s + 1),
+                )
+            }
+            Technique::Merge(i) => {
+                mis.merge(&ly[i], &cz[k - i], &cz[k - i - 1], c[i - 1], at(i + 1))
+            }
+        }
     }
 }
 

@@ -1,0 +1,548 @@
+//! `lt mis-check --integrator vcm|bpm`: the weights `vcm` and `bpm` applied to the paths they
+//! completed, by connection or by merging, against the from-scratch oracle
+//! (`Densities::vcm_weight`, which knows every connection technique and merging at every non-delta
+//! x_i with density η ∏_{j≤i} l_j ∏_{j≥i} c_j), and the partition of unity of the integrator's own
+//! recursion replayed on the oracle's densities (`SubpathMis::replay`) over every technique that
+//! can make the path.
+//!
+//! **Merged paths have two x_i**: the light vertex y_i and the camera vertex z within r of it.
+//! The oracle (`Densities::merged`) takes the light side from the path through y_i (a specular
+//! x_{i−1} aims the light walk at y_i, not z), the camera side from the path through z, and the
+//! two densities joining them from z's BSDF with the light vertex's incoming direction, as
+//! Georgiev et al. define a merge. It rebuilds every direction from positions, so the tolerance
+//! is that of connections, max(τ, κ) over both paths.
+
+use crate::mis_check::{path_tolerance, MisCheckArgs, DEFAULT_TOLERANCE, SUM_TOLERANCE};
+use lt_core::path::{Densities, Heuristic, Path, PathVertex, SubpathMis, Technique, TechniqueSet};
+use lt_core::Scene;
+use lt_integrators::connect_merge::{initial_radius, Engine, VcmParams};
+use lt_integrators::radius::InitialRadius;
+use lt_integrators::record::{Completed, Merged, Recorder};
+use lt_integrators::splat::Splats;
+use std::collections::BTreeMap;
+use std::fmt::{self, Write as _};
+
+/// What to sample and how to judge it.
+#[derive(Clone, Copy, Debug)]
+pub struct VcmOptions {
+    /// vcm (true) or bpm (false).
+    pub connections: bool,
+    pub heuristic: Heuristic,
+    /// Paths kept per (k, technique).
+    pub paths: usize,
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub seed: u64,
+    pub resolution: u32,
+    pub max_passes: u32,
+    pub light_paths: Option<u64>,
+    pub tolerance: f64,
+    pub radius: InitialRadius,
+}
+
+impl VcmOptions {
+    pub fn new(scene: &Scene, connections: bool) -> VcmOptions {
+        VcmOptions {
+            connections,
+            heuristic: Heuristic::Power,
+            paths: 1000,
+            max_depth: scene.settings.max_depth,
+            rr_depth: scene.settings.rr_depth,
+            seed: 1,
+            resolution: 16,
+            max_passes: 2000,
+            light_paths: None,
+            tolerance: DEFAULT_TOLERANCE,
+            // Large radii (relative to the 16² film's footprint) so merging techniques carry
+            // weights far from 0 and 1, where a wrong density shows.
+            radius: InitialRadius::Pixels(2.0),
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        if self.connections {
+            "vcm"
+        } else {
+            "bpm"
+        }
+    }
+
+    fn params(&self) -> VcmParams {
+        VcmParams {
+            max_depth: self.max_depth,
+            rr_depth: self.rr_depth,
+            mis: self.heuristic,
+            light_paths: self.light_paths,
+            radius: self.radius,
+            alpha: lt_integrators::connect_merge::DEFAULT_ALPHA,
+            connections: self.connections,
+            merging: true,
+        }
+    }
+}
+
+/// One recorded path.
+#[derive(Clone, Debug)]
+pub struct VcmRecord {
+    pub technique: Technique,
+    pub light: Vec<PathVertex>,
+    pub camera: Vec<PathVertex>,
+    pub weight: f64,
+    /// η of the pass that made it.
+    pub eta: f64,
+}
+
+impl VcmRecord {
+    pub fn k(&self) -> usize {
+        match self.technique {
+            Technique::Connect(_) => self.light.len() + self.camera.len() - 1,
+            Technique::Merge(_) => self.light.len() + self.camera.len() - 2,
+        }
+    }
+
+    /// The path with x_i at the camera vertex (merges) or as connected.
+    pub fn path(&self) -> Path {
+        match self.technique {
+            Technique::Connect(_) => Path::from_subpaths(&self.light, &self.camera),
+            Technique::Merge(i) => Path::from_subpaths(&self.light[..i], &self.camera),
+        }
+    }
+
+    /// For merges, the path with x_i at the light vertex.
+    pub fn light_side_path(&self) -> Option<Path> {
+        let Technique::Merge(_) = self.technique else {
+            return None;
+        };
+        let t = self.camera.len();
+        Some(Path::from_subpaths(&self.light, &self.camera[..t - 1]))
+    }
+}
+
+/// Keeps up to `quota` paths per (k, technique).
+pub struct VcmCollector {
+    quota: usize,
+    max_depth: usize,
+    counts: BTreeMap<(usize, Technique), usize>,
+    pub records: Vec<VcmRecord>,
+    pub too_long: usize,
+    eta: f64,
+}
+
+impl VcmCollector {
+    fn keep(&mut self, k: usize, t: Technique) -> bool {
+        if k > self.max_depth || k == 0 {
+            self.too_long += 1;
+            return false;
+        }
+        let n = self.counts.entry((k, t)).or_insert(0);
+        if *n >= self.quota {
+            return false;
+        }
+        *n += 1;
+        true
+    }
+
+    fn full(&self) -> bool {
+        (1..=self.max_depth).all(|k| {
+            self.counts
+                .iter()
+                .filter(|((kk, _), _)| *kk == k)
+                .map(|(_, n)| n)
+                .sum::<usize>()
+                >= self.quota
+        })
+    }
+}
+
+impl Recorder for VcmCollector {
+    const ACTIVE: bool = true;
+
+    fn completed(&mut self, p: Completed) {
+        let k = p.light.len() + p.camera.len() - 1;
+        if self.keep(k, Technique::Connect(p.s)) {
+            self.records.push(VcmRecord {
+                technique: Technique::Connect(p.s),
+                light: p.light.to_vec(),
+                camera: p.camera.to_vec(),
+                weight: p.weight,
+                eta: self.eta,
+            });
+        }
+    }
+
+    fn merged(&mut self, p: Merged) {
+        let k = p.light.len() + p.camera.len() - 2;
+        if self.keep(k, Technique::Merge(p.i)) {
+            self.records.push(VcmRecord {
+                technique: Technique::Merge(p.i),
+                light: p.light.to_vec(),
+                camera: p.camera.to_vec(),
+                weight: p.weight,
+                eta: self.eta,
+            });
+        }
+    }
+}
+
+/// Sets `scene`'s film to the check's resolution.
+pub fn prepare_scene(scene: &mut Scene, opts: &VcmOptions) {
+    scene.camera = scene
+        .camera
+        .with_resolution(opts.resolution, opts.resolution);
+}
+
+/// Runs passes of the integrator on `scene` (at the check's resolution) until every length has
+/// its paths or `max_passes` ran.
+pub fn collect(scene: &Scene, opts: &VcmOptions) -> (VcmCollector, u32) {
+    let params = opts.params();
+    let engine = Engine::new(&params, scene);
+    let r0 = initial_radius(scene, params.radius);
+    let mut c = VcmCollector {
+        quota: opts.paths,
+        max_depth: opts.max_depth as usize,
+        counts: BTreeMap::new(),
+        records: Vec::new(),
+        too_long: 0,
+        eta: 0.0,
+    };
+    let cam = &scene.camera;
+    let mut scratch = engine.scratch();
+    let mut passes = 0;
+    while passes < opts.max_passes && !c.full() {
+        let setup = engine.setup(r0, passes);
+        let lights = engine.trace_light_paths(&setup, opts.seed, passes);
+        c.eta = setup.eta;
+        let items = (cam.pixel_count() as u64).max(params.light_path_count(scene));
+        let mut splats = Splats::new(cam.width, cam.height);
+        for i in 0..items {
+            engine.item(
+                &setup,
+                &lights,
+                opts.seed,
+                passes,
+                i,
+                &mut splats,
+                &mut scratch,
+                &mut c,
+            );
+        }
+        passes += 1;
+    }
+    (c, passes)
+}
+
+/// The verdict on one path.
+#[derive(Clone, Debug)]
+pub struct VcmCheck {
+    pub k: usize,
+    pub technique: Technique,
+    pub oracle: f64,
+    pub mismatch: f64,
+    /// The tolerance the mismatch is held to.
+    pub allowed: f64,
+    /// For merges, Σ |ln| of the two cross densities' ratios between the two x_i.
+    pub ambiguity: f64,
+    /// Σ of the replayed weights over the techniques, minus 1.
+    pub sum_error: f64,
+    /// Largest |replayed − oracle| weight over the techniques.
+    pub replay_error: f64,
+    pub techniques: Vec<Technique>,
+}
+
+fn relative(a: f64, b: f64) -> f64 {
+    if a == b {
+        return 0.0;
+    }
+    let r = (a - b).abs() / a.abs().max(b.abs());
+    if r.is_nan() {
+        1.0
+    } else {
+        r
+    }
+}
+
+fn densities(scene: &Scene, path: &Path, ratio: f64) -> Densities {
+    let mut d = path.densities(scene);
+    d.light_tracing_ratio = ratio;
+    d
+}
+
+/// Checks one record.
+pub fn check_record(scene: &Scene, r: &VcmRecord, opts: &VcmOptions, ratio: f64) -> VcmCheck {
+    let set = TechniqueSet {
+        connections: opts.connections,
+        merging_eta: r.eta,
+    };
+    let h = opts.heuristic;
+    let path = r.path();
+    let mut kappa = path.condition();
+    let d = match r.technique {
+        Technique::Merge(_) => {
+            let mut d = Densities::merged(scene, &r.light, &r.camera);
+            d.light_tracing_ratio = ratio;
+            if let Some(other) = r.light_side_path() {
+                kappa = kappa.max(other.condition());
+            }
+            d
+        }
+        Technique::Connect(_) => densities(scene, &path, ratio),
+    };
+    let oracle = d.vcm_weight(set, r.technique, h);
+    let mismatch = relative(r.weight, oracle);
+    let ambiguity = 0.0;
+    let allowed = path_tolerance(opts.tolerance, kappa);
+    let mis = SubpathMis::new(h, set, ratio);
+    let techniques = d.vcm_techniques(set);
+    let mut sum = 0.0;
+    let mut replay_error = 0.0f64;
+    for &t in &techniques {
+        let w = mis.replay(&d, t);
+        replay_error = replay_error.max((w - d.vcm_weight(set, t, h)).abs());
+        sum += w;
+    }
+    VcmCheck {
+        k: path.k(),
+        technique: r.technique,
+        oracle,
+        mismatch,
+        allowed,
+        ambiguity,
+        sum_error: if sum.is_nan() {
+            f64::INFINITY
+        } else {
+            sum - 1.0
+        },
+        replay_error,
+        techniques,
+    }
+}
+
+/// One line per path length.
+#[derive(Clone, Debug, Default)]
+pub struct VcmRow {
+    pub k: usize,
+    pub connections: usize,
+    pub merges: usize,
+    pub max_sum_error: f64,
+    pub max_mismatch_connect: f64,
+    pub max_mismatch_merge: f64,
+    pub max_ambiguity: f64,
+    pub max_replay_error: f64,
+    /// Techniques seen valid on the recorded paths: connections (s) and merges (i).
+    pub valid_connect: std::collections::BTreeSet<usize>,
+    pub valid_merge: std::collections::BTreeSet<usize>,
+    pub over: usize,
+    pub sum_fail: usize,
+}
+
+pub struct VcmReport {
+    pub scene: String,
+    pub options: VcmOptions,
+    pub passes: u32,
+    pub rows: Vec<VcmRow>,
+    pub too_long: usize,
+    pub examples: Vec<String>,
+}
+
+impl VcmReport {
+    pub fn failures(&self) -> usize {
+        self.too_long
+            + self
+                .rows
+                .iter()
+                .map(|r| r.over.max(r.sum_fail))
+                .sum::<usize>()
+    }
+
+    pub fn passed(&self) -> bool {
+        self.failures() == 0
+    }
+
+    pub fn checked(&self) -> usize {
+        self.rows.iter().map(|r| r.connections + r.merges).sum()
+    }
+
+    pub fn merges(&self) -> usize {
+        self.rows.iter().map(|r| r.merges).sum()
+    }
+}
+
+/// Samples and checks; `scene`'s film is set to the check's resolution first.
+pub fn check_scene(scene: &mut Scene, opts: &VcmOptions, name: &str) -> VcmReport {
+    prepare_scene(scene, opts);
+    let (c, passes) = collect(scene, opts);
+    check_records(scene, &c.records, opts, passes, c.too_long, name)
+}
+
+/// Checks every record (from `collect`, or altered by hand in tests).
+pub fn check_records(
+    scene: &Scene,
+    records: &[VcmRecord],
+    opts: &VcmOptions,
+    passes: u32,
+    too_long: usize,
+    name: &str,
+) -> VcmReport {
+    let n = scene.camera.pixel_count() as u64;
+    let ratio = opts.light_paths.unwrap_or(n) as f64 / n as f64;
+    let mut rows: Vec<VcmRow> = (0..=opts.max_depth as usize)
+        .map(|k| VcmRow {
+            k,
+            ..VcmRow::default()
+        })
+        .collect();
+    let mut examples = Vec::new();
+    for r in records {
+        let v = check_record(scene, r, opts, ratio);
+        let row = &mut rows[v.k.min(opts.max_depth as usize)];
+        match v.technique {
+            Technique::Connect(_) => {
+                row.connections += 1;
+                row.max_mismatch_connect = row.max_mismatch_connect.max(v.mismatch);
+            }
+            Technique::Merge(_) => {
+                row.merges += 1;
+                row.max_mismatch_merge = row.max_mismatch_merge.max(v.mismatch);
+                row.max_ambiguity = row.max_ambiguity.max(v.ambiguity);
+            }
+        }
+        for t in &v.techniques {
+            match *t {
+                Technique::Connect(s) => row.valid_connect.insert(s),
+                Technique::Merge(i) => row.valid_merge.insert(i),
+            };
+        }
+        row.max_sum_error = row.max_sum_error.max(v.sum_error.abs());
+        row.max_replay_error = row.max_replay_error.max(v.replay_error);
+        let over = !(v.mismatch <= v.allowed);
+        let sum_fail = !(v.sum_error.abs() <= SUM_TOLERANCE);
+        row.over += over as usize;
+        row.sum_fail += sum_fail as usize;
+        let shown = examples
+            .iter()
+            .filter(|e: &&String| e.contains("Σw−1 FAIL") == sum_fail)
+            .count();
+        if (over || sum_fail) && shown < 3 {
+            examples.push(format!(
+                "k={} {:?} weight={:.9e} oracle={:.9e} rel={:.3e} allowed={:.3e} ambiguity={:.3e} Σw−1={:.3e}{} techniques={:?}",
+                v.k, v.technique, r.weight, v.oracle, v.mismatch, v.allowed, v.ambiguity,
+                v.sum_error, if sum_fail { " Σw−1 FAIL" } else { "" }, v.techniques
+            ));
+        }
+    }
+    rows.retain(|r| r.k >= 1);
+    VcmReport {
+        scene: name.to_string(),
+        options: *opts,
+        passes,
+        rows,
+        too_long,
+        examples,
+    }
+}
+
+fn set_string(s: &std::collections::BTreeSet<usize>) -> String {
+    if s.is_empty() {
+        return "-".into();
+    }
+    s.iter()
+        .map(|x| x.to_string())
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+impl fmt::Display for VcmReport {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        writeln!(
+            f,
+            "mis-check {} {} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ max(τ={:e}, κ, 2δ); (b) |Σw−1| ≤ {:e} over connections and merges",
+            self.scene,
+            self.options.name(),
+            self.options.heuristic.name(),
+            self.passes,
+            self.options.tolerance,
+            SUM_TOLERANCE
+        )?;
+        writeln!(
+            f,
+            "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9} {:>9} {:>9} {:>9} {:>8} {:>5} {:>5}",
+            "k",
+            "conn",
+            "merges",
+            "valid s",
+            "valid merge i",
+            "max|Σw−1|",
+            "rel conn",
+            "rel merge",
+            "δ merge",
+            "replay",
+            "over",
+            "Σfail"
+        )?;
+        for r in &self.rows {
+            writeln!(
+                f,
+                "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9.2e} {:>9.2e} {:>9.2e} {:>9.2e} {:>8.1e} {:>5} {:>5}",
+                r.k,
+                r.connections,
+                r.merges,
+                set_string(&r.valid_connect),
+                set_string(&r.valid_merge),
+                r.max_sum_error,
+                r.max_mismatch_connect,
+                r.max_mismatch_merge,
+                r.max_ambiguity,
+                r.max_replay_error,
+                r.over,
+                r.sum_fail
+            )?;
+        }
+        if self.too_long > 0 {
+            writeln!(f, "{} paths reported beyond max_depth", self.too_long)?;
+        }
+        for e in &self.examples {
+            writeln!(f, "  FAIL {e}")?;
+        }
+        let verdict = if self.passed() { "ok" } else { "FAILED" };
+        writeln!(
+            f,
+            "{verdict}: {} paths checked ({} merged), {} failing",
+            self.checked(),
+            self.merges(),
+            self.failures()
+        )
+    }
+}
+
+/// `lt mis-check --integrator vcm|bpm`.
+pub fn run(args: &MisCheckArgs) -> Result<String, String> {
+    let mut scene = lt_core::scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let mut opts = VcmOptions::new(&scene, args.integrator == "vcm");
+    if let Some(m) = &args.mis {
+        opts.heuristic = Heuristic::parse(m)?;
+    }
+    if let Some(d) = args.max_depth {
+        if d == 0 {
+            return Err("mis-check: max_depth must be at least 1".into());
+        }
+        opts.max_depth = d;
+    }
+    if args.light_paths == Some(0) {
+        return Err("mis-check: light_paths must be at least 1".into());
+    }
+    opts.light_paths = args.light_paths;
+    opts.paths = args.paths;
+    opts.seed = args.seed;
+    opts.resolution = args.resolution;
+    opts.max_passes = args.max_passes;
+    opts.tolerance = args.tolerance;
+    let name = args.scene.display().to_string();
+    let report = check_scene(&mut scene, &opts, &name);
+    let mut out = String::new();
+    write!(out, "{report}").unwrap();
+    if report.passed() {
+        Ok(out)
+    } else {
+        Err(out)
+    }
+}

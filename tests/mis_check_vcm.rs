@@ -1,0 +1,115 @@
+//! `lt mis-check --integrator vcm|bpm` as a test: on every shipped scene the weights vcm and bpm
+//! applied, by connection and by merging, agree with the from-scratch oracle
+//! (`Densities::vcm_weight`, merges through `Densities::merged`), and their recursion replayed on
+//! the oracle's densities sums to one over every connection and merging technique of each path.
+//! Plus proof that the check can fail.
+
+use lt_core::path::{Heuristic, Technique};
+use lt_experiments::mis_check_vcm::{
+    check_records, check_scene, collect, prepare_scene, VcmOptions, VcmRecord, VcmReport,
+};
+use lt_tests::{shipped_scene, shipped_scene_names};
+
+/// Paths per (length, technique).
+const PATHS: usize = 60;
+
+fn options(scene: &lt_core::Scene, connections: bool, h: Heuristic) -> VcmOptions {
+    let mut o = VcmOptions::new(scene, connections);
+    o.heuristic = h;
+    o.paths = PATHS;
+    o.max_passes = 60;
+    o.seed = 7;
+    o
+}
+
+fn check_all(connections: bool, h: Heuristic) {
+    let mut failed = Vec::new();
+    let (mut paths, mut merges) = (0, 0);
+    for name in &shipped_scene_names() {
+        let mut scene = shipped_scene(name, None);
+        let opts = options(&scene, connections, h);
+        let report = check_scene(&mut scene, &opts, name);
+        assert!(report.checked() > 0, "{name}: no paths recorded\n{report}");
+        paths += report.checked();
+        merges += report.merges();
+        if !report.passed() {
+            failed.push(format!("{report}"));
+        }
+    }
+    eprintln!("{paths} paths checked, {merges} of them merged");
+    assert!(merges > 1000, "too few merged paths to mean anything: {merges}");
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+#[test]
+fn vcm_power_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all(true, Heuristic::Power);
+}
+
+#[test]
+fn vcm_balance_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all(true, Heuristic::Balance);
+}
+
+#[test]
+fn bpm_power_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all(false, Heuristic::Power);
+}
+
+/// Records of cornell-box by vcm (or bpm), with the options that made them.
+fn cornell_records(connections: bool) -> (lt_core::Scene, VcmOptions, Vec<VcmRecord>) {
+    let mut scene = shipped_scene("cornell-box", None);
+    let mut opts = options(&scene, connections, Heuristic::Power);
+    opts.paths = 30;
+    opts.max_depth = 4;
+    prepare_scene(&mut scene, &opts);
+    let (c, _) = collect(&scene, &opts);
+    (scene, opts, c.records)
+}
+
+fn check(scene: &lt_core::Scene, opts: &VcmOptions, records: &[VcmRecord]) -> VcmReport {
+    check_records(scene, records, opts, 0, 0, "cornell-box")
+}
+
+fn is_merge(r: &VcmRecord) -> bool {
+    matches!(r.technique, Technique::Merge(_))
+}
+
+#[test]
+fn a_perturbed_merge_weight_fails() {
+    for connections in [true, false] {
+        let (scene, opts, mut records) = cornell_records(connections);
+        assert!(check(&scene, &opts, &records).passed());
+        let i = records
+            .iter()
+            .position(|r| is_merge(r) && r.weight > 1e-3 && r.weight < 0.999)
+            .expect("a merged path with a weight strictly between 0 and 1");
+        records[i].weight *= 1.01;
+        let report = check(&scene, &opts, &records);
+        assert_eq!(report.failures(), 1, "{report}");
+    }
+}
+
+#[test]
+fn a_wrong_merging_count_fails() {
+    // η = N_VM π r² judged as twice (or without merging, η = 0) what the pass used: every
+    // weight of a path that merging could also make is off.
+    for scale in [2.0, 0.0] {
+        let (scene, opts, mut records) = cornell_records(true);
+        for r in &mut records {
+            r.eta *= scale;
+        }
+        let report = check(&scene, &opts, &records);
+        let merged_wrong = report.rows.iter().map(|r| r.over).sum::<usize>();
+        assert!(merged_wrong > records.len() / 4, "η × {scale}: {report}");
+    }
+}
+
+#[test]
+fn connections_judged_as_bpm_fail() {
+    // vcm's weights judged as if it only merged (bpm): the connection techniques' share is missing.
+    let (scene, mut opts, records) = cornell_records(true);
+    opts.connections = false;
+    let report = check(&scene, &opts, &records);
+    assert!(!report.passed(), "{report}");
+}
