@@ -341,7 +341,7 @@ impl<'a> Engine<'a> {
                 continue;
             };
             let camera = PathVertex::camera(cam, Color::ONE);
-            let c_y = reverse_density(yv, &camera, cam.pdf_dir(c.dir)) as f64;
+            let c_y = reverse_density(yv, &camera, cam.pdf_dir(camera.dir_to(yv))) as f64;
             let w = if s == 1 {
                 setup.mis.light_tracing_origin(&ly[0], c_y)
             } else {
