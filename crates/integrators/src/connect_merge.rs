@@ -134,8 +134,8 @@ pub struct LightPaths {
     pub mis: Vec<LightMis>,
     /// Path j is `vertices[starts[j]..starts[j + 1]]`.
     pub starts: Vec<u32>,
-    /// Mergeable vertices: flat index, and segments from the light.
-    merge_vertex: Vec<(u32, u32)>,
+    /// Mergeable vertices, compact (what a merge reads, contiguous).
+    merge_vertex: Vec<MergeVertex>,
     merge_positions: Vec<Vec3>,
     grid: Option<PointGrid>,
 }
@@ -150,6 +150,25 @@ impl LightPaths {
     pub fn merge_candidates(&self) -> usize {
         self.merge_vertex.len()
     }
+}
+
+/// What a merge reads of a stored light vertex y_j, in one place.
+#[derive(Clone, Copy, Debug)]
+struct MergeVertex {
+    /// Unit direction towards y_{j−1}: the light's incoming direction ω_y.
+    wi: Vec3,
+    /// |n_g · ω_y| of y_j's own surface.
+    cos_g: f32,
+    beta: Color,
+    /// Segments from the light (j).
+    segments: u32,
+    /// Index in the flat vertex arrays (for the record).
+    index: u32,
+    /// Turns a solid-angle density at y_j towards y_{j−1} into y_{j−1}'s measure
+    /// (`walk::reverse_density` of y_{j−1} from y_j, factored: |cos at y_{j−1}| / d², 1 at
+    /// infinity, 0 on a point light).
+    to_prev: f32,
+    mis: LightMis,
 }
 
 /// Whether a connection technique can join `a` and `b` (both non-delta).
@@ -252,10 +271,22 @@ impl<'a> Engine<'a> {
             for j in 0..m as usize {
                 let (a, b) = (out.starts[j], out.starts[j + 1]);
                 for (d, idx) in (a + 1..b).enumerate() {
-                    if out.mis[idx as usize].mergeable {
-                        out.merge_vertex.push((idx, d as u32 + 1));
-                        out.merge_positions.push(out.vertices[idx as usize].p);
+                    let mis = out.mis[idx as usize];
+                    if !mis.mergeable {
+                        continue;
                     }
+                    let (y, before) =
+                        (&out.vertices[idx as usize], &out.vertices[idx as usize - 1]);
+                    out.merge_vertex.push(MergeVertex {
+                        wi: y.wo,
+                        cos_g: y.ng.dot(y.wo).abs(),
+                        beta: y.beta,
+                        segments: d as u32 + 1,
+                        index: idx,
+                        to_prev: reverse_density(before, y, 1.0),
+                        mis,
+                    });
+                    out.merge_positions.push(y.p);
                 }
             }
             out.grid = Some(PointGrid::build(&out.merge_positions, 2.0 * setup.radius));
@@ -661,42 +692,34 @@ impl<'a> Engine<'a> {
         let wo_side = zv.ng.dot(zv.wo);
         let mut sum = Color::ZERO;
         grid.for_each_within(&lights.merge_positions, zv.p, setup.radius, |e, _| {
-            let (vi, segments) = lights.merge_vertex[e as usize];
-            if segments + camera_segments > max_k {
+            let y = &lights.merge_vertex[e as usize];
+            if y.segments + camera_segments > max_k {
                 return;
             }
-            let yv = &lights.vertices[vi as usize];
-            let wi = yv.wo;
             // The light arrived on the side the camera looks from (a thin wall lit from behind
-            // stays dark in front), and not along the photon's own surface.
-            let cos_g = yv.ng.dot(wi).abs();
-            if zv.ng.dot(wi) * wo_side <= 0.0 || !(cos_g > 0.0) {
+            // stays dark in front), and not along the light vertex's own surface.
+            if zv.ng.dot(y.wi) * wo_side <= 0.0 || !(y.cos_g > 0.0) {
                 return;
             }
-            let ev = bsdf.eval(&sf, zv.wo, wi, TransportMode::Radiance);
+            let ev = bsdf.eval(&sf, zv.wo, y.wi, TransportMode::Radiance);
             if ev.f_cos == Color::ZERO {
                 return;
             }
-            let value = zv.beta * ev.f_cos * yv.beta / cos_g;
-            let before = &lights.vertices[vi as usize - 1];
-            let c_y_prev = reverse_density(before, yv, ev.pdf_w) as f64;
+            let value = zv.beta * ev.f_cos * y.beta / y.cos_g;
+            let c_y_prev = (ev.pdf_w * y.to_prev) as f64;
             let l_z_prev = if t >= 3 {
                 reverse_density(&z[t - 2], zv, ev.pdf_rev_w) as f64
             } else {
                 0.0
             };
-            let w = setup.mis.merge(
-                &lights.mis[vi as usize],
-                &zr[t - 1],
-                &zr[t - 2],
-                c_y_prev,
-                l_z_prev,
-            );
+            let w = setup
+                .mis
+                .merge(&y.mis, &zr[t - 1], &zr[t - 2], c_y_prev, l_z_prev);
             if R::ACTIVE {
-                let first = vi as usize - segments as usize;
+                let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
                 rec.merged(Merged {
-                    i: segments as usize,
-                    light: &lights.vertices[first..=vi as usize],
+                    i: y.segments as usize,
+                    light: &lights.vertices[first..=vi],
                     camera: &z[..t],
                     weight: w,
                     value: value * setup.merge_norm,
