@@ -2,11 +2,12 @@
 //! t-corrected z over blocks × channels; `lt_estimators::agreement`):
 //!
 //! 1. Per path length: `light` and `bdpt` (MIS power, balance and none) against `pt` at every
-//!    max_depth 1…5 on `cornell-box`, `cornell-mesh-light`, `cornell-env` and `sun-room`. A bias
-//!    in paths of exactly k segments first shows at max_depth = k, so the failing depth names the
-//!    path length. None of these four scenes has a delta surface (mirror, glass) or a delta light,
-//!    so light tracing, which cannot join the pinhole to a delta vertex, renders every path the
-//!    camera can see, and all five estimators estimate the same image.
+//!    max_depth 1…5 on `cornell-box`, `cornell-mesh-light`, `cornell-env`, `sun-room` and
+//!    `cornell-directional`. A bias in paths of exactly k segments first shows at max_depth = k,
+//!    so the failing depth names the path length. None of these scenes has a delta surface
+//!    (mirror, glass), so light tracing, which cannot join the pinhole to a delta vertex, renders
+//!    every path the camera can see, and all five estimators estimate the same image. The only
+//!    delta light among them, `cornell-directional`'s, is never seen directly by any estimator.
 //! 2. Through glass: `light` against `bdpt` on `cornell-point-caustic` (where `pt` is exactly zero
 //!    on the caustic, and light tracing must show it), `bdpt` against `pt` on
 //!    `cornell-glass-light`.
@@ -219,6 +220,14 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_env() {
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_sun_room() {
     per_depth("sun-room", 1..=5);
+}
+
+/// A directional light (a delta in direction) through a skylight: reached only by next-event
+/// estimation and by light walks starting from it, so bdpt's s = 1 must keep its weight and
+/// s = 0 and light tracing's x0 get none. At max_depth 1 every image is exactly black.
+#[test]
+fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_directional() {
+    per_depth("cornell-directional", 1..=5);
 }
 
 /// Blocks any of whose pixels (sampled at 4×4 positions each, edges included) see the sphere

@@ -32,6 +32,12 @@ const BLACK: &[(&str, &str, Black, &str)] = &[
          hits it on ~1e-5 of the bounces that see the window, none in 48²×16 samples",
     ),
     (
+        "pt-bsdf",
+        "cornell-directional",
+        Black::Exact,
+        "its only light is a directional light, a single direction no BSDF sample hits",
+    ),
+    (
         "light",
         "caustic-sds",
         Black::Exact,

@@ -120,6 +120,15 @@ fn sun_scene(solid_angle: f32) -> Scene {
         }],
     )
 }
+fn directional_scene() -> Scene {
+    build(
+        vec![floor()],
+        vec![LightDesc::Directional {
+            direction: sun_dir(),
+            irradiance: Color::new(3.0, 2.0, 1.0),
+        }],
+    )
+}
 fn env_scene() -> Scene {
     build(
         vec![floor()],
@@ -473,7 +482,7 @@ fn distant_lights_emit_over_the_bounding_disk() {
     // Ray origins are uniform on the disk of the bounding sphere's radius r, perpendicular to the
     // ray, upstream of the scene: half of them lie within r/√2 of its centre.
     let n = 200_000u64;
-    for scene in [sun_scene(SUN_LARGE), env_scene()] {
+    for scene in [sun_scene(SUN_LARGE), env_scene(), directional_scene()] {
         let li = scene.lights.iter().position(|l| l.is_infinite()).unwrap();
         let l = &scene.lights[li];
         let (c, r) = scene.bounding_sphere;
@@ -534,4 +543,42 @@ fn sun_samples_at_the_rim_keep_a_nonzero_pdf() {
             );
         }
     }
+}
+
+#[test]
+fn directional_light_is_a_delta_in_direction() {
+    // Delta in direction, not position; at infinity. NEE returns its one direction with the
+    // discrete density 1 and the irradiance; no direction has a solid-angle pdf or escaping
+    // radiance; emitted rays all travel along −direction from the bounding disk.
+    let scene = directional_scene();
+    let l = &scene.lights[0];
+    let e = Color::new(3.0, 2.0, 1.0);
+    let Light::Directional(d) = l else {
+        panic!("not a directional light: {l:?}")
+    };
+    assert!((d.direction - sun_dir()).length() < 1e-6);
+    assert!(l.is_infinite() && l.delta_direction() && !l.delta_position() && l.is_delta());
+    assert_eq!(scene.infinite_lights, vec![0]);
+    let b = scene.bounding_sphere;
+    let mut s = Sampler::new(5, 0, 0);
+    for _ in 0..1000 {
+        let p = Vec3::new(s.next_f32() - 0.5, 0.0, s.next_f32() - 0.5);
+        let ls = l.sample_li(p, s.next_2d()).unwrap();
+        assert_eq!(ls.wi, d.direction);
+        assert!(ls.delta && ls.pdf_w == 1.0 && ls.radiance == e && ls.distance.is_infinite());
+        assert_eq!(l.pdf_li(p, ls.wi, ls.p, ls.n), 0.0);
+        assert_eq!(l.escaped(ls.wi), Color::ZERO);
+        let w = Vec3::new(s.next_f32() - 0.5, s.next_f32(), s.next_f32() - 0.5).normalize();
+        assert_eq!(l.pdf_li(p, w, w, -w), 0.0);
+        assert_eq!(l.emitted(-w, w), Color::ZERO);
+        let le = l.sample_le(s.next_2d(), s.next_2d(), b).unwrap();
+        assert_eq!(le.ray.d, -d.direction);
+        assert!(le.pdf_dir == 1.0 && le.radiance == e);
+        assert!((le.pdf_pos - 1.0 / (PI * b.1 * b.1)).abs() <= gamma(4) * le.pdf_pos);
+        assert_eq!(l.pdf_le(le.n, le.ray.d, b), (le.pdf_pos, 1.0));
+    }
+    // Power: the luminance of the flux through the bounding disk, E π R².
+    let lum = 0.2126 * 3.0 + 0.7152 * 2.0 + 0.0722 * 1.0;
+    let expected = lum * PI * b.1 * b.1;
+    assert!((l.power(b) - expected).abs() <= 1e-6 * expected);
 }

@@ -301,3 +301,81 @@ fn walks_under_a_sun_and_a_point_light_match_p_and_f() {
         }
     }
 }
+
+/// Two directional lights (deltas in direction) above the plane, with unequal powers, so that
+/// light selection pmfs are 2/3 and 1/3.
+fn directional_pair() -> PlaneLight {
+    PlaneLight::Directional {
+        dir: Vec3::new(0.3, 1.0, 0.2),
+        irradiance: 2.0,
+        second: Some((Vec3::new(-0.8, 0.6, -0.3), 1.0)),
+    }
+}
+
+#[test]
+fn techniques_agree_on_a_plane_under_two_directional_lights() {
+    // s = 0 cannot hit a single direction (p_0 = 0): only NEE and light tracing.
+    techniques_agree(directional_pair(), [0, 50_000, 1_000_000]);
+}
+
+#[test]
+fn directional_light_paths_match_p_and_f_and_only_nee_and_light_walks_reach_them() {
+    // x0 is a delta in direction: next-event estimation (s = 1, density pmf) and light walks
+    // (s = 2: pmf · 1, then the bounding disk's density at x1) reach it; a camera walk cannot hit
+    // it (p_0 = 0) and the pinhole cannot be joined to it (no k = 1 path, p = 0 if built).
+    let scene = plane(directional_pair());
+    let pmfs = [0, 1].map(|i| scene.light_sampler.pmf(i));
+    assert!((pmfs[0] - 2.0 / 3.0).abs() < 1e-6, "pmfs {pmfs:?}");
+    for camera in [true, false] {
+        let made = collect(&scene, 13, 20_000, camera, 2);
+        let by_s = |s: usize| made.iter().filter(|m| m.s == s).count();
+        assert!(
+            by_s(0) == 0 && by_s(if camera { 1 } else { 2 }) > 1_000,
+            "s=0: {}, s=1: {}, s=2: {}",
+            by_s(0),
+            by_s(1),
+            by_s(2)
+        );
+        assert!(
+            made.iter().all(|m| m.path.k() == 2),
+            "a k = 1 path was made"
+        );
+        let (wp, wf, _) = check_made(&scene, &made);
+        for m in &made {
+            assert!(m.path.vertices[0].delta, "x0 carries its delta direction");
+            let d = m.path.densities(&scene);
+            assert_eq!(d.camera[0], 0.0, "no walk hits a direction");
+            assert!(!d.valid(0) && d.valid(1) && d.valid(2) && !d.valid(3));
+            let pdfs = d.all();
+            assert!(
+                pdfs[0] == 0.0 && pdfs[1] > 0.0 && pdfs[2] > 0.0 && pdfs[3] == 0.0,
+                "{pdfs:?}"
+            );
+            for beta in [1.0, 2.0] {
+                let sum: f64 = (0..4).map(|s| power_weight(&pdfs, s, beta)).sum();
+                assert!((sum - 1.0).abs() < 1e-9, "β={beta}: Σw = {sum}");
+                for s in 0..4 {
+                    let by_ratios = power_weight_by_ratios(&d, s, beta);
+                    assert!(rel_close(power_weight(&pdfs, s, beta), by_ratios, 1e-9));
+                }
+            }
+        }
+        println!(
+            "two directional lights, camera walks {camera}: {} paths, worst rel. error p {wp:.2e}, \
+             f {wf:.2e}",
+            made.len()
+        );
+    }
+    // x0 joined to the pinhole would be technique 1 of a one-segment path: not a technique.
+    let le = scene.lights[0]
+        .sample_le(
+            lt_core::math::Vec2::splat(0.5),
+            lt_core::math::Vec2::splat(0.5),
+            scene.bounding_sphere,
+        )
+        .unwrap();
+    let x0 = PathVertex::light_emitted(&scene, 0, &le, pmfs[0]);
+    assert!(x0.is_infinite() && x0.delta && x0.is_delta_light());
+    let cam = PathVertex::camera(&scene.camera, lt_core::math::Color::ONE);
+    assert_eq!(Path::new(vec![x0, cam]).pdfs(&scene), vec![0.0; 3]);
+}

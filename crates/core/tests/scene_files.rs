@@ -365,6 +365,89 @@ fn sun_needs_exactly_one_of_radiance_and_irradiance() {
     );
 }
 
+/// A directional light table appended to BASE, with `keys` as its body.
+fn with_directional(keys: &str) -> String {
+    format!("{BASE}\n[[lights]]\ntype = \"directional\"\n{keys}")
+}
+
+#[test]
+fn directional_light_loads_normalised() {
+    let text = with_directional("direction = [0.0, 2.0, 0.0]\nirradiance = [3.0, 2.0, 1.0]\n");
+    let s = load_in(&text, Path::new(FILE)).unwrap_or_else(|e| panic!("{e}"));
+    let Some(lt_core::light::Light::Directional(d)) = s.lights.last() else {
+        panic!("no directional light: {:?}", s.lights)
+    };
+    assert_eq!(d.direction, lt_core::math::Vec3::Y);
+    assert_eq!(d.irradiance, lt_core::math::Color::new(3.0, 2.0, 1.0));
+}
+
+#[test]
+fn directional_light_with_a_zero_direction_is_rejected() {
+    let text = with_directional("direction = [0.0, 0.0, 0.0]\nirradiance = 1.0\n");
+    assert_err(
+        &fail(&text),
+        Some(line_of(&text, "direction = [0.0, 0.0")),
+        &["`direction`", "zero vector"],
+    );
+}
+
+#[test]
+fn directional_light_needs_irradiance_and_direction() {
+    let text = with_directional("direction = [0.0, 1.0, 0.0]\n");
+    assert_err(
+        &fail(&text),
+        Some(line_of(&text, "[[lights]]")),
+        &["missing required key `irradiance`", "directional light"],
+    );
+    let text = with_directional("irradiance = 1.0\n");
+    assert_err(
+        &fail(&text),
+        Some(line_of(&text, "[[lights]]")),
+        &["missing required key `direction`", "directional light"],
+    );
+}
+
+#[test]
+fn directional_light_refuses_radiance() {
+    // Alone or beside an irradiance: a delta in direction has no radiance.
+    for keys in [
+        "direction = [0.0, 1.0, 0.0]\nradiance = 1.0\n",
+        "direction = [0.0, 1.0, 0.0]\nirradiance = 1.0\nradiance = 1.0\n",
+    ] {
+        let text = with_directional(keys);
+        assert_err(
+            &fail(&text),
+            Some(line_of(&text, "\nradiance = 1.0") + 1),
+            &[
+                "directional light takes `irradiance`",
+                "not `radiance`",
+                "sun",
+            ],
+        );
+    }
+    // Keys of other light types are refused as for any element.
+    let text =
+        with_directional("direction = [0.0, 1.0, 0.0]\nirradiance = 1.0\nsolid_angle = 0.1\n");
+    assert_err(
+        &fail(&text),
+        Some(line_of(&text, "solid_angle")),
+        &["`solid_angle`", "does not apply", "directional"],
+    );
+}
+
+#[test]
+fn unknown_light_type_lists_the_known_ones() {
+    let text = format!("{BASE}\n[[lights]]\ntype = \"spot\"\n");
+    assert_err(
+        &fail(&text),
+        Some(line_of(&text, "\"spot\"")),
+        &[
+            "unknown light type `spot`",
+            "point, sun, directional or environment",
+        ],
+    );
+}
+
 #[test]
 fn undefined_material() {
     let text = replace("material = \"red\"", "material = \"blue\"");

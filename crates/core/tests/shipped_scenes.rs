@@ -9,7 +9,7 @@ use lt_core::scene::{load_scene, ShapeGeometry, SurfaceHit};
 use lt_core::Scene;
 use std::path::PathBuf;
 
-const SCENES: [&str; 10] = [
+const SCENES: [&str; 11] = [
     "cornell-box",
     "cornell-small-light",
     "cornell-glass-light",
@@ -20,6 +20,7 @@ const SCENES: [&str; 10] = [
     "caustic-sds",
     "veach-mis",
     "veach-door",
+    "cornell-directional",
 ];
 
 fn scenes_dir() -> PathBuf {
@@ -279,6 +280,59 @@ fn sun_room_is_closed_but_for_the_window() {
                 (1.0..=2.0).contains(&p.y) && (-0.75..=0.75).contains(&p.z),
                 "ray {d} from {eye} escapes at {p}"
             );
+        }
+    }
+}
+
+#[test]
+fn cornell_directional_is_lit_by_one_directional_light_through_the_skylight() {
+    let s = load("cornell-directional");
+    assert_eq!(s.lights.len(), 1);
+    let Light::Directional(d) = &s.lights[0] else {
+        panic!("the light is not directional: {:?}", s.lights[0])
+    };
+    assert!((d.direction - Vec3::new(0.5, 1.0, -0.1).normalize()).length() < 1e-6);
+    assert_eq!(d.irradiance, Color::new(10.0, 9.0, 7.5));
+    assert!(
+        s.shapes.iter().all(|sh| sh.light.is_none()),
+        "no emissive shapes"
+    );
+    // Lit through the skylight and in view: the red wall (x = -1, normal +x), the floor beside
+    // it and the large box's right face; shaded by the large box: the floor behind it.
+    let lit = |p: Vec3, n: Vec3| {
+        let q = p + n * 1e-3;
+        s.visible_between(q, q + d.direction * 10.0)
+    };
+    let seen = |p: Vec3, n: Vec3| {
+        s.camera.project(p).is_some() && s.visible_between(s.camera.eye, p + n * 1e-3)
+    };
+    for (p, n) in [
+        (Vec3::new(-1.0, -0.5, 0.2), Vec3::X),
+        (Vec3::new(-0.8, -1.0, 0.5), Vec3::Y),
+    ] {
+        assert!(lit(p, n) && seen(p, n), "{p} should be sunlit and in view");
+    }
+    assert!(
+        !lit(Vec3::new(-0.9, -1.0, -0.6), Vec3::Y),
+        "behind the large box"
+    );
+    assert!(!lit(Vec3::new(0.6, -1.0, 0.0), Vec3::Y), "outside the beam");
+    // Closed but for the skylight (x, z in -0.5..0.5 at y = 1) and the open front (z = 1).
+    for eye in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.9, -0.9, -0.9)] {
+        for dir in sphere_directions(20000) {
+            if s.intersect(&Ray::new(eye, dir)).is_some() {
+                continue;
+            }
+            let through = |t: f32| eye + dir * t;
+            let sky = dir.y > 0.0 && {
+                let p = through((1.0 - eye.y) / dir.y);
+                p.x.abs() <= 0.5 && p.z.abs() <= 0.5
+            };
+            let front = dir.z > 0.0 && {
+                let p = through((1.0 - eye.z) / dir.z);
+                p.x.abs() <= 1.0 && p.y.abs() <= 1.0
+            };
+            assert!(sky || front, "ray {dir} from {eye} escapes through a crack");
         }
     }
 }

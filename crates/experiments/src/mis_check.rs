@@ -338,10 +338,12 @@ fn unit_towards(from: &PathVertex, to: &PathVertex) -> lt_core::Vec3 {
     from.dir_to(to)
 }
 
+/// The `delta` flag a walk stores: a delta surface, or a light delta in direction.
 fn is_delta(scene: &Scene, v: &PathVertex) -> bool {
     match v.kind {
         VertexKind::Surface { material } => scene.material(material).is_delta(),
-        _ => false,
+        VertexKind::Light { light, .. } => scene.lights[light as usize].delta_direction(),
+        VertexKind::Camera => false,
     }
 }
 
@@ -543,7 +545,9 @@ fn kind_name(scene: &Scene, v: &PathVertex) -> String {
         VertexKind::Camera => "camera".into(),
         VertexKind::Light { light, infinite } => {
             let l = &scene.lights[light as usize];
-            let what = if infinite {
+            let what = if l.delta_direction() {
+                "directional"
+            } else if infinite {
                 "infinite"
             } else if l.delta_position() {
                 "point"

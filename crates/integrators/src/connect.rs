@@ -38,7 +38,9 @@ pub fn eval_towards(
 
 /// Joins light-subpath vertex `y` (x0 on a light, or a non-delta surface) to the pinhole.
 /// `None` when it is off the film, faces away, is occluded or contributes nothing. A point light
-/// (delta position) cannot be seen and returns `None`.
+/// (delta position) cannot be seen and returns `None`; so does a directional light (delta
+/// direction: `escaped` is zero towards any camera ray, and `scatter::connectable` already
+/// refuses its x0).
 pub fn connect_to_camera(scene: &Scene, y: &PathVertex) -> Option<CameraConnection> {
     let cam = &scene.camera;
     let camera = PathVertex::camera(cam, Color::ONE);
@@ -87,14 +89,15 @@ pub fn connect_to_camera(scene: &Scene, y: &PathVertex) -> Option<CameraConnecti
 }
 
 /// Density of x0 when next-event estimation from x1 chooses it: pmf · pdf_li in x0's measure
-/// (area; solid angle at infinity; the pmf alone for a point light). Mirrors `Path::densities`.
+/// (area; solid angle at infinity; the pmf alone for a delta light, point or directional).
+/// Mirrors `Path::densities`.
 pub fn nee_density(scene: &Scene, x0: &PathVertex, x1: &PathVertex) -> f64 {
     let VertexKind::Light { light, .. } = x0.kind else {
         return 0.0;
     };
     let l = &scene.lights[light as usize];
     let pmf = scene.light_sampler.pmf(light as usize) as f64;
-    if l.delta_position() {
+    if l.is_delta() {
         return pmf;
     }
     let pdf_w = l.pdf_li(x1.p, x1.dir_to(x0), x0.p, x0.ng);

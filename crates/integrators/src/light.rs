@@ -5,8 +5,9 @@
 //! One technique only, so no MIS: each splat is β · f · We · cos θ_c / d² over the M light
 //! subpaths of the pass. It cannot render what the camera sees through a delta surface (a mirror
 //! or glass seen directly, or an emitter behind glass): the connection would end at a delta
-//! vertex, whose density of being reached is zero. A point light is never seen directly either,
-//! by any technique. Tests comparing `light` with other integrators exclude exactly those paths.
+//! vertex, whose density of being reached is zero. A point light or a directional light is never
+//! seen directly either, by any technique (its x0 is not connectable or emits nothing towards
+//! the camera). Tests comparing `light` with other integrators exclude exactly those paths.
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|

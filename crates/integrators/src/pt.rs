@@ -4,9 +4,11 @@
 //! At every non-delta vertex one light is chosen by power and sampled towards the vertex (NEE);
 //! the BSDF-sampled continuation may hit an emitter too. Both techniques can produce the same path,
 //! so each contribution is weighted by the heuristic over their solid-angle pdfs at the vertex.
-//! Delta lights (point) and delta BSDF lobes (mirror, glass) are reached by one technique only
-//! and get weight one. `techniques = light` or `bsdf` keeps one of the two (weight one where it
-//! is the only one left): Veach's MIS comparison on `veach-mis` is four runs of this integrator.
+//! Delta lights (point, directional) and delta BSDF lobes (mirror, glass) are reached by one
+//! technique only and get weight one: a delta light's `pdf_li` is 0, so BSDF sampling never
+//! finds it, and its `sample_li` reports `delta`. `techniques = light` or `bsdf` keeps one of the
+//! two (weight one where it is the only one left): Veach's MIS comparison on `veach-mis` is four
+//! runs of this integrator.
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|

@@ -1,7 +1,8 @@
 //! `pt-bsdf` — path tracing by BSDF sampling alone: light is found only when a sampled path hits an
 //! emitter or escapes to a light at infinity. It shares no light-sampling code with `pt`, which is
 //! why it is the independent cross-check of `pt` (the two must agree within their standard errors).
-//! It cannot see delta lights (point lights), and converges slowly for small lights.
+//! It cannot see delta lights (point and directional lights: a BSDF sample never hits a point or
+//! a single direction), and converges slowly for small lights.
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|

@@ -265,16 +265,18 @@ fn random_walk(
 }
 
 /// The density of generating `target` from `from` with a solid-angle density `pdf_w` at `from`,
-/// in `target`'s measure; zero where a walk cannot land (a point light's delta position).
+/// in `target`'s measure; zero where a walk cannot land: a delta light, in position (a point) or
+/// in direction (a directional light), see `PathVertex::is_delta_light`.
 #[inline]
 pub fn reverse_density(target: &PathVertex, from: &PathVertex, pdf_w: f32) -> f32 {
-    if is_point_light(target) {
+    if target.is_delta_light() {
         return 0.0;
     }
     from.convert_density(pdf_w, target)
 }
 
-/// A light vertex without a surface (a point light): no walk can arrive at it.
+/// A light vertex without a surface (a point light): no walk can arrive at it. A directional
+/// light cannot be arrived at either; `PathVertex::is_delta_light` tests for both.
 #[inline]
 pub fn is_point_light(v: &PathVertex) -> bool {
     matches!(

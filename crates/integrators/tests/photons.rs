@@ -12,6 +12,8 @@
 //!    the sun (its radiance is L inside a cone of Ω sr, `light/sun.rs`) — and a black quad of area A
 //!    catches E A, with E = π L per side for the environment and E = L (n·a) π sin²θmax for the sun
 //!    on the side facing it (a cone of half-angle θmax around a, wholly above the quad's horizon).
+//!    A directional light of irradiance E (a delta in direction) sends E through every unit of the
+//!    disk's area: the sphere catches E π r², the quad E A (n·a) on the side facing it.
 //!    The luminance of the emitted flux is also held to `Light::power`, what light selection uses.
 //! 2. A thin wall lit from behind stays black in front, for every registered integrator, with
 //!    photons gathered for direct light where an integrator offers it.
@@ -298,6 +300,39 @@ fn flux_cases() -> Vec<Case> {
     // sunlight reaches the underside, exactly.
     let under = landing_flux(&s, 8, down);
     assert_eq!(under.kept, 0, "sunlight reached the quad's underside");
+
+    // A directional light along the sun's axis: every photon path carries E π R² / pmf, so only
+    // whether it lands varies.
+    let irradiance = Color::new(2.0, 3.0, 1.0);
+    let directional = LightDesc::Directional {
+        direction: axis,
+        irradiance,
+    };
+    let unit_sphere = ShapeGeometry::Sphere {
+        center: Vec3::ZERO,
+        radius: 1.0,
+    };
+    let s = caught(unit_sphere, directional.clone());
+    cases.push(Case {
+        name: "directional on a sphere",
+        flux: landing_flux(&s, 9, |_| true),
+        expected: irradiance * PI,
+        power: Some(s.lights[0].power(s.bounding_sphere) as f64 * catch_fraction(&s)),
+        closed: false,
+    });
+    let s = caught(plane(), directional);
+    cases.push(Case {
+        name: "directional on a quad, facing it",
+        flux: landing_flux(&s, 10, up),
+        expected: irradiance * (4.0 * axis.z),
+        power: None,
+        closed: false,
+    });
+    let under = landing_flux(&s, 10, down);
+    assert_eq!(
+        under.kept, 0,
+        "directional light reached the quad's underside"
+    );
     cases
 }
 

@@ -101,6 +101,7 @@ fn walk_densities_match_the_oracle_on_shipped_scenes() {
         "sun-room",
         "cornell-env",
         "veach-mis",
+        "cornell-directional",
     ] {
         let sc = scene(name);
         let (count, worst, over) = check(&sc, 4000, 1e-3);

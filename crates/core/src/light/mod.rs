@@ -4,16 +4,22 @@
 //! (b) `sample_le`: an emitted ray, with the positional pdf (area on the light, or on the disk a
 //!     distant light emits over) and the directional pdf (solid angle) kept separate;
 //! (c) `pdf_le`: those two pdfs for a given emitted ray.
-//! Delta lights report a pdf of 1 in their delta dimension and say so with `delta_position` /
-//! `delta_direction`. Light selection (by power) is `LightSampler`; its pmf is never folded into
-//! the pdfs here.
+//! Delta lights report a pdf of 1 in their delta dimension and say so with `delta_position`
+//! (point: its position is a Dirac, its directions have a density) / `delta_direction`
+//! (directional: its direction is a Dirac, the positions of its emitted rays have a density on the
+//! bounding disk). Either way `sample_li` returns `delta` with the discrete pdf 1, `pdf_li` is 0
+//! and no walk can hit the light; only a delta in direction also forbids deterministic
+//! connections to it (see `path::scatter::connectable` and `path::mis::Chain::valid`). Light
+//! selection (by power) is `LightSampler`; its pmf is never folded into the pdfs here.
 
 mod area;
+mod directional;
 mod environment;
 mod point;
 mod sun;
 
 pub use area::AreaLight;
+pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
 pub use point::PointLight;
 pub use sun::SunLight;
@@ -36,7 +42,8 @@ pub struct LightLiSample {
     /// short of the light's surface by its real error instead of a guessed one.
     pub p_err: Vec3,
     pub distance: f32,
-    /// Radiance arriving along −wi (point lights: intensity / distance²).
+    /// Radiance arriving along −wi, delta-stripped for delta lights: intensity / distance² for a
+    /// point light, irradiance for a directional light (what f_s·cos multiplies in both cases).
     pub radiance: Color,
     /// Solid-angle pdf at the shading point; 1 for a delta light.
     pub pdf_w: f32,
@@ -54,11 +61,11 @@ pub struct LightLeSample {
     pub p_err: Vec3,
     /// Normal at the ray origin (for distant lights: the ray direction).
     pub n: Vec3,
-    /// Emitted radiance along the ray (point lights: intensity).
+    /// Emitted radiance along the ray (point lights: intensity; directional lights: irradiance).
     pub radiance: Color,
     /// Area pdf of the origin (1 for a point light).
     pub pdf_pos: f32,
-    /// Solid-angle pdf of the direction (1 for a delta direction).
+    /// Solid-angle pdf of the direction (the discrete 1 for a delta direction).
     pub pdf_dir: f32,
 }
 
@@ -67,6 +74,7 @@ pub enum Light {
     Area(AreaLight),
     Point(PointLight),
     Sun(SunLight),
+    Directional(DirectionalLight),
     Environment(EnvironmentLight),
 }
 
@@ -94,24 +102,42 @@ impl Light {
                 solid_angle,
                 radiance,
             } => Light::Sun(SunLight::new(direction, solid_angle, radiance)),
+            LightDesc::Directional {
+                direction,
+                irradiance,
+            } => Light::Directional(DirectionalLight::new(direction, irradiance)),
             LightDesc::Environment { radiance } => {
                 Light::Environment(EnvironmentLight { radiance })
             }
         }
     }
 
-    /// At infinity: seen by rays that leave the scene.
+    /// At infinity (sun, directional, environment): a path vertex on it is a direction, and its
+    /// emitted rays start on the bounding disk. Rays leaving the scene reach the sun and the
+    /// environment (`escaped`), never the Dirac of a directional light.
     pub fn is_infinite(&self) -> bool {
-        matches!(self, Light::Sun(_) | Light::Environment(_))
+        matches!(
+            self,
+            Light::Sun(_) | Light::Directional(_) | Light::Environment(_)
+        )
     }
 
+    /// A point light: a delta in position (uniform in direction).
     pub fn delta_position(&self) -> bool {
         matches!(self, Light::Point(_))
     }
 
-    /// No light here is a delta in direction: the sun has a finite cone so it takes part in MIS.
+    /// A directional light: a delta in direction (its emitted rays have an area density on the
+    /// bounding disk). The sun is not: its finite cone has a solid-angle pdf and takes part in MIS.
     pub fn delta_direction(&self) -> bool {
-        false
+        matches!(self, Light::Directional(_))
+    }
+
+    /// Delta in position or direction: `sample_li` picks it with the discrete density 1 (so
+    /// next-event estimation chooses x0 with the light-selection pmf alone), `pdf_li` is 0, and
+    /// no walk can hit it (c_0 = 0).
+    pub fn is_delta(&self) -> bool {
+        self.delta_position() || self.delta_direction()
     }
 
     pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightLiSample> {
@@ -119,6 +145,7 @@ impl Light {
             Light::Area(l) => l.sample_li(p, u),
             Light::Point(l) => l.sample_li(p),
             Light::Sun(l) => l.sample_li(u),
+            Light::Directional(l) => Some(l.sample_li()),
             Light::Environment(l) => l.sample_li(u),
         }
     }
@@ -128,7 +155,7 @@ impl Light {
     pub fn pdf_li(&self, p: Vec3, wi: Vec3, light_p: Vec3, light_n: Vec3) -> f32 {
         match self {
             Light::Area(l) => l.pdf_li(p, wi, light_p, light_n),
-            Light::Point(_) => 0.0,
+            Light::Point(_) | Light::Directional(_) => 0.0,
             Light::Sun(l) => l.pdf_li(wi),
             Light::Environment(_) => environment::pdf_li(),
         }
@@ -142,7 +169,8 @@ impl Light {
         }
     }
 
-    /// Radiance a light at infinity sends along a ray leaving the scene in direction `dir`.
+    /// Radiance a light at infinity sends along a ray leaving the scene in direction `dir`; zero
+    /// for a directional light, whose single direction no ray hits (it has measure zero).
     pub fn escaped(&self, dir: Vec3) -> Color {
         match self {
             Light::Sun(l) => l.escaped(dir),
@@ -161,17 +189,21 @@ impl Light {
             Light::Area(l) => l.sample_le(u_pos, u_dir),
             Light::Point(l) => Some(l.sample_le(u_dir)),
             Light::Sun(l) => Some(l.sample_le(u_pos, u_dir, bounds)),
+            Light::Directional(l) => Some(l.sample_le(u_pos, bounds)),
             Light::Environment(l) => Some(l.sample_le(u_pos, u_dir, bounds)),
         }
     }
 
     /// (area pdf of the origin, solid-angle pdf of the direction) of an emitted ray.
     /// For lights at infinity `dir` is the direction light travels and `p`, `n` are ignored.
+    /// Delta dimensions report the discrete 1 (a point light's position, a directional light's
+    /// direction).
     pub fn pdf_le(&self, n: Vec3, dir: Vec3, bounds: (Vec3, f32)) -> (f32, f32) {
         match self {
             Light::Area(l) => l.pdf_le(n, dir),
             Light::Point(_) => (1.0, crate::sampling::UNIFORM_SPHERE_PDF),
             Light::Sun(l) => l.pdf_le(dir, bounds),
+            Light::Directional(l) => l.pdf_le(bounds),
             Light::Environment(_) => environment::pdf_le(bounds),
         }
     }
@@ -182,6 +214,7 @@ impl Light {
             Light::Area(l) => l.power(),
             Light::Point(l) => 4.0 * crate::math::PI * luminance(l.intensity),
             Light::Sun(l) => l.power(bounds),
+            Light::Directional(l) => l.power(bounds),
             Light::Environment(l) => environment::power(l, bounds),
         }
     }

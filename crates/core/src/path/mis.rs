@@ -96,10 +96,25 @@ impl Chain<'_> {
 
     /// Whether technique s can produce the path at all, judged by structure only: s = k+1 needs
     /// a camera a walk can hit (never, with a pinhole); 1 ≤ s ≤ k connects x_{s−1} with x_s,
-    /// which must both be connectable. (s = 0 with a point light is excluded by `camera[0]` = 0.)
+    /// which must both be connectable — except technique 1 when it is next-event estimation
+    /// (`one_is_nee`): x0 is then sampled by the light itself (`Light::sample_li`), which can
+    /// draw any light's Dirac, so only x1 must be connectable.
+    ///
+    /// This is where a light delta in direction (a directional light, `connectable[0]` false) is
+    /// decided, once for the oracle and every integrator: next-event estimation (s = 1, k ≥ 2)
+    /// and the light walks from it (s ≥ 2) are valid; joining it to the pinhole (s = 1 = k,
+    /// light tracing's x0) is not; nor is s = 0, since no walk hits a single direction
+    /// (`camera[0]` = 0 says the same as a density, as it does for a point light, which
+    /// `connectable[0]` leaves connectable).
     #[inline]
     pub fn valid(&self, s: usize) -> bool {
-        s <= self.k() && (s == 0 || (self.connectable[s - 1] && self.connectable[s]))
+        let k = self.k();
+        match s {
+            _ if s > k => false,
+            0 => self.connectable[0],
+            1 if self.one_is_nee() => self.connectable[1],
+            _ => self.connectable[s - 1] && self.connectable[s],
+        }
     }
 
     /// Whether technique 1 takes x0 from next-event estimation. It does whenever a camera subpath
@@ -151,9 +166,10 @@ impl Chain<'_> {
     /// p_{i+1} / p_i = l_i / c_i. When technique 1 is next-event estimation it draws x0 by `nee`
     /// instead of l_0, so the chain steps from 0 straight to 2 (ratio l_0·l_1 / (c_0·c_1)) and
     /// p_1 hangs off a neighbour (p_1 / p_0 = nee / c_0). Every divisor is a density of p_s itself,
-    /// hence non-zero: no remap0 (pbrt) is needed, and a delta light's c_0 = 0 zeroes p_0 by
-    /// itself. Delta-stripped densities keep the chain finite through delta vertices; techniques
-    /// that connect there are zeroed at the end. `out` must hold k+2 entries.
+    /// hence non-zero: no remap0 (pbrt) is needed, and a delta light's c_0 = 0 (point or
+    /// directional) zeroes p_0 by itself. Delta-stripped densities keep the chain finite through
+    /// delta vertices; techniques that connect there are zeroed at the end. `out` must hold k+2
+    /// entries.
     pub fn relative(&self, s: usize, out: &mut [f64]) {
         let k = self.k();
         let (l, c) = (self.light, self.camera);

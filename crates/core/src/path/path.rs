@@ -22,16 +22,19 @@ pub struct Path {
 #[derive(Clone, Debug)]
 pub struct Densities {
     /// `light[i]`: density of x_i when the light subpath generates it, given x0 … x_{i−1}.
-    /// `light[0]` = pmf · pdf_le position (solid angle pdf_le direction at infinity);
-    /// `light[k]` = 0, since no walk hits a pinhole.
+    /// `light[0]` = pmf · pdf_le position (solid angle pdf_le direction at infinity: the
+    /// discrete 1 for a directional light); `light[1]` after a light at infinity is the bounding
+    /// disk's density times |cos θ1|; `light[k]` = 0, since no walk hits a pinhole.
     pub light: Vec<f64>,
     /// `camera[i]`: density of x_i when the camera subpath generates it, given x_{i+1} … xk.
-    /// `camera[k]` = 1 (pinhole); `camera[0]` = 0 for a light with a delta position.
+    /// `camera[k]` = 1 (pinhole); `camera[0]` = 0 for a delta light (point or directional).
     pub camera: Vec<f64>,
     /// Density of x0 when next-event estimation from x1 chooses it (technique s = 1 when k ≥ 2):
-    /// pmf · pdf_li converted to area at x0 (solid angle at infinity, pmf for a point light).
+    /// pmf · pdf_li converted to area at x0 (solid angle at infinity, the pmf alone for a delta
+    /// light: point or directional).
     pub nee: f64,
-    /// `connectable[i]`: a connection edge may end at x_i (not a delta surface).
+    /// `connectable[i]`: a connection edge may end at x_i (not a delta surface, not a light
+    /// delta in direction; see `scatter::connectable` and `Chain::valid`).
     pub connectable: Vec<bool>,
     /// Light subpaths per camera sample in a pass (M/N, see `mis`); 1 by default.
     pub light_tracing_ratio: f64,
@@ -155,7 +158,8 @@ impl Path {
     /// Dirac in the direction towards the light, as a camera walk samples it. That is the
     /// convention of every technique that samples the vertex from the camera side; see
     /// `contribution_for` for the others. At a point light Le is the intensity and G has no
-    /// cosine at x0; at infinity Le is the radiance along x0.p.
+    /// cosine at x0; at infinity Le is the radiance along x0.p, and for a directional light
+    /// (a delta in direction, stripped like a delta lobe) its irradiance.
     /// The result is f64: per-segment factors scale as 1/length², which underflows f32 for long
     /// paths in scenes measured in kilometres.
     pub fn contribution(&self, scene: &Scene) -> DVec3 {
@@ -174,6 +178,7 @@ impl Path {
         let x0 = &v[0];
         let le = match self.light(scene) {
             Light::Point(p) => p.intensity,
+            Light::Directional(d) => d.irradiance,
             l if x0.is_infinite() => l.escaped(x0.p),
             l => l.emitted(x0.ng, x0.dir_to(&v[1])),
         };
@@ -217,8 +222,9 @@ impl Path {
             pl[i] = v[i - 1].convert_density(pdf_w, &v[i]) as f64;
         }
 
-        // Next-event estimation of x0 from x1.
-        let nee = if light.delta_position() {
+        // Next-event estimation of x0 from x1: a delta light (point or directional) is chosen
+        // with the discrete density 1, so by the pmf alone.
+        let nee = if light.is_delta() {
             pmf
         } else {
             let pdf_w = light.pdf_li(x1.p, x1.dir_to(x0), x0.p, x0.ng);
@@ -236,7 +242,9 @@ impl Path {
                 .pdf_w;
             pc[i] = v[i + 1].convert_density(pdf_w, &v[i]) as f64;
         }
-        if light.delta_position() {
+        // No walk hits a delta light: a point has no area, a directional light's one direction
+        // has no solid angle.
+        if light.is_delta() {
             pc[0] = 0.0;
         }
 

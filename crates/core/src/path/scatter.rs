@@ -121,7 +121,11 @@ const MAGNIFIED_TOL: f32 = 1e-2;
 const UNAMBIGUOUS_RATIO: f32 = 0.05;
 
 /// True when a connection (a deterministic edge between two subpaths) may end at `v`: never at a
-/// delta surface; always at the camera and at lights (none of ours is delta in direction).
+/// delta surface, nor at a light delta in direction (a directional light: the edge would have to
+/// match its Dirac); always at the camera and at other lights (a point light's delta is in
+/// position, which an edge to it matches by construction). Next-event estimation is not a
+/// deterministic edge — the light samples its own Dirac — and `Chain::valid` lets technique 1
+/// through whatever x0 is.
 pub fn connectable(scene: &Scene, v: &PathVertex) -> bool {
     match v.kind {
         VertexKind::Surface { material } => !scene.material(material).is_delta(),

@@ -15,10 +15,11 @@ pub enum VertexKind {
     /// The pinhole. `ng` = `ns` = the viewing axis, so G(x_{k−1} ↔ x_k) carries the camera's cos θ
     /// that `Camera::importance` (N / (A cos⁴θ)) expects.
     Camera,
-    /// A light endpoint (x0 of a full path). With `infinite` (sun, environment) the vertex sits at
-    /// infinity: `p` is the unit direction from the scene towards the light, densities of this
-    /// vertex are solid angle and G(x0 ↔ x1) = |cos θ1|. A point light has `ng` = `ns` = 0:
-    /// it has no surface, so G carries no cosine at it.
+    /// A light endpoint (x0 of a full path). With `infinite` (sun, directional, environment) the
+    /// vertex sits at infinity: `p` is the unit direction from the scene towards the light,
+    /// densities of this vertex are solid angle (the discrete 1 for a directional light's
+    /// delta direction) and G(x0 ↔ x1) = |cos θ1|. A point light has `ng` = `ns` = 0: it has no
+    /// surface, so G carries no cosine at it. A directional light's x0 has `delta` set.
     Light { light: u32, infinite: bool },
     /// A scattering surface.
     Surface { material: u32 },
@@ -48,6 +49,9 @@ pub struct PathVertex {
     pub pdf_rev: f32,
     /// The vertex scattered (or will scatter) through a delta lobe: it cannot be connected to.
     /// Integrators set it from `BsdfSample::delta`; the from-scratch `Path` code asks the material.
+    /// At a light vertex it means the same thing for the emission: the light is delta in
+    /// direction (directional), set by the light constructors here. (A delta in position, a
+    /// point light, shows as `on_surface()` false instead: the two deltas are kept apart.)
     pub delta: bool,
     /// Unit direction towards the vertex the walk came from, exactly as the walk traced it (zero
     /// at endpoints). Connections evaluate the BSDF with it instead of rebuilding it from two f32
@@ -138,8 +142,9 @@ impl PathVertex {
     }
 
     /// x0 of a light subpath from `Light::sample_le` after choosing the light with `pmf`.
-    /// `pdf_fwd` = pmf · pdf_pos (area; 1 for a point light), or pmf · pdf_dir (solid angle) at
-    /// infinity, where the position on the disk belongs to x1; `beta` = Le / pdf_fwd.
+    /// `pdf_fwd` = pmf · pdf_pos (area; 1 for a point light), or pmf · pdf_dir (solid angle; the
+    /// discrete 1 for a directional light) at infinity, where the position on the disk belongs to
+    /// x1; `beta` = Le / pdf_fwd.
     pub fn light_emitted(scene: &Scene, light: u32, s: &LightLeSample, pmf: f32) -> PathVertex {
         let l = &scene.lights[light as usize];
         if l.is_infinite() {
@@ -148,7 +153,9 @@ impl PathVertex {
                 light,
                 infinite: true,
             };
-            return PathVertex::endpoint(kind, -s.ray.d, s.ray.d, s.radiance / pdf, pdf);
+            let mut v = PathVertex::endpoint(kind, -s.ray.d, s.ray.d, s.radiance / pdf, pdf);
+            v.delta = l.delta_direction();
+            return v;
         }
         let pdf = pmf * s.pdf_pos;
         let n = if l.delta_position() { Vec3::ZERO } else { s.n };
@@ -167,8 +174,9 @@ impl PathVertex {
     }
 
     /// x0 chosen by next-event estimation from `from` (`Light::sample_li`, light chosen with `pmf`):
-    /// `pdf_fwd` = pmf · pdf_li converted to area at x0 (solid angle at infinity, discrete 1 for a
-    /// point light). `beta` = Le / pdf_fwd (for a point light Le is the intensity).
+    /// `pdf_fwd` = pmf · pdf_li converted to area at x0 (solid angle at infinity), or pmf alone
+    /// for a delta light (point, directional: `LightLiSample::delta`, discrete 1). `beta` =
+    /// Le / pdf_fwd (Le: a point light's intensity, a directional light's irradiance).
     pub fn light_sampled(
         scene: &Scene,
         light: u32,
@@ -186,6 +194,7 @@ impl PathVertex {
         };
         let mut v = PathVertex::endpoint(kind, p, n, Color::ZERO, 0.0);
         v.p_err = s.p_err;
+        v.delta = l.delta_direction();
         v.pdf_fwd = if s.delta {
             pmf
         } else {
@@ -203,6 +212,15 @@ impl PathVertex {
     #[inline]
     pub fn is_infinite(&self) -> bool {
         matches!(self.kind, VertexKind::Light { infinite: true, .. })
+    }
+
+    /// True at a light vertex that no walk can arrive at, whose reverse density c_0 is therefore
+    /// zero: a light delta in position (a point light, which has no surface) or in direction (a
+    /// directional light, `delta`). `Path::densities` says the same from the scene's light
+    /// (`Light::is_delta`).
+    #[inline]
+    pub fn is_delta_light(&self) -> bool {
+        matches!(self.kind, VertexKind::Light { .. }) && (self.delta || !self.on_surface())
     }
 
     /// True when the vertex has a surface (a normal) whose cosine enters G and area conversions.

@@ -126,6 +126,12 @@ pub enum LightDesc {
         solid_angle: f32,
         radiance: Color,
     },
+    /// A light delta in direction: `direction` (unit) points from the scene towards it, and
+    /// `irradiance` is what a surface facing it receives (W/m²). See `light::DirectionalLight`.
+    Directional {
+        direction: Vec3,
+        irradiance: Color,
+    },
     Environment {
         radiance: Color,
     },
@@ -238,7 +244,7 @@ impl SceneBuilder {
 
     /// Indexes the scene, recentred on `scene_origin` of its geometry: every shape, point light
     /// and the camera eye are stored as world − origin (see `Scene::origin`); directions (sun,
-    /// environment, shading normals) are unchanged.
+    /// directional light, environment, shading normals) are unchanged.
     pub fn build(mut self) -> Scene {
         let origin = scene_origin(&self.shapes);
         if origin != Vec3::ZERO {

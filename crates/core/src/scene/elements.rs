@@ -319,6 +319,36 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<LightDesc>, SceneError> 
                 radiance,
             }
         }
+        "directional" => {
+            // A delta in direction has no solid angle, so no radiance: say so before the generic
+            // "does not apply" check would.
+            if let Some(r) = &d.radiance {
+                return Err(ctx.at(
+                    r.span(),
+                    "a directional light takes `irradiance` (W/m² on a surface facing it), not \
+                     `radiance`: it is a delta in direction, with no solid angle to spread a \
+                     radiance over (for a light of finite angular size use type = \"sun\")",
+                ));
+            }
+            ctx.only(&given, &["direction", "irradiance"], &what)?;
+            let dir = ctx.need(&d.direction, "direction", &span, &what)?;
+            let direction = ctx.vec3(dir, "direction")?;
+            if !(direction.length() > 0.0) {
+                return Err(ctx.at(
+                    dir.span(),
+                    "`direction` (towards the light) is the zero vector",
+                ));
+            }
+            let irradiance = ctx.color(
+                ctx.need(&d.irradiance, "irradiance", &span, &what)?,
+                "irradiance",
+                false,
+            )?;
+            LightDesc::Directional {
+                direction: direction.normalize(),
+                irradiance,
+            }
+        }
         "environment" => {
             ctx.only(&given, &["radiance"], &what)?;
             LightDesc::Environment {
@@ -332,13 +362,16 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<LightDesc>, SceneError> 
         other => {
             return Err(ctx.at(
                 d.kind.span(),
-                format!("unknown light type `{other}` (expected point, sun or environment)"),
+                format!(
+                    "unknown light type `{other}` (expected point, sun, directional or environment)"
+                ),
             ))
         }
     };
     let power = match &desc {
         LightDesc::Point { intensity: c, .. }
         | LightDesc::Sun { radiance: c, .. }
+        | LightDesc::Directional { irradiance: c, .. }
         | LightDesc::Environment { radiance: c } => c.max_element(),
     };
     Ok((power > 0.0).then_some(desc))

@@ -49,6 +49,10 @@ impl Scene {
                     solid_angle: s.solid_angle,
                     radiance: s.radiance,
                 }),
+                Light::Directional(d) => b.add_light(LightDesc::Directional {
+                    direction: d.direction,
+                    irradiance: d.irradiance,
+                }),
                 Light::Environment(e) => b.add_light(LightDesc::Environment {
                     radiance: e.radiance,
                 }),
@@ -93,6 +97,11 @@ mod tests {
             position: Vec3::Y,
             intensity: Color::ONE,
         });
+        let to_light = Vec3::new(0.6, 0.8, 0.0);
+        b.add_light(LightDesc::Directional {
+            direction: to_light,
+            irradiance: Color::splat(2.0),
+        });
         let s = b.build();
         // Modelled around the world origin: kept as given.
         assert_eq!(s.origin, Vec3::ZERO);
@@ -102,8 +111,11 @@ mod tests {
         assert_eq!(t.origin, Vec3::new(0.25, 0.0, 0.0) + off);
         let world = |p: Vec3| p + t.origin;
         assert_eq!(world(t.camera.eye), s.camera.eye + off);
-        assert_eq!(t.lights.len(), 2);
+        assert_eq!(t.lights.len(), 3);
         assert!(matches!(&t.lights[1], Light::Point(p) if world(p.position) == Vec3::Y + off));
+        // A direction is not a position: the directional light is unchanged.
+        assert!(matches!(&t.lights[2], Light::Directional(d)
+            if d.direction == to_light.normalize() && d.irradiance == Color::splat(2.0)));
         assert!(
             matches!(t.shapes[1].geometry, ShapeGeometry::Sphere { center, .. } if world(center) == Vec3::X + off)
         );

@@ -146,6 +146,13 @@ pub enum PlaneLight {
         omega: f32,
         radiance: f32,
     },
+    /// A directional light (a delta in direction) towards `dir` of irradiance `irradiance`, and
+    /// optionally a second one, (direction, irradiance), so that light selection pmfs are not 1.
+    Directional {
+        dir: Vec3,
+        irradiance: f32,
+        second: Option<(Vec3, f32)>,
+    },
 }
 
 pub const PLANE_ALBEDO: f32 = 0.5;
@@ -189,13 +196,26 @@ pub fn plane(light: PlaneLight) -> Scene {
             solid_angle: omega,
             radiance: Color::splat(radiance),
         }),
+        PlaneLight::Directional {
+            dir,
+            irradiance,
+            second,
+        } => {
+            for (d, e) in std::iter::once((dir, irradiance)).chain(second) {
+                b.add_light(LightDesc::Directional {
+                    direction: d.normalize(),
+                    irradiance: Color::splat(e),
+                });
+            }
+        }
     }
     b.build()
 }
 
 /// Exact irradiance at `x` (normal +y) from the plane scene's light, ignoring occlusion (none
 /// occludes the plane). Quad: Lambert's polygon formula E = Le/2 · Σ Θ_i (n · û_i);
-/// point: I cos/d²; sun: E = L ∫_cone cos dω = L π sin²θmax (n · d) for a cone above the horizon.
+/// point: I cos/d²; sun: E = L ∫_cone cos dω = L π sin²θmax (n · d) for a cone above the
+/// horizon; directional: E (n · d) for each light above the horizon.
 pub fn plane_irradiance(light: PlaneLight, x: Vec3) -> f64 {
     let n = Vec3::Y.as_dvec3();
     match light {
@@ -226,6 +246,14 @@ pub fn plane_irradiance(light: PlaneLight, x: Vec3) -> f64 {
                 * (2.0 - h)
                 * n.dot(dir.normalize().as_dvec3())
         }
+        PlaneLight::Directional {
+            dir,
+            irradiance,
+            second,
+        } => std::iter::once((dir, irradiance))
+            .chain(second)
+            .map(|(d, e)| e as f64 * n.dot(d.normalize().as_dvec3()).max(0.0))
+            .sum(),
     }
 }
 

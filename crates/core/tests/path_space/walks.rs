@@ -53,8 +53,12 @@ pub fn camera_walk(
     for k in 1..=max_k {
         let prev = *verts.last().unwrap();
         let Some(hit) = scene.intersect(&ray) else {
-            // Escaped: every light at infinity is an x0 in solid angle, G = |cos| at prev.
+            // Escaped: every light at infinity is an x0 in solid angle, G = |cos| at prev — but
+            // a directional light's single direction, which no ray hits (measure zero).
             for &li in &scene.infinite_lights {
+                if scene.lights[li as usize].delta_direction() {
+                    continue;
+                }
                 let x0 = PathVertex::light_escaped(li, ray.d, beta.as_vec3(), pdf_w);
                 let le = scene.lights[li as usize].escaped(ray.d).as_dvec3();
                 out(Made {
@@ -130,8 +134,10 @@ fn nee(
         scene
             .material(hit.material)
             .eval(&hit.shading_frame(), wo, ls.wi, TransportMode::Radiance);
-    // Density of x0 and the arrival factor at it (cos/d², 1/d² at a point, 1 at infinity).
-    let (pa, g) = if ls.delta {
+    // Density of x0 and the arrival factor at it (cos/d², 1/d² at a point, 1 at infinity; a
+    // directional light is at infinity with the discrete density 1).
+    let point = ls.delta && !light.is_infinite();
+    let (pa, g) = if point {
         (1.0, 1.0 / (ls.p - hit.p).length_squared())
     } else if light.is_infinite() {
         (ls.pdf_w, 1.0)
@@ -142,7 +148,8 @@ fn nee(
         )
     };
     // A point light's LightLiSample radiance is I/d²: Le·G needs the intensity I and G with 1/d².
-    let le = if ls.delta {
+    // A directional light's is its irradiance, the delta-stripped Le at infinity.
+    let le = if point {
         ls.radiance * (ls.p - hit.p).length_squared()
     } else {
         ls.radiance
@@ -189,8 +196,9 @@ pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
     let mut ray = le.ray;
     let cam = &scene.camera;
     // x0 itself connected to the pinhole: technique 1 of a one-segment path (an emitter seen
-    // directly), by the emitted point's density alone. A point light has no surface to be seen.
-    if !light.delta_position() && max_k >= 1 {
+    // directly), by the emitted point's density alone. A point light has no surface to be seen,
+    // and no camera ray hits a directional light's single direction.
+    if !light.is_delta() && max_k >= 1 {
         let towards_cam = if infinite {
             Some((-x0.p, 1.0f32))
         } else {
