@@ -9,7 +9,7 @@
 //!   light vertex's incoming direction evaluated in the camera vertex's BSDF.
 //!
 //! All techniques share one MIS (`lt_core::path::SubpathMis`): merging at x_i counts
-//! η = M π rᵢ² times a connection (Georgiev et al. 2012, eq. 11, η_VCM). The per-vertex
+//! η = M π rᵢ² times a connection (Georgiev et al. 2012's η_VCM). The per-vertex
 //! records (their dVCM/dVC/dVM) are formed once per subpath from the walks' stored densities, so
 //! a weight is O(1). Radii shrink as rᵢ = r₀ · i^((α−1)/2), i = 1, 2, … (Knaus & Zwicker's
 //! rate, as in SmallVCM, α = 0.75); r₀ is pixel-footprint relative by default (at the mean

@@ -2,7 +2,7 @@
 //! every path, under every heuristic, with and without connections and merging.
 
 use super::*;
-use crate::path::merging::Technique;
+use crate::path::merging::{Technique, TechniqueSet};
 use crate::path::Densities;
 use rand_pcg::rand_core::Rng as _;
 use rand_pcg::Pcg32;
@@ -42,7 +42,9 @@ fn random_densities(rng: &mut Pcg64, k: usize) -> Densities {
         *c = rng.gen_bool(0.75);
     }
     if rng.gen_bool(0.2) {
+        // A delta light: a point light (x0 connectable) or a directional one (not).
         camera[0] = 0.0;
+        connectable[0] = rng.gen_bool(0.5);
     }
     Densities {
         light,
@@ -50,72 +52,6 @@ fn random_densities(rng: &mut Pcg64, k: usize) -> Densities {
         nee,
         connectable,
         light_tracing_ratio: 10f64.powf(rng.gen_range(-1.0..1.0)),
-    }
-}
-
-/// The records the integrator would build for this path, light vertices x0 … x_{k−1} and camera
-/// vertices z_m = x_{k−m}, m = 0 … k, with the chain's densities as the stored ones.
-fn records(mis: &SubpathMis, d: &Densities) -> (Vec<LightMis>, Vec<CameraMis>) {
-    let k = d.k();
-    let (l, c, conn) = (&d.light, &d.camera, &d.connectable);
-    let mut light = vec![mis.light_origin(l[0])];
-    for j in 1..k {
-        let c_pp = if j >= 2 { c[j - 2] } else { 0.0 };
-        let y = mis.light_vertex(
-            j,
-            l[j],
-            &light[j - 1],
-            c_pp,
-            conn[j - 1] && conn[j],
-            d.nee / l[0],
-            conn[j],
-        );
-        light.push(y);
-    }
-    let mut camera = vec![mis.camera_origin()];
-    for m in 1..=k {
-        let i = k - m;
-        let z = mis.camera_vertex(
-            m,
-            c[i],
-            &camera[m - 1],
-            l[i + 1],
-            conn[i] && conn[i + 1],
-            conn[i] && i >= 1,
-        );
-        camera.push(z);
-    }
-    (light, camera)
-}
-
-fn recursive_weight(mis: &SubpathMis, d: &Densities, t: Technique) -> f64 {
-    let k = d.k();
-    let (l, c, conn) = (&d.light, &d.camera, &d.connectable);
-    let (ly, cz) = records(mis, d);
-    let at = |i: usize| if i <= k { l[i] } else { 0.0 };
-    match t {
-        Technique::Connect(0) if k == 1 => mis.emitter_seen(c[0], l[0], conn[0] && conn[1]),
-        Technique::Connect(0) => {
-            mis.emitter_hit(&cz[k - 1], c[0], l[0], l[1], d.nee, conn[0] && conn[1])
-        }
-        Technique::Connect(1) if k == 1 => mis.light_tracing_origin(&ly[0], c[0]),
-        Technique::Connect(1) => {
-            mis.next_event(&cz[k - 1], &cz[k - 2], d.nee, c[0], l[0], l[1], at(2))
-        }
-        Technique::Connect(s) if s == k => mis.light_tracing(&ly[k - 1], c[k - 1], c[k - 2]),
-        Technique::Connect(s) => {
-            let t = k + 1 - s;
-            mis.connection(
-                &ly[s - 1],
-                &cz[t - 1],
-                &cz[t - 2],
-                c[s - 1],
-                c[s - 2],
-                l[s],
-                at(s + 1),
-            )
-        }
-        Technique::Merge(i) => mis.merge(&ly[i], &cz[k - i], &cz[k - i - 1], c[i - 1], at(i + 1)),
     }
 }
 
@@ -139,7 +75,7 @@ fn recursive_weights_equal_the_oracle_on_random_chains() {
             let mis = SubpathMis::new(h, set, d.light_tracing_ratio);
             for t in d.vcm_techniques(set) {
                 let want = d.vcm_weight(set, t, h);
-                let got = recursive_weight(&mis, &d, t);
+                let got = mis.replay(&d, t);
                 let err = (got - want).abs() / want.max(1e-300);
                 worst = worst.max(err.min(1.0));
                 assert!(
@@ -170,7 +106,7 @@ fn without_merging_the_recursion_is_bdpts_chain() {
             if want == 0.0 {
                 continue;
             }
-            let got = recursive_weight(&mis, &d, Technique::Connect(s));
+            let got = mis.replay(&d, Technique::Connect(s));
             assert!(
                 (got - want).abs() <= 1e-9 * want,
                 "s {s}: recursive {got} chain {want}\n{d:?}"
