@@ -37,7 +37,10 @@ fn check_all(connections: bool, h: Heuristic) {
         }
     }
     eprintln!("{paths} paths checked, {merges} of them merged");
-    assert!(merges > 1000, "too few merged paths to mean anything: {merges}");
+    assert!(
+        merges > 1000,
+        "too few merged paths to mean anything: {merges}"
+    );
     assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
 
