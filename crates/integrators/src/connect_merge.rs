@@ -127,23 +127,33 @@ pub fn initial_radius(scene: &Scene, radius: InitialRadius) -> f32 {
     }
 }
 
-/// The light subpaths of one pass, flattened, with their MIS records and the merge index.
+/// The light subpaths of one pass with their MIS records and the merge index. Paths are kept in
+/// the fixed chunks they were traced in (no copy into one array), and a run reuses the buffers
+/// from pass to pass (`Engine::trace_light_paths_into`).
 #[derive(Default)]
 pub struct LightPaths {
-    pub vertices: Vec<PathVertex>,
-    pub mis: Vec<LightMis>,
-    /// Path j is `vertices[starts[j]..starts[j + 1]]`.
-    pub starts: Vec<u32>,
+    chunks: Vec<LightChunk>,
     /// Mergeable vertices, compact (what a merge reads, contiguous).
     merge_vertex: Vec<MergeVertex>,
     merge_positions: Vec<Vec3>,
     grid: Option<PointGrid>,
 }
 
+/// Light subpaths c·LIGHT_CHUNK … of one pass.
+#[derive(Default)]
+struct LightChunk {
+    vertices: Vec<PathVertex>,
+    mis: Vec<LightMis>,
+    /// Path j of the chunk is `vertices[starts[j]..starts[j + 1]]`.
+    starts: Vec<u32>,
+}
+
 impl LightPaths {
     pub fn path(&self, j: usize) -> (&[PathVertex], &[LightMis]) {
-        let (a, b) = (self.starts[j] as usize, self.starts[j + 1] as usize);
-        (&self.vertices[a..b], &self.mis[a..b])
+        let c = &self.chunks[j / LIGHT_CHUNK as usize];
+        let l = j % LIGHT_CHUNK as usize;
+        let (a, b) = (c.starts[l] as usize, c.starts[l + 1] as usize);
+        (&c.vertices[a..b], &c.mis[a..b])
     }
 
     /// Stored light vertices (for the record and memory figures).
@@ -162,7 +172,8 @@ struct MergeVertex {
     beta: Color,
     /// Segments from the light (j).
     segments: u32,
-    /// Index in the flat vertex arrays (for the record).
+    /// Where the vertex is kept: chunk and index in it (for the record).
+    chunk: u32,
     index: u32,
     /// Turns a solid-angle density at y_j towards y_{j−1} into y_{j−1}'s measure
     /// (`walk::reverse_density` of y_{j−1} from y_j, factored: |cos at y_{j−1}| / d², 1 at
@@ -237,51 +248,64 @@ impl<'a> Engine<'a> {
 
     /// Traces the pass's light subpaths and forms their MIS records (and the merge index).
     pub fn trace_light_paths(&self, setup: &PassSetup, seed: u64, pass: u32) -> LightPaths {
+        let mut out = LightPaths::default();
+        self.trace_light_paths_into(setup, seed, pass, &mut out);
+        out
+    }
+
+    /// `trace_light_paths` into `out`, reusing its buffers.
+    pub fn trace_light_paths_into(
+        &self,
+        setup: &PassSetup,
+        seed: u64,
+        pass: u32,
+        out: &mut LightPaths,
+    ) {
         let scene = self.scene;
         let m = setup.light_paths;
-        let chunks: Vec<(Vec<PathVertex>, Vec<LightMis>, Vec<u32>)> = (0..m.div_ceil(LIGHT_CHUNK))
-            .into_par_iter()
-            .map(|c| {
+        let n_chunks = m.div_ceil(LIGHT_CHUNK) as usize;
+        out.chunks.resize_with(n_chunks, LightChunk::default);
+        out.chunks
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                let c = c as u64;
                 let mut sub = Subpath::with_capacity(self.params.max_depth as usize);
-                let (mut verts, mut recs, mut lens) = (Vec::new(), Vec::new(), Vec::new());
+                chunk.vertices.clear();
+                chunk.mis.clear();
+                chunk.starts.clear();
+                chunk.starts.push(0);
                 for j in c * LIGHT_CHUNK..((c + 1) * LIGHT_CHUNK).min(m) {
                     let mut ls = Sampler::for_item(Domain::Light, seed, j, pass as u64);
                     light_subpath(scene, &mut ls, self.params.limits(false), &mut sub);
-                    let start = recs.len();
-                    light_records(scene, &setup.mis, &sub.vertices, &mut recs);
-                    verts.extend_from_slice(&sub.vertices);
-                    lens.push((recs.len() - start) as u32);
+                    light_records(scene, &setup.mis, &sub.vertices, &mut chunk.mis);
+                    chunk.vertices.extend_from_slice(&sub.vertices);
+                    chunk.starts.push(chunk.vertices.len() as u32);
                 }
-                (verts, recs, lens)
-            })
-            .collect();
-        let mut out = LightPaths {
-            starts: vec![0],
-            ..LightPaths::default()
-        };
-        for (v, r, lens) in chunks {
-            for len in lens {
-                let s = *out.starts.last().unwrap();
-                out.starts.push(s + len);
-            }
-            out.vertices.extend(v);
-            out.mis.extend(r);
+            });
+        out.merge_vertex.clear();
+        out.merge_positions.clear();
+        out.grid = None;
+        if !self.params.merging {
+            return;
         }
-        if self.params.merging {
-            for j in 0..m as usize {
-                let (a, b) = (out.starts[j], out.starts[j + 1]);
-                for (d, idx) in (a + 1..b).enumerate() {
-                    let mis = out.mis[idx as usize];
+        for (c, chunk) in out.chunks.iter().enumerate() {
+            for w in chunk.starts.windows(2) {
+                for (d, idx) in (w[0] + 1..w[1]).enumerate() {
+                    let mis = chunk.mis[idx as usize];
                     if !mis.mergeable {
                         continue;
                     }
-                    let (y, before) =
-                        (&out.vertices[idx as usize], &out.vertices[idx as usize - 1]);
+                    let (y, before) = (
+                        &chunk.vertices[idx as usize],
+                        &chunk.vertices[idx as usize - 1],
+                    );
                     out.merge_vertex.push(MergeVertex {
                         wi: y.wo,
                         cos_g: y.ng.dot(y.wo).abs(),
                         beta: y.beta,
                         segments: d as u32 + 1,
+                        chunk: c as u32,
                         index: idx,
                         to_prev: reverse_density(before, y, 1.0),
                         mis,
@@ -289,9 +313,8 @@ impl<'a> Engine<'a> {
                     out.merge_positions.push(y.p);
                 }
             }
-            out.grid = Some(PointGrid::build(&out.merge_positions, 2.0 * setup.radius));
         }
-        out
+        out.grid = Some(PointGrid::build(&out.merge_positions, 2.0 * setup.radius));
     }
 
     pub fn scratch(&self) -> Scratch {
@@ -719,7 +742,7 @@ impl<'a> Engine<'a> {
                 let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
                 rec.merged(Merged {
                     i: y.segments as usize,
-                    light: &lights.vertices[first..=vi],
+                    light: &lights.chunks[y.chunk as usize].vertices[first..=vi],
                     camera: &z[..t],
                     weight: w,
                     value: value * setup.merge_norm,
@@ -804,6 +827,8 @@ pub struct Run<'a> {
     sum: Image,
     passes: u32,
     log: ProgressLog,
+    /// The last pass's light subpaths: buffers reused by the next.
+    lights: LightPaths,
 }
 
 impl<'a> Run<'a> {
@@ -816,6 +841,7 @@ impl<'a> Run<'a> {
             sum: Image::new(cam.width as usize, cam.height as usize),
             passes: 0,
             log: ProgressLog::default(),
+            lights: LightPaths::default(),
         }
     }
 }
@@ -823,8 +849,11 @@ impl<'a> Run<'a> {
 impl ProgressiveRun for Run<'_> {
     fn pass(&mut self, pass: u32) -> u64 {
         let setup = self.engine.setup(self.r0, pass);
-        let lights = self.engine.trace_light_paths(&setup, self.seed, pass);
-        let (img, invalid) = self.engine.render_pass(&setup, &lights, self.seed, pass);
+        self.engine
+            .trace_light_paths_into(&setup, self.seed, pass, &mut self.lights);
+        let (img, invalid) = self
+            .engine
+            .render_pass(&setup, &self.lights, self.seed, pass);
         for (a, b) in self.sum.data.iter_mut().zip(&img.data) {
             for c in 0..3 {
                 a[c] += b[c];
