@@ -39,6 +39,12 @@ const BLACK: &[(&str, &str, Black, &str)] = &[
     ),
     (
         "pt-bsdf",
+        "smallvcm-spheres-sun",
+        Black::Exact,
+        "its only light is a directional light, a single direction no BSDF sample hits",
+    ),
+    (
+        "pt-bsdf",
         "smallvcm-spheres-point",
         Black::Exact,
         "its only light is a point light, which BSDF sampling never hits",

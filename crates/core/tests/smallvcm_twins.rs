@@ -35,9 +35,9 @@ fn mesh_center(s: &Scene, shape: u32) -> Vec3 {
     m.positions.iter().copied().sum::<Vec3>() / m.positions.len() as f32
 }
 
-/// The twins of SmallVCM's `--report` scenes (its src/scene.hxx, `LoadCornellBox`); the sun one
-/// joins when the directional light parses.
-const SMALLVCM_TWINS: [&str; 3] = [
+/// The twins of SmallVCM's `--report` scenes (its src/scene.hxx, `LoadCornellBox`).
+const SMALLVCM_TWINS: [&str; 4] = [
+    "smallvcm-spheres-sun",
     "smallvcm-mirror-ball",
     "smallvcm-spheres-point",
     "smallvcm-spheres-background",
@@ -132,6 +132,17 @@ fn smallvcm_twins_have_smallvcms_lights() {
     assert_eq!(p.position, Vec3::new(0.0, -0.5, 1.0));
     assert!(close(p.intensity.x * 4.0 * PI, 70.0, 1e-6), "70 W");
     assert_eq!(s.shapes.len(), 7, "five walls and two balls: no light box");
+
+    let s = load("smallvcm-spheres-sun");
+    assert_eq!(s.lights.len(), 1);
+    let Light::Directional(d) = &s.lights[0] else {
+        panic!("not a directional light")
+    };
+    // SmallVCM's DirectionalLight(-1, 1.5, -1) is the direction light travels; ours points back.
+    assert!((d.direction - Vec3::new(1.0, -1.5, 1.0).normalize()).length() < 1e-6);
+    assert_eq!(d.irradiance, Color::new(10.0, 4.0, 0.0), "(0.5, 0.2, 0) x 20");
+    assert_eq!(s.shapes.len(), 12, "five walls, five light-box faces, two balls");
+    assert!(s.shapes.iter().all(|sh| sh.light.is_none()), "no emitter");
 
     let s = load("smallvcm-spheres-background");
     assert_eq!(s.lights.len(), 1);
