@@ -125,3 +125,32 @@ fn consistent_estimators_get_error_bars_only_from_runs() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `--no-merge` reaches vcm as `merging = false` (its image is then bdpt's, see
+/// tests/vcm_is_bdpt.rs), and the record says so; other integrators refuse the key.
+#[test]
+fn no_merge_turns_vcm_into_bdpt() {
+    let dir = temp_dir("no_merge");
+    let render = |integrator: &str, extra: &[&str]| {
+        let out = dir.join(format!("{integrator}.exr"));
+        let o = lt()
+            .args(["render", "-i", integrator, "--spp", "1", "--quiet", "-o"])
+            .arg(&out)
+            .args(extra)
+            .arg(repo().join("scenes/cornell-box.toml"))
+            .output()
+            .unwrap();
+        (
+            o.status.success(),
+            String::from_utf8_lossy(&o.stderr).to_string(),
+        )
+    };
+    let (ok, err) = render("vcm", &["--no-merge"]);
+    assert!(ok, "{err}");
+    let record = std::fs::read_to_string(dir.join("vcm.json")).unwrap();
+    assert!(record.contains("merging"), "{record}");
+    let (ok, err) = render("bdpt", &["--no-merge"]);
+    assert!(!ok, "bdpt took --no-merge");
+    assert!(err.contains("merging"), "{err}");
+    let _ = std::fs::remove_dir_all(dir);
+}
