@@ -240,8 +240,8 @@ pub struct VcmCheck {
     pub mismatch: f64,
     /// The tolerance the mismatch is held to.
     pub allowed: f64,
-    /// For merges, Σ |ln| of the two cross densities' ratios between the two x_i.
-    pub ambiguity: f64,
+    /// The path's condition κ (for merges, the larger of its two paths').
+    pub condition: f64,
     /// Σ of the replayed weights over the techniques, minus 1.
     pub sum_error: f64,
     /// Largest |replayed − oracle| weight over the techniques.
@@ -289,7 +289,6 @@ pub fn check_record(scene: &Scene, r: &VcmRecord, opts: &VcmOptions, ratio: f64)
     };
     let oracle = d.vcm_weight(set, r.technique, h);
     let mismatch = relative(r.weight, oracle);
-    let ambiguity = 0.0;
     let allowed = path_tolerance(opts.tolerance, kappa);
     let mis = SubpathMis::new(h, set, ratio);
     let techniques = d.vcm_techniques(set);
@@ -306,7 +305,7 @@ pub fn check_record(scene: &Scene, r: &VcmRecord, opts: &VcmOptions, ratio: f64)
         oracle,
         mismatch,
         allowed,
-        ambiguity,
+        condition: kappa,
         sum_error: if sum.is_nan() {
             f64::INFINITY
         } else {
@@ -326,7 +325,10 @@ pub struct VcmRow {
     pub max_sum_error: f64,
     pub max_mismatch_connect: f64,
     pub max_mismatch_merge: f64,
-    pub max_ambiguity: f64,
+    /// Largest mismatch over well-conditioned paths (κ ≤ τ), connections and merges.
+    pub max_mismatch_well: f64,
+    /// Ill-conditioned paths (κ > τ), held to κ.
+    pub ill: usize,
     pub max_replay_error: f64,
     /// Techniques seen valid on the recorded paths: connections (s) and merges (i).
     pub valid_connect: std::collections::BTreeSet<usize>,
@@ -403,7 +405,6 @@ pub fn check_records(
             Technique::Merge(_) => {
                 row.merges += 1;
                 row.max_mismatch_merge = row.max_mismatch_merge.max(v.mismatch);
-                row.max_ambiguity = row.max_ambiguity.max(v.ambiguity);
             }
         }
         for t in &v.techniques {
@@ -411,6 +412,11 @@ pub fn check_records(
                 Technique::Connect(s) => row.valid_connect.insert(s),
                 Technique::Merge(i) => row.valid_merge.insert(i),
             };
+        }
+        if v.condition <= opts.tolerance {
+            row.max_mismatch_well = row.max_mismatch_well.max(v.mismatch);
+        } else {
+            row.ill += 1;
         }
         row.max_sum_error = row.max_sum_error.max(v.sum_error.abs());
         row.max_replay_error = row.max_replay_error.max(v.replay_error);
@@ -424,8 +430,8 @@ pub fn check_records(
             .count();
         if (over || sum_fail) && shown < 3 {
             examples.push(format!(
-                "k={} {:?} weight={:.9e} oracle={:.9e} rel={:.3e} allowed={:.3e} ambiguity={:.3e} Σw−1={:.3e}{} techniques={:?}",
-                v.k, v.technique, r.weight, v.oracle, v.mismatch, v.allowed, v.ambiguity,
+                "k={} {:?} weight={:.9e} oracle={:.9e} rel={:.3e} allowed={:.3e} κ={:.3e} Σw−1={:.3e}{} techniques={:?}",
+                v.k, v.technique, r.weight, v.oracle, v.mismatch, v.allowed, v.condition,
                 v.sum_error, if sum_fail { " Σw−1 FAIL" } else { "" }, v.techniques
             ));
         }
@@ -455,7 +461,7 @@ impl fmt::Display for VcmReport {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         writeln!(
             f,
-            "mis-check {} {} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ max(τ={:e}, κ, 2δ); (b) |Σw−1| ≤ {:e} over connections and merges",
+            "mis-check {} {} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ max(τ={:e}, κ); (b) |Σw−1| ≤ {:e} over connections and merges",
             self.scene,
             self.options.name(),
             self.options.heuristic.name(),
@@ -465,7 +471,7 @@ impl fmt::Display for VcmReport {
         )?;
         writeln!(
             f,
-            "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9} {:>9} {:>9} {:>9} {:>8} {:>5} {:>5}",
+            "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9} {:>9} {:>9} {:>9} {:>5} {:>8} {:>5} {:>5}",
             "k",
             "conn",
             "merges",
@@ -474,7 +480,8 @@ impl fmt::Display for VcmReport {
             "max|Σw−1|",
             "rel conn",
             "rel merge",
-            "δ merge",
+            "rel κ≤τ",
+            "ill",
             "replay",
             "over",
             "Σfail"
@@ -482,7 +489,7 @@ impl fmt::Display for VcmReport {
         for r in &self.rows {
             writeln!(
                 f,
-                "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9.2e} {:>9.2e} {:>9.2e} {:>9.2e} {:>8.1e} {:>5} {:>5}",
+                "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9.2e} {:>9.2e} {:>9.2e} {:>9.2e} {:>5} {:>8.1e} {:>5} {:>5}",
                 r.k,
                 r.connections,
                 r.merges,
@@ -491,7 +498,8 @@ impl fmt::Display for VcmReport {
                 r.max_sum_error,
                 r.max_mismatch_connect,
                 r.max_mismatch_merge,
-                r.max_ambiguity,
+                r.max_mismatch_well,
+                r.ill,
                 r.max_replay_error,
                 r.over,
                 r.sum_fail
