@@ -27,9 +27,11 @@ use lt_estimators::blocks::{block_means, BlockEstimate};
 use lt_estimators::fit::fit_log_log;
 use lt_estimators::running::RunningStat;
 use lt_estimators::Image;
-use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
-use lt_tests::{render_blocks, shipped_scene};
-use std::ops::ControlFlow;
+use lt_integrators::IntegratorParams;
+use lt_tests::{
+    bias2_decrease, bias2_without_reference, inverse_variance_weights, reference_noise,
+    render_blocks, shipped_scene,
+};
 
 const BLOCK: usize = 8;
 const RUNS: u64 = 16;
@@ -38,112 +40,15 @@ fn scene() -> Scene {
     shipped_scene("cornell-box", Some((32, 32)))
 }
 
-/// `RUNS` independent runs, each run's estimate kept after every pass count in `checkpoints`:
-/// result[c][k] is run k at checkpoint c.
+/// `RUNS` independent runs on `scene()`, each run's estimate kept after every pass count in
+/// `checkpoints`: result[c][k] is run k at checkpoint c.
 fn runs_at(
     integrator: &str,
     params: &IntegratorParams,
     checkpoints: &[u32],
     seed: u64,
 ) -> Vec<Vec<Image>> {
-    let scene = scene();
-    let integ = make_integrator(integrator, &scene, params).unwrap();
-    let mut out = vec![Vec::new(); checkpoints.len()];
-    for k in 0..RUNS {
-        let opts = RenderOptions {
-            passes: *checkpoints.last().unwrap(),
-            time_limit: None,
-            seed: seed + k,
-            threads: 0,
-        };
-        let r = render(&scene, &integ, &opts, |r| {
-            if let Some(c) = checkpoints.iter().position(|&n| n == r.passes_done) {
-                out[c].push(r.estimate());
-            }
-            ControlFlow::Continue(())
-        })
-        .unwrap();
-        assert_eq!(r.invalid_samples, 0, "{integrator}: invalid samples");
-    }
-    out
-}
-
-/// Σ over blocks and channels of w [(x̄ − r)² − s²/K], over the runs `keep` selects.
-fn bias2_without_reference(
-    blocks: &[Image],
-    reference: &BlockEstimate,
-    weights: &[[f64; 3]],
-    keep: impl Fn(usize) -> bool,
-) -> f64 {
-    let mut sum = 0.0;
-    for b in 0..reference.regions() {
-        for c in 0..3 {
-            let s = RunningStat::from_slice(
-                &blocks
-                    .iter()
-                    .enumerate()
-                    .filter(|(k, _)| keep(*k))
-                    .map(|(_, x)| x.data[b][c])
-                    .collect::<Vec<_>>(),
-            );
-            let r = reference.mean[b][c];
-            sum +=
-                ((s.mean() - r).powi(2) - s.sample_variance() / s.count() as f64) * weights[b][c];
-        }
-    }
-    sum
-}
-
-/// Σ w se²_ref: the reference's own noise in S(N).
-fn reference_noise(reference: &BlockEstimate, weights: &[[f64; 3]]) -> f64 {
-    (0..reference.regions())
-        .flat_map(|b| (0..3).map(move |c| (b, c)))
-        .map(|(b, c)| reference.std_error[b][c].powi(2) * weights[b][c])
-        .sum()
-}
-
-/// Per block and channel, 1 / (the variance of the K-run mean at the last pass count + the
-/// reference's variance): blocks whose estimate is noisy (a light's edge, where the visible
-/// points' position within their pixels dominates) count less, in every S(N) alike.
-fn weights(last: &[Image], reference: &BlockEstimate) -> Vec<[f64; 3]> {
-    (0..reference.regions())
-        .map(|b| {
-            std::array::from_fn(|c| {
-                let s =
-                    RunningStat::from_slice(&last.iter().map(|x| x.data[b][c]).collect::<Vec<_>>());
-                1.0 / (s.sample_variance() / s.count() as f64 + reference.std_error[b][c].powi(2))
-            })
-        })
-        .collect()
-}
-
-/// Δ = S(a) − S(b) and its standard error (jackknife over runs + the reference's cross term).
-fn bias2_decrease(
-    a: &[Image],
-    b: &[Image],
-    reference: &BlockEstimate,
-    w: &[[f64; 3]],
-) -> (f64, f64) {
-    let k = a.len();
-    let s =
-        |x: &[Image], keep: &dyn Fn(usize) -> bool| bias2_without_reference(x, reference, w, keep);
-    let full = s(a, &|_| true) - s(b, &|_| true);
-    let loo: Vec<f64> = (0..k)
-        .map(|j| s(a, &|i| i != j) - s(b, &|i| i != j))
-        .collect();
-    let mean = loo.iter().sum::<f64>() / k as f64;
-    let jack = (k as f64 - 1.0) / k as f64 * loo.iter().map(|x| (x - mean).powi(2)).sum::<f64>();
-    let mut cross = 0.0;
-    for blk in 0..reference.regions() {
-        for c in 0..3 {
-            let m = |x: &[Image]| x.iter().map(|i| i.data[blk][c]).sum::<f64>() / k as f64;
-            cross += 4.0
-                * (m(a) - m(b)).powi(2)
-                * reference.std_error[blk][c].powi(2)
-                * w[blk][c].powi(2);
-        }
-    }
-    (full, (jack + cross).sqrt())
+    lt_tests::runs_at(&scene(), integrator, params, checkpoints, RUNS, seed)
 }
 
 /// The long unbiased reference, per block.
@@ -166,7 +71,7 @@ fn bias_of_progressive_photon_mapping_shrinks_with_passes() {
             .iter()
             .map(|rs| rs.iter().map(|r| block_means(r, BLOCK)).collect())
             .collect();
-        let w = weights(blocks.last().unwrap(), &reference);
+        let w = inverse_variance_weights(blocks.last().unwrap(), &reference);
         let noise = reference_noise(&reference, &w);
         let s: Vec<f64> = blocks
             .iter()

@@ -2,8 +2,8 @@
 
 use lt_core::scene::load_scene;
 use lt_core::Scene;
-use lt_estimators::blocks::RunningBlocks;
-use lt_estimators::running::RunningImage;
+use lt_estimators::blocks::{BlockEstimate, RunningBlocks};
+use lt_estimators::running::{RunningImage, RunningStat};
 use lt_estimators::Image;
 use lt_integrators::{make_integrator, render, IntegratorParams, Kind, RenderOptions};
 use std::ops::ControlFlow;
@@ -111,4 +111,119 @@ pub fn render_blocks(
             (rendered, blocks)
         }
     }
+}
+
+// Bias² of a consistent estimator against an unbiased reference, from K independent runs (moved
+// here from consistency.rs, which documents the statistic; vcm_consistency.rs uses it too).
+// Per block b and channel c, relative to the reference r: S(N) = Σ w [(x̄_b(N) − r_b)² −
+// s²_b(N)/K] − Σ w se²_ref,b, the unbiased estimate of Σ w bias², with inverse-variance weights w.
+
+/// `runs` independent runs (seeds `seed`, `seed + 1`, …) of `integrator` on `scene`, each run's
+/// estimate kept after every pass count in `checkpoints` (ascending): result[c][k] is run k at
+/// checkpoint c. Asserts that no run produced an invalid sample.
+pub fn runs_at(
+    scene: &Scene,
+    integrator: &str,
+    params: &IntegratorParams,
+    checkpoints: &[u32],
+    runs: u64,
+    seed: u64,
+) -> Vec<Vec<Image>> {
+    let integ = make_integrator(integrator, scene, params).unwrap();
+    let mut out = vec![Vec::new(); checkpoints.len()];
+    for k in 0..runs {
+        let opts = RenderOptions {
+            passes: *checkpoints.last().unwrap(),
+            time_limit: None,
+            seed: seed + k,
+            threads: 0,
+        };
+        let r = render(scene, &integ, &opts, |r| {
+            if let Some(c) = checkpoints.iter().position(|&n| n == r.passes_done) {
+                out[c].push(r.estimate());
+            }
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+        assert_eq!(r.invalid_samples, 0, "{integrator}: invalid samples");
+    }
+    out
+}
+
+/// Σ over blocks and channels of w [(x̄ − r)² − s²/K], over the runs `keep` selects.
+pub fn bias2_without_reference(
+    blocks: &[Image],
+    reference: &BlockEstimate,
+    weights: &[[f64; 3]],
+    keep: impl Fn(usize) -> bool,
+) -> f64 {
+    let mut sum = 0.0;
+    for b in 0..reference.regions() {
+        for c in 0..3 {
+            let s = RunningStat::from_slice(
+                &blocks
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| keep(*k))
+                    .map(|(_, x)| x.data[b][c])
+                    .collect::<Vec<_>>(),
+            );
+            let r = reference.mean[b][c];
+            sum +=
+                ((s.mean() - r).powi(2) - s.sample_variance() / s.count() as f64) * weights[b][c];
+        }
+    }
+    sum
+}
+
+/// Σ w se²_ref: the reference's own noise in S(N).
+pub fn reference_noise(reference: &BlockEstimate, weights: &[[f64; 3]]) -> f64 {
+    (0..reference.regions())
+        .flat_map(|b| (0..3).map(move |c| (b, c)))
+        .map(|(b, c)| reference.std_error[b][c].powi(2) * weights[b][c])
+        .sum()
+}
+
+/// Per block and channel, 1 / (the variance of the K-run mean at the last pass count + the
+/// reference's variance): blocks whose estimate is noisy (a light's edge, where the visible
+/// points' position within their pixels dominates) count less, in every S(N) alike.
+pub fn inverse_variance_weights(last: &[Image], reference: &BlockEstimate) -> Vec<[f64; 3]> {
+    (0..reference.regions())
+        .map(|b| {
+            std::array::from_fn(|c| {
+                let s =
+                    RunningStat::from_slice(&last.iter().map(|x| x.data[b][c]).collect::<Vec<_>>());
+                1.0 / (s.sample_variance() / s.count() as f64 + reference.std_error[b][c].powi(2))
+            })
+        })
+        .collect()
+}
+
+/// Δ = S(a) − S(b) and its standard error (jackknife over runs + the reference's cross term).
+pub fn bias2_decrease(
+    a: &[Image],
+    b: &[Image],
+    reference: &BlockEstimate,
+    w: &[[f64; 3]],
+) -> (f64, f64) {
+    let k = a.len();
+    let s =
+        |x: &[Image], keep: &dyn Fn(usize) -> bool| bias2_without_reference(x, reference, w, keep);
+    let full = s(a, &|_| true) - s(b, &|_| true);
+    let loo: Vec<f64> = (0..k)
+        .map(|j| s(a, &|i| i != j) - s(b, &|i| i != j))
+        .collect();
+    let mean = loo.iter().sum::<f64>() / k as f64;
+    let jack = (k as f64 - 1.0) / k as f64 * loo.iter().map(|x| (x - mean).powi(2)).sum::<f64>();
+    let mut cross = 0.0;
+    for blk in 0..reference.regions() {
+        for c in 0..3 {
+            let m = |x: &[Image]| x.iter().map(|i| i.data[blk][c]).sum::<f64>() / k as f64;
+            cross += 4.0
+                * (m(a) - m(b)).powi(2)
+                * reference.std_error[blk][c].powi(2)
+                * w[blk][c].powi(2);
+        }
+    }
+    (full, (jack + cross).sqrt())
 }
