@@ -169,6 +169,8 @@ struct MergeVertex {
     wi: Vec3,
     /// |n_g · ω_y| of y_j's own surface.
     cos_g: f32,
+    /// y_j's geometric normal.
+    ng: Vec3,
     beta: Color,
     /// Segments from the light (j).
     segments: u32,
@@ -303,6 +305,7 @@ impl<'a> Engine<'a> {
                     out.merge_vertex.push(MergeVertex {
                         wi: y.wo,
                         cos_g: y.ng.dot(y.wo).abs(),
+                        ng: y.ng,
                         beta: y.beta,
                         segments: d as u32 + 1,
                         chunk: c as u32,
@@ -720,8 +723,11 @@ impl<'a> Engine<'a> {
                 return;
             }
             // The light arrived on the side the camera looks from (a thin wall lit from behind
-            // stays dark in front), and not along the light vertex's own surface.
-            if zv.ng.dot(y.wi) * wo_side <= 0.0 || !(y.cos_g > 0.0) {
+            // stays dark in front), not along the light vertex's own surface, and on a surface
+            // facing the same way (within 90°): a photon on the sunlit outside of a wall is never
+            // merged at the inner surface meeting that wall at an edge (the leak the SmallVCM
+            // sun twin showed; Mitsuba's photon lookups test normals the same way).
+            if zv.ng.dot(y.wi) * wo_side <= 0.0 || !(y.cos_g > 0.0) || !(y.ng.dot(zv.ng) > 0.0) {
                 return;
             }
             let ev = bsdf.eval(&sf, zv.wo, y.wi, TransportMode::Radiance);
