@@ -723,11 +723,13 @@ impl<'a> Engine<'a> {
                 return;
             }
             // The light arrived on the side the camera looks from (a thin wall lit from behind
-            // stays dark in front), not along the light vertex's own surface, and on a surface
-            // facing the same way (within 90°): a photon on the sunlit outside of a wall is never
-            // merged at the inner surface meeting that wall at an edge (the leak the SmallVCM
-            // sun twin showed; Mitsuba's photon lookups test normals the same way).
-            if zv.ng.dot(y.wi) * wo_side <= 0.0 || !(y.cos_g > 0.0) || !(y.ng.dot(zv.ng) > 0.0) {
+            // stays dark in front), not along the light vertex's own surface, and on the same
+            // side of its own surface (front or back, by the shapes' normals) as the camera
+            // looks at z: light stored on the sunlit outside of a wall is never merged at the
+            // inner surface meeting that wall at an edge (the leak the SmallVCM sun twin showed),
+            // while merges across an inner corner stay.
+            let y_front = y.ng.dot(y.wi) > 0.0;
+            if zv.ng.dot(y.wi) * wo_side <= 0.0 || !(y.cos_g > 0.0) || y_front != (wo_side > 0.0) {
                 return;
             }
             let ev = bsdf.eval(&sf, zv.wo, y.wi, TransportMode::Radiance);
