@@ -140,8 +140,16 @@ fn smallvcm_twins_have_smallvcms_lights() {
     };
     // SmallVCM's DirectionalLight(-1, 1.5, -1) is the direction light travels; ours points back.
     assert!((d.direction - Vec3::new(1.0, -1.5, 1.0).normalize()).length() < 1e-6);
-    assert_eq!(d.irradiance, Color::new(10.0, 4.0, 0.0), "(0.5, 0.2, 0) x 20");
-    assert_eq!(s.shapes.len(), 12, "five walls, five light-box faces, two balls");
+    assert_eq!(
+        d.irradiance,
+        Color::new(10.0, 4.0, 0.0),
+        "(0.5, 0.2, 0) x 20"
+    );
+    assert_eq!(
+        s.shapes.len(),
+        12,
+        "five walls, five light-box faces, two balls"
+    );
     assert!(s.shapes.iter().all(|sh| sh.light.is_none()), "no emitter");
 
     let s = load("smallvcm-spheres-background");
