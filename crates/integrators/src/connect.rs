@@ -126,3 +126,67 @@ pub fn emission_densities(scene: &Scene, x0: &PathVertex, x1: Option<&PathVertex
     };
     (pmf * first as f64, x0.convert_density(second, x1) as f64)
 }
+
+/// A shadow-ray join of light vertex `y` and camera vertex `z` (both connectable surfaces): the
+/// two end evaluations and the unweighted contribution β_y f_y f_z β_z / d² (G's cosines are in
+/// the `f_cos`s). `None` when coincident, zero or occluded.
+pub struct Joined {
+    pub light_end: BsdfEval,
+    pub camera_end: BsdfEval,
+    pub value: Color,
+}
+
+pub fn join(scene: &Scene, y: &PathVertex, z: &PathVertex) -> Option<Joined> {
+    let d = y.p - z.p;
+    let d2 = d.length_squared();
+    if !(d2 > 0.0) {
+        return None;
+    }
+    let dir = d / d2.sqrt();
+    let light_end = eval_towards(scene, y, -dir, TransportMode::Importance)?;
+    let camera_end = eval_towards(scene, z, dir, TransportMode::Radiance)?;
+    let value = y.beta * light_end.f_cos * camera_end.f_cos * z.beta / d2;
+    (value != Color::ZERO && scene.connection_visible(y, z)).then_some(Joined {
+        light_end,
+        camera_end,
+        value,
+    })
+}
+
+/// Next-event estimation from camera vertex `z`: one light chosen by power and sampled towards
+/// it (three numbers from `sampler`, in this order, whatever happens after the choice).
+pub struct NextEvent {
+    /// x0 as `PathVertex::light_sampled` makes it (pdf_fwd = next-event's density).
+    pub x0: PathVertex,
+    /// z's BSDF towards x0 (radiance mode).
+    pub camera_end: BsdfEval,
+    /// β_z f_cos Le / (pmf pdf_w): the unweighted contribution.
+    pub value: Color,
+}
+
+pub fn next_event(
+    scene: &Scene,
+    z: &PathVertex,
+    sampler: &mut lt_core::sampling::Sampler,
+) -> Option<NextEvent> {
+    let (li, pmf, _) = scene.light_sampler.sample(sampler.next_f32())?;
+    let u = sampler.next_2d();
+    let ls = scene.lights[li].sample_li(z.p, u)?;
+    if ls.radiance == Color::ZERO || ls.pdf_w == 0.0 {
+        return None;
+    }
+    let camera_end = eval_towards(scene, z, ls.wi, TransportMode::Radiance)?;
+    if camera_end.f_cos == Color::ZERO {
+        return None;
+    }
+    let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, z);
+    if !scene.connection_visible(&x0, z) {
+        return None;
+    }
+    let value = z.beta * camera_end.f_cos * ls.radiance / (pmf * ls.pdf_w);
+    Some(NextEvent {
+        x0,
+        camera_end,
+        value,
+    })
+}

@@ -15,7 +15,9 @@
 //! rate, as in SmallVCM, α = 0.75); r₀ is pixel-footprint relative by default (at the mean
 //! primary-hit distance: one radius for the whole pass, which η needs) or scene relative.
 
-use crate::connect::{connect_to_camera, emission_densities, eval_towards, nee_density};
+use crate::connect::{
+    connect_to_camera, emission_densities, join, nee_density, next_event, Joined, NextEvent,
+};
 use crate::params::ParamReader;
 use crate::radius::InitialRadius;
 use crate::record::{Completed, Merged, NoRecord, Recorder};
@@ -486,7 +488,7 @@ impl<'a> Engine<'a> {
             }
             if self.params.connections {
                 if t <= max_k {
-                    l += self.next_event(mis, z, zr, t, &mut cs, raster, rec);
+                    l += self.next_event_weighted(mis, z, zr, t, &mut cs, raster, rec);
                 }
                 for s in 2..=y.len().min(max_k + 1 - t) {
                     l += self.connect(mis, y, ly, z, zr, s, t, raster, rec);
@@ -569,7 +571,7 @@ impl<'a> Engine<'a> {
     /// s = 1 at camera vertex z_{t−1}: one light chosen by power and sampled towards it (the
     /// random numbers `bdpt` draws, in its order).
     #[allow(clippy::too_many_arguments)]
-    fn next_event<R: Recorder>(
+    fn next_event_weighted<R: Recorder>(
         &self,
         mis: &SubpathMis,
         z: &[PathVertex],
@@ -581,26 +583,14 @@ impl<'a> Engine<'a> {
     ) -> Color {
         let scene = self.scene;
         let zv = &z[t - 1];
-        let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
+        let Some(NextEvent {
+            x0,
+            camera_end: ev_z,
+            value,
+        }) = next_event(scene, zv, sampler)
+        else {
             return Color::ZERO;
         };
-        let u = sampler.next_2d();
-        let Some(ls) = scene.lights[li].sample_li(zv.p, u) else {
-            return Color::ZERO;
-        };
-        if ls.radiance == Color::ZERO || ls.pdf_w == 0.0 {
-            return Color::ZERO;
-        }
-        let Some(ev_z) = eval_towards(scene, zv, ls.wi, TransportMode::Radiance) else {
-            return Color::ZERO;
-        };
-        if ev_z.f_cos == Color::ZERO {
-            return Color::ZERO;
-        }
-        let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, zv);
-        if !scene.connection_visible(&x0, zv) {
-            return Color::ZERO;
-        }
         let c0 = reverse_density(&x0, zv, ev_z.pdf_w) as f64;
         let (l0, l1) = emission_densities(scene, &x0, Some(zv));
         let l2 = if t >= 3 {
@@ -610,7 +600,6 @@ impl<'a> Engine<'a> {
         };
         let nee = x0.pdf_fwd as f64;
         let w = mis.next_event(&zr[t - 1], &zr[t - 2], nee, c0, l0, l1, l2);
-        let value = zv.beta * ev_z.f_cos * ls.radiance / (pmf * ls.pdf_w);
         if R::ACTIVE {
             rec.completed(Completed {
                 s: 1,
@@ -644,22 +633,14 @@ impl<'a> Engine<'a> {
         if !connectable(scene, yv) {
             return Color::ZERO;
         }
-        let d = yv.p - zv.p;
-        let d2 = d.length_squared();
-        if !(d2 > 0.0) {
-            return Color::ZERO;
-        }
-        let dir = d / d2.sqrt();
-        let (Some(ev_y), Some(ev_z)) = (
-            eval_towards(scene, yv, -dir, TransportMode::Importance),
-            eval_towards(scene, zv, dir, TransportMode::Radiance),
-        ) else {
+        let Some(Joined {
+            light_end: ev_y,
+            camera_end: ev_z,
+            value: c,
+        }) = join(scene, yv, zv)
+        else {
             return Color::ZERO;
         };
-        let c = yv.beta * ev_y.f_cos * ev_z.f_cos * zv.beta / d2;
-        if c == Color::ZERO || !scene.connection_visible(yv, zv) {
-            return Color::ZERO;
-        }
         let c_y = reverse_density(yv, zv, ev_z.pdf_w) as f64;
         let c_y_prev = reverse_density(&y[s - 2], yv, ev_y.pdf_rev_w) as f64;
         let l_z = yv.convert_density(ev_y.pdf_w, zv) as f64;
