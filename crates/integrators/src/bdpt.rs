@@ -20,13 +20,15 @@
 //! | `mis` | power/balance/none | power | heuristic over the strategies (none: uniform weights) |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
 
-use crate::connect::{connect_to_camera, emission_densities, eval_towards, nee_density};
+use crate::connect::{
+    connect_to_camera, emission_densities, join, nee_density, next_event, Joined, NextEvent,
+};
 use crate::params::ParamReader;
 use crate::record::{Completed, NoRecord, Recorder};
 use crate::splat::{splat_pass_with, Splats};
 use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::Integrator;
-use lt_core::bsdf::{BsdfEval, TransportMode};
+use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
 use lt_core::path::scatter::connectable;
 use lt_core::path::{Chain, Heuristic, PathVertex, VertexKind};
@@ -330,7 +332,7 @@ impl Bdpt {
             }
             // s = 1: next-event estimation from z_{t−1}.
             if t <= max_k {
-                l += self.next_event(scene, z, t, &mut cs, ratio, raster, rec);
+                l += self.next_event_weighted(scene, z, t, &mut cs, ratio, raster, rec);
             }
             // s ≥ 2: shadow rays to the light subpath's vertices.
             for s in 2..=y.len().min(max_k + 1 - t) {
@@ -338,22 +340,14 @@ impl Bdpt {
                 if !connectable(scene, yv) {
                     continue;
                 }
-                let d = yv.p - zv.p;
-                let d2 = d.length_squared();
-                if !(d2 > 0.0) {
-                    continue;
-                }
-                let dir = d / d2.sqrt();
-                let (Some(ev_y), Some(ev_z)) = (
-                    eval_towards(scene, yv, -dir, TransportMode::Importance),
-                    eval_towards(scene, zv, dir, TransportMode::Radiance),
-                ) else {
+                let Some(Joined {
+                    light_end: ev_y,
+                    camera_end: ev_z,
+                    value: c,
+                }) = join(scene, yv, zv)
+                else {
                     continue;
                 };
-                let c = yv.beta * ev_y.f_cos * ev_z.f_cos * zv.beta / d2;
-                if c == Color::ZERO || !scene.connection_visible(yv, zv) {
-                    continue;
-                }
                 let split = Split {
                     light: &y[..s],
                     camera: &z[..t],
@@ -445,7 +439,7 @@ impl Bdpt {
 
     /// Strategy s = 1 at camera vertex z_{t−1}: one light chosen by power and sampled towards it.
     #[allow(clippy::too_many_arguments)]
-    fn next_event<R: Recorder>(
+    fn next_event_weighted<R: Recorder>(
         &self,
         scene: &Scene,
         z: &[PathVertex],
@@ -455,27 +449,14 @@ impl Bdpt {
         raster: Vec2,
         rec: &mut R,
     ) -> Color {
-        let zv = &z[t - 1];
-        let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
+        let Some(NextEvent {
+            x0,
+            camera_end: ev_z,
+            value,
+        }) = next_event(scene, &z[t - 1], sampler)
+        else {
             return Color::ZERO;
         };
-        let u = sampler.next_2d();
-        let Some(ls) = scene.lights[li].sample_li(zv.p, u) else {
-            return Color::ZERO;
-        };
-        if ls.radiance == Color::ZERO || ls.pdf_w == 0.0 {
-            return Color::ZERO;
-        }
-        let Some(ev_z) = eval_towards(scene, zv, ls.wi, TransportMode::Radiance) else {
-            return Color::ZERO;
-        };
-        if ev_z.f_cos == Color::ZERO {
-            return Color::ZERO;
-        }
-        let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, zv);
-        if !scene.connection_visible(&x0, zv) {
-            return Color::ZERO;
-        }
         let split = Split {
             light: std::slice::from_ref(&x0),
             camera: &z[..t],
@@ -492,12 +473,12 @@ impl Bdpt {
                 light: std::slice::from_ref(&x0),
                 camera: &z[..t],
                 weight: w,
-                value: zv.beta * ev_z.f_cos * ls.radiance / (pmf * ls.pdf_w),
+                value,
                 raster,
                 alternatives: &[],
             });
         }
-        zv.beta * ev_z.f_cos * ls.radiance * (w as f32 / (pmf * ls.pdf_w))
+        value * w as f32
     }
 
     /// One pass with every path reported to `rec` (for `lt mis-check`), pixel by pixel on one
