@@ -2,10 +2,17 @@
 
 pub mod bench;
 pub mod bench_cmd;
+pub mod cache;
+pub mod cluster;
 pub mod compare;
+pub mod convert_cmd;
 pub mod image_io;
 pub mod integrator_args;
 pub mod mis_check;
 pub mod mis_check_vcm;
+pub mod plot;
+pub mod reference_cmd;
 pub mod render_cmd;
+pub mod report;
 pub mod strategies;
+pub mod study;

@@ -1,6 +1,8 @@
-//! `lt` — the testbed's command line: render scenes, compare images, list integrators.
+//! `lt` — the testbed's command line: render scenes, compare images, run the studies, plan and
+//! merge work for a cluster, convert scenes.
 
 use clap::{Parser, Subcommand};
+use lt_experiments as x;
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -13,13 +15,32 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to EXR (+ PNG preview, standard-error EXR, JSON record).
-    Render(lt_experiments::render_cmd::RenderArgs),
+    Render(x::render_cmd::RenderArgs),
     /// Compare two EXR images: metrics, per-block z-scores, and OpenImageIO's view when installed.
-    Compare(lt_experiments::compare::CompareArgs),
+    Compare(x::compare::CompareArgs),
     /// Measure BVH and integrator throughput (results/bench.md).
-    Bench(lt_experiments::bench_cmd::BenchArgs),
+    Bench(x::bench_cmd::BenchArgs),
     /// Check an integrator's MIS weights (pt, bdpt) against the from-scratch path-space oracle.
-    MisCheck(lt_experiments::mis_check::MisCheckArgs),
+    MisCheck(x::mis_check::MisCheckArgs),
+    /// Render (or reuse from the cache) a long reference image of a scene.
+    Reference(x::reference_cmd::ReferenceArgs),
+    /// Run a study (convergence, unbiased-vs-consistent, radius-shrinkage, equal-time,
+    /// per-length, or all) into results/<study>/.
+    Study(x::study::StudyArgs),
+    /// Write results/index.html from the studies' outputs.
+    Report(x::report::ReportArgs),
+    /// Write one of our scenes as Mitsuba 3 XML.
+    Convert(x::convert_cmd::ConvertArgs),
+    /// Merge partial renders (--partial) or independent runs exactly into one image.
+    Merge(x::cluster::MergeArgs),
+    /// Split a render or a study into independent shards for a cluster.
+    Plan(x::cluster::PlanArgs),
+    /// Run one shard of a plan.
+    RunShard(x::cluster::RunShardArgs),
+    /// Hand a plan to Slurm, GNU parallel or the local pool.
+    Submit(x::cluster::SubmitArgs),
+    /// Merge a plan's finished shards into its render or study outputs.
+    Collect(x::cluster::CollectArgs),
     /// List the integrators.
     List,
 }
@@ -27,10 +48,19 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Render(a) => lt_experiments::render_cmd::run(a),
-        Command::Compare(a) => lt_experiments::compare::run(a).map(|report| print!("{report}")),
-        Command::Bench(a) => lt_experiments::bench_cmd::run(a).map(|table| print!("{table}")),
-        Command::MisCheck(a) => lt_experiments::mis_check::run(a).map(|table| print!("{table}")),
+        Command::Render(a) => x::render_cmd::run(a),
+        Command::Compare(a) => x::compare::run(a).map(|report| print!("{report}")),
+        Command::Bench(a) => x::bench_cmd::run(a).map(|table| print!("{table}")),
+        Command::MisCheck(a) => x::mis_check::run(a).map(|table| print!("{table}")),
+        Command::Reference(a) => x::reference_cmd::run(a),
+        Command::Study(a) => x::study::run(a),
+        Command::Report(a) => x::report::run(a),
+        Command::Convert(a) => x::convert_cmd::run(a),
+        Command::Merge(a) => x::cluster::merge(a),
+        Command::Plan(a) => x::cluster::plan(a),
+        Command::RunShard(a) => x::cluster::run_shard(a),
+        Command::Submit(a) => x::cluster::submit(a),
+        Command::Collect(a) => x::cluster::collect(a),
         Command::List => {
             for i in lt_integrators::INTEGRATORS {
                 println!("{:10} {}", i.name, i.about);
