@@ -309,6 +309,7 @@ impl SceneBuilder {
             light_sampler,
             infinite_lights,
             bounding_sphere,
+            source_files: Vec::new(),
             accel,
         }
     }

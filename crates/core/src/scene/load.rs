@@ -52,7 +52,12 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
         Some(span) => ctx.at(span, e.message().trim_end().to_string()),
         None => ctx.whole(e.message().trim_end().to_string()),
     })?;
-    super::elements::assemble(&ctx, &file)
+    let mut scene = super::elements::assemble(&ctx, &file)?;
+    let meshes = file.shapes.iter().filter_map(|s| s.get_ref().file.as_ref());
+    scene.source_files = std::iter::once(path.to_path_buf())
+        .chain(meshes.map(|f| ctx.base_dir.join(f.get_ref())))
+        .collect();
+    Ok(scene)
 }
 
 /// What error messages need: the file's name and text (for line numbers) and its directory.

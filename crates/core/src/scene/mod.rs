@@ -73,6 +73,9 @@ pub struct Scene {
     pub infinite_lights: Vec<u32>,
     /// Bounding sphere of the geometry (centre, radius): distant lights emit over its disk.
     pub bounding_sphere: (Vec3, f32),
+    /// The files the scene was read from, the scene file first, then every mesh it names in file
+    /// order: what a content hash of the scene must cover. Empty for scenes built in code.
+    pub source_files: Vec<std::path::PathBuf>,
     pub(crate) accel: Accel,
 }
 
