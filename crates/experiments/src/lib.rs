@@ -8,6 +8,7 @@ pub mod compare;
 pub mod convert_cmd;
 pub mod image_io;
 pub mod integrator_args;
+pub mod manifest;
 pub mod mis_check;
 pub mod mis_check_vcm;
 pub mod plot;
