@@ -1,1 +1,185 @@
-//! The content-addressed cache of finished renders (not yet).
+//! The one content-addressed cache of finished work: references, study runs and cluster shards
+//! all live in it. An entry is a folder named by the hash of what made it — the key material (a
+//! JSON value: scene content hash, integrator, parameters, seeds, pass counts) together with the
+//! code version — so a rerun finds what is finished and redoes nothing, and any change to a scene
+//! or to the rendering code makes new entries instead of serving stale ones.
+//!
+//! An entry is built in a temporary folder and renamed into place, so an interrupted run leaves
+//! no half-written entry: it is either finished and complete, or absent.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Hash of the sources that decide what a render produces (see build.rs).
+pub const CODE_VERSION: &str = env!("LT_CODE_VERSION");
+
+/// The file in every entry holding its key material, for a reader who wants to know what it is.
+pub const KEY_FILE: &str = "key.json";
+
+static BUILT: AtomicU64 = AtomicU64::new(0);
+static REUSED: AtomicU64 = AtomicU64::new(0);
+
+/// Entries this process built and found finished: what a resumed run reports.
+pub fn counts() -> (u64, u64) {
+    (BUILT.load(Ordering::SeqCst), REUSED.load(Ordering::SeqCst))
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Key(pub String);
+
+impl std::fmt::Display for Key {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// The key of some material: blake3 over the code version and the canonical JSON (serde_json's
+/// maps are sorted, so equal values serialise to equal bytes).
+pub fn key_of(material: &Value) -> Key {
+    let mut h = blake3::Hasher::new();
+    h.update(CODE_VERSION.as_bytes());
+    h.update(b"\n");
+    h.update(material.to_string().as_bytes());
+    Key(h.finalize().to_hex()[..32].to_string())
+}
+
+/// The content hash of a scene: every file it was read from (`Scene::source_files`), names
+/// excluded, so a moved or copied scene keeps its hash and an edited mesh changes it.
+pub fn scene_hash(files: &[PathBuf]) -> Result<String, String> {
+    if files.is_empty() {
+        return Err("the scene names no source files, so it has no content hash".into());
+    }
+    let mut h = blake3::Hasher::new();
+    for f in files {
+        let bytes =
+            std::fs::read(f).map_err(|e| format!("cannot read {} to hash it: {e}", f.display()))?;
+        h.update(&(bytes.len() as u64).to_le_bytes());
+        h.update(&bytes);
+    }
+    Ok(h.finalize().to_hex()[..32].to_string())
+}
+
+#[derive(Clone, Debug)]
+pub struct Cache {
+    pub root: PathBuf,
+}
+
+impl Cache {
+    pub fn new(root: impl Into<PathBuf>) -> Cache {
+        Cache { root: root.into() }
+    }
+
+    /// Where the entry of `key` lives (whether or not it is finished).
+    pub fn path(&self, key: &Key) -> PathBuf {
+        self.root.join(&key.0[..2]).join(&key.0)
+    }
+
+    /// The finished entry of `key`, if there is one.
+    pub fn lookup(&self, key: &Key) -> Option<PathBuf> {
+        let p = self.path(key);
+        p.join(KEY_FILE).is_file().then_some(p)
+    }
+
+    /// The entry of `material`: the finished one if it exists, else `build` fills a fresh folder
+    /// which then becomes the entry in one rename. When two processes race, the first rename
+    /// wins and the other's folder is dropped; both return the winner.
+    pub fn get_or_build(
+        &self,
+        material: &Value,
+        build: impl FnOnce(&Path) -> Result<(), String>,
+    ) -> Result<PathBuf, String> {
+        let key = key_of(material);
+        if let Some(p) = self.lookup(&key) {
+            REUSED.fetch_add(1, Ordering::SeqCst);
+            return Ok(p);
+        }
+        let dest = self.path(&key);
+        let parent = dest.parent().expect("entries have a parent folder");
+        std::fs::create_dir_all(parent)
+            .map_err(|e| format!("cannot create the cache folder {}: {e}", parent.display()))?;
+        let tmp = parent.join(format!(".tmp-{}-{}", key.0, std::process::id()));
+        let _ = std::fs::remove_dir_all(&tmp);
+        std::fs::create_dir_all(&tmp)
+            .map_err(|e| format!("cannot create {}: {e}", tmp.display()))?;
+        let result = build(&tmp).and_then(|()| {
+            let text = serde_json::to_string_pretty(&serde_json::json!({
+                "code_version": CODE_VERSION,
+                "material": material,
+            }))
+            .map_err(|e| e.to_string())?;
+            std::fs::write(tmp.join(KEY_FILE), text)
+                .map_err(|e| format!("cannot write {}: {e}", tmp.join(KEY_FILE).display()))
+        });
+        if let Err(e) = result {
+            let _ = std::fs::remove_dir_all(&tmp);
+            return Err(e);
+        }
+        match std::fs::rename(&tmp, &dest) {
+            Ok(()) => {
+                BUILT.fetch_add(1, Ordering::SeqCst);
+                Ok(dest)
+            }
+            Err(_) if self.lookup(&key).is_some() => {
+                let _ = std::fs::remove_dir_all(&tmp);
+                REUSED.fetch_add(1, Ordering::SeqCst);
+                Ok(dest)
+            }
+            Err(e) => {
+                let _ = std::fs::remove_dir_all(&tmp);
+                Err(format!(
+                    "cannot move the finished entry into {}: {e}",
+                    dest.display()
+                ))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp_cache(name: &str) -> Cache {
+        let dir = std::env::temp_dir().join(format!("lt-cache-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        Cache::new(dir)
+    }
+
+    #[test]
+    fn equal_material_is_built_once_and_different_material_twice() {
+        let cache = temp_cache("once");
+        let mut builds = 0;
+        let a = serde_json::json!({"seed": 1, "integrator": "pt"});
+        // Same map, other insertion order: the same key.
+        let a2 = serde_json::json!({"integrator": "pt", "seed": 1});
+        let b = serde_json::json!({"seed": 2, "integrator": "pt"});
+        for m in [&a, &a2, &b, &a] {
+            cache
+                .get_or_build(m, |dir| {
+                    builds += 1;
+                    std::fs::write(dir.join("x"), b"1").map_err(|e| e.to_string())
+                })
+                .unwrap();
+        }
+        assert_eq!(builds, 2);
+        assert_eq!(key_of(&a), key_of(&a2));
+        assert_ne!(key_of(&a), key_of(&b));
+    }
+
+    #[test]
+    fn a_failed_build_leaves_no_entry() {
+        let cache = temp_cache("fail");
+        let m = serde_json::json!({"n": 1});
+        let r = cache.get_or_build(&m, |dir| {
+            std::fs::write(dir.join("half"), b"x").unwrap();
+            Err("interrupted".into())
+        });
+        assert!(r.is_err());
+        assert!(cache.lookup(&key_of(&m)).is_none());
+        let leftovers = std::fs::read_dir(cache.path(&key_of(&m)).parent().unwrap())
+            .unwrap()
+            .count();
+        assert_eq!(leftovers, 0, "the temporary folder is removed");
+    }
+}

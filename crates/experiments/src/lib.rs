@@ -15,5 +15,6 @@ pub mod plot;
 pub mod reference_cmd;
 pub mod render_cmd;
 pub mod report;
+pub mod runs;
 pub mod strategies;
 pub mod study;
