@@ -9,6 +9,7 @@ pub mod blocks;
 pub mod efficiency;
 pub mod fit;
 pub mod image;
+pub mod jackknife;
 pub mod metrics;
 pub mod running;
 
@@ -25,5 +26,6 @@ pub use blocks::{block_means, BlockEstimate, RunningBlocks};
 pub use efficiency::{efficiency, time_to_mse, time_to_mse_extrapolated};
 pub use fit::{fit_line, fit_log_log, LineFit};
 pub use image::Image;
+pub use jackknife::{jackknife, Jackknifed};
 pub use metrics::{image_metrics, psnr, ChannelMetrics, ImageMetrics};
 pub use running::{RunningImage, RunningStat};
