@@ -6,6 +6,8 @@ pub mod cache;
 pub mod cluster;
 pub mod compare;
 pub mod convert_cmd;
+pub mod flip;
+pub mod gallery;
 pub mod image_io;
 pub mod integrator_args;
 pub mod manifest;

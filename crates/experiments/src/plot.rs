@@ -1,7 +1,32 @@
 //! Charts the studies draw, written as SVG and PNG with the font that ships in the repository
 //! (no system fonts). The studies describe a chart; this module alone knows plotters.
+//!
+//! - Axes are linear or log₁₀ (`log_x`, `log_y`). A log axis is drawn as a linear axis over
+//!   log₁₀ of the data with its own ticks: decades (and 2…9 between them as light lines), or
+//!   1-2-5 steps when less than two decades are in view.
+//! - Points that are not finite, or not positive on a log axis, are skipped (a skipped point
+//!   breaks the line); a chart with nothing left to draw still writes both files, saying
+//!   "no data". Nothing here panics on data.
+//! - An error bar is drawn for each point with a finite `y_interval`; on a log y axis a
+//!   non-positive lower end (a bias² interval that includes 0) runs to the bottom of the plot.
+//! - Colours are the Okabe–Ito palette (colour-blind safe, ordered so neighbours differ in
+//!   lightness) and each measured series also gets its own marker shape, so the series stay
+//!   apart in grayscale. A `Style::Fitted` series is a dashed line without markers, in the colour
+//!   of the measured series whose name is the longest prefix of its own name ("pt" → "pt fit"),
+//!   or the next colour when there is none.
+//! - The legend sits in a column right of the plot, so it never covers data.
+//! - Text is DejaVu Sans (`assets/fonts/`), embedded and registered with plotters' `ab_glyph`
+//!   backend; the SVG names the same family with generic fall-backs for viewers without it.
 
+use crate::image_io::{write_atomic, write_atomic_with};
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
 use std::path::{Path, PathBuf};
+use std::sync::Once;
 
 /// How a series is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,7 +57,816 @@ pub struct Chart {
     pub series: Vec<Series>,
 }
 
+/// Pixel size of both the PNG and the SVG canvas.
+pub const CHART_SIZE: (u32, u32) = (960, 600);
+
+/// The family name the embedded font is registered under (and the SVG asks for).
+const FONT: &str = "DejaVu Sans";
+static FONT_BYTES: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+static REGISTER: Once = Once::new();
+
+fn register_font() {
+    REGISTER.call_once(|| {
+        // The file is part of the source tree: it parses or the build is broken.
+        if plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES).is_err() {
+            panic!("assets/fonts/DejaVuSans.ttf is not a font");
+        }
+    });
+}
+
+/// Okabe & Ito's colour-blind-safe palette (yellow left out: unreadable on white), ordered so
+/// that consecutive colours differ in lightness as well as hue.
+const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),   // blue
+    RGBColor(213, 94, 0),    // vermillion
+    RGBColor(0, 158, 115),   // bluish green
+    RGBColor(0, 0, 0),       // black
+    RGBColor(230, 159, 0),   // orange
+    RGBColor(204, 121, 167), // reddish purple
+    RGBColor(86, 180, 233),  // sky blue
+];
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Marker {
+    Circle,
+    Square,
+    Triangle,
+    Diamond,
+}
+
+const MARKERS: [Marker; 4] = [
+    Marker::Circle,
+    Marker::Square,
+    Marker::Triangle,
+    Marker::Diamond,
+];
+
+/// How one series is drawn: colour, marker (measured only), whether filled, dashed.
+#[derive(Clone, Copy, Debug)]
+struct Look {
+    color: RGBColor,
+    marker: Option<(Marker, bool)>,
+    dashed: bool,
+}
+
+/// Looks for every series, in order (see the module comment for the rules).
+fn looks(series: &[Series]) -> Vec<Look> {
+    let mut next = 0usize;
+    let mut measured: Vec<(usize, &str, usize)> = Vec::new(); // (series, name, colour index)
+    let mut out = Vec::with_capacity(series.len());
+    for (i, s) in series.iter().enumerate() {
+        match s.style {
+            Style::Measured => {
+                let k = next;
+                next += 1;
+                measured.push((i, &s.name, k));
+                // Markers cycle faster than colours and go hollow on the second round of
+                // colours, so (colour, marker, fill) stays distinct for 56 series.
+                let marker = MARKERS[k % MARKERS.len()];
+                let filled = (k / PALETTE.len()) % 2 == 0;
+                out.push(Look {
+                    color: PALETTE[k % PALETTE.len()],
+                    marker: Some((marker, filled)),
+                    dashed: false,
+                });
+            }
+            Style::Fitted => {
+                let parent = measured
+                    .iter()
+                    .filter(|(_, name, _)| !name.is_empty() && s.name.starts_with(name))
+                    .max_by_key(|(_, name, _)| name.len());
+                let k = match parent {
+                    Some(&(_, _, k)) => k,
+                    None => {
+                        next += 1;
+                        next - 1
+                    }
+                };
+                out.push(Look {
+                    color: PALETTE[k % PALETTE.len()],
+                    marker: None,
+                    dashed: true,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// One axis: whether it is log₁₀, and the range drawn (in plotted units: log₁₀ of the data on
+/// a log axis).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Axis {
+    log: bool,
+    lo: f64,
+    hi: f64,
+}
+
+impl Axis {
+    /// Data value → plotted value, or None when it cannot be drawn on this axis.
+    fn to_plot(log: bool, v: f64) -> Option<f64> {
+        if !v.is_finite() {
+            None
+        } else if log {
+            if v > 0.0 {
+                Some(v.log10())
+            } else {
+                None
+            }
+        } else {
+            Some(v)
+        }
+    }
+
+    /// The range covering `values` (plotted units) with a 5 % margin; None when empty.
+    fn covering(log: bool, values: impl Iterator<Item = f64>) -> Option<Axis> {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for v in values {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        if !(lo <= hi) {
+            return None;
+        }
+        let span = hi - lo;
+        let pad = if span > 0.0 {
+            0.05 * span
+        } else if log {
+            0.5
+        } else {
+            (lo.abs() * 0.1).max(1.0)
+        };
+        Some(Axis {
+            log,
+            lo: lo - pad,
+            hi: hi + pad,
+        })
+    }
+
+    /// (bold ticks with labels, light ticks), in plotted units.
+    fn ticks(&self) -> (Vec<f64>, Vec<f64>) {
+        if self.log {
+            log_ticks(self.lo, self.hi)
+        } else {
+            (linear_ticks(self.lo, self.hi), Vec::new())
+        }
+    }
+
+    /// Tick labels for `ticks` (plotted units). On a log axis whose ticks leave the range
+    /// plain decimals cover, every label is written m×10ᵉ, so one axis reads one way.
+    fn labeller(&self, ticks: &[f64]) -> impl Fn(&f64) -> String {
+        let log = self.log;
+        let powers = log
+            && ticks
+                .iter()
+                .any(|&t| !(1e-3..1e5).contains(&10f64.powf(t).abs()));
+        move |&v: &f64| {
+            if !log {
+                format_number(v)
+            } else if powers {
+                format_power(10f64.powf(v))
+            } else {
+                format_number(10f64.powf(v))
+            }
+        }
+    }
+}
+
+/// Ticks at 1, 2 or 5 × 10ᵏ, about six across [lo, hi].
+fn linear_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let span = hi - lo;
+    if !(span > 0.0) || !span.is_finite() {
+        return vec![lo];
+    }
+    let raw = span / 6.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last)
+        .map(|i| {
+            let v = i as f64 * step;
+            // Snap values that should be 0 (−1e-17 and the like).
+            if v.abs() < step * 1e-9 {
+                0.0
+            } else {
+                v
+            }
+        })
+        .collect()
+}
+
+/// Log₁₀ ticks over [lo, hi] (exponents): every decade (every 2nd, 3rd… when there are many)
+/// with 2…9 as light ticks; with less than two decades in view, 1-2-5 bold and the rest light.
+fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let (d0, d1) = (lo.floor() as i64, hi.ceil() as i64);
+    let inside = |v: f64| v >= lo - 1e-12 && v <= hi + 1e-12;
+    let decades = hi - lo;
+    let (mut bold, mut light) = (Vec::new(), Vec::new());
+    if decades >= 2.0 {
+        let every = ((decades / 8.0).ceil() as i64).max(1);
+        for d in d0..=d1 {
+            let v = d as f64;
+            if inside(v) && d.rem_euclid(every) == 0 {
+                bold.push(v);
+            } else if inside(v) {
+                light.push(v);
+            }
+            if every == 1 {
+                for m in 2..=9 {
+                    let w = v + (m as f64).log10();
+                    if inside(w) {
+                        light.push(w);
+                    }
+                }
+            }
+        }
+    } else {
+        for d in d0..=d1 {
+            for m in 1..=9 {
+                let w = d as f64 + (m as f64).log10();
+                if !inside(w) {
+                    continue;
+                }
+                if m == 1 || m == 2 || m == 5 || decades < 0.5 {
+                    bold.push(w);
+                } else {
+                    light.push(w);
+                }
+            }
+        }
+        if bold.len() < 2 {
+            // Less than a factor of 2 in view: fall back to linear steps in the data.
+            let lin = linear_ticks(10f64.powf(lo), 10f64.powf(hi));
+            bold = lin
+                .into_iter()
+                .filter(|v| *v > 0.0)
+                .map(f64::log10)
+                .collect();
+            light.clear();
+        }
+    }
+    (bold, light)
+}
+
+/// A linear coordinate over plotted units with our own ticks (plotters' `WithKeyPoints` over
+/// f64 takes no label formatter).
+struct Ticked {
+    inner: RangedCoordf64,
+    bold: Vec<f64>,
+    light: Vec<f64>,
+}
+
+impl Ticked {
+    fn new(axis: &Axis) -> Ticked {
+        let (bold, light) = axis.ticks();
+        Ticked {
+            inner: (axis.lo..axis.hi).into(),
+            bold,
+            light,
+        }
+    }
+}
+
+impl Ranged for Ticked {
+    type ValueType = f64;
+    type FormatOption = DefaultFormatting;
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(value, limit)
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            self.light.clone()
+        } else {
+            self.bold.clone()
+        }
+    }
+}
+
+/// A tick label: plain decimals between 10⁻³ and 10⁵, else m×10ᵉ with superscripts.
+pub fn format_number(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    let a = v.abs();
+    if (1e-3..1e5).contains(&a) {
+        // Enough decimals for 3 significant digits, trailing zeros dropped.
+        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{v:.decimals$}");
+        let s = if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        };
+        return s.replace('-', "−");
+    }
+    format_power(v)
+}
+
+/// m×10ᵉ with a superscript exponent ("10⁻³" when m is 1).
+pub fn format_power(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format_number(v);
+    }
+    // Rounding: 9.9996e-4 must read 10⁻³, not 10×10⁻⁴.
+    let mut e = v.abs().log10().floor() as i32;
+    if (v.abs() / 10f64.powi(e) * 100.0).round() >= 1000.0 {
+        e += 1;
+    }
+    let m = v / 10f64.powi(e);
+    let exp = superscript(e);
+    let ms = format!("{m:.2}");
+    let ms = ms
+        .trim_end_matches('0')
+        .trim_end_matches('.')
+        .replace('-', "−");
+    match ms.as_str() {
+        "1" => format!("10{exp}"),
+        "−1" => format!("−10{exp}"),
+        _ => format!("{ms}×10{exp}"),
+    }
+}
+
+fn superscript(e: i32) -> String {
+    const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let mut s = String::new();
+    if e < 0 {
+        s.push('⁻');
+    }
+    for c in e.unsigned_abs().to_string().chars() {
+        s.push(DIGITS[c.to_digit(10).unwrap_or(0) as usize]);
+    }
+    s
+}
+
+/// A series in plotted units: runs of drawable points (a skipped point ends a run) and error
+/// bars (x, low, high), low None when it runs to the bottom of the plot.
+struct Prepared {
+    runs: Vec<Vec<(f64, f64)>>,
+    bars: Vec<(f64, Option<f64>, f64)>,
+}
+
+fn prepare(chart: &Chart) -> Vec<Prepared> {
+    chart
+        .series
+        .iter()
+        .map(|s| {
+            let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+            let mut bars = Vec::new();
+            for (i, &(x, y)) in s.points.iter().enumerate() {
+                let px = Axis::to_plot(chart.log_x, x);
+                let py = Axis::to_plot(chart.log_y, y);
+                match (px, py) {
+                    (Some(px), Some(py)) => {
+                        runs.last_mut().expect("one run at least").push((px, py));
+                        if let Some(&(lo, hi)) = s.y_interval.get(i) {
+                            if let Some(phi) = Axis::to_plot(chart.log_y, hi) {
+                                if lo.is_finite() && lo <= hi {
+                                    let plo = Axis::to_plot(chart.log_y, lo);
+                                    bars.push((px, plo, phi));
+                                }
+                            }
+                        }
+                    }
+                    _ => {
+                        if !runs.last().expect("one run at least").is_empty() {
+                            runs.push(Vec::new());
+                        }
+                    }
+                }
+            }
+            runs.retain(|r| !r.is_empty());
+            Prepared { runs, bars }
+        })
+        .collect()
+}
+
 /// Writes `stem.svg` and `stem.png` and returns both paths (svg, png).
-pub fn write_chart(_stem: &Path, _chart: &Chart) -> Result<(PathBuf, PathBuf), String> {
-    Err("plots are not written yet".into())
+pub fn write_chart(stem: &Path, chart: &Chart) -> Result<(PathBuf, PathBuf), String> {
+    register_font();
+    let svg_path = with_suffix(stem, "svg");
+    let png_path = with_suffix(stem, "png");
+    if let Some(dir) = stem.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    let prepared = prepare(chart);
+
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, CHART_SIZE).into_drawing_area();
+        draw(&root, chart, &prepared).map_err(|e| format!("{}: {e}", svg_path.display()))?;
+        root.present()
+            .map_err(|e| format!("{}: {e}", svg_path.display()))?;
+    }
+    let svg = svg.replace(
+        &format!("font-family=\"{FONT}\""),
+        &format!("font-family=\"{FONT}, Verdana, Arial, sans-serif\""),
+    );
+    write_atomic(&svg_path, svg.as_bytes())?;
+
+    let (w, h) = CHART_SIZE;
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, CHART_SIZE).into_drawing_area();
+        draw(&root, chart, &prepared).map_err(|e| format!("{}: {e}", png_path.display()))?;
+        root.present()
+            .map_err(|e| format!("{}: {e}", png_path.display()))?;
+    }
+    let img = image::RgbImage::from_raw(w, h, rgb).expect("buffer matches size");
+    write_atomic_with(&png_path, |tmp| {
+        img.save_with_format(tmp, image::ImageFormat::Png)
+            .map_err(|e| format!("cannot write PNG {}: {e}", png_path.display()))
+    })?;
+    Ok((svg_path, png_path))
+}
+
+/// `stem` with `.ext` appended (a stem may contain dots: "mse.spp" → "mse.spp.svg").
+fn with_suffix(stem: &Path, ext: &str) -> PathBuf {
+    let mut s = stem.as_os_str().to_owned();
+    s.push(".");
+    s.push(ext);
+    PathBuf::from(s)
+}
+
+fn font(size: f64) -> TextStyle<'static> {
+    (FONT, size).into_font().color(&BLACK)
+}
+
+type DrawResult<E> = Result<(), DrawingAreaErrorKind<E>>;
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &Chart,
+    prepared: &[Prepared],
+) -> DrawResult<DB::ErrorType> {
+    root.fill(&WHITE)?;
+    let xs = prepared
+        .iter()
+        .flat_map(|p| p.runs.iter().flatten().map(|&(x, _)| x));
+    let ys = prepared.iter().flat_map(|p| {
+        p.runs.iter().flatten().map(|&(_, y)| y).chain(
+            p.bars
+                .iter()
+                .flat_map(|&(_, lo, hi)| lo.into_iter().chain([hi])),
+        )
+    });
+    let (x_axis, y_axis) = match (
+        Axis::covering(chart.log_x, xs),
+        Axis::covering(chart.log_y, ys),
+    ) {
+        (Some(x), Some(y)) => (x, y),
+        _ => return draw_empty(root, chart),
+    };
+
+    let looks = looks(&chart.series);
+    let legend: Vec<usize> = (0..chart.series.len())
+        .filter(|&i| !prepared[i].runs.is_empty() && !chart.series[i].name.is_empty())
+        .collect();
+    let legend_font = if legend.len() > 20 { 12.0 } else { 15.0 };
+    let row = legend_font * 1.5;
+    let text_w = legend
+        .iter()
+        .map(|&i| {
+            root.estimate_text_size(&chart.series[i].name, &font(legend_font))
+                .map(|(w, _)| w)
+                .unwrap_or(0)
+        })
+        .max()
+        .unwrap_or(0);
+    let (w, _) = root.dim_in_pixel();
+    let legend_w = if legend.is_empty() {
+        10
+    } else {
+        (text_w + 60).clamp(120, w / 3)
+    };
+    let (plot_area, legend_area) = root.split_horizontally(w - legend_w);
+
+    let mut cc = ChartBuilder::on(&plot_area)
+        .caption(&chart.title, font(22.0))
+        .margin(12)
+        .x_label_area_size(56)
+        .y_label_area_size(84)
+        .build_cartesian_2d(Ticked::new(&x_axis), Ticked::new(&y_axis))?;
+    let x_fmt = x_axis.labeller(&x_axis.ticks().0);
+    let y_fmt = y_axis.labeller(&y_axis.ticks().0);
+    cc.configure_mesh()
+        .x_desc(&chart.x_label)
+        .y_desc(&chart.y_label)
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .label_style(font(14.0))
+        .axis_desc_style(font(16.0))
+        .bold_line_style(RGBColor(200, 200, 200))
+        .light_line_style(RGBColor(236, 236, 236))
+        .draw()?;
+
+    let floor = y_axis.lo;
+    for (p, look) in prepared.iter().zip(&looks) {
+        let style = ShapeStyle::from(&look.color).stroke_width(2);
+        for run in &p.runs {
+            if look.dashed {
+                cc.draw_series(std::iter::once(DashedPathElement::new(
+                    run.iter().copied(),
+                    10,
+                    6,
+                    style,
+                )))?;
+            } else if run.len() > 1 {
+                cc.draw_series(std::iter::once(PathElement::new(run.clone(), style)))?;
+            }
+        }
+        let thin = ShapeStyle::from(&look.color).stroke_width(1);
+        for &(x, lo, hi) in &p.bars {
+            let lo = lo.unwrap_or(floor);
+            cc.draw_series(std::iter::once(PathElement::new(
+                vec![(x, lo), (x, hi)],
+                thin,
+            )))?;
+            // Caps: short horizontal strokes in pixels, whatever the axis.
+            for y in [lo, hi] {
+                cc.draw_series(std::iter::once(
+                    EmptyElement::at((x, y)) + PathElement::new(vec![(-4, 0), (4, 0)], thin),
+                ))?;
+            }
+        }
+        if let Some((marker, filled)) = look.marker {
+            for run in &p.runs {
+                cc.draw_series(
+                    run.iter()
+                        .map(|&pt| EmptyElement::at(pt) + marker_shape(marker, filled, look.color)),
+                )?;
+            }
+        }
+    }
+
+    // The legend column: a line sample (with the marker) and the name per series.
+    let (_, lh) = legend_area.dim_in_pixel();
+    let top = ((lh as f64 - row * legend.len() as f64) / 2.0).max(40.0) as i32;
+    for (j, &i) in legend.iter().enumerate() {
+        let look = looks[i];
+        let y = top + (row * j as f64) as i32;
+        let style = ShapeStyle::from(&look.color).stroke_width(2);
+        if look.dashed {
+            legend_area.draw(&DashedPathElement::new(
+                [(4, y), (40, y)].into_iter(),
+                7,
+                4,
+                style,
+            ))?;
+        } else {
+            legend_area.draw(&PathElement::new(vec![(4, y), (40, y)], style))?;
+        }
+        if let Some((marker, filled)) = look.marker {
+            legend_area
+                .draw(&(EmptyElement::at((22, y)) + marker_shape(marker, filled, look.color)))?;
+        }
+        legend_area.draw(&Text::new(
+            chart.series[i].name.clone(),
+            (48, y - (legend_font * 0.6) as i32),
+            font(legend_font),
+        ))?;
+    }
+    Ok(())
+}
+
+/// A marker centred on (0, 0) in pixels.
+fn marker_shape<DB: DrawingBackend>(
+    marker: Marker,
+    filled: bool,
+    color: RGBColor,
+) -> DynElement<'static, DB, (i32, i32)> {
+    let style = if filled {
+        ShapeStyle::from(&color).filled()
+    } else {
+        ShapeStyle::from(&color).stroke_width(2)
+    };
+    const R: i32 = 5;
+    match marker {
+        Marker::Circle => Circle::new((0, 0), R, style).into_dyn(),
+        Marker::Square => Rectangle::new([(-R + 1, -R + 1), (R - 1, R - 1)], style).into_dyn(),
+        Marker::Triangle => {
+            let pts = vec![(0, -R - 1), (R + 1, R - 1), (-R - 1, R - 1), (0, -R - 1)];
+            if filled {
+                Polygon::new(pts, style).into_dyn()
+            } else {
+                PathElement::new(pts, style).into_dyn()
+            }
+        }
+        Marker::Diamond => {
+            let pts = vec![
+                (0, -R - 1),
+                (R + 1, 0),
+                (0, R + 1),
+                (-R - 1, 0),
+                (0, -R - 1),
+            ];
+            if filled {
+                Polygon::new(pts, style).into_dyn()
+            } else {
+                PathElement::new(pts, style).into_dyn()
+            }
+        }
+    }
+}
+
+fn draw_empty<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &Chart,
+) -> DrawResult<DB::ErrorType> {
+    let (w, h) = root.dim_in_pixel();
+    let centred = |size: f64| {
+        font(size).pos(plotters::style::text_anchor::Pos::new(
+            plotters::style::text_anchor::HPos::Center,
+            plotters::style::text_anchor::VPos::Center,
+        ))
+    };
+    root.draw(&Text::new(
+        chart.title.clone(),
+        (w as i32 / 2, 40),
+        centred(22.0),
+    ))?;
+    root.draw(&Text::new(
+        "no data".to_string(),
+        (w as i32 / 2, h as i32 / 2),
+        centred(28.0).color(&RGBColor(120, 120, 120)),
+    ))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("lt-plot-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn measured(name: &str, points: Vec<(f64, f64)>) -> Series {
+        Series {
+            name: name.into(),
+            points,
+            y_interval: Vec::new(),
+            style: Style::Measured,
+        }
+    }
+
+    fn png_size(path: &Path) -> (u32, u32) {
+        let img = image::open(path).unwrap();
+        (img.width(), img.height())
+    }
+
+    #[test]
+    fn writes_both_files_with_legend_and_error_bars() {
+        let d = tmp("full");
+        let n: Vec<f64> = (0..8).map(|i| 2f64.powi(i)).collect();
+        let mut pt = measured("pt", n.iter().map(|&n| (n, 0.1 / n)).collect());
+        pt.y_interval = n.iter().map(|&n| (0.08 / n, 0.12 / n)).collect();
+        let fit = Series {
+            name: "pt fit, slope −1.00".into(),
+            points: vec![(1.0, 0.1), (128.0, 0.1 / 128.0)],
+            y_interval: vec![],
+            style: Style::Fitted,
+        };
+        let chart = Chart {
+            title: "MSE against spp".into(),
+            x_label: "spp".into(),
+            y_label: "MSE".into(),
+            log_x: true,
+            log_y: true,
+            series: vec![
+                pt,
+                fit,
+                measured("bdpt", n.iter().map(|&n| (n, 0.05 / n)).collect()),
+            ],
+        };
+        let (svg, png) = write_chart(&d.join("mse"), &chart).unwrap();
+        assert_eq!(svg, d.join("mse.svg"));
+        assert_eq!(png, d.join("mse.png"));
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(text.starts_with("<svg"), "{}", &text[..40.min(text.len())]);
+        for word in ["MSE against spp", "pt fit, slope −1.00", "bdpt", "spp"] {
+            assert!(text.contains(word), "svg lacks {word}");
+        }
+        assert!(text.contains("DejaVu Sans"));
+        assert_eq!(png_size(&png), CHART_SIZE);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn bad_points_are_skipped_and_empty_charts_say_so() {
+        let d = tmp("bad");
+        let chart = Chart {
+            title: "nothing drawable".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: true,
+            log_y: true,
+            series: vec![
+                measured(
+                    "a",
+                    vec![(0.0, 1.0), (-1.0, 2.0), (f64::NAN, 1.0), (1.0, -3.0)],
+                ),
+                measured("b", vec![(1.0, f64::INFINITY)]),
+                measured("c", vec![]),
+            ],
+        };
+        let (svg, png) = write_chart(&d.join("empty"), &chart).unwrap();
+        assert!(std::fs::read_to_string(&svg).unwrap().contains("no data"));
+        assert_eq!(png_size(&png), CHART_SIZE);
+
+        // The same points on linear axes: the finite ones are drawn, NaN/inf skipped.
+        let mut lin = chart.clone();
+        lin.log_x = false;
+        lin.log_y = false;
+        lin.series[0].y_interval = vec![(f64::NAN, 1.0), (3.0, 1.0), (0.0, 0.0), (-4.0, -2.0)];
+        let (svg, _) = write_chart(&d.join("lin"), &lin).unwrap();
+        assert!(!std::fs::read_to_string(&svg).unwrap().contains("no data"));
+
+        // One point, zero span on both axes.
+        let one = Chart {
+            series: vec![measured("one", vec![(3.0, 3.0)])],
+            ..chart.clone()
+        };
+        let (svg, _) = write_chart(&d.join("one"), &one).unwrap();
+        assert!(!std::fs::read_to_string(&svg).unwrap().contains("no data"));
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn log_ticks_are_decades_or_one_two_five() {
+        let (bold, light) = log_ticks(-3.2, 0.1);
+        assert_eq!(bold, vec![-3.0, -2.0, -1.0, 0.0]);
+        assert!(light.len() >= 8 * 3);
+        let (bold, _) = log_ticks(0.05, 0.9); // 1.12 … 7.9
+        let vals: Vec<f64> = bold.iter().map(|v| 10f64.powf(*v)).collect();
+        assert_eq!(vals.len(), 2, "{vals:?}");
+        assert!((vals[0] - 2.0).abs() < 1e-9 && (vals[1] - 5.0).abs() < 1e-9);
+        // Narrower than a factor of two: linear steps, still more than one tick.
+        let (bold, _) = log_ticks(0.0, 0.1);
+        assert!(bold.len() >= 2, "{bold:?}");
+    }
+
+    #[test]
+    fn numbers_read_well() {
+        assert_eq!(format_number(0.001), "0.001");
+        assert_eq!(format_number(250.0), "250");
+        assert_eq!(format_number(0.5), "0.5");
+        assert_eq!(format_number(1e-5), "10⁻⁵");
+        assert_eq!(format_number(2e-5), "2×10⁻⁵");
+        assert_eq!(format_number(-0.25), "−0.25");
+        assert_eq!(format_number(1e6), "10⁶");
+        assert_eq!(format_power(0.001), "10⁻³");
+        assert_eq!(format_power(0.00099999), "10⁻³");
+        assert_eq!(format_power(0.5), "5×10⁻¹");
+        let axis = Axis {
+            log: true,
+            lo: -4.2,
+            hi: -0.9,
+        };
+        let label = axis.labeller(&axis.ticks().0);
+        assert_eq!(label(&-2.0), "10⁻²");
+        let axis = Axis { lo: -2.2, ..axis };
+        assert_eq!(axis.labeller(&axis.ticks().0)(&-2.0), "0.01");
+    }
+
+    #[test]
+    fn fitted_lines_take_their_measured_colour() {
+        let s = vec![
+            measured("pt", vec![]),
+            measured("ppm", vec![]),
+            Series {
+                name: "ppm fit".into(),
+                points: vec![],
+                y_interval: vec![],
+                style: Style::Fitted,
+            },
+            Series {
+                name: "predicted".into(),
+                points: vec![],
+                y_interval: vec![],
+                style: Style::Fitted,
+            },
+        ];
+        let l = looks(&s);
+        assert_eq!(l[2].color, l[1].color);
+        assert_ne!(l[3].color, l[0].color);
+        assert_ne!(l[3].color, l[1].color);
+        assert!(l[2].dashed && l[2].marker.is_none());
+    }
 }
