@@ -30,7 +30,32 @@ impl std::fmt::Display for SceneError {
 
 impl std::error::Error for SceneError {}
 
+/// Reads a scene file, TOML or (by the `.xml` extension) Mitsuba XML, with the process's default
+/// `LoadOptions` (`xml::set_default_load_options`); an XML load's substitutions are printed to
+/// stderr, and with `verbose` its ignored parameters too.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    let opts = super::xml::default_load_options();
+    let (scene, report) = load_scene_with(path, &opts)?;
+    report.print(opts.verbose);
+    Ok(scene)
+}
+
+/// Reads a scene file with explicit options; the report lists what an XML load substituted and
+/// ignored (always empty for TOML).
+pub fn load_scene_with(
+    path: &Path,
+    opts: &super::xml::LoadOptions,
+) -> Result<(Scene, super::xml::LoadReport), SceneError> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+    {
+        return super::xml::load_xml(path, opts);
+    }
+    Ok((load_toml(path)?, Default::default()))
+}
+
+fn load_toml(path: &Path) -> Result<Scene, SceneError> {
     let text = std::fs::read_to_string(path).map_err(|e| SceneError {
         file: path.display().to_string(),
         line: None,

@@ -12,10 +12,12 @@ pub mod ray_stats;
 mod transform;
 mod translated;
 mod visibility;
+pub mod xml;
 
 pub use builder::{LightDesc, SceneBuilder, ShapeGeometry, TriangleMesh};
 pub use hit::SurfaceHit;
-pub use load::{load_scene, load_scene_str, SceneError};
+pub use load::{load_scene, load_scene_str, load_scene_with, SceneError};
+pub use xml::{set_default_load_options, LoadOptions, LoadReport};
 
 use crate::bsdf::Material;
 use crate::camera::Camera;

@@ -10,6 +10,14 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Where a Mitsuba XML scene asks for something lt lacks (Beckmann roughness, a Gaussian pixel
+    /// filter, spectra, unbounded max_depth), substitute the nearest it has and list each
+    /// substitution, instead of refusing the scene.
+    #[arg(long, global = true)]
+    approximate: bool,
+    /// List the parameters of an XML scene that were accepted but change nothing lt renders.
+    #[arg(long, global = true)]
+    verbose: bool,
 }
 
 #[derive(Subcommand)]
@@ -47,6 +55,10 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    lt_core::scene::set_default_load_options(lt_core::scene::LoadOptions {
+        approximate: cli.approximate,
+        verbose: cli.verbose,
+    });
     let result = match &cli.command {
         Command::Render(a) => x::render_cmd::run(a),
         Command::Compare(a) => x::compare::run(a).map(|report| print!("{report}")),

@@ -1,0 +1,851 @@
+//! The plugin subset: the XML's sensor, integrator, BSDFs, shapes and emitters turned into a
+//! `Scene` through `SceneBuilder`, each value checked on the way (reference: docs/xml.md).
+
+use super::doc::{Doc, Elem};
+use super::props::{textures_refused, ColorUse, Ids, Plugin};
+use super::values::Xform;
+use super::{ply, LoadOptions, LoadReport};
+use crate::bsdf::{Dielectric, Diffuse, Glossy, Material, Mirror};
+use crate::camera::{Camera, FovAxis};
+use crate::math::Color;
+use crate::scene::transform::{check_quad, check_solid};
+use crate::scene::{
+    LightDesc, RenderSettings, Scene, SceneBuilder, SceneError, ShapeGeometry, TriangleMesh,
+};
+use glam::{DMat4, DVec3, DVec4, Mat4};
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+/// GGX α below this is numerically a mirror (the TOML loader's bound).
+const MIN_ROUGHNESS: f64 = 1e-4;
+/// What `--approximate` puts in place of Mitsuba's unbounded `max_depth = -1`.
+pub const UNBOUNDED_DEPTH_SUBSTITUTE: u32 = 64;
+
+/// Parameters Mitsuba writes by default that change nothing lt renders, per plugin kind.
+const SENSOR_IGNORED: [&str; 5] = [
+    "near_clip",
+    "far_clip",
+    "focus_distance",
+    "shutter_open",
+    "shutter_close",
+];
+const FILM_IGNORED: [&str; 3] = ["pixel_format", "component_format", "file_format"];
+const SAMPLER_IGNORED: [&str; 3] = ["seed", "jitter", "strength"];
+
+/// IORs Mitsuba knows by name (its `int_ior`/`ext_ior` strings).
+const NAMED_IORS: [(&str, f64); 23] = [
+    ("vacuum", 1.0),
+    ("helium", 1.000036),
+    ("hydrogen", 1.000132),
+    ("air", 1.000277),
+    ("carbon dioxide", 1.00045),
+    ("water", 1.333),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.52045),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.470),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("pet", 1.575),
+    ("diamond", 2.419),
+];
+
+pub(super) struct Loader<'a> {
+    doc: &'a Doc,
+    opts: &'a LoadOptions,
+    pub report: LoadReport,
+    ids: Ids<'a>,
+    /// Material ids of BSDF elements already converted (by element address).
+    materials: HashMap<*const Elem, u32>,
+    default_material: Option<u32>,
+    /// Mesh files read, in order.
+    pub meshes: Vec<PathBuf>,
+}
+
+fn collect_ids<'a>(doc: &'a Doc, e: &'a Elem, ids: &mut Ids<'a>) -> Result<(), SceneError> {
+    for c in &e.children {
+        if c.tag != "ref" {
+            if let Some(id) = c.attr("id") {
+                if ids.insert(id, c).is_some() {
+                    return Err(doc.err(c, format!("the id `{id}` is defined twice")));
+                }
+            }
+        }
+        collect_ids(doc, c, ids)?;
+    }
+    Ok(())
+}
+
+pub(super) fn load<'a>(
+    doc: &'a Doc,
+    opts: &LoadOptions,
+) -> Result<(Scene, LoadReport, Vec<PathBuf>), SceneError> {
+    let mut ids = Ids::new();
+    collect_ids(doc, &doc.root, &mut ids)?;
+    let mut l = Loader {
+        doc,
+        opts,
+        report: LoadReport::default(),
+        ids,
+        materials: HashMap::new(),
+        default_material: None,
+        meshes: Vec::new(),
+    };
+    let root = &doc.root;
+    let by_tag = |t: &'static str| root.children.iter().filter(move |c| c.tag == t);
+    for c in &root.children {
+        match c.tag.as_str() {
+            "sensor" | "integrator" | "bsdf" | "shape" | "emitter" => {}
+            "texture" => return Err(textures_refused(doc, c)),
+            "medium" | "phase" => {
+                return Err(doc.err(
+                    c,
+                    format!("participating media are not supported: <{}>", c.tag),
+                ))
+            }
+            other => {
+                return Err(doc.err(
+                    c,
+                    format!("<{other}> is not supported at the top level of a scene"),
+                ))
+            }
+        }
+    }
+    let sensors: Vec<&Elem> = by_tag("sensor").collect();
+    let sensor = match sensors[..] {
+        [] => return Err(doc.err(root, "the scene has no <sensor> (lt needs a camera)")),
+        [s] => s,
+        [_, second, ..] => {
+            return Err(doc.err(
+                second,
+                "a second <sensor>: lt renders one camera, keep only one",
+            ))
+        }
+    };
+    let (camera, spp) = l.sensor(sensor)?;
+    let integrators: Vec<&Elem> = by_tag("integrator").collect();
+    if integrators.len() > 1 {
+        return Err(doc.err(integrators[1], "a second <integrator>"));
+    }
+    let (max_depth, rr_depth) = l.integrator(integrators.first().copied(), root)?;
+    let settings = RenderSettings {
+        max_depth,
+        rr_depth,
+        spp,
+    };
+    let mut b = SceneBuilder::new(camera, settings);
+    // Top-level BSDFs first, in document order, so each is checked even when unused.
+    for c in by_tag("bsdf") {
+        l.material(c, &mut b)?;
+    }
+    let mut emitters = 0;
+    for c in &root.children {
+        match c.tag.as_str() {
+            "shape" => emitters += l.shape(c, &mut b)? as usize,
+            "emitter" => {
+                if let Some(desc) = l.emitter(c)? {
+                    b.add_light(desc);
+                    emitters += 1;
+                }
+            }
+            _ => {}
+        }
+    }
+    if emitters == 0 {
+        return Err(doc.err(
+            root,
+            "the scene has no light: no emitter with a non-zero value",
+        ));
+    }
+    let Loader { report, meshes, .. } = l;
+    Ok((b.build(), report, meshes))
+}
+
+impl<'a> Loader<'a> {
+    fn plugin(&mut self, e: &'a Elem) -> Result<Plugin<'a>, SceneError> {
+        Plugin::new(self.doc, &self.ids, e, &mut self.report)
+    }
+
+    /// Refuses, or with `--approximate` records, a substitution.
+    fn substitute(
+        &mut self,
+        e: &Elem,
+        refusal: String,
+        substitution: String,
+    ) -> Result<(), SceneError> {
+        if !self.opts.approximate {
+            return Err(self.doc.err(
+                e,
+                format!("{refusal}; pass --approximate to {substitution}"),
+            ));
+        }
+        let place = self.doc.place(e);
+        self.report
+            .substitutions
+            .push(format!("{place}: {refusal}: {substitution} instead"));
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- sensor, film, sampler
+
+    fn sensor(&mut self, e: &'a Elem) -> Result<(Camera, u32), SceneError> {
+        let p = self.plugin(e)?;
+        if p.kind != "perspective" {
+            return Err(p.err(
+                e,
+                format!(
+                    "sensor `{}` is not supported (lt has a pinhole camera: perspective)",
+                    p.kind
+                ),
+            ));
+        }
+        for k in ["principal_point_offset_x", "principal_point_offset_y"] {
+            if let Some(v) = p.float(k)? {
+                if v != 0.0 {
+                    return Err(p.err(
+                        e,
+                        format!("`{k}` = {v}: an off-centre principal point is not supported"),
+                    ));
+                }
+            }
+        }
+        if p.has("srf") {
+            return Err(p.err(e, "a sensor response function (`srf`) is not supported"));
+        }
+        let film = p.one_nested(&["film"], "film")?;
+        let (w, h) = self.film(film, e)?;
+        let spp = match p.one_nested(&["sampler"], "sampler")? {
+            Some(s) => self.sampler(s)?,
+            None => 4,
+        };
+        let fov_given = p.float("fov")?;
+        let focal = p.string("focal_length")?;
+        let axis = match p.string("fov_axis")? {
+            None => "x",
+            Some((a, ae)) => match a {
+                "x" | "y" | "diagonal" | "smaller" | "larger" => a,
+                _ => {
+                    return Err(p.err(
+                        ae,
+                        format!("`fov_axis` must be x, y, diagonal, smaller or larger, got `{a}`"),
+                    ))
+                }
+            },
+        };
+        let (fov, axis) = match (fov_given, focal) {
+            (Some(_), Some((_, fe))) => {
+                return Err(p.err(fe, "give the sensor `fov` or `focal_length`, not both"))
+            }
+            (Some(f), None) => (f, axis),
+            (None, f) => {
+                let (text, at) = f.map(|(t, fe)| (t, fe)).unwrap_or(("50mm", e));
+                let mm = text.trim().trim_end_matches("mm").trim();
+                let f: f64 = mm.parse().ok().filter(|f: &f64| *f > 0.0 && f.is_finite()).ok_or_else(|| {
+                    p.err(at, format!("`focal_length` must be a positive length in mm like \"50mm\", got `{text}`"))
+                })?;
+                // 35 mm film equivalent: the field of view across the 36 × 24 mm frame's diagonal.
+                let diag = (36.0f64 * 36.0 + 24.0 * 24.0).sqrt();
+                (2.0 * (diag / (2.0 * f)).atan().to_degrees(), "diagonal")
+            }
+        };
+        // A diagonal fov is the same camera as the x fov of this resolution (exact).
+        let (fov, axis) = if axis == "diagonal" {
+            let t = (0.5 * fov.to_radians()).tan() * w as f64 / ((w * w + h * h) as f64).sqrt();
+            (2.0 * t.atan().to_degrees(), FovAxis::X)
+        } else {
+            let a = match axis {
+                "x" => FovAxis::X,
+                "y" => FovAxis::Y,
+                "smaller" => FovAxis::Smaller,
+                _ => FovAxis::Larger,
+            };
+            (fov, a)
+        };
+        let (eye, target, up) = match p.transform("to_world")? {
+            None => (DVec3::ZERO, DVec3::Z, DVec3::Y),
+            Some((
+                Xform {
+                    lookat: Some([o, t, u]),
+                    ..
+                },
+                _,
+            )) => (o, t, u),
+            Some((Xform { m, .. }, te)) => camera_frame(&p, &m, te)?,
+        };
+        let f32v = |v: DVec3| v.as_vec3();
+        let camera = Camera::look_at(f32v(eye), f32v(target), f32v(up), fov as f32, axis, w, h)
+            .map_err(|m| p.err(e, format!("degenerate camera: {m}")))?;
+        p.finish(&SENSOR_IGNORED, &mut self.report)?;
+        Ok((camera, spp))
+    }
+
+    /// Width and height; the reconstruction filter must be a one-pixel box.
+    fn film(&mut self, film: Option<&'a Elem>, sensor: &Elem) -> Result<(u32, u32), SceneError> {
+        let Some(f) = film else {
+            self.substitute(
+                sensor,
+                "the sensor has no <film>, and Mitsuba's default hdrfilm (768 × 576) reconstructs with a Gaussian filter, which lt does not have".into(),
+                "use lt's one-pixel box filter".into(),
+            )?;
+            return Ok((768, 576));
+        };
+        let p = self.plugin(f)?;
+        if p.kind != "hdrfilm" {
+            return Err(p.err(
+                f,
+                format!("film `{}` is not supported (only hdrfilm)", p.kind),
+            ));
+        }
+        let dim = |k: &str, d: i64| -> Result<u32, SceneError> {
+            let v = p.integer(k)?.unwrap_or(d);
+            if !(1..=1 << 16).contains(&v) {
+                return Err(p.err(
+                    f,
+                    format!("film `{k}` must be between 1 and 65536, got {v}"),
+                ));
+            }
+            Ok(v as u32)
+        };
+        let (w, h) = (dim("width", 768)?, dim("height", 576)?);
+        for k in [
+            "crop_offset_x",
+            "crop_offset_y",
+            "crop_width",
+            "crop_height",
+        ] {
+            if p.has(k) {
+                let v = p.integer(k)?.unwrap_or(0);
+                let full = match k {
+                    "crop_width" => v == w as i64,
+                    "crop_height" => v == h as i64,
+                    _ => v == 0,
+                };
+                if !full {
+                    return Err(p.err(f, format!("a crop window (`{k}` = {v}) is not supported")));
+                }
+            }
+        }
+        if p.boolean("sample_border")? == Some(true) {
+            return Err(p.err(f, "`sample_border` = true is not supported"));
+        }
+        match p.one_nested(&["rfilter"], "rfilter")? {
+            None => self.substitute(
+                f,
+                "hdrfilm's default reconstruction filter is a Gaussian, which lt does not have (give <rfilter type=\"box\"/>)".into(),
+                "use lt's one-pixel box filter".into(),
+            )?,
+            Some(r) => {
+                let rp = self.plugin(r)?;
+                if rp.kind == "box" {
+                    if let Some(rad) = rp.float("radius")? {
+                        if rad != 0.5 {
+                            self.substitute(
+                                r,
+                                format!("a box filter of radius {rad} px (lt's box is one pixel, radius 0.5)"),
+                                "use the one-pixel box".into(),
+                            )?;
+                        }
+                    }
+                } else {
+                    self.substitute(
+                        r,
+                        format!("reconstruction filter `{}` is not supported (lt has only the one-pixel box)", rp.kind),
+                        "use the box filter".into(),
+                    )?;
+                    // The approximation replaces the whole filter: its parameters go with it.
+                    for k in ["radius", "stddev", "b", "c", "lobes"] {
+                        let _ = rp.take_elem(k);
+                    }
+                }
+                rp.finish(&[], &mut self.report)?;
+            }
+        }
+        p.finish(&FILM_IGNORED, &mut self.report)?;
+        Ok((w, h))
+    }
+
+    fn sampler(&mut self, s: &'a Elem) -> Result<u32, SceneError> {
+        let p = self.plugin(s)?;
+        match p.kind {
+            "independent" | "stratified" | "multijitter" | "orthogonal" | "ldsampler" => {}
+            other => return Err(p.err(s, format!("sampler `{other}` is not supported"))),
+        }
+        if p.kind != "independent" {
+            self.report.ignored.push(format!(
+                "{}: sampler `{}`: lt draws its own independent streams (same expectation, other noise)",
+                self.doc.place(s),
+                p.kind
+            ));
+        }
+        let n = p.integer("sample_count")?.unwrap_or(4);
+        if !(1..=u32::MAX as i64).contains(&n) {
+            return Err(p.err(s, format!("`sample_count` must be at least 1, got {n}")));
+        }
+        p.finish(&SAMPLER_IGNORED, &mut self.report)?;
+        Ok(n as u32)
+    }
+
+    fn integrator(&mut self, e: Option<&'a Elem>, root: &Elem) -> Result<(u32, u32), SceneError> {
+        let (depth, rr, at) = match e {
+            None => (-1, 5, root),
+            Some(e) => {
+                let p = self.plugin(e)?;
+                match p.kind {
+                    "path" | "volpath" | "volpathmis" | "ptracer" => {}
+                    other => {
+                        return Err(p.err(
+                            e,
+                            format!("integrator `{other}` is not supported (lt reads path, volpath, volpathmis and ptracer for their max_depth; the estimator is chosen on lt's command line)"),
+                        ))
+                    }
+                }
+                if p.boolean("hide_emitters")? == Some(true) {
+                    return Err(p.err(e, "`hide_emitters` = true is not supported"));
+                }
+                let depth = p.integer("max_depth")?.unwrap_or(-1);
+                let rr = p.integer("rr_depth")?.unwrap_or(5);
+                p.finish(&["samples_per_pass"], &mut self.report)?;
+                (depth, rr, e)
+            }
+        };
+        let depth = match depth {
+            -1 => {
+                self.substitute(
+                    at,
+                    "max_depth = -1 (unbounded, Mitsuba's default) is not supported: lt's estimators size their paths by max_depth".into(),
+                    format!("use max_depth = {UNBOUNDED_DEPTH_SUBSTITUTE}"),
+                )?;
+                UNBOUNDED_DEPTH_SUBSTITUTE
+            }
+            d if d >= 1 && d <= 1 << 20 => d as u32,
+            d => {
+                return Err(self.doc.err(
+                    at,
+                    format!("`max_depth` must be -1 or between 1 and 2^20, got {d} (1 = emitters seen directly)"),
+                ))
+            }
+        };
+        if !(0..=1 << 20).contains(&rr) {
+            return Err(self.doc.err(
+                at,
+                format!("`rr_depth` must be between 0 and 2^20, got {rr}"),
+            ));
+        }
+        Ok((depth, rr as u32))
+    }
+
+    // ---------------------------------------------------------------- BSDFs
+
+    /// The material id of a BSDF element (converted once, however often it is referenced).
+    fn material(&mut self, e: &'a Elem, b: &mut SceneBuilder) -> Result<u32, SceneError> {
+        let key = e as *const Elem;
+        if let Some(&id) = self.materials.get(&key) {
+            return Ok(id);
+        }
+        let m = self.bsdf(e, false)?;
+        let id = b.add_material(m);
+        self.materials.insert(key, id);
+        Ok(id)
+    }
+
+    fn bsdf(&mut self, e: &'a Elem, in_twosided: bool) -> Result<Material, SceneError> {
+        let p = self.plugin(e)?;
+        let opts = self.opts;
+        let m = match p.kind {
+            "diffuse" => {
+                let albedo = p
+                    .color("reflectance", ColorUse::Reflectance, opts, &mut self.report)?
+                    .unwrap_or(Color::splat(0.5));
+                Material::Diffuse(Diffuse { albedo })
+            }
+            "twosided" => {
+                if in_twosided {
+                    return Err(p.err(e, "a twosided BSDF inside a twosided BSDF"));
+                }
+                let inner = p.nested(&["bsdf"]);
+                match inner[..] {
+                    [one] => {
+                        let m = self.bsdf(one, true)?;
+                        if matches!(m, Material::Dielectric(_)) {
+                            return Err(p.err(one, "twosided cannot wrap a dielectric (it transmits)"));
+                        }
+                        m
+                    }
+                    [] => return Err(p.err(e, "twosided needs a nested BSDF")),
+                    [_, second, ..] => {
+                        return Err(p.err(
+                            second,
+                            "twosided with different front and back BSDFs is not supported (lt's materials reflect alike on both sides)",
+                        ))
+                    }
+                }
+            }
+            "dielectric" => {
+                for k in ["specular_reflectance", "specular_transmittance"] {
+                    if let Some(c) = p.color(k, ColorUse::Reflectance, opts, &mut self.report)? {
+                        if c != Color::ONE {
+                            return Err(p.err(e, format!("`{k}` ≠ 1 on a dielectric is not supported (lt's glass has exact Fresnel only)")));
+                        }
+                    }
+                }
+                let int = self.ior(&p, "int_ior", 1.5046)?;
+                let ext = self.ior(&p, "ext_ior", 1.000277)?;
+                let ior = int / ext;
+                if !(ior > 0.0) || !(ior as f32).is_finite() {
+                    return Err(p.err(e, format!("the relative IOR {int}/{ext} is not a positive number")));
+                }
+                Material::Dielectric(Dielectric { ior: ior as f32 })
+            }
+            "conductor" | "roughconductor" => {
+                if let Some((name, me)) = p.string("material")? {
+                    if name != "none" {
+                        return Err(p.err(me, format!("conductor material `{name}` (a complex IOR) is not supported: lt has only material=\"none\" with a constant specular_reflectance")));
+                    }
+                }
+                for k in ["eta", "k"] {
+                    if let Some(ke) = p.take_elem(k) {
+                        return Err(p.err(ke, format!("`{k}` (a complex IOR) is not supported: lt's conductors are material=\"none\" with a constant specular_reflectance")));
+                    }
+                }
+                let reflectance = p
+                    .color("specular_reflectance", ColorUse::Reflectance, opts, &mut self.report)?
+                    .unwrap_or(Color::ONE);
+                if p.kind == "conductor" {
+                    Material::Mirror(Mirror { reflectance })
+                } else {
+                    let roughness = self.roughness(&p)?;
+                    Material::Glossy(Glossy {
+                        reflectance,
+                        roughness,
+                    })
+                }
+            }
+            other => {
+                return Err(p.err(
+                    e,
+                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, conductor, roughconductor and twosided)"),
+                ))
+            }
+        };
+        let ignored: &[&str] = if p.kind == "roughconductor" {
+            &["sample_visible"]
+        } else {
+            &[]
+        };
+        p.finish(ignored, &mut self.report)?;
+        Ok(m)
+    }
+
+    /// An IOR given as a number or by one of Mitsuba's names.
+    fn ior(&self, p: &Plugin<'a>, key: &str, default: f64) -> Result<f64, SceneError> {
+        let Some(e) = p.take_elem(key) else {
+            return Ok(default);
+        };
+        let v = e.attr("value").unwrap_or("");
+        let x = match e.tag.as_str() {
+            "float" | "integer" => super::values::number(self.doc, e, v, key)?,
+            "string" => match NAMED_IORS
+                .iter()
+                .find(|(n, _)| *n == v.trim().to_ascii_lowercase())
+            {
+                Some(&(_, x)) => x,
+                None => {
+                    return Err(p.err(
+                        e,
+                        format!("`{key}`: `{v}` is not an IOR Mitsuba knows by name"),
+                    ))
+                }
+            },
+            _ => {
+                return Err(p.err(
+                    e,
+                    format!("`{key}` must be a <float> or a <string> naming a material"),
+                ))
+            }
+        };
+        if !(x > 0.0) {
+            return Err(p.err(e, format!("`{key}` must be positive, got {x}")));
+        }
+        Ok(x)
+    }
+
+    fn roughness(&mut self, p: &Plugin<'a>) -> Result<f32, SceneError> {
+        let e = p.elem;
+        let dist = p.string("distribution")?;
+        match dist {
+            Some(("ggx", _)) => {}
+            Some(("beckmann", de)) => self.substitute(
+                de,
+                "the Beckmann distribution is not supported (lt's rough conductor is GGX)".into(),
+                "use GGX of the same α".into(),
+            )?,
+            None => self.substitute(
+                e,
+                "roughconductor's default Beckmann distribution is not supported (lt's rough conductor is GGX; give distribution=\"ggx\")".into(),
+                "use GGX of the same α".into(),
+            )?,
+            Some((other, de)) => {
+                return Err(p.err(de, format!("`distribution` must be ggx or beckmann, got `{other}`")))
+            }
+        }
+        let alpha = p.float("alpha")?;
+        let (au, av) = (p.float("alpha_u")?, p.float("alpha_v")?);
+        let a = match (alpha, au, av) {
+            (Some(a), None, None) => a,
+            (None, None, None) => 0.1,
+            (None, Some(u), Some(v)) if u == v => u,
+            (None, Some(_), Some(_)) => {
+                return Err(p.err(
+                    e,
+                    "an anisotropic roughness (alpha_u ≠ alpha_v) is not supported",
+                ))
+            }
+            _ => return Err(p.err(e, "give `alpha`, or both `alpha_u` and `alpha_v`")),
+        };
+        if !(a >= MIN_ROUGHNESS) || !(a.is_finite()) {
+            return Err(p.err(e, format!("`alpha` must be at least {MIN_ROUGHNESS}, got {a} (use a conductor for a mirror)")));
+        }
+        Ok(a as f32)
+    }
+
+    // ---------------------------------------------------------------- shapes
+
+    /// Adds the shape; returns whether it emits.
+    fn shape(&mut self, e: &'a Elem, b: &mut SceneBuilder) -> Result<bool, SceneError> {
+        let p = self.plugin(e)?;
+        let doc = self.doc;
+        let xform = p.transform("to_world")?;
+        let flip = p.boolean("flip_normals")?.unwrap_or(false);
+        let ctx = doc.ctx(e.src);
+        let (m, span) = match &xform {
+            Some((x, te)) => (x.m, te.range.clone()),
+            None => (DMat4::IDENTITY, e.range.clone()),
+        };
+        let m32: Mat4 = m.as_mat4();
+        let geometry = match p.kind {
+            "rectangle" => {
+                check_quad(&ctx, &m32, span)?;
+                ShapeGeometry::Mesh(TriangleMesh::unit_rectangle().transformed(&m32))
+            }
+            "cube" => {
+                check_solid(&ctx, &m32, span, "cube")?;
+                ShapeGeometry::Mesh(TriangleMesh::unit_cube().transformed(&m32))
+            }
+            "sphere" => {
+                let c = DVec3::from_array(p.vec3("center")?.unwrap_or([0.0; 3]));
+                let r = p.float("radius")?.unwrap_or(1.0);
+                if !(r > 0.0) {
+                    return Err(p.err(e, format!("sphere `radius` must be positive, got {r}")));
+                }
+                let (center, radius) = match &xform {
+                    None => (c, r),
+                    Some((x, te)) => {
+                        let s = similarity_scale(&x.m).ok_or_else(|| {
+                            p.err(te, "a sphere's to_world must be a rotation, uniform scale and translation (an ellipsoid is not supported)")
+                        })?;
+                        (x.m.transform_point3(c), r * s)
+                    }
+                };
+                ShapeGeometry::Sphere {
+                    center: center.as_vec3(),
+                    radius: radius as f32,
+                }
+            }
+            "obj" | "ply" => {
+                let Some((file, fe)) = p.string("filename")? else {
+                    return Err(p.err(e, format!("shape `{}` needs a `filename`", p.kind)));
+                };
+                let face_normals = p.boolean("face_normals")?.unwrap_or(false);
+                check_solid(&ctx, &m32, span, "mesh")?;
+                let spanned = toml::Spanned::new(fe.range.clone(), file.to_string());
+                let path = ctx.base_dir.join(file);
+                let mut mesh = if p.kind == "obj" {
+                    crate::scene::obj::load_obj(&ctx, &spanned)?
+                } else {
+                    ply::load_ply(&ctx, &spanned)?
+                };
+                self.meshes.push(path);
+                if face_normals {
+                    mesh.normals = None;
+                }
+                let mesh = mesh.transformed(&m32);
+                if !((0..mesh.indices.len()).map(|i| mesh.triangle_area(i)).sum::<f32>() > 0.0) {
+                    return Err(p.err(fe, "the mesh has zero area (every triangle is degenerate)"));
+                }
+                ShapeGeometry::Mesh(mesh)
+            }
+            other => {
+                return Err(p.err(
+                    e,
+                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, obj and ply)"),
+                ))
+            }
+        };
+        let bsdf = p.one_nested(&["bsdf"], "BSDF")?;
+        let material = match bsdf {
+            Some(be) => self.material(be, b)?,
+            None => match self.default_material {
+                Some(id) => id,
+                None => {
+                    let id = b.add_material(Material::Diffuse(Diffuse {
+                        albedo: Color::splat(0.5),
+                    }));
+                    self.default_material = Some(id);
+                    id
+                }
+            },
+        };
+        let emission = match p.one_nested(&["emitter"], "emitter")? {
+            None => None,
+            Some(em) => {
+                let ep = self.plugin(em)?;
+                if ep.kind != "area" {
+                    return Err(ep.err(
+                        em,
+                        format!(
+                            "emitter `{}` inside a shape: only `area` emitters attach to shapes",
+                            ep.kind
+                        ),
+                    ));
+                }
+                let r = ep
+                    .color("radiance", ColorUse::Emission, self.opts, &mut self.report)?
+                    .unwrap_or(Color::ONE);
+                ep.finish(&["sampling_weight"], &mut self.report)?;
+                (r.max_element() > 0.0).then_some(r)
+            }
+        };
+        let ignored: &[&str] = match p.kind {
+            "obj" | "ply" => &["flip_tex_coords"],
+            _ => &[],
+        };
+        p.finish(ignored, &mut self.report)?;
+        let emits = emission.is_some();
+        b.add_shape(geometry, material, emission, flip);
+        Ok(emits)
+    }
+
+    // ---------------------------------------------------------------- emitters
+
+    fn emitter(&mut self, e: &'a Elem) -> Result<Option<LightDesc>, SceneError> {
+        let p = self.plugin(e)?;
+        let opts = self.opts;
+        let desc = match p.kind {
+            "point" => {
+                let intensity = p
+                    .color("intensity", ColorUse::Emission, opts, &mut self.report)?
+                    .unwrap_or(Color::ONE);
+                let pos = p.vec3("position")?;
+                let xf = p.transform("to_world")?;
+                let position = match (pos, xf) {
+                    (Some(_), Some((_, te))) => {
+                        return Err(p.err(te, "give a point light `position` or `to_world`, not both"))
+                    }
+                    (Some(v), None) => DVec3::from_array(v),
+                    (None, Some((x, _))) => x.m.transform_point3(DVec3::ZERO),
+                    (None, None) => DVec3::ZERO,
+                };
+                LightDesc::Point {
+                    position: position.as_vec3(),
+                    intensity,
+                }
+            }
+            "constant" => LightDesc::Environment {
+                radiance: p
+                    .color("radiance", ColorUse::Emission, opts, &mut self.report)?
+                    .unwrap_or(Color::ONE),
+            },
+            "directional" => {
+                let irradiance = p
+                    .color("irradiance", ColorUse::Emission, opts, &mut self.report)?
+                    .unwrap_or(Color::ONE);
+                let d = p.vec3("direction")?;
+                let xf = p.transform("to_world")?;
+                // Mitsuba's direction is the one the light travels along; lt's points to the light.
+                let travel = match (d, xf) {
+                    (Some(_), Some((_, te))) => {
+                        return Err(p.err(te, "give a directional light `direction` or `to_world`, not both"))
+                    }
+                    (Some(v), None) => DVec3::from_array(v),
+                    (None, Some((x, _))) => x.m.transform_vector3(DVec3::Z),
+                    (None, None) => DVec3::Z,
+                };
+                // Normalised in f32 as the TOML loader does, so a converted scene reads back exactly.
+                let towards = -travel.as_vec3();
+                if !(towards.length() > 0.0) || !towards.is_finite() {
+                    return Err(p.err(e, "the directional light's `direction` is the zero vector"));
+                }
+                LightDesc::Directional {
+                    direction: towards.normalize(),
+                    irradiance,
+                }
+            }
+            "area" => return Err(p.err(e, "an area emitter must be nested in a shape")),
+            "envmap" => return Err(textures_refused(self.doc, e)),
+            other => {
+                return Err(p.err(
+                    e,
+                    format!("emitter `{other}` is not supported (lt reads area, point, constant and directional)"),
+                ))
+            }
+        };
+        p.finish(&["sampling_weight"], &mut self.report)?;
+        let power = match &desc {
+            LightDesc::Point { intensity: c, .. }
+            | LightDesc::Directional { irradiance: c, .. }
+            | LightDesc::Environment { radiance: c }
+            | LightDesc::Sun { radiance: c, .. } => c.max_element(),
+        };
+        Ok((power > 0.0).then_some(desc))
+    }
+}
+
+/// The uniform scale of a similarity transform (rotation × uniform scale + translation).
+fn similarity_scale(m: &DMat4) -> Option<f64> {
+    let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.truncate());
+    let s = cols[0].length();
+    let tol = 1e-5 * s;
+    let ok = s > 0.0
+        && cols.iter().all(|c| (c.length() - s).abs() <= tol)
+        && cols[0].dot(cols[1]).abs() <= tol * s
+        && cols[0].dot(cols[2]).abs() <= tol * s
+        && cols[1].dot(cols[2]).abs() <= tol * s;
+    ok.then_some(s)
+}
+
+/// Eye, target and up of a camera `to_world` matrix (Mitsuba's camera looks along local +z with
+/// +y up; its local +x is image left). Refuses matrices that skew or mirror the view.
+fn camera_frame(p: &Plugin, m: &DMat4, te: &Elem) -> Result<(DVec3, DVec3, DVec3), SceneError> {
+    let eye = m.transform_point3(DVec3::ZERO);
+    let col = |v: DVec4| (*m * v).truncate();
+    let (left, up, fwd) = (col(DVec4::X), col(DVec4::Y), col(DVec4::Z));
+    let (ln, un, fnn) = (
+        left.normalize_or_zero(),
+        up.normalize_or_zero(),
+        fwd.normalize_or_zero(),
+    );
+    let skew = ln
+        .dot(un)
+        .abs()
+        .max(ln.dot(fnn).abs())
+        .max(un.dot(fnn).abs());
+    if !(fnn.length() > 0.0 && un.length() > 0.0 && ln.length() > 0.0) || skew > 1e-4 {
+        return Err(p.err(te, "the camera's to_world skews or flattens the view (it must be a rotation and translation)"));
+    }
+    if un.cross(fnn).dot(ln) < 0.0 {
+        return Err(p.err(
+            te,
+            "the camera's to_world mirrors the image (negative determinant): not supported",
+        ));
+    }
+    Ok((eye, eye + fnn, un))
+}

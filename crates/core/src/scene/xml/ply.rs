@@ -1,0 +1,106 @@
+//! PLY meshes (ASCII and binary, either byte order) through `ply-rs-bw`: vertex `x y z`, optional
+//! `nx ny nz` (kept as shading normals), and faces as `vertex_indices` (or `vertex_index`) lists,
+//! fan-triangulated. Errors point at the scene's `filename`.
+
+use crate::math::Vec3;
+use crate::scene::load::Ctx;
+use crate::scene::{SceneError, TriangleMesh};
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{DefaultElement, Property};
+use toml::Spanned;
+
+pub(super) fn load_ply(ctx: &Ctx, file: &Spanned<String>) -> Result<TriangleMesh, SceneError> {
+    let path = ctx.base_dir.join(file.get_ref());
+    let shown = path.display();
+    let bytes = match std::fs::read(&path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(ctx.at(
+                file.span(),
+                format!(
+                    "mesh file `{}` not found (looked for {shown})",
+                    file.get_ref()
+                ),
+            ))
+        }
+        Err(e) => return Err(ctx.at(file.span(), format!("cannot read mesh file {shown}: {e}"))),
+    };
+    let bad = |msg: String| ctx.at(file.span(), format!("malformed PLY file {shown}: {msg}"));
+    let parsed = std::panic::catch_unwind(|| {
+        Parser::<DefaultElement>::new().read_ply(&mut bytes.as_slice())
+    });
+    let ply = match parsed {
+        Ok(Ok(p)) => p,
+        Ok(Err(e)) => return Err(bad(e.to_string())),
+        Err(_) => return Err(bad("the PLY reader failed on it".into())),
+    };
+    let Some(vertices) = ply.payload.get("vertex") else {
+        return Err(bad("it has no `vertex` element".into()));
+    };
+    let scalar = |v: &DefaultElement, k: &str| v.get(k).and_then(Property::to_f32_lossy);
+    let mut positions = Vec::with_capacity(vertices.len());
+    let mut normals = Some(Vec::with_capacity(vertices.len()));
+    for (i, v) in vertices.iter().enumerate() {
+        let (Some(x), Some(y), Some(z)) = (scalar(v, "x"), scalar(v, "y"), scalar(v, "z")) else {
+            return Err(bad(format!("vertex {i} lacks a numeric x, y or z")));
+        };
+        positions.push(Vec3::new(x, y, z));
+        match (scalar(v, "nx"), scalar(v, "ny"), scalar(v, "nz")) {
+            (Some(a), Some(b), Some(c)) => {
+                if let Some(ns) = &mut normals {
+                    ns.push(Vec3::new(a, b, c));
+                }
+            }
+            _ => normals = None,
+        }
+    }
+    let n = positions.len();
+    let mut indices = Vec::new();
+    let faces = ply.payload.get("face").map(Vec::as_slice).unwrap_or(&[]);
+    for (i, f) in faces.iter().enumerate() {
+        let Some(list) = f.get("vertex_indices").or_else(|| f.get("vertex_index")) else {
+            return Err(bad(format!("face {i} has no vertex_indices list")));
+        };
+        let idx: Vec<i64> = match list {
+            Property::ListChar(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListUChar(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListShort(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListUShort(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListInt(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListUInt(v) => v.iter().map(|&x| x as i64).collect(),
+            _ => {
+                return Err(bad(format!(
+                    "face {i}: vertex_indices is not a list of integers"
+                )))
+            }
+        };
+        if idx.len() < 3 {
+            return Err(bad(format!("face {i} has fewer than 3 vertices")));
+        }
+        if let Some(&k) = idx.iter().find(|&&k| k < 0 || k as usize >= n) {
+            return Err(bad(format!(
+                "face {i}: vertex index {k} is out of range (0..{n})"
+            )));
+        }
+        for j in 1..idx.len() - 1 {
+            indices.push([idx[0] as u32, idx[j] as u32, idx[j + 1] as u32]);
+        }
+    }
+    if indices.is_empty() {
+        return Err(bad("it has no faces".into()));
+    }
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(bad("a vertex position is NaN or infinite".into()));
+    }
+    if normals
+        .as_ref()
+        .is_some_and(|ns| ns.iter().any(|v| !v.is_finite()))
+    {
+        return Err(bad("a vertex normal is NaN or infinite".into()));
+    }
+    Ok(TriangleMesh {
+        positions,
+        normals,
+        indices,
+    })
+}

@@ -1,0 +1,335 @@
+//! One of our TOML scenes as Mitsuba 3 XML (`lt convert`), wherever Mitsuba can express it: the
+//! scene is loaded (so everything is checked as for rendering), then written from its file's own
+//! description — rectangles and cubes as `rectangle`/`cube` with the exact f32 `to_world` the
+//! loader built, meshes as `obj` files referenced relative to the output, spheres as `sphere`.
+//! Our materials reflect alike on both sides, so the one-sided Mitsuba BSDFs are wrapped in
+//! `twosided`. Numbers are written as the shortest decimal that reads back to the same f32, so
+//! toml → xml → load gives the same scene bit for bit.
+//!
+//! Refused: the `sun` light (Mitsuba 3 has no distant light of finite solid angle; a
+//! directional light or an environment map would change the image, so nothing is approximated).
+
+use super::super::format::{ColorDef, SceneFile, ShapeDef};
+use super::super::load::Ctx;
+use super::super::transform::shape_matrix;
+use super::super::SceneError;
+use std::fmt::Write as _;
+use std::path::{Component, Path, PathBuf};
+
+/// The XML text of the TOML scene at `scene`, with mesh paths relative to `out_dir` (the
+/// directory the XML will be written to).
+pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError> {
+    let text = std::fs::read_to_string(scene).map_err(|e| SceneError {
+        file: scene.display().to_string(),
+        line: None,
+        column: None,
+        message: format!("cannot read the scene file: {e}"),
+    })?;
+    if scene
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+    {
+        return Err(SceneError {
+            file: scene.display().to_string(),
+            line: None,
+            column: None,
+            message: "this is already an XML scene (lt convert reads our TOML scenes)".into(),
+        });
+    }
+    // Everything checked exactly as for rendering.
+    let loaded = super::super::load_scene_str(&text, scene)?;
+    let ctx = Ctx {
+        file: scene.display().to_string(),
+        text: &text,
+        base_dir: scene.parent().map(Path::to_path_buf).unwrap_or_default(),
+    };
+    let file: SceneFile =
+        toml::from_str(&text).map_err(|e| ctx.whole(e.message().trim_end().to_string()))?;
+    for l in &file.lights {
+        let d = l.get_ref();
+        if d.kind.get_ref() == "sun" {
+            return Err(ctx.at(
+                d.kind.span(),
+                "Mitsuba 3 has no sun of finite solid angle (its `directional` is a delta in \
+                 direction, its `sunsky` a sky model): this scene cannot be written as Mitsuba \
+                 XML without changing its image, and lt convert does not approximate",
+            ));
+        }
+    }
+    let mut x = String::new();
+    let name = scene
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let _ = writeln!(x, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
+    let _ = writeln!(
+        x,
+        "<!-- {} as Mitsuba 3 XML, written by `lt convert` (render it with Mitsuba's `scalar_rgb` or `llvm_ad_rgb` variant). -->",
+        esc(&name)
+    );
+    let _ = writeln!(x, "<scene version=\"3.0.0\">");
+    let s = loaded.settings;
+    let _ = writeln!(
+        x,
+        "    <integrator type=\"path\">\n        <integer name=\"max_depth\" value=\"{}\"/>\n        <integer name=\"rr_depth\" value=\"{}\"/>\n    </integrator>",
+        s.max_depth, s.rr_depth
+    );
+    // Camera: the look-at as written (f32, as the loader reads it).
+    let c = file.camera.get_ref();
+    let v = |a: &[f64; 3]| {
+        let f = a.map(|x| x as f32);
+        format!("{}, {}, {}", f[0], f[1], f[2])
+    };
+    let up =
+        c.up.as_ref()
+            .map(|u| *u.get_ref())
+            .unwrap_or([0.0, 1.0, 0.0]);
+    let axis = match c.fov_axis.unwrap_or(crate::camera::FovAxis::X) {
+        crate::camera::FovAxis::X => "x",
+        crate::camera::FovAxis::Y => "y",
+        crate::camera::FovAxis::Smaller => "smaller",
+        crate::camera::FovAxis::Larger => "larger",
+    };
+    let [w, h] = *c.resolution.get_ref();
+    let _ = writeln!(x, "    <sensor type=\"perspective\">");
+    let _ = writeln!(
+        x,
+        "        <float name=\"fov\" value=\"{}\"/>",
+        *c.fov.get_ref() as f32
+    );
+    let _ = writeln!(x, "        <string name=\"fov_axis\" value=\"{axis}\"/>");
+    let _ = writeln!(
+        x,
+        "        <transform name=\"to_world\">\n            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>\n        </transform>",
+        v(c.eye.get_ref()),
+        v(c.target.get_ref()),
+        v(&up)
+    );
+    let _ = writeln!(
+        x,
+        "        <sampler type=\"independent\">\n            <integer name=\"sample_count\" value=\"{}\"/>\n        </sampler>",
+        s.spp
+    );
+    let _ = writeln!(
+        x,
+        "        <film type=\"hdrfilm\">\n            <integer name=\"width\" value=\"{w}\"/>\n            <integer name=\"height\" value=\"{h}\"/>\n            <rfilter type=\"box\"/>\n        </film>\n    </sensor>"
+    );
+    // Materials, in file order, by name.
+    let mut mats: Vec<_> = file.materials.iter().collect();
+    mats.sort_by_key(|(_, d)| d.span().start);
+    for (mname, def) in mats {
+        let d = def.get_ref();
+        let rgb = |c: &Option<toml::Spanned<ColorDef>>, default: f64| {
+            let a = c.as_ref().map(|c| c.get_ref().0).unwrap_or([default; 3]);
+            v(&a)
+        };
+        let id = esc(mname);
+        let body = match d.kind.get_ref().as_str() {
+            "diffuse" => format!(
+                "<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"diffuse\">\n            <rgb name=\"reflectance\" value=\"{}\"/>\n        </bsdf>\n    </bsdf>",
+                rgb(&d.albedo, 0.0)
+            ),
+            "mirror" => format!(
+                "<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"conductor\">\n            <string name=\"material\" value=\"none\"/>\n            <rgb name=\"specular_reflectance\" value=\"{}\"/>\n        </bsdf>\n    </bsdf>",
+                rgb(&d.reflectance, 1.0)
+            ),
+            "glossy" => format!(
+                "<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"roughconductor\">\n            <string name=\"material\" value=\"none\"/>\n            <string name=\"distribution\" value=\"ggx\"/>\n            <float name=\"alpha\" value=\"{}\"/>\n            <rgb name=\"specular_reflectance\" value=\"{}\"/>\n        </bsdf>\n    </bsdf>",
+                d.roughness.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(0.0),
+                rgb(&d.reflectance, 1.0)
+            ),
+            "dielectric" => format!(
+                "<bsdf type=\"dielectric\" id=\"{id}\">\n        <float name=\"int_ior\" value=\"{}\"/>\n        <float name=\"ext_ior\" value=\"1\"/>\n    </bsdf>",
+                d.ior.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(1.0)
+            ),
+            other => {
+                return Err(ctx.at(d.kind.span(), format!("material type `{other}` has no Mitsuba counterpart here")))
+            }
+        };
+        let _ = writeln!(x, "    {body}");
+    }
+    for def in &file.shapes {
+        let d = def.get_ref();
+        x.push_str(&shape(&ctx, d, out_dir, &v)?);
+    }
+    for l in &file.lights {
+        let d = l.get_ref();
+        let col = |c: &Option<toml::Spanned<ColorDef>>| {
+            c.as_ref().map(|c| c.get_ref().0).unwrap_or([0.0; 3])
+        };
+        let zero = |c: [f64; 3]| c.iter().all(|&x| x as f32 == 0.0);
+        match d.kind.get_ref().as_str() {
+            "point" => {
+                let i = col(&d.intensity);
+                if zero(i) {
+                    continue;
+                }
+                let p = d
+                    .position
+                    .as_ref()
+                    .map(|p| *p.get_ref())
+                    .unwrap_or_default();
+                let _ = writeln!(
+                    x,
+                    "    <emitter type=\"point\">\n        <point name=\"position\" value=\"{}\"/>\n        <rgb name=\"intensity\" value=\"{}\"/>\n    </emitter>",
+                    v(&p),
+                    v(&i)
+                );
+            }
+            "directional" => {
+                let e = col(&d.irradiance);
+                if zero(e) {
+                    continue;
+                }
+                // Ours points towards the light, Mitsuba's along the light's travel: the f32
+                // direction as the TOML gives it, negated (exact; both loaders normalise it).
+                let dir = d
+                    .direction
+                    .as_ref()
+                    .map(|p| *p.get_ref())
+                    .unwrap_or_default();
+                let u = glam::Vec3::from_array(dir.map(|x| x as f32));
+                let _ = writeln!(
+                    x,
+                    "    <emitter type=\"directional\">\n        <vector name=\"direction\" value=\"{}, {}, {}\"/>\n        <rgb name=\"irradiance\" value=\"{}\"/>\n    </emitter>",
+                    -u.x,
+                    -u.y,
+                    -u.z,
+                    v(&e)
+                );
+            }
+            "environment" => {
+                let r = col(&d.radiance);
+                if zero(r) {
+                    continue;
+                }
+                let _ = writeln!(
+                    x,
+                    "    <emitter type=\"constant\">\n        <rgb name=\"radiance\" value=\"{}\"/>\n    </emitter>",
+                    v(&r)
+                );
+            }
+            other => {
+                return Err(ctx.at(
+                    d.kind.span(),
+                    format!("light type `{other}` has no Mitsuba counterpart"),
+                ))
+            }
+        }
+    }
+    x.push_str("</scene>\n");
+    Ok(x)
+}
+
+fn shape(
+    ctx: &Ctx,
+    d: &ShapeDef,
+    out_dir: &Path,
+    v: &dyn Fn(&[f64; 3]) -> String,
+) -> Result<String, SceneError> {
+    let mut x = String::new();
+    let matrix = |x: &mut String| -> Result<(), SceneError> {
+        let (m, _) = shape_matrix(ctx, d)?;
+        let rows: Vec<String> = (0..4)
+            .map(|r| {
+                let row = m.row(r);
+                format!("{} {} {} {}", row.x, row.y, row.z, row.w)
+            })
+            .collect();
+        let _ = writeln!(
+            x,
+            "        <transform name=\"to_world\">\n            <matrix value=\"{}\"/>\n        </transform>",
+            rows.join("  ")
+        );
+        Ok(())
+    };
+    match d.kind.get_ref().as_str() {
+        "quad" | "cube" => {
+            let t = if d.kind.get_ref() == "quad" {
+                "rectangle"
+            } else {
+                "cube"
+            };
+            let _ = writeln!(x, "    <shape type=\"{t}\">");
+            matrix(&mut x)?;
+        }
+        "mesh" => {
+            let file = d
+                .file
+                .as_ref()
+                .map(|f| f.get_ref().clone())
+                .unwrap_or_default();
+            let abs = ctx.base_dir.join(&file);
+            let rel = relative(&abs, out_dir);
+            let _ = writeln!(x, "    <shape type=\"obj\">");
+            let _ = writeln!(
+                x,
+                "        <string name=\"filename\" value=\"{}\"/>",
+                esc(&rel.to_string_lossy())
+            );
+            // Without normals on every vertex our meshes shade flat; Mitsuba would compute
+            // smooth vertex normals, so ask it for face normals then.
+            let mesh =
+                super::super::obj::load_obj(ctx, d.file.as_ref().expect("checked by the load"))?;
+            if mesh.normals.is_none() {
+                let _ = writeln!(x, "        <boolean name=\"face_normals\" value=\"true\"/>");
+            }
+            matrix(&mut x)?;
+        }
+        "sphere" => {
+            let c = d.center.as_ref().map(|c| *c.get_ref()).unwrap_or_default();
+            let r = d.radius.as_ref().map(|r| *r.get_ref()).unwrap_or(1.0);
+            let _ = writeln!(x, "    <shape type=\"sphere\">");
+            let _ = writeln!(x, "        <point name=\"center\" value=\"{}\"/>", v(&c));
+            let _ = writeln!(x, "        <float name=\"radius\" value=\"{}\"/>", r as f32);
+        }
+        other => {
+            return Err(ctx.at(
+                d.kind.span(),
+                format!("shape type `{other}` has no Mitsuba counterpart"),
+            ))
+        }
+    }
+    if d.flip_normals {
+        let _ = writeln!(x, "        <boolean name=\"flip_normals\" value=\"true\"/>");
+    }
+    let _ = writeln!(x, "        <ref id=\"{}\"/>", esc(d.material.get_ref()));
+    if let Some(e) = &d.emission {
+        let c = e.get_ref().0;
+        if c.iter().any(|&k| k as f32 > 0.0) {
+            let _ = writeln!(
+                x,
+                "        <emitter type=\"area\">\n            <rgb name=\"radiance\" value=\"{}\"/>\n        </emitter>",
+                v(&c)
+            );
+        }
+    }
+    x.push_str("    </shape>\n");
+    Ok(x)
+}
+
+/// `path` relative to `dir` when both resolve (else `path` made absolute).
+fn relative(path: &Path, dir: &Path) -> PathBuf {
+    let (Ok(p), Ok(d)) = (path.canonicalize(), dir.canonicalize()) else {
+        return std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    };
+    let pc: Vec<Component> = p.components().collect();
+    let dc: Vec<Component> = d.components().collect();
+    let common = pc.iter().zip(&dc).take_while(|(a, b)| a == b).count();
+    let mut out = PathBuf::new();
+    for _ in common..dc.len() {
+        out.push("..");
+    }
+    for c in &pc[common..] {
+        out.push(c);
+    }
+    out
+}
+
+/// Escapes text for an XML attribute value.
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
