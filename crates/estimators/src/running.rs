@@ -140,6 +140,43 @@ impl RunningImage {
         self.n += other.n;
     }
 
+    /// An accumulator from its stored state: `count` passes, per-pixel mean and sum of squared
+    /// deviations (M2), row-major — what a partial render keeps so that it can be merged exactly.
+    pub fn from_parts(
+        width: usize,
+        height: usize,
+        count: u64,
+        mean: Vec<[f64; 3]>,
+        m2: Vec<[f64; 3]>,
+    ) -> Result<Self, String> {
+        let n = width * height;
+        if mean.len() != n || m2.len() != n {
+            return Err(format!(
+                "a {width}x{height} accumulator needs {n} pixels of mean and of M2, got {} and {}",
+                mean.len(),
+                m2.len()
+            ));
+        }
+        if count == 0 && (mean.iter().chain(&m2).flatten().any(|&v| v != 0.0)) {
+            return Err("an accumulator of no passes must be all zeros".into());
+        }
+        if m2.iter().flatten().any(|&v| v < 0.0) {
+            return Err("a sum of squared deviations (M2) is negative".into());
+        }
+        Ok(RunningImage {
+            width,
+            height,
+            n: count,
+            mean,
+            m2,
+        })
+    }
+
+    /// The stored state: per-pixel mean and M2, row-major (see `from_parts`).
+    pub fn parts(&self) -> (&[[f64; 3]], &[[f64; 3]]) {
+        (&self.mean, &self.m2)
+    }
+
     pub fn count(&self) -> u64 {
         self.n
     }
@@ -291,6 +328,21 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn parts_round_trip_and_bad_parts_are_refused() {
+        let mut rng = Rng::new(11);
+        let mut r = RunningImage::new(3, 2);
+        (0..5).for_each(|_| r.add(&random_image(&mut rng, 3, 2)));
+        let (m, m2) = r.parts();
+        let back = RunningImage::from_parts(3, 2, r.count(), m.to_vec(), m2.to_vec()).unwrap();
+        assert_eq!(back, r);
+        assert!(RunningImage::from_parts(3, 2, 5, m[..5].to_vec(), m2.to_vec()).is_err());
+        let mut neg = m2.to_vec();
+        neg[2][1] = -1.0;
+        assert!(RunningImage::from_parts(3, 2, 5, m.to_vec(), neg).is_err());
+        assert!(RunningImage::from_parts(3, 2, 0, m.to_vec(), m2.to_vec()).is_err());
     }
 
     #[test]

@@ -40,8 +40,16 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub integrator_args: crate::integrator_args::IntegratorArgs,
     /// Output EXR; `.png`, `.json` and (where there is an honest one) `.stderr.exr` beside it.
-    #[arg(long, short)]
-    pub output: PathBuf,
+    #[arg(long, short, required_unless_present = "partial")]
+    pub output: Option<PathBuf>,
+    /// Render only passes A..B (A to B-1, counted from 0) of the seed: with --partial, one shard
+    /// of a render split by passes (unbiased integrators).
+    #[arg(long, value_name = "A..B", requires = "partial")]
+    pub passes: Option<String>,
+    /// Write the exact accumulation (count, per-pixel mean and M2 in f64, scene hash, parameters)
+    /// to OUT instead of images, for `lt merge`; with --runs K, of K runs (seeds seed…seed+K-1).
+    #[arg(long, value_name = "OUT", conflicts_with_all = ["time", "strategies", "output"])]
+    pub partial: Option<PathBuf>,
     /// Seconds between checkpoints of the partial image (an interrupted run keeps what it finished).
     #[arg(long, default_value_t = 30.0)]
     pub checkpoint: f64,
@@ -70,7 +78,7 @@ pub fn sibling(out: &Path, suffix: &str) -> PathBuf {
 /// Writes the image, its preview and, when there is an honest one, its standard error. Where
 /// there is none (one run of a consistent estimator) a stale `.stderr.exr` from an earlier render
 /// is removed, so no file beside the image claims an error bar it does not have.
-fn write_outputs(out: &Path, mean: &Image, std_error: Option<&Image>) -> Result<(), String> {
+pub fn write_outputs(out: &Path, mean: &Image, std_error: Option<&Image>) -> Result<(), String> {
     write_exr(out, mean)?;
     write_png_preview(&sibling(out, ".png"), mean)?;
     let se_path = sibling(out, ".stderr.exr");
@@ -105,6 +113,13 @@ fn log_json(log: &ProgressLog) -> serde_json::Value {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
+    if let Some(part) = &args.partial {
+        return crate::cluster::partial::render_partial_cmd(args, part);
+    }
+    let output = args
+        .output
+        .as_deref()
+        .ok_or("give -o OUT.exr (or --partial OUT)")?;
     if let Some(dir) = &args.strategies {
         if args.integrator != "bdpt" {
             return Err(format!(
@@ -150,7 +165,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     };
     let kind = estimator.kind();
     let write_all = |mean: &Image, se: Option<&Image>| -> Result<(), String> {
-        write_outputs(&args.output, mean, se)?;
+        write_outputs(output, mean, se)?;
         if let Some((dir, integ, meta)) = &pyramid {
             integ.with_pyramid(|p| write_pyramid(dir, p, meta))?;
         }
@@ -279,7 +294,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         "strategy_length": pyramid.as_ref().map(|_| args.strategy_length),
     });
     crate::image_io::write_atomic(
-        &sibling(&args.output, ".json"),
+        &sibling(output, ".json"),
         serde_json::to_string_pretty(&record).unwrap().as_bytes(),
     )?;
     if !args.quiet {
@@ -294,7 +309,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             first.passes,
             secs,
             total_passes as f64 / secs,
-            args.output.display()
+            output.display()
         );
         let mut warnings: Vec<&str> = result
             .runs

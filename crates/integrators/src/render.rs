@@ -204,6 +204,58 @@ fn render_in(
     }
 }
 
+/// Passes `passes.start .. passes.end` of an unbiased estimator under one seed: what one shard of
+/// a sharded render computes. Pass p is `render_pass(scene, seed, p)` whatever the range, so the
+/// ranges of a split cover exactly the passes of the whole render, and passes are accumulated in
+/// order, so the range 0..N is bit for bit the accumulator `render` keeps (at any thread count).
+pub struct PassRange {
+    pub accumulated: RunningImage,
+    /// The passes done (`passes.start ..` the last one finished).
+    pub passes: std::ops::Range<u32>,
+    pub elapsed: Duration,
+    pub invalid_samples: u64,
+}
+
+/// Renders passes `passes` of `integrator` with `seed` on `threads` workers (0 = one per core).
+/// `on_pass(done, accumulated)` is told after each pass (`done` passes of the range finished);
+/// when it breaks, the range stops short (the result says where).
+pub fn render_pass_range(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    seed: u64,
+    passes: std::ops::Range<u32>,
+    threads: usize,
+    mut on_pass: impl FnMut(u32, &RunningImage) -> ControlFlow<()>,
+) -> Result<PassRange, String> {
+    if passes.is_empty() {
+        return Err(format!(
+            "the pass range {}..{} is empty",
+            passes.start, passes.end
+        ));
+    }
+    let pool = pool(threads)?;
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let start = Instant::now();
+    let mut acc = RunningImage::new(w, h);
+    let mut invalid = 0;
+    let mut pass = passes.start;
+    while pass < passes.end {
+        let (img, bad) = pool.install(|| integrator.render_pass(scene, seed, pass));
+        acc.add(&img);
+        invalid += bad;
+        pass += 1;
+        if on_pass(pass - passes.start, &acc).is_break() {
+            break;
+        }
+    }
+    Ok(PassRange {
+        accumulated: acc,
+        passes: passes.start..pass,
+        elapsed: start.elapsed(),
+        invalid_samples: invalid,
+    })
+}
+
 /// One run of `render_runs`.
 pub struct RunSummary {
     pub seed: u64,

@@ -1,19 +1,29 @@
-//! Scale-out: exact partial renders, their merge, and plans of shards for Slurm or GNU parallel
-//! (issue 14; not yet).
+//! Scale-out (issue 14): exact partial renders and their merge, and plans of independent shards
+//! handed to Slurm, GNU parallel or the local pool. The testbed plans the work and merges it; the
+//! cluster's own scheduler runs it. Every shard's output lives in the experiments' one cache
+//! (`crate::cache`), keyed by the hash of its inputs, so a rerun redoes only what is missing.
+//!
+//! - `partial`: the `.ltp` format (count, per-pixel mean and M2 in f64, identity), the pass-range
+//!   and run-set renders, and the exact merge with its refusals.
+//! - `merge`: `lt merge`.
+//! - `plan`: `lt plan render|study`, the plan folder.
+//! - `shard`: `lt run-shard`, with per-shard state files.
+//! - `submit`: `lt submit --slurm|--parallel|--local`.
+//! - `collect`: `lt collect`.
+//! - `study_link`: which renders a study needs and how its outputs are made.
+//!
+//! See docs/cluster.md.
 
-use clap::Args;
+pub mod collect;
+pub mod merge;
+pub mod partial;
+pub mod plan;
+pub mod shard;
+pub mod study_link;
+pub mod submit;
 
-macro_rules! not_yet {
-    ($args:ident, $fn:ident, $what:literal) => {
-        #[derive(Args, Debug)]
-        pub struct $args {}
-        pub fn $fn(_: &$args) -> Result<(), String> {
-            Err(concat!("lt ", $what, " is not written yet").into())
-        }
-    };
-}
-not_yet!(MergeArgs, merge, "merge");
-not_yet!(PlanArgs, plan, "plan");
-not_yet!(RunShardArgs, run_shard, "run-shard");
-not_yet!(SubmitArgs, submit, "submit");
-not_yet!(CollectArgs, collect, "collect");
+pub use collect::{collect, CollectArgs};
+pub use merge::{merge, MergeArgs};
+pub use plan::{plan, PlanArgs};
+pub use shard::{run_shard, RunShardArgs};
+pub use submit::{submit, SubmitArgs};

@@ -1,0 +1,81 @@
+//! The seam between plans and the studies: which renders a study needs (`lt plan study`) and
+//! how its outputs are made once they are in the cache (`lt collect`, which runs the study
+//! again: every render is then found).
+//!
+//! Until `study::plan` and `study::run_named` are on main, a built-in study stands in:
+//! `smoke`, a handful of small `pt` renders of the Cornell box, and collecting it writes
+//! `RESULTS/smoke/summary.json` from the cached entries. This file is the one place to switch.
+
+use crate::cache::Cache;
+use crate::runs::{Executor, RunSpec};
+use std::path::Path;
+
+fn smoke(scale: &str, scenes: &Path) -> Result<Vec<RunSpec>, String> {
+    let (res, passes, seeds) = match scale {
+        "test" => ((16, 16), 4, 2),
+        "quick" => ((64, 64), 16, 4),
+        "full" => ((256, 256), 256, 8),
+        other => return Err(format!("unknown scale '{other}' (test, quick, full)")),
+    };
+    let scene = scenes.join("cornell-box.toml");
+    Ok((1..=seeds)
+        .map(|seed| {
+            RunSpec::new(&scene, "pt", seed, passes)
+                .resolution(Some(res))
+                .snapshots([passes / 4, passes / 2])
+        })
+        .collect())
+}
+
+/// Every render study `name` needs at `scale`.
+pub fn plan(name: &str, scale: &str, scenes: &Path) -> Result<Vec<RunSpec>, String> {
+    match name {
+        "smoke" => smoke(scale, scenes),
+        other => Err(format!(
+            "lt plan study: study '{other}' cannot be planned by this build (it knows: smoke)"
+        )),
+    }
+}
+
+/// Makes study `name`'s outputs under `results`, rendering whatever the cache lacks; returns
+/// a line per render and how many were made here.
+pub fn collect(
+    name: &str,
+    scale: &str,
+    results: &Path,
+    scenes: &Path,
+    cache: &Path,
+    threads: usize,
+) -> Result<(Vec<String>, usize), String> {
+    let specs = plan(name, scale, scenes)?;
+    let exec = Executor {
+        cache: Cache::new(cache),
+        threads,
+    };
+    let mut rows = Vec::new();
+    let mut lines = Vec::new();
+    let mut made = 0;
+    for spec in &specs {
+        if exec.lookup(spec)?.is_none() {
+            made += 1;
+        }
+        let entry = exec.run(spec)?;
+        let img = entry.image()?;
+        let mean = img.data.iter().flatten().sum::<f64>() / (img.data.len() * 3).max(1) as f64;
+        lines.push(format!("{}: mean {mean:.6}", spec.label()));
+        rows.push(serde_json::json!({
+            "run": spec.label(),
+            "entry": entry.dir,
+            "mean": mean,
+            "seconds": entry.record.seconds,
+        }));
+    }
+    let dir = results.join(name);
+    std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let text = serde_json::to_string_pretty(
+        &serde_json::json!({ "study": name, "scale": scale, "runs": rows }),
+    )
+    .map_err(|e| e.to_string())?;
+    crate::image_io::write_atomic(&dir.join("summary.json"), text.as_bytes())?;
+    Ok((lines, made))
+}
