@@ -123,7 +123,7 @@ fn looks(series: &[Series]) -> Vec<Look> {
                 // Markers cycle faster than colours and go hollow on the second round of
                 // colours, so (colour, marker, fill) stays distinct for 56 series.
                 let marker = MARKERS[k % MARKERS.len()];
-                let filled = (k / PALETTE.len()) % 2 == 0;
+                let filled = (k / PALETTE.len()).is_multiple_of(2);
                 out.push(Look {
                     color: PALETTE[k % PALETTE.len()],
                     marker: Some((marker, filled)),
@@ -536,7 +536,7 @@ fn draw<DB: DrawingBackend>(
     let legend: Vec<usize> = (0..chart.series.len())
         .filter(|&i| !prepared[i].runs.is_empty() && !chart.series[i].name.is_empty())
         .collect();
-    let legend_font = if legend.len() > 20 { 12.0 } else { 15.0 };
+    let legend_font = if legend.len() > 16 { 14.0 } else { 18.0 };
     let row = legend_font * 1.5;
     let text_w = legend
         .iter()
@@ -556,10 +556,10 @@ fn draw<DB: DrawingBackend>(
     let (plot_area, legend_area) = root.split_horizontally(w - legend_w);
 
     let mut cc = ChartBuilder::on(&plot_area)
-        .caption(&chart.title, font(22.0))
+        .caption(&chart.title, font(26.0))
         .margin(12)
-        .x_label_area_size(56)
-        .y_label_area_size(84)
+        .x_label_area_size(64)
+        .y_label_area_size(100)
         .build_cartesian_2d(Ticked::new(&x_axis), Ticked::new(&y_axis))?;
     let x_fmt = x_axis.labeller(&x_axis.ticks().0);
     let y_fmt = y_axis.labeller(&y_axis.ticks().0);
@@ -568,8 +568,8 @@ fn draw<DB: DrawingBackend>(
         .y_desc(&chart.y_label)
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
-        .label_style(font(14.0))
-        .axis_desc_style(font(16.0))
+        .label_style(font(18.0))
+        .axis_desc_style(font(20.0))
         .bold_line_style(RGBColor(200, 200, 200))
         .light_line_style(RGBColor(236, 236, 236))
         .draw()?;
@@ -622,7 +622,7 @@ fn draw<DB: DrawingBackend>(
         let style = ShapeStyle::from(&look.color).stroke_width(2);
         if look.dashed {
             legend_area.draw(&DashedPathElement::new(
-                [(4, y), (40, y)].into_iter(),
+                [(4, y), (40, y)],
                 7,
                 4,
                 style,

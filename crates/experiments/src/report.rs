@@ -1,7 +1,36 @@
-//! `lt report`: results/index.html from the studies' manifests (not yet).
+//! `lt report`: one self-contained page, `RESULTS/index.html`, from the studies' manifests
+//! (`manifest::Manifest`): per study its Markdown summary, figures (the SVG shown, the PNG
+//! linked), tables (with their CSV) and galleries, where a reader wipes or flips between the
+//! reference and an estimate and sees a chosen crop enlarged. CSS and JavaScript are inline,
+//! images are linked relatively (the results folder can be moved or served as it is), and
+//! nothing is fetched from the network.
+//!
+//! The page carries a hidden self-check (`report/selfcheck.js`, the first script to run): it
+//! counts window errors, unhandled rejections and `console.error` calls, waits for the page's
+//! images, and writes a JSON line into `<pre id="lt-selfcheck" hidden>` — what
+//! `tests/report_browser.rs` reads from Chromium's dumped DOM.
 
+mod html;
+mod markdown;
+
+use crate::image_io::write_atomic;
+use crate::manifest::{Manifest, MANIFEST_FILE};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+pub use html::{images_in_page, SELFCHECK_ID};
+
+/// The studies in the order the page shows them; any other study folder follows, by name.
+pub const ORDER: [&str; 5] = [
+    "convergence",
+    "unbiased-vs-consistent",
+    "radius-shrinkage",
+    "equal-time",
+    "per-length",
+];
+
+/// The page's file name inside the results folder.
+pub const INDEX_FILE: &str = "index.html";
 
 #[derive(Args, Debug)]
 pub struct ReportArgs {
@@ -10,6 +39,87 @@ pub struct ReportArgs {
     pub results: PathBuf,
 }
 
-pub fn run(_args: &ReportArgs) -> Result<(), String> {
-    Err("lt report is not written yet".into())
+pub fn run(args: &ReportArgs) -> Result<(), String> {
+    let path = write_report(&args.results)?;
+    println!("{}", path.display());
+    Ok(())
+}
+
+/// One study folder as the page shows it: its manifest, or why it could not be read.
+pub struct StudyDir {
+    /// The folder's name inside the results folder (what links are relative to).
+    pub folder: String,
+    pub manifest: Result<Manifest, String>,
+    /// The summary's Markdown, or why there is none to show.
+    pub summary: Result<String, String>,
+}
+
+/// Every sub-folder of `results` holding a manifest, in report order (`ORDER`, then by name).
+pub fn find_studies(results: &Path) -> Result<Vec<StudyDir>, String> {
+    let entries = std::fs::read_dir(results)
+        .map_err(|e| format!("cannot read results folder {}: {e}", results.display()))?;
+    let mut folders: Vec<String> = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|e| format!("cannot read {}: {e}", results.display()))?;
+        let path = entry.path();
+        if path.is_dir() && path.join(MANIFEST_FILE).is_file() {
+            if let Some(name) = path.file_name().and_then(|n| n.to_str()) {
+                folders.push(name.to_string());
+            }
+        }
+    }
+    let rank = |f: &str| ORDER.iter().position(|s| *s == f).unwrap_or(ORDER.len());
+    folders.sort_by(|a, b| rank(a).cmp(&rank(b)).then_with(|| a.cmp(b)));
+    Ok(folders
+        .into_iter()
+        .map(|folder| {
+            let dir = results.join(&folder);
+            let manifest = Manifest::read(&dir);
+            let summary = match &manifest {
+                Ok(m) if m.summary.is_empty() => Ok(String::new()),
+                Ok(m) => {
+                    let p = dir.join(&m.summary);
+                    std::fs::read_to_string(&p)
+                        .map_err(|e| format!("cannot read {}: {e}", p.display()))
+                }
+                Err(_) => Ok(String::new()),
+            };
+            StudyDir {
+                folder,
+                manifest,
+                summary,
+            }
+        })
+        .collect())
+}
+
+/// Writes `results/index.html` (atomically) and returns its path. Problems a reader should see
+/// — an unreadable manifest or summary, a file a manifest names but the folder lacks — are
+/// shown on the page and printed as warnings; they do not stop the page from being written.
+pub fn write_report(results: &Path) -> Result<PathBuf, String> {
+    let studies = find_studies(results)?;
+    for s in &studies {
+        let dir = results.join(&s.folder);
+        match &s.manifest {
+            Err(e) => eprintln!("warning: {e}"),
+            Ok(m) => {
+                for f in html::files_named(m) {
+                    if !dir.join(f).is_file() {
+                        eprintln!(
+                            "warning: {} names {f}, which {} lacks",
+                            dir.join(MANIFEST_FILE).display(),
+                            dir.display()
+                        );
+                    }
+                }
+            }
+        }
+        if let Err(e) = &s.summary {
+            eprintln!("warning: {e}");
+        }
+    }
+    let page = html::page(&studies);
+    let path = results.join(INDEX_FILE);
+    write_atomic(&path, page.as_bytes())?;
+    Ok(path)
 }
