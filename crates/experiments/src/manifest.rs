@@ -77,6 +77,34 @@ pub struct Crop {
     pub h: u32,
 }
 
+impl Table {
+    /// Writes the table as CSV to `study_dir/<self.csv>` (atomically; fields holding a comma,
+    /// quote or line break are quoted, quotes doubled), creating the parent folder.
+    pub fn write_csv(&self, study_dir: &Path) -> Result<PathBuf, String> {
+        let path = study_dir.join(&self.csv);
+        if let Some(d) = path.parent() {
+            std::fs::create_dir_all(d)
+                .map_err(|e| format!("cannot create {}: {e}", d.display()))?;
+        }
+        let mut text = String::new();
+        for row in std::iter::once(&self.columns).chain(&self.rows) {
+            let fields: Vec<String> = row.iter().map(|f| csv_field(f)).collect();
+            text.push_str(&fields.join(","));
+            text.push('\n');
+        }
+        write_atomic(&path, text.as_bytes())?;
+        Ok(path)
+    }
+}
+
+fn csv_field(f: &str) -> String {
+    if f.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", f.replace('"', "\"\""))
+    } else {
+        f.to_string()
+    }
+}
+
 impl Manifest {
     /// A manifest with no figures, tables or galleries yet.
     pub fn new(study: &str, title: &str, scale: &str) -> Manifest {
@@ -166,6 +194,27 @@ mod tests {
         let path = m.write(&dir).unwrap();
         assert_eq!(path, dir.join(MANIFEST_FILE));
         assert_eq!(Manifest::read(&dir).unwrap(), m);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn tables_write_quoted_csv() {
+        let dir = std::env::temp_dir().join(format!("lt-manifest-csv-{}", std::process::id()));
+        let t = Table {
+            title: "t".into(),
+            caption: String::new(),
+            csv: "sub/t.csv".into(),
+            columns: vec!["name".into(), "value".into()],
+            rows: vec![
+                vec!["a, b".into(), "1".into()],
+                vec!["say \"hi\"".into(), "2".into()],
+            ],
+        };
+        let path = t.write_csv(&dir).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(path).unwrap(),
+            "name,value\n\"a, b\",1\n\"say \"\"hi\"\"\",2\n"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -494,6 +494,24 @@ pub fn write_chart(stem: &Path, chart: &Chart) -> Result<(PathBuf, PathBuf), Str
     Ok((svg_path, png_path))
 }
 
+/// Writes `study_dir/<stem>.svg` and `.png` (`stem` relative to the study folder, e.g.
+/// "mse_spp" or "plots/mse_spp") and returns the manifest's figure: the chart's title, the
+/// caption, and both paths relative to `study_dir`.
+pub fn write_figure(
+    study_dir: &Path,
+    stem: &str,
+    chart: &Chart,
+    caption: &str,
+) -> Result<crate::manifest::Figure, String> {
+    write_chart(&study_dir.join(stem), chart)?;
+    Ok(crate::manifest::Figure {
+        title: chart.title.clone(),
+        caption: caption.into(),
+        svg: format!("{stem}.svg"),
+        png: format!("{stem}.png"),
+    })
+}
+
 /// `stem` with `.ext` appended (a stem may contain dots: "mse.spp" → "mse.spp.svg").
 fn with_suffix(stem: &Path, ext: &str) -> PathBuf {
     let mut s = stem.as_os_str().to_owned();
@@ -621,12 +639,7 @@ fn draw<DB: DrawingBackend>(
         let y = top + (row * j as f64) as i32;
         let style = ShapeStyle::from(&look.color).stroke_width(2);
         if look.dashed {
-            legend_area.draw(&DashedPathElement::new(
-                [(4, y), (40, y)],
-                7,
-                4,
-                style,
-            ))?;
+            legend_area.draw(&DashedPathElement::new([(4, y), (40, y)], 7, 4, style))?;
         } else {
             legend_area.draw(&PathElement::new(vec![(4, y), (40, y)], style))?;
         }
@@ -765,6 +778,13 @@ mod tests {
         }
         assert!(text.contains("DejaVu Sans"));
         assert_eq!(png_size(&png), CHART_SIZE);
+        let f = write_figure(&d, "plots/again", &chart, "caption").unwrap();
+        assert_eq!(
+            (f.svg.as_str(), f.png.as_str()),
+            ("plots/again.svg", "plots/again.png")
+        );
+        assert_eq!(f.title, "MSE against spp");
+        assert!(d.join("plots/again.svg").is_file() && d.join("plots/again.png").is_file());
         std::fs::remove_dir_all(&d).unwrap();
     }
 

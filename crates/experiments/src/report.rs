@@ -123,3 +123,52 @@ pub fn write_report(results: &Path) -> Result<PathBuf, String> {
     write_atomic(&path, page.as_bytes())?;
     Ok(path)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn studies_in_report_order_and_broken_ones_shown() {
+        let dir = std::env::temp_dir().join(format!("lt-report-order-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        for name in ["zeta", "per-length", "alpha", "convergence", "equal-time"] {
+            let d = dir.join(name);
+            std::fs::create_dir_all(&d).unwrap();
+            let mut m = Manifest::new(name, &format!("Study {name}"), "test");
+            if name == "alpha" {
+                m.summary = "missing.md".into();
+            }
+            m.write(&d).unwrap();
+        }
+        std::fs::create_dir_all(dir.join("broken")).unwrap();
+        std::fs::write(dir.join("broken").join(MANIFEST_FILE), "{").unwrap();
+        std::fs::create_dir_all(dir.join("not-a-study")).unwrap();
+        let found = find_studies(&dir).unwrap();
+        let names: Vec<&str> = found.iter().map(|s| s.folder.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "convergence",
+                "equal-time",
+                "per-length",
+                "alpha",
+                "broken",
+                "zeta"
+            ]
+        );
+        let page = std::fs::read_to_string(write_report(&dir).unwrap()).unwrap();
+        assert!(page.contains("missing.md"), "the missing summary is named");
+        assert!(
+            page.contains("broken/manifest.json"),
+            "the broken manifest is named"
+        );
+        let order: Vec<usize> = names
+            .iter()
+            .map(|n| page.find(&format!("id=\"study-{n}\"")).unwrap())
+            .collect();
+        assert!(order.windows(2).all(|w| w[0] < w[1]), "{order:?}");
+        assert!(write_report(&dir.join("nowhere")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
