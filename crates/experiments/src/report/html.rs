@@ -271,7 +271,8 @@ fn gallery(h: &mut String, folder: &str, id: &str, g: &Gallery) {
          <input type=\"range\" class=\"wipe\" min=\"0\" max=\"100\" step=\"0.1\" value=\"50\" \
          aria-label=\"wipe position\">\
          <button type=\"button\" class=\"toggle\" hidden>Show reference</button>\
-         <span class=\"hint\">drag to wipe · F flips · click the image to move the crop</span>\
+         <span class=\"hint\">drag: wipe · click: move the crop (shift-click when flipping) · \
+         F: flip · ←/→: next estimate</span>\
          </div>"
     );
     let _ = writeln!(
@@ -293,7 +294,10 @@ fn gallery(h: &mut String, folder: &str, id: &str, g: &Gallery) {
          </div><figcaption>{rl}</figcaption></figure>\
          <figure><div class=\"crop\"><img class=\"zest\" src=\"{first_src}\" alt=\"{fa} crop\">\
          </div><figcaption class=\"zlabel\">{fl}</figcaption></figure>\
-         <p class=\"zinfo\"></p></div>\n</div>",
+         <p class=\"zbar\"><button type=\"button\" class=\"zsize\" data-f=\"0.5\" \
+         title=\"smaller crop, larger zoom\">+</button><button type=\"button\" \
+         class=\"zsize\" data-f=\"2\" title=\"larger crop, smaller zoom\">−</button> \
+         <span class=\"zinfo\"></span></p></div>\n</div>",
         ra = esc(&g.reference.label),
         fa = esc(&first.label),
         rl = esc(&g.reference.label),

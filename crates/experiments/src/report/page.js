@@ -133,6 +133,24 @@
       placeCrop();
     }
 
+    // Halve or double the crop about its centre (at least 4 pixels, at most the image).
+    function resizeCrop(f) {
+      var s = size();
+      if (!crop || !(s.w > 0)) return;
+      var cx = crop.x + crop.w / 2;
+      var cy = crop.y + crop.h / 2;
+      crop.w = Math.max(4, Math.min(s.w, Math.round(crop.w * f)));
+      crop.h = Math.max(4, Math.min(s.h, Math.round(crop.h * f)));
+      crop.x = Math.round(cx - crop.w / 2);
+      crop.y = Math.round(cy - crop.h / 2);
+      placeCrop();
+    }
+    Array.prototype.forEach.call(g.querySelectorAll("button.zsize"), function (b) {
+      b.addEventListener("click", function () {
+        resizeCrop(Number(b.getAttribute("data-f")));
+      });
+    });
+
     var dragging = false;
     var moved = false;
     stage.addEventListener("pointerdown", function (e) {
@@ -197,6 +215,8 @@
       update();
       var r = stage.getBoundingClientRect();
       moveCrop({ clientX: r.left + r.width / 3, clientY: r.top + r.height / 3 });
+      resizeCrop(0.5);
+      resizeCrop(2);
       if (items.length) select(items[0]);
     };
   }
