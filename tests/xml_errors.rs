@@ -418,7 +418,13 @@ fn xml_features_read_as_mitsuba_reads_them() {
     };
     let (obj, ply, bin) = (mesh(0), mesh(1), mesh(2));
     assert_eq!(obj.indices.len(), 2);
-    assert!(obj.normals.is_none());
+    // No normals in the OBJ: computed (angle-weighted) as Mitsuba does; a flat quad's are +z.
+    assert!(obj
+        .normals
+        .as_ref()
+        .unwrap()
+        .iter()
+        .all(|n| *n == lt_core::Vec3::Z));
     assert!(ply.normals.is_some());
     assert_eq!(bin.indices, vec![[0, 1, 2], [0, 2, 3]]);
     assert!(obj.positions.iter().all(|p| p.z == -1.0));
@@ -429,5 +435,39 @@ fn xml_features_read_as_mitsuba_reads_them() {
         .all(|p| p.z == -3.0 && p.x.abs() == 2.0));
     assert_eq!(scene.lights.len(), 2);
     assert!(scene.shapes[3].light.is_some());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The x field of view Mitsuba 3.9.1 reports (`x_fov`) for a 64 × 32 film with each way of
+/// giving it, held to our camera's ray at the middle of the image's right edge.
+#[test]
+fn xml_fields_of_view_are_mitsubas() {
+    let d = dir("fov");
+    for (sensor, mitsuba_x_fov) in [
+        (
+            "<float name=\"fov\" value=\"45\"/><string name=\"fov_axis\" value=\"y\"/>",
+            79.2785,
+        ),
+        ("<string name=\"focal_length\" value=\"35mm\"/>", 57.8712),
+        ("", 42.3117),
+        (
+            "<float name=\"fov\" value=\"45\"/><string name=\"fov_axis\" value=\"diagonal\"/>",
+            40.6577,
+        ),
+    ] {
+        let text = scene_xml("")
+            .replace("<float name=\"fov\" value=\"40\"/>", sensor)
+            .replace("value=\"24\"", "value=\"32\"")
+            .replace("value=\"32\"/><integer", "value=\"64\"/><integer");
+        let (scene, _) = load_in(&d, "scene.xml", &text, LoadOptions::default()).unwrap();
+        let c = &scene.camera;
+        assert_eq!((c.width, c.height), (64, 32));
+        let r = c.generate_ray(lt_core::Vec2::new(64.0, 16.0));
+        let x_fov = 2.0 * r.d.angle_between(c.forward()).to_degrees();
+        assert!(
+            (x_fov - mitsuba_x_fov).abs() < 2e-3,
+            "{sensor}: {x_fov} vs {mitsuba_x_fov}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&d);
 }

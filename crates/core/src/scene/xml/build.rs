@@ -676,6 +676,9 @@ impl<'a> Loader<'a> {
                 self.meshes.push(path);
                 if face_normals {
                     mesh.normals = None;
+                } else if mesh.normals.is_none() {
+                    // Mitsuba shades a mesh without normals smoothly, with normals it computes.
+                    mesh.normals = Some(vertex_normals(&mesh));
                 }
                 let mesh = mesh.transformed(&m32);
                 if !((0..mesh.indices.len()).map(|i| mesh.triangle_area(i)).sum::<f32>() > 0.0) {
@@ -809,6 +812,30 @@ impl<'a> Loader<'a> {
     }
 }
 
+/// Angle-weighted vertex normals (each face's unit normal weighted by its angle at the vertex),
+/// what Mitsuba computes for a mesh file without normals (checked against it on a tetrahedron).
+fn vertex_normals(m: &TriangleMesh) -> Vec<glam::Vec3> {
+    let mut acc = vec![DVec3::ZERO; m.positions.len()];
+    for t in &m.indices {
+        let p = t.map(|i| m.positions[i as usize].as_dvec3());
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        if !(n.length() > 0.0) {
+            continue;
+        }
+        let n = n.normalize();
+        for k in 0..3 {
+            let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+            let angle = a.angle_between(b);
+            if angle.is_finite() {
+                acc[t[k] as usize] += angle * n;
+            }
+        }
+    }
+    acc.into_iter()
+        .map(|n| n.normalize_or_zero().as_vec3())
+        .collect()
+}
+
 /// The uniform scale of a similarity transform (rotation × uniform scale + translation).
 fn similarity_scale(m: &DMat4) -> Option<f64> {
     let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.truncate());
@@ -848,4 +875,30 @@ fn camera_frame(p: &Plugin, m: &DMat4, te: &Elem) -> Result<(DVec3, DVec3, DVec3
         ));
     }
     Ok((eye, eye + fnn, un))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Mitsuba 3.9.1's vertex normals of the OBJ tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1)
+    /// with faces 1 3 2, 1 2 4, 1 4 3, 2 3 4, at the vertex (0,1,0).
+    #[test]
+    fn xml_vertex_normals_are_mitsubas() {
+        let m = TriangleMesh {
+            positions: vec![
+                glam::Vec3::ZERO,
+                glam::Vec3::X,
+                glam::Vec3::Y,
+                glam::Vec3::Z,
+            ],
+            normals: None,
+            indices: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        };
+        let n = vertex_normals(&m);
+        let theirs = glam::Vec3::new(-0.275_421_47, 0.921_024_4, -0.275_421_47);
+        assert!((n[2] - theirs).abs().max_element() < 1e-6, "{:?}", n[2]);
+        let k = -(1.0f32 / 3.0).sqrt();
+        assert!((n[0] - glam::Vec3::splat(k)).abs().max_element() < 1e-6);
+    }
 }
