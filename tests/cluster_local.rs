@@ -262,5 +262,45 @@ fn a_study_plan_is_collected_from_the_cache() {
         "{out}"
     );
     assert!(results.join("smoke").join("summary.json").is_file());
+
+    // The same study with its renders split into pass ranges (cut at the snapshots 1, 2, 4):
+    // collecting merges them into the renders' own entries, equal to the whole renders within
+    // one f32 ulp, and the study then finds every render.
+    let split_plan = dir.join("split-plan");
+    let split_cache = dir.join("split-cache");
+    let mut args2 = args.to_vec();
+    let (sc, sp) = (split_cache.to_str().unwrap(), split_plan.to_str().unwrap());
+    args2[10] = sc;
+    args2[12] = sp;
+    args2.extend(["--split-passes", "2"]);
+    lt_ok(&lt, &args2);
+    let planned = lt_experiments::cluster::plan::Plan::read(&split_plan).unwrap();
+    assert_eq!((planned.shards.len(), planned.assemble.len()), (6, 2));
+    let out = lt_ok(&lt, &["submit", sp, "--local"]);
+    assert!(
+        out.contains("merged the pass ranges of 2 split renders")
+            && out.contains("2 renders found in the cache, 0 made here"),
+        "{out}"
+    );
+    let (whole, split) = (
+        lt_experiments::cache::Cache::new(&cache),
+        lt_experiments::cache::Cache::new(&split_cache),
+    );
+    let mut worst = 0;
+    for a in &planned.assemble {
+        let key = lt_experiments::cache::Key(a.key.clone());
+        let (dw, ds) = (whole.lookup(&key).unwrap(), split.lookup(&key).unwrap());
+        for f in [
+            "snapshot-1.exr",
+            "snapshot-2.exr",
+            "snapshot-4.exr",
+            "stderr.exr",
+        ] {
+            let (ulps, _, _) = ulp_distance(&dw.join(f), &ds.join(f));
+            worst = worst.max(ulps);
+        }
+    }
+    eprintln!("split study renders vs whole ones: at most {worst} f32 ulp");
+    assert!(worst <= 1);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -170,9 +170,23 @@ pub fn collect(args: &CollectArgs) -> Result<(), String> {
             results,
             scenes,
         } => {
+            let mut assembled = 0;
+            for a in &plan.assemble {
+                if a.shards.iter().any(|&i| missing.contains(&i)) {
+                    continue;
+                }
+                if super::assemble::assemble(&plan, a)? {
+                    assembled += 1;
+                }
+            }
+            if assembled > 0 {
+                eprintln!(
+                    "merged the pass ranges of {assembled} split renders into their cache entries"
+                );
+            }
             if !missing.is_empty() {
                 eprintln!(
-                    "warning: the study renders the {} missing shards here",
+                    "warning: the study renders what the {} missing shards lacked here",
                     missing.len()
                 );
             }

@@ -10,10 +10,12 @@
 //! - `shard`: `lt run-shard`, with per-shard state files.
 //! - `submit`: `lt submit --slurm|--parallel|--local`.
 //! - `collect`: `lt collect`.
+//! - `assemble`: a study render split into pass ranges made back into its cache entry.
 //! - `study_link`: which renders a study needs and how its outputs are made.
 //!
 //! See docs/cluster.md.
 
+pub mod assemble;
 pub mod collect;
 pub mod merge;
 pub mod partial;

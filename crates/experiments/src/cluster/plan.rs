@@ -63,6 +63,17 @@ pub enum Target {
     },
 }
 
+/// A study render split into pass ranges: its shards' parts become its cache entry when collected.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Assembly {
+    pub spec: RunSpec,
+    /// The render's own cache key (`RunSpec::key_material`).
+    pub key: String,
+    pub cache: PathBuf,
+    /// The shards holding its pass ranges, in pass order.
+    pub shards: Vec<usize>,
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Plan {
     pub format: String,
@@ -75,6 +86,9 @@ pub struct Plan {
     pub threads: usize,
     pub target: Target,
     pub shards: Vec<Shard>,
+    /// Study renders split into pass ranges (`lt plan study --split-passes`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub assemble: Vec<Assembly>,
 }
 
 impl Plan {
@@ -260,6 +274,11 @@ pub struct PlanStudyArgs {
     /// The shipped scenes.
     #[arg(long, default_value = "scenes")]
     pub scenes: PathBuf,
+    /// Split every single-run render of an unbiased integrator longer than M passes (a long
+    /// reference) into pass ranges of at most M, cut at its snapshots too; collecting merges
+    /// them into the render's cache entry, where the study finds it.
+    #[arg(long, value_name = "M")]
+    pub split_passes: Option<u32>,
     #[command(flatten)]
     pub common: PlanCommon,
 }
@@ -281,6 +300,27 @@ pub fn split_by(n: u32, m: u32) -> Vec<(u32, u32)> {
     (0..n.div_ceil(m))
         .map(|i| (i * m, ((i + 1) * m).min(n)))
         .collect()
+}
+
+/// Pass ranges covering 0..passes, cut at every snapshot and at most `m` long.
+pub fn cuts(passes: u32, snapshots: &[u32], m: u32) -> Vec<(u32, u32)> {
+    let mut b: Vec<u32> = snapshots
+        .iter()
+        .copied()
+        .filter(|&p| p > 0 && p < passes)
+        .collect();
+    b.push(0);
+    b.push(passes);
+    b.sort_unstable();
+    b.dedup();
+    let mut out = Vec::new();
+    for w in b.windows(2) {
+        let len = w[1] - w[0];
+        for (x, y) in split_even(len, len.div_ceil(m.max(1))) {
+            out.push((w[0] + x, w[0] + y));
+        }
+    }
+    out
 }
 
 fn pieces(
@@ -512,6 +552,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), String> {
                     span,
                 },
                 shards,
+                assemble: Vec::new(),
             };
             (dir, plan, c.force)
         }
@@ -521,21 +562,57 @@ pub fn plan(args: &PlanArgs) -> Result<(), String> {
             let cache = absolute(&c.cache)?;
             let results = absolute(&a.results)?;
             let scenes = absolute(&a.scenes)?;
+            if a.split_passes == Some(0) {
+                return Err("--split-passes must be at least 1".into());
+            }
             let mut shards = Vec::new();
-            for (index, spec) in study_link::plan(&a.name, &a.scale, &scenes)?
-                .into_iter()
-                .enumerate()
-            {
+            let mut assemble = Vec::new();
+            for spec in study_link::plan(&a.name, &a.scale, &scenes)? {
                 let mut spec = spec;
                 spec.scene = absolute(&spec.scene)?;
                 let scene = spec.load_scene()?;
                 let key = key_of(&spec.key_material(&scene)?).0;
-                shards.push(Shard {
-                    index,
+                let kind = lt_integrators::registry::find(&spec.integrator)?.kind;
+                let split = a.split_passes.filter(|&m| {
+                    spec.runs == 1 && kind == lt_integrators::Kind::Unbiased && spec.passes > m
+                });
+                let Some(m) = split else {
+                    shards.push(Shard {
+                        index: shards.len(),
+                        key,
+                        cache: cache.clone(),
+                        label: spec.label(),
+                        work: Work::Run(spec),
+                    });
+                    continue;
+                };
+                let mut parts = Vec::new();
+                for (start, end) in cuts(spec.passes, &spec.snapshots, m) {
+                    let job = PartialJob {
+                        scene: spec.scene.clone(),
+                        resolution: spec.resolution,
+                        integrator: spec.integrator.clone(),
+                        params: normalize_params(&spec.params),
+                        span: Span::Passes {
+                            seed: spec.seed,
+                            start,
+                            end,
+                        },
+                    };
+                    parts.push(shards.len());
+                    shards.push(Shard {
+                        index: shards.len(),
+                        key: key_of(&job.key_material(&scene)?).0,
+                        cache: cache.clone(),
+                        label: format!("{}: passes {start}..{end}", spec.label()),
+                        work: Work::Partial(job),
+                    });
+                }
+                assemble.push(Assembly {
+                    spec,
                     key,
                     cache: cache.clone(),
-                    label: spec.label(),
-                    work: Work::Run(spec),
+                    shards: parts,
                 });
             }
             let plan = Plan {
@@ -551,6 +628,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), String> {
                     scenes,
                 },
                 shards,
+                assemble,
             };
             (dir, plan, c.force)
         }
@@ -585,6 +663,11 @@ mod tests {
                 assert_eq!(s.last().unwrap().1, n);
                 assert!(s.windows(2).all(|w| w[0].1 == w[1].0));
             }
+            let c = cuts(n, &[1, n / 2, n + 5], 3);
+            assert_eq!((c[0].0, c.last().unwrap().1), (0, n));
+            assert!(c.windows(2).all(|w| w[0].1 == w[1].0));
+            assert!(c.iter().all(|(a, b)| b - a <= 3));
+            assert!(n < 2 || c.iter().any(|&(_, b)| b == n / 2));
             let s = split_by(n, 3);
             assert_eq!(s.last().unwrap().1, n);
             assert!(s.windows(2).all(|w| w[0].1 == w[1].0));
