@@ -301,7 +301,9 @@ fn report_page_loads_cleanly_in_chromium_and_the_check_can_fail() {
                    !! report_browser: Chromium not found (/usr/bin/chromium or LT_CHROMIUM):\n\
                    !! the report page was NOT checked in a browser. apt-get install chromium\n\
                    !!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!\n";
-        eprintln!("{msg}");
+        // Straight to the process's stderr: the test harness captures eprintln!, and this
+        // must be seen even when the test passes.
+        let _ = std::io::Write::write_all(&mut std::io::stderr(), msg.as_bytes());
         assert!(
             std::env::var("LT_REQUIRE_BROWSER").as_deref() != Ok("1"),
             "LT_REQUIRE_BROWSER=1 but Chromium is not installed"
