@@ -191,6 +191,11 @@ fn bad_requests_get_one_clear_error() {
         ],
     );
     assert!(e.contains("empty"), "{e}");
+    let e = lt_err(&lt, &["render", s, "--passes", "0..2", "-o", "y.exr"]);
+    assert!(e.contains("--partial"), "{e}");
+    let xs = x.to_str().unwrap();
+    let e = lt_err(&lt, &["render", s, "--time", "1", "--partial", xs]);
+    assert!(e.contains("--time"), "{e}");
     let e = lt_err(&lt, &["run-shard", dir.to_str().unwrap(), "0"]);
     assert!(e.contains("plan.json"), "{e}");
     // Runs of a consistent estimator shard and collect as --runs K does.

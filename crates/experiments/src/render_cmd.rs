@@ -44,7 +44,7 @@ pub struct RenderArgs {
     pub output: Option<PathBuf>,
     /// Render only passes A..B (A to B-1, counted from 0) of the seed: with --partial, one shard
     /// of a render split by passes (unbiased integrators).
-    #[arg(long, value_name = "A..B", requires = "partial")]
+    #[arg(long, value_name = "A..B")]
     pub passes: Option<String>,
     /// Write the exact accumulation (count, per-pixel mean and M2 in f64, scene hash, parameters)
     /// to OUT instead of images, for `lt merge`; with --runs K, of K runs (seeds seed…seed+K-1).
@@ -115,6 +115,11 @@ fn log_json(log: &ProgressLog) -> serde_json::Value {
 pub fn run(args: &RenderArgs) -> Result<(), String> {
     if let Some(part) = &args.partial {
         return crate::cluster::partial::render_partial_cmd(args, part);
+    }
+    if let Some(p) = &args.passes {
+        return Err(format!(
+            "--passes {p} renders a part for `lt merge`: give --partial OUT.ltp"
+        ));
     }
     let output = args
         .output

@@ -762,6 +762,20 @@ pub fn render_partial_cmd(args: &crate::render_cmd::RenderArgs, out: &Path) -> R
     if args.runs == 0 {
         return Err("--runs must be at least 1".into());
     }
+    if args.time.is_some() {
+        return Err(
+            "--partial takes a fixed number of passes (--passes A..B or --spp N), not \
+                    --time: a part must be reproducible to be merged"
+                .into(),
+        );
+    }
+    if args.output.is_some() || args.strategies.is_some() {
+        return Err(
+            "--partial writes the part only: drop -o/--strategies (lt merge writes the \
+                    images)"
+                .into(),
+        );
+    }
     let params = normalize_params(args.integrator_args.to_params()?.pairs());
     let mut job = PartialJob {
         scene: args.scene.clone(),

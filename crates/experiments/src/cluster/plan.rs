@@ -195,6 +195,7 @@ pub struct PlanArgs {
 }
 
 #[derive(Subcommand, Debug)]
+#[allow(clippy::large_enum_variant)] // parsed once
 pub enum PlanWhat {
     /// Split one render into shards: pass ranges of one seed (unbiased integrators) or groups of
     /// independent runs (--runs K; the only split of pm, ppm, sppm, bpm, vcm).

@@ -255,11 +255,8 @@ fn parallel(dir: &Path, plan: &Plan, args: &SubmitArgs) -> Result<bool, String> 
         Some(j) => j.clone(),
         None => {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-            if plan.threads == 0 {
-                "1".into()
-            } else {
-                (cores / plan.threads).max(1).to_string()
-            }
+            // Shards of every core (threads 0) run one at a time.
+            cores.checked_div(plan.threads).unwrap_or(1).max(1).to_string()
         }
     };
     let joblog = dir.join(JOBLOG);
