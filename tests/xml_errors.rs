@@ -471,3 +471,37 @@ fn xml_fields_of_view_are_mitsubas() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A disk is refused, and with `--approximate` becomes an inscribed 256-gon of nearly its area
+/// (π r² (1 − 1.0e-4)), facing +z like Mitsuba's.
+#[test]
+fn xml_disk_is_an_approximation() {
+    let d = dir("disk");
+    let text = scene_xml(
+        "    <shape type=\"disk\">\n        <transform name=\"to_world\"><scale value=\"0.5\"/></transform>\n    </shape>",
+    );
+    fails(
+        &d,
+        &text,
+        line_of(&text, "disk"),
+        &["disk", "--approximate"],
+    );
+    let opts = LoadOptions {
+        approximate: true,
+        verbose: false,
+    };
+    let (scene, report) = load_in(&d, "scene.xml", &text, opts).unwrap();
+    assert_eq!(report.substitutions.len(), 1, "{report:?}");
+    let ShapeGeometry::Mesh(m) = &scene.shapes[0].geometry else {
+        panic!()
+    };
+    let area: f32 = (0..m.indices.len()).map(|i| m.triangle_area(i)).sum();
+    let exact = std::f32::consts::PI * 0.25;
+    assert!(
+        ((area - exact) / exact + 1.0e-4).abs() < 2e-6,
+        "{area} vs {exact}"
+    );
+    let [a, b, c] = m.triangle(0);
+    assert!((b - a).cross(c - a).z > 0.0);
+    let _ = std::fs::remove_dir_all(&d);
+}

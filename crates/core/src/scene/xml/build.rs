@@ -85,8 +85,8 @@ fn collect_ids<'a>(doc: &'a Doc, e: &'a Elem, ids: &mut Ids<'a>) -> Result<(), S
     Ok(())
 }
 
-pub(super) fn load<'a>(
-    doc: &'a Doc,
+pub(super) fn load(
+    doc: &Doc,
     opts: &LoadOptions,
 ) -> Result<(Scene, LoadReport, Vec<PathBuf>), SceneError> {
     let mut ids = Ids::new();
@@ -247,7 +247,7 @@ impl<'a> Loader<'a> {
             }
             (Some(f), None) => (f, axis),
             (None, f) => {
-                let (text, at) = f.map(|(t, fe)| (t, fe)).unwrap_or(("50mm", e));
+                let (text, at) = f.unwrap_or(("50mm", e));
                 let mm = text.trim().trim_end_matches("mm").trim();
                 let f: f64 = mm.parse().ok().filter(|f: &f64| *f > 0.0 && f.is_finite()).ok_or_else(|| {
                     p.err(at, format!("`focal_length` must be a positive length in mm like \"50mm\", got `{text}`"))
@@ -426,7 +426,7 @@ impl<'a> Loader<'a> {
                 )?;
                 UNBOUNDED_DEPTH_SUBSTITUTE
             }
-            d if d >= 1 && d <= 1 << 20 => d as u32,
+            d if (1..=1 << 20).contains(&d) => d as u32,
             d => {
                 return Err(self.doc.err(
                     at,
@@ -660,6 +660,15 @@ impl<'a> Loader<'a> {
                     radius: radius as f32,
                 }
             }
+            "disk" => {
+                check_quad(&ctx, &m32, span)?;
+                self.substitute(
+                    e,
+                    "the analytic disk is not supported (lt has no disk primitive)".into(),
+                    format!("use a {DISK_SIDES}-gon inscribed in it (area {:.1e} smaller)", disk_area_deficit()),
+                )?;
+                ShapeGeometry::Mesh(unit_disk_fan().transformed(&m32))
+            }
             "obj" | "ply" => {
                 let Some((file, fe)) = p.string("filename")? else {
                     return Err(p.err(e, format!("shape `{}` needs a `filename`", p.kind)));
@@ -689,7 +698,7 @@ impl<'a> Loader<'a> {
             other => {
                 return Err(p.err(
                     e,
-                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, obj and ply)"),
+                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, obj and ply, and disk with --approximate)"),
                 ))
             }
         };
@@ -809,6 +818,32 @@ impl<'a> Loader<'a> {
             | LightDesc::Sun { radiance: c, .. } => c.max_element(),
         };
         Ok((power > 0.0).then_some(desc))
+    }
+}
+
+/// Sides of the polygon `--approximate` puts in place of a disk.
+const DISK_SIDES: u32 = 256;
+
+/// The relative area a regular `DISK_SIDES`-gon inscribed in a circle lacks.
+fn disk_area_deficit() -> f64 {
+    let t = std::f64::consts::TAU / DISK_SIDES as f64;
+    1.0 - DISK_SIDES as f64 * t.sin() / std::f64::consts::TAU
+}
+
+/// Mitsuba's disk (radius 1 in the z = 0 plane, normal +z) as a fan of triangles.
+fn unit_disk_fan() -> TriangleMesh {
+    let mut positions = vec![glam::Vec3::ZERO];
+    for k in 0..DISK_SIDES {
+        let (s, c) = (std::f64::consts::TAU * k as f64 / DISK_SIDES as f64).sin_cos();
+        positions.push(glam::Vec3::new(c as f32, s as f32, 0.0));
+    }
+    let indices = (0..DISK_SIDES)
+        .map(|k| [0, 1 + k, 1 + (k + 1) % DISK_SIDES])
+        .collect();
+    TriangleMesh {
+        positions,
+        normals: None,
+        indices,
     }
 }
 
