@@ -505,3 +505,43 @@ fn xml_disk_is_an_approximation() {
     assert!((b - a).cross(c - a).z > 0.0);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The shipped Cornell box rewritten with Mitsuba 0.6's camelCase names (`toWorld`, `maxDepth`,
+/// `sampleCount`, `fovAxis`, …; Mitsuba 3.9.1 loads this file too) is the same scene.
+#[test]
+fn xml_version_0_6_names_are_upgraded() {
+    let d = dir("v06");
+    let shipped = lt_tests::scenes_dir().join("xml/cornell-box.xml");
+    let mut text = std::fs::read_to_string(&shipped)
+        .unwrap()
+        .replace("version=\"3.0.0\"", "version=\"0.6.0\"");
+    for (new, old) in [
+        ("to_world", "toWorld"),
+        ("max_depth", "maxDepth"),
+        ("fov_axis", "fovAxis"),
+        ("sample_count", "sampleCount"),
+        ("near_clip", "nearClip"),
+        ("far_clip", "farClip"),
+        ("focus_distance", "focusDistance"),
+        ("pixel_format", "pixelFormat"),
+        ("component_format", "componentFormat"),
+    ] {
+        text = text.replace(&format!("\"{new}\""), &format!("\"{old}\""));
+    }
+    assert!(text.contains("\"toWorld\"") && !text.contains("\"to_world\""));
+    let (old, report) = load_in(&d, "cornell-0.6.xml", &text, LoadOptions::default()).unwrap();
+    let (new, _) = load_scene_with(&shipped, &LoadOptions::default()).unwrap();
+    assert!(report.substitutions.is_empty());
+    assert_eq!(report.ignored.len(), 5, "{report:?}");
+    assert_eq!(old.settings, new.settings);
+    assert_eq!(
+        format!("{:?}", old.materials),
+        format!("{:?}", new.materials)
+    );
+    assert_eq!(format!("{:?}", old.shapes), format!("{:?}", new.shapes));
+    assert_eq!(format!("{:?}", old.lights), format!("{:?}", new.lights));
+    let r = lt_core::Vec2::new(100.0, 30.0);
+    let (a, b) = (old.camera.generate_ray(r), new.camera.generate_ray(r));
+    assert_eq!((a.o, a.d), (b.o, b.d));
+    let _ = std::fs::remove_dir_all(&d);
+}
