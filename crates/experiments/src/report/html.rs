@@ -166,7 +166,7 @@ fn study(h: &mut String, s: &StudyDir) {
             let _ = writeln!(
                 h,
                 "<div class=\"summary\">\n{}</div>",
-                markdown::render(md, &url(&s.folder, ""))
+                markdown::render(without_title(md, &m.title), &url(&s.folder, ""))
             );
         }
         Ok(_) => {}
@@ -188,6 +188,17 @@ fn study(h: &mut String, s: &StudyDir) {
         gallery(h, &s.folder, &format!("g-{id}-{i}"), g);
     }
     h.push_str("</section>\n");
+}
+
+/// The summary without a first line "# <title>" (the section's heading already says it).
+fn without_title<'a>(md: &'a str, title: &str) -> &'a str {
+    let rest = md.trim_start();
+    let (first, tail) = rest.split_once('\n').unwrap_or((rest, ""));
+    if first.trim_end().strip_prefix("# ").map(str::trim) == Some(title.trim()) {
+        tail
+    } else {
+        md
+    }
 }
 
 fn figure(h: &mut String, folder: &str, f: &Figure) {
@@ -337,6 +348,15 @@ mod tests {
         assert_eq!(url("equal-time", "g/pt 1.png"), "equal-time/g/pt%201.png");
         assert_eq!(url("x", "ä\"#.svg"), "x/%C3%A4%22%23.svg");
         assert_eq!(slug("Per length (k ≤ 5)"), "per-length-k-5");
+        assert_eq!(
+            without_title("# Convergence\n\nText\n", "Convergence"),
+            "\nText\n"
+        );
+        assert_eq!(
+            without_title("# Other\nText", "Convergence"),
+            "# Other\nText"
+        );
+        assert_eq!(without_title("# Convergence", "Convergence"), "");
         assert!(numeric("1.2e-3") && numeric("−0.98 ± 0.02") && !numeric("pt") && !numeric("-"));
     }
 }
