@@ -17,33 +17,48 @@ pub fn scratch(name: &str) -> PathBuf {
     d
 }
 
-/// The `lt` binary, copied into `dir` so that a rebuild during the test cannot change it under
-/// the shards. `LT_BIN` names one; else it is the `lt` cargo built beside this test (the
-/// workspace's `cargo test` builds it).
-pub fn lt_binary(dir: &Path) -> PathBuf {
-    let built = match std::env::var_os("LT_BIN") {
-        Some(p) => PathBuf::from(p),
-        None => {
-            let exe = std::env::current_exe().unwrap();
-            // target/<profile>/deps/<test>-<hash> → target/<profile>/lt
-            exe.parent().unwrap().parent().unwrap().join("lt")
-        }
-    };
-    assert!(
-        built.is_file(),
-        "no lt binary at {}: build it (cargo build --release --bin lt) or set LT_BIN",
-        built.display()
-    );
-    let copy = dir.join("lt");
-    std::fs::copy(&built, &copy).unwrap();
-    copy
+/// The `lt` binary, copied once per test process (so that a rebuild during the tests cannot
+/// change it under the shards). `LT_BIN` names one; else it is the `lt` cargo built beside this
+/// test (the workspace's `cargo test` builds it).
+pub fn lt_binary(_dir: &Path) -> PathBuf {
+    static COPY: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    COPY.get_or_init(|| {
+        let built = match std::env::var_os("LT_BIN") {
+            Some(p) => PathBuf::from(p),
+            None => {
+                let exe = std::env::current_exe().unwrap();
+                // target/<profile>/deps/<test>-<hash> → target/<profile>/lt
+                exe.parent().unwrap().parent().unwrap().join("lt")
+            }
+        };
+        assert!(
+            built.is_file(),
+            "no lt binary at {}: build it (cargo build --release --bin lt) or set LT_BIN",
+            built.display()
+        );
+        let dir = std::env::temp_dir().join(format!("lt-bin-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = dir.join("lt.part");
+        std::fs::copy(&built, &tmp).unwrap();
+        let copy = dir.join("lt");
+        std::fs::rename(&tmp, &copy).unwrap();
+        copy
+    })
+    .clone()
 }
 
+/// Runs `cmd`; retries while the binary is "text file busy" (a file being written when another
+/// test thread forked keeps a write handle until that child execs).
 pub fn run(cmd: &mut Command) -> Output {
-    let out = cmd
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
-    out
+    for _ in 0..100 {
+        match cmd.output() {
+            Err(e) if e.raw_os_error() == Some(26) => {
+                std::thread::sleep(std::time::Duration::from_millis(20))
+            }
+            r => return r.unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}")),
+        }
+    }
+    panic!("{cmd:?}: text file busy for 2 s")
 }
 
 /// Runs `lt ARGS`, asserting success; returns stdout + stderr.

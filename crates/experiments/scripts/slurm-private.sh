@@ -41,7 +41,7 @@ start() {
   local ctld_port=${3:-$(free_port $((20000 + $$ % 20000)))}
   local slurmd_port=${4:-$(free_port $((ctld_port + 1)))}
   local host cpus mem
-  host=$(hostname -s)
+  host=$(hostname -s 2>/dev/null || cut -d. -f1 /proc/sys/kernel/hostname)
   cpus=$(nproc)
   mem=$(awk '/MemTotal/ {print int($2 / 1024 / 2)}' /proc/meminfo)
   cat >"$conf" <<EOF

@@ -169,6 +169,7 @@ pub fn collect(args: &CollectArgs) -> Result<(), String> {
             scale,
             results,
             scenes,
+            cache,
         } => {
             let mut assembled = 0;
             for a in &plan.assemble {
@@ -190,13 +191,8 @@ pub fn collect(args: &CollectArgs) -> Result<(), String> {
                     missing.len()
                 );
             }
-            let cache = plan
-                .shards
-                .first()
-                .map(|s| s.cache.clone())
-                .unwrap_or_else(|| results.join("cache"));
             let (lines, made) =
-                study_link::collect(name, scale, results, scenes, &cache, args.threads)?;
+                study_link::collect(name, scale, results, scenes, cache, args.threads)?;
             for l in &lines {
                 eprintln!("{l}");
             }

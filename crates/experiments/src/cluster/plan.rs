@@ -60,6 +60,8 @@ pub enum Target {
         scale: String,
         results: PathBuf,
         scenes: PathBuf,
+        /// The study's cache of runs (references live in RESULTS/references).
+        cache: PathBuf,
     },
 }
 
@@ -209,9 +211,10 @@ pub struct PlanCommon {
     /// The plan folder to write.
     #[arg(long, short)]
     pub output: PathBuf,
-    /// The cache the shards write into (share it with `lt study`: the default is theirs).
-    #[arg(long, default_value = "results/cache")]
-    pub cache: PathBuf,
+    /// The cache the shards write into (default results/cache; for a study plan RESULTS/cache,
+    /// the one `lt study` reads, with its references in RESULTS/references).
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
     /// The lt binary the shard commands run (default: this one). On a cluster it must be on a
     /// filesystem every node mounts at the same path.
     #[arg(long)]
@@ -534,7 +537,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), String> {
         PlanWhat::Render(a) => {
             let c = &a.common;
             let dir = absolute(&c.output)?;
-            let cache = absolute(&c.cache)?;
+            let cache = absolute(c.cache.as_deref().unwrap_or(Path::new("results/cache")))?;
             let (shards, span) = render_shards(a, &cache)?;
             let output = match &a.image {
                 Some(p) => absolute(p)?,
@@ -560,16 +563,17 @@ pub fn plan(args: &PlanArgs) -> Result<(), String> {
         PlanWhat::Study(a) => {
             let c = &a.common;
             let dir = absolute(&c.output)?;
-            let cache = absolute(&c.cache)?;
             let results = absolute(&a.results)?;
+            let cache = absolute(&c.cache.clone().unwrap_or_else(|| results.join("cache")))?;
             let scenes = absolute(&a.scenes)?;
             if a.split_passes == Some(0) {
                 return Err("--split-passes must be at least 1".into());
             }
             let mut shards = Vec::new();
             let mut assemble = Vec::new();
-            for spec in study_link::plan(&a.name, &a.scale, &scenes)? {
+            for (spec, role) in study_link::plan(&a.name, &a.scale, &scenes)? {
                 let mut spec = spec;
+                let cache = study_link::cache_for(role, &cache, &results);
                 spec.scene = absolute(&spec.scene)?;
                 let scene = spec.load_scene()?;
                 let key = key_of(&spec.key_material(&scene)?).0;
@@ -627,6 +631,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), String> {
                     scale: a.scale.clone(),
                     results,
                     scenes,
+                    cache,
                 },
                 shards,
                 assemble,

@@ -8,7 +8,24 @@
 
 use crate::cache::Cache;
 use crate::runs::{Executor, RunSpec};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Which of a study's caches a render belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// The study's runs: the cache given (default RESULTS/cache).
+    Runs,
+    /// Long references: RESULTS/references.
+    References,
+}
+
+/// The cache folder of `role`.
+pub fn cache_for(role: Role, runs_cache: &Path, results: &Path) -> PathBuf {
+    match role {
+        Role::Runs => runs_cache.to_path_buf(),
+        Role::References => results.join("references"),
+    }
+}
 
 fn smoke(scale: &str, scenes: &Path) -> Result<Vec<RunSpec>, String> {
     let (res, passes, seeds) = match scale {
@@ -27,10 +44,13 @@ fn smoke(scale: &str, scenes: &Path) -> Result<Vec<RunSpec>, String> {
         .collect())
 }
 
-/// Every render study `name` needs at `scale`.
-pub fn plan(name: &str, scale: &str, scenes: &Path) -> Result<Vec<RunSpec>, String> {
+/// Every render study `name` needs at `scale`, with the cache it belongs in.
+pub fn plan(name: &str, scale: &str, scenes: &Path) -> Result<Vec<(RunSpec, Role)>, String> {
     match name {
-        "smoke" => smoke(scale, scenes),
+        "smoke" => Ok(smoke(scale, scenes)?
+            .into_iter()
+            .map(|s| (s, Role::Runs))
+            .collect()),
         other => Err(format!(
             "lt plan study: study '{other}' cannot be planned by this build (it knows: smoke)"
         )),
@@ -48,14 +68,14 @@ pub fn collect(
     threads: usize,
 ) -> Result<(Vec<String>, usize), String> {
     let specs = plan(name, scale, scenes)?;
-    let exec = Executor {
-        cache: Cache::new(cache),
-        threads,
-    };
     let mut rows = Vec::new();
     let mut lines = Vec::new();
     let mut made = 0;
-    for spec in &specs {
+    for (spec, role) in &specs {
+        let exec = Executor {
+            cache: Cache::new(cache_for(*role, cache, results)),
+            threads,
+        };
         if exec.lookup(spec)?.is_none() {
             made += 1;
         }

@@ -256,7 +256,11 @@ fn parallel(dir: &Path, plan: &Plan, args: &SubmitArgs) -> Result<bool, String> 
         None => {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             // Shards of every core (threads 0) run one at a time.
-            cores.checked_div(plan.threads).unwrap_or(1).max(1).to_string()
+            cores
+                .checked_div(plan.threads)
+                .unwrap_or(1)
+                .max(1)
+                .to_string()
         }
     };
     let joblog = dir.join(JOBLOG);
