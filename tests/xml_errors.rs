@@ -374,14 +374,20 @@ fn xml_features_read_as_mitsuba_reads_them() {
         <transform name="to_world"><scale value="2"/><translate z="-3"/></transform></shape>
     <shape type="sphere"><point name="center" x="0" y="0" z="-5"/><float name="radius" value="0.5"/>
         <emitter type="area"><rgb name="radiance" value="1, 2, 3"/></emitter></shape>"#;
-    let text = scene_xml(body).replace(
-        "<float name=\"fov\" value=\"40\"/>",
-        "<float name=\"fov\" value=\"40\"/><float name=\"near_clip\" value=\"0.01\"/>",
-    );
+    let text = scene_xml(body)
+        .replace(
+            "<float name=\"fov\" value=\"40\"/>",
+            "<float name=\"fov\" value=\"40\"/><float name=\"near_clip\" value=\"0.01\"/>",
+        )
+        .replace(
+            "<rfilter",
+            "<boolean name=\"banner\" value=\"false\"/><rfilter",
+        );
     let (scene, report) = load_in(&d, "scene.xml", &text, LoadOptions::default()).unwrap();
     assert!(report.substitutions.is_empty(), "{report:?}");
-    // near_clip and the ref's name.
-    assert_eq!(report.ignored.len(), 2, "{report:#?}");
+    // near_clip, the film's banner and the ref's name.
+    assert_eq!(report.ignored.len(), 3, "{report:#?}");
+    assert!(report.ignored.iter().any(|s| s.contains("banner")));
     assert!(report.ignored.iter().any(|s| s.contains("near_clip")));
     assert!(report.ignored.iter().any(|s| s.contains("`name`")));
     assert_eq!(

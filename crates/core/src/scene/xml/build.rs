@@ -29,7 +29,7 @@ const SENSOR_IGNORED: [&str; 5] = [
     "shutter_open",
     "shutter_close",
 ];
-const FILM_IGNORED: [&str; 3] = ["pixel_format", "component_format", "file_format"];
+const FILM_IGNORED: [&str; 4] = ["pixel_format", "component_format", "file_format", "banner"];
 const SAMPLER_IGNORED: [&str; 3] = ["seed", "jitter", "strength"];
 
 /// IORs Mitsuba knows by name (its `int_ior`/`ext_ior` strings).
