@@ -55,7 +55,7 @@ impl Span {
             Span::Passes { start, end, .. } => (start as u64, end as u64),
             Span::Runs {
                 first_seed, runs, ..
-            } => (first_seed, first_seed + runs as u64),
+            } => (first_seed, first_seed.saturating_add(runs as u64)),
         }
     }
 
@@ -68,7 +68,7 @@ impl Span {
                 passes,
             } => format!(
                 "runs of seeds {first_seed}..{} × {passes} passes",
-                first_seed + runs as u64
+                first_seed.saturating_add(runs as u64)
             ),
         }
     }
@@ -286,6 +286,11 @@ impl PartialJob {
                 Err(format!("the pass range {start}..{end} is empty"))
             }
             Span::Runs { runs: 0, .. } => Err("a part of runs needs at least one run".into()),
+            Span::Runs {
+                first_seed, runs, ..
+            } if first_seed.checked_add(runs as u64).is_none() => {
+                Err("the seeds of the runs overflow: use a smaller --seed".into())
+            }
             Span::Runs { passes: 0, .. } => Err("a run needs at least one pass".into()),
             _ => Ok(()),
         }
@@ -473,8 +478,16 @@ impl Partial {
         let mean = take(w * h);
         let m2 = take(w * h);
         let expected = match header.span {
-            Span::Passes { start, end, .. } => end as u64 - start as u64,
-            Span::Runs { runs, .. } => runs as u64,
+            Span::Passes { start, end, .. } if end > start => (end - start) as u64,
+            Span::Runs {
+                first_seed, runs, ..
+            } if runs > 0 && first_seed.checked_add(runs as u64).is_some() => runs as u64,
+            _ => {
+                return Err(format!(
+                    "corrupt header: impossible span ({})",
+                    header.span.describe()
+                ))
+            }
         };
         if header.count != expected {
             return Err(format!(

@@ -386,6 +386,9 @@ pub fn render_shards(args: &PlanRenderArgs, cache: &Path) -> Result<(Vec<Shard>,
     if args.runs == 0 {
         return Err("--runs must be at least 1".into());
     }
+    if args.seed.checked_add(args.runs as u64).is_none() {
+        return Err("--seed + --runs overflows: use a smaller --seed".into());
+    }
     let (spans, total) = if args.runs > 1 {
         if args.passes_per_shard.is_some() {
             return Err(
