@@ -574,7 +574,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), String> {
             }
             let mut shards = Vec::new();
             let mut assemble = Vec::new();
-            for (spec, role) in study_link::plan(&a.name, &a.scale, &scenes)? {
+            for (spec, role) in study_link::plan(&a.name, &a.scale, &results, &scenes, &cache)? {
                 let mut spec = spec;
                 let cache = study_link::cache_for(role, &cache, &results);
                 spec.scene = absolute(&spec.scene)?;

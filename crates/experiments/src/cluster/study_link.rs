@@ -45,7 +45,13 @@ fn smoke(scale: &str, scenes: &Path) -> Result<Vec<RunSpec>, String> {
 }
 
 /// Every render study `name` needs at `scale`, with the cache it belongs in.
-pub fn plan(name: &str, scale: &str, scenes: &Path) -> Result<Vec<(RunSpec, Role)>, String> {
+pub fn plan(
+    name: &str,
+    scale: &str,
+    _results: &Path,
+    scenes: &Path,
+    _cache: &Path,
+) -> Result<Vec<(RunSpec, Role)>, String> {
     match name {
         "smoke" => Ok(smoke(scale, scenes)?
             .into_iter()
@@ -67,7 +73,7 @@ pub fn collect(
     cache: &Path,
     threads: usize,
 ) -> Result<(Vec<String>, usize), String> {
-    let specs = plan(name, scale, scenes)?;
+    let specs = plan(name, scale, results, scenes, cache)?;
     let mut rows = Vec::new();
     let mut lines = Vec::new();
     let mut made = 0;
