@@ -10,20 +10,13 @@
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 /// Hash of the sources that decide what a render produces (see build.rs).
 pub const CODE_VERSION: &str = env!("LT_CODE_VERSION");
 
 /// The file in every entry holding its key material, for a reader who wants to know what it is.
 pub const KEY_FILE: &str = "key.json";
-
-static BUILT: AtomicU64 = AtomicU64::new(0);
-static REUSED: AtomicU64 = AtomicU64::new(0);
-
-/// Entries this process built and found finished: what a resumed run reports.
-pub fn counts() -> (u64, u64) {
-    (BUILT.load(Ordering::SeqCst), REUSED.load(Ordering::SeqCst))
-}
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Key(pub String);
@@ -60,14 +53,30 @@ pub fn scene_hash(files: &[PathBuf]) -> Result<String, String> {
     Ok(h.finalize().to_hex()[..32].to_string())
 }
 
+/// A cache folder, and how many entries this handle (and its clones) built and found finished:
+/// what a resumed run reports.
 #[derive(Clone, Debug)]
 pub struct Cache {
     pub root: PathBuf,
+    built: Arc<AtomicU64>,
+    reused: Arc<AtomicU64>,
 }
 
 impl Cache {
     pub fn new(root: impl Into<PathBuf>) -> Cache {
-        Cache { root: root.into() }
+        Cache {
+            root: root.into(),
+            built: Arc::default(),
+            reused: Arc::default(),
+        }
+    }
+
+    /// (entries built, entries found finished) through this handle.
+    pub fn counts(&self) -> (u64, u64) {
+        (
+            self.built.load(Ordering::SeqCst),
+            self.reused.load(Ordering::SeqCst),
+        )
     }
 
     /// Where the entry of `key` lives (whether or not it is finished).
@@ -91,7 +100,7 @@ impl Cache {
     ) -> Result<PathBuf, String> {
         let key = key_of(material);
         if let Some(p) = self.lookup(&key) {
-            REUSED.fetch_add(1, Ordering::SeqCst);
+            self.reused.fetch_add(1, Ordering::SeqCst);
             return Ok(p);
         }
         let dest = self.path(&key);
@@ -117,12 +126,12 @@ impl Cache {
         }
         match std::fs::rename(&tmp, &dest) {
             Ok(()) => {
-                BUILT.fetch_add(1, Ordering::SeqCst);
+                self.built.fetch_add(1, Ordering::SeqCst);
                 Ok(dest)
             }
             Err(_) if self.lookup(&key).is_some() => {
                 let _ = std::fs::remove_dir_all(&tmp);
-                REUSED.fetch_add(1, Ordering::SeqCst);
+                self.reused.fetch_add(1, Ordering::SeqCst);
                 Ok(dest)
             }
             Err(e) => {

@@ -21,6 +21,7 @@
 //! | `radius_update` | global/local | global | Knaus & Zwicker's global schedule or Hachisuka's per-pixel update |
 //! | `kernel` | disk/epanechnikov | disk | density-estimation kernel, normalised over the disk |
 //! | `direct` | nee/photons | nee | direct light by next-event estimation or from photons |
+//! | `visible_seed` | u64 | the run's seed | seed of the one camera pass: runs that share it share their visible points and differ in photons only, so their spread is the variance at fixed points that Knaus & Zwicker's rates describe |
 
 use crate::params::ParamReader;
 use crate::progressive::{ProgressiveParams, ProgressiveState};
@@ -33,12 +34,15 @@ use rayon::prelude::*;
 
 pub struct Ppm {
     pub params: ProgressiveParams,
+    /// Seed of the camera pass, when it is not the run's.
+    pub visible_seed: Option<u64>,
 }
 
 impl Ppm {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<Ppm, String> {
         Ok(Ppm {
             params: ProgressiveParams::read(scene, r, "ppm")?,
+            visible_seed: r.get::<u64>("visible_seed")?,
         })
     }
 }
@@ -53,6 +57,7 @@ impl Progressive for Ppm {
             params: &self.params,
             scene,
             seed,
+            visible_seed: self.visible_seed.unwrap_or(seed),
             fixed: Vec::new(),
             prefixes: Vec::new(),
             state: ProgressiveState::new(scene),
@@ -64,6 +69,7 @@ struct PpmRun<'a> {
     params: &'a ProgressiveParams,
     scene: &'a Scene,
     seed: u64,
+    visible_seed: u64,
     /// The visible points of the camera pass (empty until pass 0).
     fixed: Vec<CameraPrefix>,
     /// This pass's prefixes: the fixed points with this pass's next-event estimate.
@@ -74,13 +80,14 @@ struct PpmRun<'a> {
 impl ProgressiveRun for PpmRun<'_> {
     fn pass(&mut self, pass: u32) -> u64 {
         let (scene, p, seed) = (self.scene, self.params, self.seed);
+        let visible_seed = self.visible_seed;
         let w = scene.camera.width as usize;
         if self.fixed.is_empty() {
             // The one camera pass, from the pixels' streams of pass 0.
             self.fixed = (0..scene.camera.pixel_count())
                 .into_par_iter()
                 .map(|j| {
-                    let mut s = Sampler::for_item(Domain::Camera, seed, j as u64, 0);
+                    let mut s = Sampler::for_item(Domain::Camera, visible_seed, j as u64, 0);
                     let raster =
                         Vec2::new((j % w) as f32 + s.next_f32(), (j / w) as f32 + s.next_f32());
                     trace_visible_point(scene, raster, &mut s, p.max_depth, p.direct)

@@ -1,0 +1,153 @@
+//! What every study runs with: its scale, the cache executors (runs and references), where it
+//! writes, and one progress bar with an ETA over all the renders it asks for.
+
+use super::reference::Reference;
+use super::{Scale, StudyArgs};
+use crate::cache::Cache;
+use crate::runs::{Executor, RunEntry, RunSpec};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+pub struct Ctx {
+    pub scale: Scale,
+    pub runs: Executor,
+    pub references: Executor,
+    pub results: PathBuf,
+    quiet: bool,
+    stop_after: Option<u64>,
+    bar: ProgressBar,
+    /// References loaded this process, by the key of their spec.
+    loaded: Mutex<Vec<(String, std::sync::Arc<Reference>)>>,
+}
+
+impl Ctx {
+    pub fn new(args: &StudyArgs) -> Result<Ctx, String> {
+        let scale = args.scale()?;
+        let cache = args
+            .cache
+            .clone()
+            .unwrap_or_else(|| args.results.join("cache"));
+        Ok(Ctx::with(
+            scale,
+            Cache::new(cache),
+            Cache::new(args.results.join("references")),
+            args.results.clone(),
+            args.threads,
+            args.quiet,
+            args.stop_after,
+        ))
+    }
+
+    pub fn with(
+        scale: Scale,
+        runs: Cache,
+        references: Cache,
+        results: PathBuf,
+        threads: usize,
+        quiet: bool,
+        stop_after: Option<u64>,
+    ) -> Ctx {
+        let bar = if quiet {
+            ProgressBar::hidden()
+        } else {
+            let b = ProgressBar::new(0);
+            b.set_style(
+                ProgressStyle::with_template(
+                    "[{elapsed_precise}] {bar:30} {pos}/{len} renders  {msg}  ETA {eta}",
+                )
+                .unwrap(),
+            );
+            b
+        };
+        Ctx {
+            scale,
+            runs: Executor {
+                cache: runs,
+                threads,
+            },
+            references: Executor {
+                cache: references,
+                threads,
+            },
+            results,
+            quiet,
+            stop_after,
+            bar,
+            loaded: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// (renders made, renders found in the cache) so far, references included.
+    pub fn counts(&self) -> (u64, u64) {
+        let (a, b) = self.runs.cache.counts();
+        let (c, d) = self.references.cache.counts();
+        (a + c, b + d)
+    }
+
+    pub fn study_dir(&self, study: &str) -> PathBuf {
+        self.results.join(study)
+    }
+
+    /// A line above the progress bar.
+    pub fn say(&self, line: &str) {
+        if !self.quiet {
+            self.bar.println(line);
+        }
+    }
+
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+
+    /// Announces `n` more renders to the progress bar (its length is what is left to ask for).
+    pub fn expect(&self, n: usize) {
+        self.bar.inc_length(n as u64);
+    }
+
+    fn check_interruption(&self) -> Result<(), String> {
+        if let Some(n) = self.stop_after {
+            if self.counts().0 >= n {
+                return Err(format!("stopped after {n} new renders (--stop-after)"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The finished entry of `spec`, rendered now if the cache lacks it.
+    pub fn run(&self, spec: &RunSpec) -> Result<RunEntry, String> {
+        self.check_interruption()?;
+        self.bar.set_message(spec.label());
+        let e = self.runs.run(spec)?;
+        self.bar.inc(1);
+        Ok(e)
+    }
+
+    /// All of `specs`, in order.
+    pub fn run_all(&self, specs: &[RunSpec]) -> Result<Vec<RunEntry>, String> {
+        self.expect(specs.len());
+        specs.iter().map(|s| self.run(s)).collect()
+    }
+
+    /// The reference of `scene` at this scale (and `max_depth`, if given), from the reference
+    /// cache or rendered now.
+    pub fn reference(
+        &self,
+        scene: &Path,
+        max_depth: Option<u32>,
+    ) -> Result<std::sync::Arc<Reference>, String> {
+        let spec = super::reference::spec(&self.scale, scene, max_depth)?;
+        let id = serde_json::to_string(&spec).unwrap_or_default();
+        if let Some((_, r)) = self.loaded.lock().unwrap().iter().find(|(k, _)| *k == id) {
+            return Ok(r.clone());
+        }
+        self.check_interruption()?;
+        self.bar.inc_length(1);
+        self.bar.set_message(format!("reference {}", spec.label()));
+        let entry = self.references.run(&spec)?;
+        self.bar.inc(1);
+        let r = std::sync::Arc::new(Reference::from_entry(&entry)?);
+        self.loaded.lock().unwrap().push((id, r.clone()));
+        Ok(r)
+    }
+}

@@ -1,0 +1,400 @@
+//! `lt study radius-shrinkage`: ppm, sppm and vcm with radius-reduction exponents α ∈ {0.3, 0.5,
+//! 2/3, 0.75, 0.9, 1}: bias², variance and MSE against passes with fitted slopes, beside the rates
+//! Knaus & Zwicker (2011, "Progressive photon mapping: a probabilistic approach") predict.
+//!
+//! With r_N² = r_1² N^(α−1) (our global schedule), pass N's variance grows as 1/r_N² and its bias
+//! as r_N², so the mean of N passes has
+//!   variance ∝ N^(−α),   bias ∝ N^(α−1), bias² ∝ N^(−2(1−α)),   MSE ∝ N^(−min(α, 2(1−α))),
+//! best at α = 2/3 (MSE ∝ N^(−2/3)); α = 1 keeps the radius and the bias. These are asymptotic
+//! rates: slopes are fitted over the last snapshots only (N ≥ 1/8 of the largest), with
+//! delete-one jackknife intervals over the independent runs.
+
+use super::metrics::subset_bias_variance;
+use super::output::{num, pct, stem, StudyOutput};
+use super::unbiased_consistent::{config_specs, decompose, runs};
+use super::{Ctx, Scale};
+use crate::plot::{Chart, Series, Style};
+use crate::runs::RunSpec;
+use lt_estimators::jackknife;
+
+pub const NAME: &str = "radius-shrinkage";
+pub const INTEGRATORS: [&str; 3] = ["ppm", "sppm", "vcm"];
+
+/// vcm keeps its radius in f32: r² then carries up to ~2 ulps of f32 rounding (2 × 2⁻²³); the
+/// check allows 8 × 2⁻²⁴ ≈ 4.8e-7 relative.
+pub const SCHEDULE_TOLERANCE: f64 = 8.0 / 16_777_216.0;
+
+pub fn alpha_text(a: f64) -> String {
+    if (a - 2.0 / 3.0).abs() < 1e-12 {
+        "2/3".into()
+    } else {
+        format!("{a}")
+    }
+}
+
+/// The parameter value passed to the integrator (the shortest text that reads back as `a`).
+fn alpha_param(a: f64) -> String {
+    format!("{a}")
+}
+
+pub fn specs(scale: &Scale) -> Vec<RunSpec> {
+    let mut v: Vec<RunSpec> = super::reference::spec(scale, &scale.focus_scene, None)
+        .into_iter()
+        .collect();
+    for i in INTEGRATORS {
+        for &a in &scale.alphas {
+            for fixed in [false, true] {
+                if fixed && i != "ppm" {
+                    continue;
+                }
+                let p = params(i, a, fixed);
+                let p: Vec<(&str, &str)> = p.iter().map(|(k, v)| (*k, v.as_str())).collect();
+                v.extend(config_specs(
+                    scale,
+                    &scale.focus_scene,
+                    i,
+                    &p,
+                    scale.progressive_passes,
+                ));
+            }
+        }
+    }
+    v
+}
+
+/// The parameters of one configuration. ppm and sppm take all light from photons here
+/// (`direct=photons`): next-event estimation, re-sampled every pass, would add a variance falling
+/// as 1/N whatever α, and Knaus & Zwicker's rates describe the photon estimate alone.
+pub fn params(integrator: &str, alpha: f64, fixed_points: bool) -> Vec<(&'static str, String)> {
+    let mut p = vec![("alpha", alpha_param(alpha))];
+    if integrator != "vcm" {
+        p.push(("direct", "photons".into()));
+    }
+    if fixed_points {
+        p.push((FIXED_POINTS.0, FIXED_POINTS.1.into()));
+    }
+    p
+}
+
+/// ppm's visible points are drawn once per run, so its spread over runs holds the spread of
+/// the points' positions in their pixels, which no pass reduces. Runs that share the camera pass
+/// (`visible_seed`) differ in photons only: their spread is the variance at fixed points whose
+/// rate Knaus & Zwicker predict.
+pub const FIXED_POINTS: (&str, &str) = ("visible_seed", "1");
+
+/// Predicted log-log slopes against N: (variance, bias², MSE, r²).
+pub fn predicted(alpha: f64) -> (f64, f64, f64, f64) {
+    let b2 = -2.0 * (1.0 - alpha);
+    (-alpha, b2, -alpha.min(2.0 * (1.0 - alpha)), alpha - 1.0)
+}
+
+/// One configuration's measured slopes over the asymptotic snapshots.
+pub struct Rates {
+    pub integrator: String,
+    pub alpha: f64,
+    /// (measured slope with its jackknife interval, or why there is none) for variance, bias², MSE.
+    pub slopes: [Result<lt_estimators::Jackknifed, String>; 3],
+    /// Slope of (r_N/r_1)² against N over the tail, from the run's log (deterministic).
+    pub r2_slope: f64,
+    /// Largest relative difference of the logged (r_N/r_1)² from Knaus & Zwicker's product.
+    pub schedule_error: f64,
+    pub passes: Vec<u32>,
+    pub r2: Vec<f64>,
+}
+
+pub fn rates(
+    ctx: &Ctx,
+    integrator: &str,
+    alpha: f64,
+    fixed_points: bool,
+) -> Result<(Rates, super::unbiased_consistent::Decomposition), String> {
+    let scale = &ctx.scale;
+    let owned = params(integrator, alpha, fixed_points);
+    let params: Vec<(&str, &str)> = owned.iter().map(|(k, v)| (*k, v.as_str())).collect();
+    let reference = ctx.reference(&scale.focus_scene, None)?;
+    let label = format!(
+        "{integrator}{} α={}",
+        if fixed_points { " (fixed points)" } else { "" },
+        alpha_text(alpha)
+    );
+    let dec = decompose(
+        ctx,
+        &scale.focus_scene,
+        &label,
+        integrator,
+        &params,
+        scale.progressive_passes,
+    )?;
+    let specs = config_specs(
+        scale,
+        &scale.focus_scene,
+        integrator,
+        &params,
+        scale.progressive_passes,
+    );
+    let entries = ctx.run_all(&specs)?;
+    let last = scale.progressive_passes;
+    let tail: Vec<u32> = dec
+        .passes
+        .iter()
+        .copied()
+        .filter(|&n| 8 * n >= last)
+        .collect();
+    let images: Vec<Vec<_>> = tail
+        .iter()
+        .map(|&n| {
+            entries
+                .iter()
+                .map(|e| e.snapshot(n))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .collect::<Result<_, _>>()?;
+    let xs: Vec<f64> = tail.iter().map(|&n| (n as f64).ln()).collect();
+    let slope_of = |which: usize| {
+        jackknife(runs(scale), scale.confidence, |kept| {
+            let ys: Vec<f64> = images
+                .iter()
+                .map(|imgs| {
+                    let (b2, v) = subset_bias_variance(imgs, kept, &reference);
+                    let y = match which {
+                        0 => v,
+                        1 => b2,
+                        _ => b2 + v,
+                    };
+                    if y > 0.0 {
+                        Ok(y.ln())
+                    } else {
+                        Err(format!(
+                            "{} ≤ 0 at some N",
+                            ["variance", "bias²", "MSE"][which]
+                        ))
+                    }
+                })
+                .collect::<Result<_, String>>()?;
+            lt_estimators::fit_line(&xs, &ys, 0.95).map(|f| f.slope)
+        })
+    };
+    let scales = &entries[0].record.radius_scale;
+    let r2: Vec<f64> = scales.iter().map(|s| s * s).collect();
+    let (lx, ly): (Vec<f64>, Vec<f64>) = r2
+        .iter()
+        .enumerate()
+        .filter(|(i, v)| 8 * (*i as u32 + 1) >= last && **v > 0.0)
+        .map(|(i, v)| (((i + 1) as f64).ln(), v.ln()))
+        .unzip();
+    let r2_slope = lt_estimators::fit_line(&lx, &ly, 0.95).map_or(f64::NAN, |f| f.slope);
+    // The schedule each integrator states: ppm's and sppm's global one r_N² = r_1² Π_{j<N}
+    // (j + α)/(j + 1) (Knaus & Zwicker's), vcm's r_N² = r_1² N^(α−1) (Georgiev et al.'s).
+    let schedule_error = r2
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let n = i as u32 + 1;
+            let exact = if integrator == "vcm" {
+                (n as f64).powf(alpha - 1.0)
+            } else {
+                lt_integrators::radius::global_scale2(n, alpha)
+            };
+            ((v - exact) / exact).abs()
+        })
+        .fold(0.0, f64::max);
+    Ok((
+        Rates {
+            integrator: integrator.into(),
+            alpha,
+            slopes: [slope_of(0), slope_of(1), slope_of(2)],
+            r2_slope,
+            schedule_error,
+            passes: (1..=r2.len() as u32).collect(),
+            r2,
+        },
+        dec,
+    ))
+}
+
+pub fn run(ctx: &Ctx) -> Result<(), String> {
+    let scale = &ctx.scale;
+    let scene = stem(&scale.focus_scene);
+    let mut out = StudyOutput::new(
+        ctx.study_dir(NAME),
+        NAME,
+        "Radius shrinkage: measured rates against Knaus & Zwicker's",
+        scale,
+    )?;
+    out.para(&format!(
+        "ppm, sppm and vcm on `{scene}` ({w} px wide), {k} independent runs of {n} passes for each \
+         α. With r_N² ∝ N^(α−1), Knaus & Zwicker predict variance ∝ N^(−α), bias² ∝ N^(−2(1−α)) \
+         and MSE ∝ N^(−min(α, 2(1−α))) — fastest at α = 2/3 — and r² ∝ N^(α−1). Slopes are fitted \
+         over the snapshots with N ≥ {tail} (the asymptotic tail), with {c} % delete-one \
+         jackknife intervals over runs. sppm's variance also has a 1/N part from its new camera \
+         samples each pass; it is the smaller one at large N only when α < 1. ppm's visible points \
+         are drawn once per run, so its spread over runs also holds where in its pixel each point \
+         fell, which no pass reduces: the rate K&Z predict is that of the variance at fixed \
+         points, measured from runs that share their camera pass (`visible_seed`). ppm and sppm take \
+         all light from photons here (`direct=photons`), since next-event estimation re-sampled \
+         every pass adds a 1/N variance whatever α. A bias² too \
+         small to tell from 0 at some N has no slope (—). The r² rows check the logged radii \
+         against each integrator's schedule: ppm's and sppm's product r_N² = r_1² Π (j + α)/(j + 1), \
+         whose slope over a finite tail is near, not at, α − 1, and vcm's r_N² = r_1² N^(α−1).",
+        w = scale.width,
+        k = runs(scale),
+        n = scale.progressive_passes,
+        tail = (scale.progressive_passes / 8).max(1),
+        c = pct(scale.confidence)
+    ));
+    let mut rows = Vec::new();
+    let mut r2_series = Vec::new();
+    for integrator in INTEGRATORS {
+        let mut decs = Vec::new();
+        for &alpha in &scale.alphas {
+            let (r, dec) = rates(ctx, integrator, alpha, false)?;
+            let (pv, pb, pm, pr) = predicted(alpha);
+            let mut quantities = vec![
+                ("variance", pv, r.slopes[0].clone()),
+                ("bias²", pb, r.slopes[1].clone()),
+                ("MSE", pm, r.slopes[2].clone()),
+            ];
+            if integrator == "ppm" {
+                let (f, _) = rates(ctx, integrator, alpha, true)?;
+                quantities.insert(1, ("variance at fixed points", pv, f.slopes[0].clone()));
+            }
+            for (name, pred, slope) in &quantities {
+                let (m, ci, diff, inside) = match slope {
+                    Ok(j) => (
+                        num(j.estimate),
+                        format!("[{}, {}]", num(j.interval.lo), num(j.interval.hi)),
+                        format!(
+                            "{} ± {}",
+                            num(j.estimate - pred),
+                            num(j.interval.hi - j.estimate)
+                        ),
+                        if j.interval.contains(*pred) {
+                            "yes"
+                        } else {
+                            "no"
+                        }
+                        .to_string(),
+                    ),
+                    Err(e) => ("—".into(), e.clone(), "—".into(), "—".into()),
+                };
+                rows.push(vec![
+                    integrator.to_string(),
+                    alpha_text(alpha),
+                    name.to_string(),
+                    m,
+                    ci,
+                    num(*pred),
+                    diff,
+                    inside,
+                ]);
+            }
+            // The radius follows the product schedule exactly; its slope over a finite tail is
+            // near α − 1, not equal to it.
+            rows.push(vec![
+                integrator.to_string(),
+                alpha_text(alpha),
+                "r²".into(),
+                num(r.r2_slope),
+                format!("schedule matched to {:.1e}", r.schedule_error),
+                num(pr),
+                num(r.r2_slope - pr),
+                if r.schedule_error < SCHEDULE_TOLERANCE {
+                    "yes"
+                } else {
+                    "no"
+                }
+                .into(),
+            ]);
+            if integrator == "ppm" {
+                r2_series.push(Series {
+                    name: format!("α = {}", alpha_text(alpha)),
+                    points: r
+                        .passes
+                        .iter()
+                        .zip(&r.r2)
+                        .map(|(&n, &v)| (n as f64, v))
+                        .collect(),
+                    y_interval: Vec::new(),
+                    style: Style::Measured,
+                });
+            }
+            decs.push(dec);
+        }
+        for (what, pick) in [
+            (
+                "variance",
+                (|d: &super::unbiased_consistent::Decomposition| d.variance.clone())
+                    as fn(&_) -> Vec<_>,
+            ),
+            ("bias²", |d| d.bias2.clone()),
+            ("MSE", |d| d.mse.clone()),
+        ] {
+            let series = decs
+                .iter()
+                .map(|d| {
+                    let iv = pick(d);
+                    Series {
+                        name: d.label.clone(),
+                        points: d
+                            .passes
+                            .iter()
+                            .zip(&iv)
+                            .map(|(&n, i)| (n as f64, i.estimate))
+                            .collect(),
+                        y_interval: iv.iter().map(|i| (i.lo, i.hi)).collect(),
+                        style: Style::Measured,
+                    }
+                })
+                .collect();
+            let file = match what {
+                "bias²" => "bias2",
+                w => w,
+            }
+            .to_lowercase();
+            out.chart(
+                &format!("{integrator}-{file}"),
+                &Chart {
+                    title: format!("{integrator} on {scene}: {what} against passes, per α"),
+                    x_label: "passes".into(),
+                    y_label: what.into(),
+                    log_x: true,
+                    log_y: true,
+                    series,
+                },
+                &format!("{integrator}: {what} of one run against passes for each α, jackknife intervals."),
+            )?;
+        }
+    }
+    out.chart(
+        "radius",
+        &Chart {
+            title: "(r_N / r_1)² against passes (ppm's global schedule)".into(),
+            x_label: "pass N".into(),
+            y_label: "(r_N / r_1)²".into(),
+            log_x: true,
+            log_y: true,
+            series: r2_series,
+        },
+        "The squared radius of each pass relative to the first: slope α − 1 on log axes.",
+    )?;
+    out.table(
+        "rates",
+        "Measured against predicted slopes",
+        "Slope of ln(quantity) against ln N over the asymptotic tail, its jackknife interval, \
+         Knaus & Zwicker's prediction, the difference (± the interval's half-width) and whether \
+         the interval contains the prediction.",
+        &[
+            "integrator",
+            "α",
+            "quantity",
+            "measured",
+            "CI",
+            "predicted",
+            "difference",
+            "inside",
+        ],
+        rows,
+        true,
+    )?;
+    out.finish()
+}

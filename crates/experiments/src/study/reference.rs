@@ -1,0 +1,110 @@
+//! Reference images: which integrator renders a scene best without bias, and the cached render
+//! every study measures against. A reference's own noise is not zero: its mean per-pixel
+//! variance (the square of its standard error) is what an MSE against it over-states by, and the
+//! studies subtract it (E[(I − R̂)²] = E[(I − R)²] + Var R̂ for independent I and R̂).
+
+use super::Scale;
+use crate::runs::{RunEntry, RunSpec};
+use lt_estimators::Image;
+use std::path::Path;
+
+/// Seeds of references start here, far from the studies' seeds (1 …), so no study run shares a
+/// random sequence with the reference it is measured against.
+pub const REFERENCE_SEED: u64 = 1_000_000;
+
+/// The reference integrator of a scene and why, by the scene file's stem. Scenes whose light
+/// reaches the camera only along L S⁺ D S⁺ E from a delta (or near-delta) light have no unbiased
+/// estimator here that samples them; they get independent runs of `vcm` at a small radius and
+/// are marked consistent.
+pub fn integrator_for(scene_stem: &str) -> (&'static str, &'static str) {
+    match scene_stem {
+        "smallvcm-spheres-point" | "smallvcm-spheres-sun" => (
+            "vcm",
+            "a delta light seen through specular balls (L S⁺ D S⁺ E): no unbiased estimator \
+             samples it; independent vcm runs at radius 1 px",
+        ),
+        "caustic-sds" => (
+            "vcm",
+            "the caustic seen in the mirror (L S D S E) is heavy-tailed for pt and bdpt; \
+             independent vcm runs at radius 1 px",
+        ),
+        _ => (
+            "bdpt",
+            "bidirectional path tracing, all strategies, power heuristic",
+        ),
+    }
+}
+
+/// Runs of a consistent reference: its standard error comes from their spread.
+pub const CONSISTENT_REFERENCE_RUNS: u32 = 8;
+
+pub fn spec(scale: &Scale, scene: &Path, max_depth: Option<u32>) -> Result<RunSpec, String> {
+    let stem = scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let (integrator, _) = integrator_for(&stem);
+    let res = super::output::film(scale, scene)?;
+    let mut s = if integrator == "vcm" {
+        RunSpec::new(
+            scene,
+            integrator,
+            REFERENCE_SEED,
+            scale.reference_passes / CONSISTENT_REFERENCE_RUNS,
+        )
+        .runs(CONSISTENT_REFERENCE_RUNS)
+        .param("radius_px", 1)
+    } else {
+        RunSpec::new(scene, integrator, REFERENCE_SEED, scale.reference_passes)
+    }
+    .resolution(Some(res));
+    if let Some(d) = max_depth {
+        s = s.param("max_depth", d);
+    }
+    Ok(s)
+}
+
+/// A reference as the studies use it.
+pub struct Reference {
+    pub image: Image,
+    /// Per pixel and channel, the variance of the reference's mean (its standard error squared).
+    pub variance: Image,
+    /// The mean of `variance`: what a raw MSE against this reference over-states.
+    pub mean_variance: f64,
+    pub integrator: String,
+    pub passes: u32,
+    pub runs: u32,
+    pub consistent: bool,
+    pub seconds: f64,
+}
+
+impl Reference {
+    pub fn from_entry(e: &RunEntry) -> Result<Reference, String> {
+        let image = e.image()?;
+        let se = e.std_error()?.ok_or_else(|| {
+            format!(
+                "reference {} has no standard error: a reference needs one",
+                e.dir.display()
+            )
+        })?;
+        let mut variance = se.clone();
+        let mut sum = 0.0;
+        for p in variance.data.iter_mut() {
+            for v in p.iter_mut() {
+                *v = if v.is_finite() { *v * *v } else { 0.0 };
+                sum += *v;
+            }
+        }
+        let mean_variance = sum / (3 * variance.data.len()).max(1) as f64;
+        Ok(Reference {
+            image,
+            variance,
+            mean_variance,
+            integrator: e.record.spec.integrator.clone(),
+            passes: e.record.spec.passes,
+            runs: e.record.spec.runs,
+            consistent: e.record.kind == "consistent",
+            seconds: e.record.seconds.last().copied().unwrap_or(0.0),
+        })
+    }
+}

@@ -1,0 +1,135 @@
+//! How big a study is: the film width, the independent runs, the pass counts, the scenes and
+//! integrators. `quick` is a newcomer's first run (all studies in minutes on 2 cores), `full` is
+//! publication scale, `test` is what the tests afford.
+
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug)]
+pub struct Scale {
+    pub name: &'static str,
+    /// Film width in pixels; the height follows the scene's aspect ratio.
+    pub width: u32,
+    /// Independent runs per configuration (the error bars of every statistic).
+    pub runs: usize,
+    /// Largest pass count; snapshots at 1, 2, 4, … up to it.
+    pub max_passes: u32,
+    /// Passes of a reference render (per run, for a consistent reference).
+    pub reference_passes: u32,
+    /// Scenes of the convergence and equal-time studies.
+    pub scenes: Vec<PathBuf>,
+    /// The scene of the studies that look at one scene closely.
+    pub focus_scene: PathBuf,
+    /// The scene of the unbiased-vs-consistent study: sharp sun shadows, so a fixed radius's
+    /// blur is a bias the runs can tell from noise.
+    pub bias_scene: PathBuf,
+    /// Scenes of the per-length study, and its longest max_depth.
+    pub length_scenes: Vec<PathBuf>,
+    pub max_length: u32,
+    /// Radius-reduction exponents of the radius-shrinkage study.
+    pub alphas: Vec<f64>,
+    /// Independent runs of the radius-shrinkage and unbiased-vs-consistent studies (their
+    /// bias² and variance come from the spread of runs alone).
+    pub bias_runs: usize,
+    /// Passes of the radius-shrinkage and unbiased-vs-consistent studies.
+    pub progressive_passes: u32,
+    /// Repetitions of the lecture's 1-D example per N.
+    pub lecture_repetitions: usize,
+    pub confidence: f64,
+}
+
+pub const ALL_ALPHAS: [f64; 6] = [0.3, 0.5, 2.0 / 3.0, 0.75, 0.9, 1.0];
+
+/// The shipped scenes (every `.toml` in the folder), sorted by name.
+pub fn shipped_scenes(dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| format!("cannot list the scenes in {}: {e}", dir.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    if v.is_empty() {
+        return Err(format!("{} holds no .toml scenes", dir.display()));
+    }
+    Ok(v)
+}
+
+impl Scale {
+    pub fn named(name: &str, scenes_dir: &Path) -> Result<Scale, String> {
+        let all = shipped_scenes(scenes_dir)?;
+        let scene = |n: &str| scenes_dir.join(format!("{n}.toml"));
+        let base = Scale {
+            name: "quick",
+            width: 32,
+            runs: 4,
+            max_passes: 32,
+            reference_passes: 1024,
+            scenes: all.clone(),
+            focus_scene: scene("cornell-box"),
+            bias_scene: scene("sun-room"),
+            length_scenes: vec![
+                scene("cornell-box"),
+                scene("cornell-glass-light"),
+                scene("caustic-sds"),
+            ],
+            max_length: 6,
+            alphas: ALL_ALPHAS.to_vec(),
+            bias_runs: 8,
+            progressive_passes: 64,
+            lecture_repetitions: 20_000,
+            confidence: 0.95,
+        };
+        match name {
+            "quick" => Ok(base),
+            "full" => Ok(Scale {
+                name: "full",
+                width: 128,
+                runs: 16,
+                max_passes: 256,
+                reference_passes: 16384,
+                max_length: 8,
+                bias_runs: 16,
+                progressive_passes: 1024,
+                lecture_repetitions: 200_000,
+                ..base
+            }),
+            "test" => Ok(Scale {
+                name: "test",
+                width: 16,
+                runs: 6,
+                max_passes: 16,
+                reference_passes: 512,
+                scenes: vec![scene("cornell-box"), scene("veach-mis")],
+                length_scenes: vec![scene("cornell-box")],
+                max_length: 3,
+                alphas: vec![0.5, 2.0 / 3.0, 1.0],
+                bias_runs: 16,
+                progressive_passes: 64,
+                lecture_repetitions: 4000,
+                // The tests check dozens of intervals; at 0.999 each, the chance that any of 50
+                // misses by luck is 1 − 0.999⁵⁰ ≈ 5 % (Šidák), which a fixed seed then pins.
+                confidence: 0.999,
+                ..base
+            }),
+            other => Err(format!("unknown scale '{other}' (quick, full, test)")),
+        }
+    }
+
+    /// Snapshot pass counts 1, 2, 4, … up to `max` (and `max` itself).
+    pub fn doublings(max: u32) -> Vec<u32> {
+        let mut v: Vec<u32> = std::iter::successors(Some(1u32), |n| n.checked_mul(2))
+            .take_while(|&n| n <= max)
+            .collect();
+        if v.last() != Some(&max) {
+            v.push(max);
+        }
+        v
+    }
+
+    /// The film of a scene at this scale: `width` wide, the scene's aspect ratio kept.
+    pub fn resolution(&self, scene_size: (u32, u32)) -> (u32, u32) {
+        let (w, h) = scene_size;
+        let height = ((self.width as f64) * h as f64 / w as f64).round().max(1.0) as u32;
+        (self.width, height)
+    }
+}

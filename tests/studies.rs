@@ -1,0 +1,216 @@
+//! Every study at the tiny test scale, asserted on its outputs: the files exist, unbiased
+//! estimators' MSE slopes contain −1, fixed-radius photon mapping's bias² interval excludes 0
+//! while pt's and bdpt's include it, PPM's variance slope contains −α, the lecture's exact bias
+//! lies in its measured interval; and an interrupted `all` resumes without redoing finished
+//! renders.
+//!
+//! The test scale's intervals are at 99.9 %: about 50 intervals are checked here, so the chance
+//! that any one misses by luck is ≈ 5 % (Šidák), which the fixed seeds then pin either way.
+
+use lt_experiments::cache::Cache;
+use lt_experiments::study::{self, Ctx, Scale};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+fn scenes() -> PathBuf {
+    lt_tests::scenes_dir()
+}
+
+fn ctx(results: &Path, stop_after: Option<u64>) -> Ctx {
+    let scale = Scale::named("test", &scenes()).unwrap();
+    Ctx::with(
+        scale,
+        Cache::new(results.join("cache")),
+        Cache::new(results.join("references")),
+        results.to_path_buf(),
+        0,
+        true,
+        stop_after,
+    )
+}
+
+/// One full test-scale run of every study, made once for all tests here: its folder and the
+/// number of renders it made.
+fn full_run() -> &'static (PathBuf, u64) {
+    static RUN: OnceLock<(PathBuf, u64)> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = std::env::temp_dir().join(format!("lt-studies-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let c = ctx(&dir, None);
+        study::run_named("all", &c).unwrap();
+        (dir, c.counts().0)
+    })
+}
+
+fn results() -> &'static PathBuf {
+    &full_run().0
+}
+
+/// A CSV as rows of column → value.
+fn csv(path: &Path) -> Vec<HashMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines
+        .map(|l| {
+            // The study tables quote cells holding commas ("[a, b]").
+            let mut cells = Vec::new();
+            let (mut cur, mut quoted) = (String::new(), false);
+            for ch in l.chars() {
+                match ch {
+                    '"' => quoted = !quoted,
+                    ',' if !quoted => cells.push(std::mem::take(&mut cur)),
+                    c => cur.push(c),
+                }
+            }
+            cells.push(cur);
+            header.iter().cloned().zip(cells).collect()
+        })
+        .collect()
+}
+
+/// "[lo, hi]" → (lo, hi).
+fn interval(text: &str) -> (f64, f64) {
+    let t = text.trim().trim_start_matches('[').trim_end_matches(']');
+    let mut it = t
+        .split(',')
+        .map(|v| v.trim().parse::<f64>().unwrap_or(f64::NAN));
+    (it.next().unwrap(), it.next().unwrap())
+}
+
+#[test]
+fn every_study_writes_its_files() {
+    let dir = results();
+    for s in study::STUDIES {
+        let d = dir.join(s);
+        let m = lt_experiments::manifest::Manifest::read(&d).unwrap();
+        assert!(d.join(&m.summary).is_file(), "{s}: summary");
+        assert!(!m.tables.is_empty(), "{s}: no tables");
+        for t in &m.tables {
+            assert!(d.join(&t.csv).is_file(), "{s}: {}", t.csv);
+        }
+        for f in &m.figures {
+            for file in [&f.svg, &f.png] {
+                let len = std::fs::metadata(d.join(file))
+                    .map(|m| m.len())
+                    .unwrap_or(0);
+                assert!(len > 0, "{s}: {file} missing or empty");
+            }
+        }
+        for g in &m.galleries {
+            for i in std::iter::once(&g.reference).chain(&g.items) {
+                assert!(d.join(&i.png).is_file(), "{s}: {}", i.png);
+            }
+        }
+    }
+    assert!(
+        !lt_experiments::manifest::Manifest::read(&dir.join("equal-time"))
+            .unwrap()
+            .galleries
+            .is_empty()
+    );
+}
+
+#[test]
+fn unbiased_estimators_converge_at_slope_minus_one() {
+    let rows = csv(&results().join("convergence/slopes.csv"));
+    let mut checked = 0;
+    for r in rows
+        .iter()
+        .filter(|r| r["scene"] == "cornell-box" && r["kind"] == "unbiased")
+    {
+        let (lo, hi) = interval(&r["CI"]);
+        assert!(
+            lo <= -1.0 && -1.0 <= hi,
+            "{} on cornell-box: MSE slope {} with interval [{lo}, {hi}] excludes −1",
+            r["integrator"],
+            r["slope vs N"]
+        );
+        assert!(
+            hi - lo < 2.0,
+            "{}: interval [{lo}, {hi}] too wide to mean anything",
+            r["integrator"]
+        );
+        checked += 1;
+    }
+    assert_eq!(checked, 4, "pt, pt-bsdf, light and bdpt");
+}
+
+#[test]
+fn fixed_radius_pm_is_biased_and_pt_is_not() {
+    let rows = csv(&results().join("unbiased-vs-consistent/final.csv"));
+    let get = |label: &str| {
+        rows.iter()
+            .find(|r| r["estimator"] == label)
+            .unwrap_or_else(|| panic!("no row {label}"))
+    };
+    for unbiased in ["pt", "bdpt"] {
+        assert_eq!(
+            get(unbiased)["includes 0"],
+            "yes",
+            "{unbiased}: {:?}",
+            get(unbiased)
+        );
+    }
+    assert_eq!(
+        get("pm (fixed radius)")["includes 0"],
+        "no",
+        "{:?}",
+        get("pm (fixed radius)")
+    );
+    // The lecture's example: the exact bias lies in every measured interval.
+    for r in csv(&results().join("unbiased-vs-consistent/lecture.csv")) {
+        assert_eq!(r["exact inside"], "yes", "lecture N = {}: {:?}", r["N"], r);
+    }
+}
+
+#[test]
+fn ppm_variance_falls_as_n_to_the_minus_alpha() {
+    let rows = csv(&results().join("radius-shrinkage/rates.csv"));
+    let mut checked = 0;
+    for r in rows
+        .iter()
+        .filter(|r| r["integrator"] == "ppm" && r["quantity"] == "variance at fixed points")
+    {
+        let (lo, hi) = interval(&r["CI"]);
+        let predicted: f64 = r["predicted"].parse().unwrap();
+        assert!(
+            lo <= predicted && predicted <= hi,
+            "ppm α = {}: variance slope {} in [{lo}, {hi}], predicted {predicted}",
+            r["α"],
+            r["measured"]
+        );
+        checked += 1;
+    }
+    assert_eq!(checked, 3);
+    for r in rows.iter().filter(|r| r["quantity"] == "r²") {
+        assert_eq!(r["inside"], "yes", "{:?}", r);
+    }
+}
+
+/// Interrupt `all` after some renders, rerun it, and count: the rerun makes exactly the renders
+/// the first run did not finish.
+#[test]
+fn an_interrupted_run_resumes_without_redoing_finished_renders() {
+    let dir = std::env::temp_dir().join(format!("lt-studies-resume-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let first = ctx(&dir, Some(40));
+    let err = study::run_named("all", &first).unwrap_err();
+    assert!(err.contains("stopped after 40"), "{err}");
+    assert_eq!(first.counts().0, 40);
+    let second = ctx(&dir, None);
+    study::run_named("all", &second).unwrap();
+    let (made, found) = second.counts();
+    let total = full_run().1;
+    eprintln!("resume: an uninterrupted run makes {total} renders; interrupted after 40, the rerun made {made} and found {found}");
+    assert_eq!(
+        made + 40,
+        total,
+        "the rerun makes exactly what the first run did not finish"
+    );
+    let third = ctx(&dir, None);
+    study::run_named("all", &third).unwrap();
+    assert_eq!(third.counts().0, 0, "a finished run redoes nothing");
+    let _ = std::fs::remove_dir_all(&dir);
+}
