@@ -309,3 +309,50 @@ fn a_study_plan_is_collected_from_the_cache() {
     assert!(worst <= 1);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_study_of_the_testbed_is_planned_and_collected_from_the_cache() {
+    let dir = scratch("cluster-real-study");
+    let lt = lt_binary(&dir);
+    let plan = dir.join("plan");
+    let results = dir.join("results");
+    let scenes = lt_tests::scenes_dir();
+    let p = plan.to_str().unwrap();
+    lt_ok(
+        &lt,
+        &[
+            "plan",
+            "study",
+            "convergence",
+            "--scale",
+            "test",
+            "--results",
+            results.to_str().unwrap(),
+            "--scenes",
+            scenes.to_str().unwrap(),
+            "--threads",
+            "1",
+            "-o",
+            p,
+        ],
+    );
+    let planned = lt_experiments::cluster::plan::Plan::read(&plan).unwrap();
+    let n = planned.shards.len();
+    let references = planned
+        .shards
+        .iter()
+        .filter(|s| s.cache == results.join("references"))
+        .count();
+    assert!(
+        n > 10 && references >= 1,
+        "{n} shards, {references} references"
+    );
+    let out = lt_ok(&lt, &["submit", p, "--local"]);
+    assert!(
+        out.contains(&format!("({n} renders found in the cache, 0 made here)")),
+        "{out}"
+    );
+    assert!(results.join("convergence").join("manifest.json").is_file());
+    eprintln!("study convergence (test scale): {n} shards ({references} references), collected with every render from the cache");
+    let _ = std::fs::remove_dir_all(&dir);
+}

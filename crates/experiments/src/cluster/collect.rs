@@ -191,7 +191,7 @@ pub fn collect(args: &CollectArgs) -> Result<(), String> {
                     missing.len()
                 );
             }
-            let (lines, made) =
+            let (lines, found, made) =
                 study_link::collect(name, scale, results, scenes, cache, args.threads)?;
             for l in &lines {
                 eprintln!("{l}");
@@ -199,7 +199,7 @@ pub fn collect(args: &CollectArgs) -> Result<(), String> {
             eprintln!(
                 "study {name} collected from {} ({} renders found in the cache, {} made here) -> {}",
                 dir.display(),
-                lines.len() - made,
+                found,
                 made,
                 results.join(name).display()
             );

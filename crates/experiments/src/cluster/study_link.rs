@@ -1,10 +1,10 @@
-//! The seam between plans and the studies: which renders a study needs (`lt plan study`) and
-//! how its outputs are made once they are in the cache (`lt collect`, which runs the study
-//! again: every render is then found).
+//! The seam between plans and the studies: which renders a study needs (`lt plan study`:
+//! `study::plan`, each render with the cache it belongs in) and how its outputs are made once
+//! they are in the cache (`lt collect`: `study::run_named`, which finds every render).
 //!
-//! Until `study::plan` and `study::run_named` are on main, a built-in study stands in:
-//! `smoke`, a handful of small `pt` renders of the Cornell box, and collecting it writes
-//! `RESULTS/smoke/summary.json` from the cached entries. This file is the one place to switch.
+//! Beside the studies, a tiny built-in one, `smoke` (a few small `pt` renders of the Cornell
+//! box; collecting it writes `RESULTS/smoke/summary.json`), exercises plans in the tests without
+//! a study's cost.
 
 use crate::cache::Cache;
 use crate::runs::{Executor, RunSpec};
@@ -48,23 +48,53 @@ fn smoke(scale: &str, scenes: &Path) -> Result<Vec<RunSpec>, String> {
 pub fn plan(
     name: &str,
     scale: &str,
-    _results: &Path,
+    results: &Path,
     scenes: &Path,
-    _cache: &Path,
+    cache: &Path,
 ) -> Result<Vec<(RunSpec, Role)>, String> {
-    match name {
-        "smoke" => Ok(smoke(scale, scenes)?
+    if name == "smoke" {
+        return Ok(smoke(scale, scenes)?
             .into_iter()
             .map(|s| (s, Role::Runs))
-            .collect()),
-        other => Err(format!(
-            "lt plan study: study '{other}' cannot be planned by this build (it knows: smoke)"
-        )),
+            .collect());
+    }
+    let ctx = crate::study::Ctx::new(&study_args(name, scale, results, scenes, cache, 0))?;
+    let planned = crate::study::plan(name, &ctx.scale, Some(&ctx))?;
+    Ok(planned
+        .into_iter()
+        .map(|(spec, role)| {
+            let role = match role {
+                crate::study::Role::Runs => Role::Runs,
+                crate::study::Role::References => Role::References,
+            };
+            (spec, role)
+        })
+        .collect())
+}
+
+fn study_args(
+    name: &str,
+    scale: &str,
+    results: &Path,
+    scenes: &Path,
+    cache: &Path,
+    threads: usize,
+) -> crate::study::StudyArgs {
+    crate::study::StudyArgs {
+        name: name.into(),
+        full: scale == "full",
+        results: results.into(),
+        cache: Some(cache.into()),
+        scenes: scenes.into(),
+        threads,
+        quiet: true,
+        stop_after: None,
+        test_scale: scale == "test",
     }
 }
 
-/// Makes study `name`'s outputs under `results`, rendering whatever the cache lacks; returns
-/// a line per render and how many were made here.
+/// Makes study `name`'s outputs under `results` by running it (every render it finds in the
+/// cache is not made again); returns a line per study and how many renders were made here.
 pub fn collect(
     name: &str,
     scale: &str,
@@ -72,8 +102,31 @@ pub fn collect(
     scenes: &Path,
     cache: &Path,
     threads: usize,
-) -> Result<(Vec<String>, usize), String> {
-    let specs = plan(name, scale, results, scenes, cache)?;
+) -> Result<(Vec<String>, usize, usize), String> {
+    if name == "smoke" {
+        return collect_smoke(name, scale, results, scenes, cache, threads);
+    }
+    let ctx = crate::study::Ctx::new(&study_args(name, scale, results, scenes, cache, threads))?;
+    crate::study::run_named(name, &ctx)?;
+    let (b1, r1) = ctx.runs.cache.counts();
+    let (b2, r2) = ctx.references.cache.counts();
+    Ok((Vec::new(), (r1 + r2) as usize, (b1 + b2) as usize))
+}
+
+/// Makes study `name`'s outputs under `results`, rendering whatever the cache lacks; returns
+/// a line per render and how many were made here.
+fn collect_smoke(
+    name: &str,
+    scale: &str,
+    results: &Path,
+    scenes: &Path,
+    cache: &Path,
+    threads: usize,
+) -> Result<(Vec<String>, usize, usize), String> {
+    let specs: Vec<(RunSpec, Role)> = smoke(scale, scenes)?
+        .into_iter()
+        .map(|s| (s, Role::Runs))
+        .collect();
     let mut rows = Vec::new();
     let mut lines = Vec::new();
     let mut made = 0;
@@ -103,5 +156,5 @@ pub fn collect(
     )
     .map_err(|e| e.to_string())?;
     crate::image_io::write_atomic(&dir.join("summary.json"), text.as_bytes())?;
-    Ok((lines, made))
+    Ok((lines.clone(), lines.len() - made, made))
 }
