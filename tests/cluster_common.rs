@@ -36,12 +36,22 @@ pub fn lt_binary(_dir: &Path) -> PathBuf {
             "no lt binary at {}: build it (cargo build --release --bin lt) or set LT_BIN",
             built.display()
         );
-        let dir = std::env::temp_dir().join(format!("lt-bin-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let tmp = dir.join("lt.part");
-        std::fs::copy(&built, &tmp).unwrap();
+        // One copy per build (named by size and modification time), shared by test processes.
+        let meta = built.metadata().unwrap();
+        let stamp = meta
+            .modified()
+            .unwrap()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_nanos();
+        let dir = std::env::temp_dir().join(format!("lt-test-bin-{}-{stamp}", meta.len()));
         let copy = dir.join("lt");
-        std::fs::rename(&tmp, &copy).unwrap();
+        if !copy.is_file() {
+            std::fs::create_dir_all(&dir).unwrap();
+            let tmp = dir.join(format!("lt.part-{}", std::process::id()));
+            std::fs::copy(&built, &tmp).unwrap();
+            std::fs::rename(&tmp, &copy).unwrap();
+        }
         copy
     })
     .clone()
