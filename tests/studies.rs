@@ -174,7 +174,7 @@ fn ppm_variance_falls_as_n_to_the_minus_alpha() {
         .filter(|r| r["integrator"] == "ppm" && r["quantity"] == "variance at fixed points")
     {
         let (lo, hi) = interval(&r["CI"]);
-        let predicted: f64 = r["predicted"].parse().unwrap();
+        let predicted: f64 = r["predicted at these N"].parse().unwrap();
         assert!(
             lo <= predicted && predicted <= hi,
             "ppm α = {}: variance slope {} in [{lo}, {hi}], predicted {predicted}",

@@ -107,7 +107,11 @@ impl Cache {
         let parent = dest.parent().expect("entries have a parent folder");
         std::fs::create_dir_all(parent)
             .map_err(|e| format!("cannot create the cache folder {}: {e}", parent.display()))?;
-        let tmp = parent.join(format!(".tmp-{}-{}", key.0, std::process::id()));
+        // Host and pid name the builder, so processes on different hosts of a shared
+        // filesystem never share a folder; folders this host's dead processes left are removed.
+        let host = hostname();
+        let tmp = parent.join(format!(".tmp-{}-{host}-{}", key.0, std::process::id()));
+        remove_stale(parent, &key, &host);
         let _ = std::fs::remove_dir_all(&tmp);
         std::fs::create_dir_all(&tmp)
             .map_err(|e| format!("cannot create {}: {e}", tmp.display()))?;
@@ -141,6 +145,34 @@ impl Cache {
                     dest.display()
                 ))
             }
+        }
+    }
+}
+
+fn hostname() -> String {
+    let h = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .unwrap_or_else(|| "host".into());
+    h.trim().replace(['/', '-'], "_")
+}
+
+/// Removes `.tmp-KEY-HOST-PID` folders of this host whose process is gone (killed builds).
+fn remove_stale(parent: &Path, key: &Key, host: &str) {
+    let prefix = format!(".tmp-{}-{host}-", key.0);
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        let Some(pid) = name.strip_prefix(&prefix) else {
+            continue;
+        };
+        let alive = pid
+            .parse::<u32>()
+            .is_ok_and(|p| Path::new(&format!("/proc/{p}")).exists());
+        if !alive {
+            let _ = std::fs::remove_dir_all(e.path());
         }
     }
 }
@@ -190,5 +222,18 @@ mod tests {
             .unwrap()
             .count();
         assert_eq!(leftovers, 0, "the temporary folder is removed");
+    }
+
+    #[test]
+    fn a_killed_builds_folder_is_removed_by_the_next_build() {
+        let cache = temp_cache("stale");
+        let m = serde_json::json!({"n": 2});
+        let key = key_of(&m);
+        let parent = cache.path(&key).parent().unwrap().to_path_buf();
+        // A pid that cannot be alive (above Linux's pid_max).
+        let stale = parent.join(format!(".tmp-{}-{}-4294967295", key.0, hostname()));
+        std::fs::create_dir_all(&stale).unwrap();
+        cache.get_or_build(&m, |_| Ok(())).unwrap();
+        assert!(!stale.exists());
     }
 }

@@ -91,7 +91,11 @@ impl Ctx {
 
     /// A line above the progress bar.
     pub fn say(&self, line: &str) {
-        if !self.quiet {
+        if self.quiet {
+        } else if self.bar.is_hidden() {
+            // Not a terminal (a log file, a cluster job): plain lines instead of a bar.
+            eprintln!("{line}");
+        } else {
             self.bar.println(line);
         }
     }

@@ -61,10 +61,27 @@ pub fn fixed_specs(scale: &Scale) -> Vec<RunSpec> {
 
 /// Pass counts at equal time on `scene`, from the convergence runs' timings (rendered if absent).
 fn equal_time_passes(ctx: &Ctx, scene: &PathBuf) -> Result<Vec<(&'static str, u32, f64)>, String> {
+    passes_from_timings(ctx, scene, true).map(|v| v.unwrap_or_default())
+}
+
+/// The same from the cache alone: None when a convergence run is not there yet (`render` false).
+fn passes_from_timings(
+    ctx: &Ctx,
+    scene: &PathBuf,
+    render: bool,
+) -> Result<Option<Vec<(&'static str, u32, f64)>>, String> {
     let scale = &ctx.scale;
     let mut cost = Vec::new();
     for i in integrators() {
-        let e = ctx.run(&convergence::spec(scale, scene, i, 0))?;
+        let spec = convergence::spec(scale, scene, i, 0);
+        let e = if render {
+            ctx.run(&spec)?
+        } else {
+            match ctx.runs.lookup(&spec)? {
+                Some(e) => e,
+                None => return Ok(None),
+            }
+        };
         let secs = e.seconds_at(scale.max_passes).unwrap_or(f64::NAN);
         cost.push((i, secs / scale.max_passes as f64));
     }
@@ -73,25 +90,30 @@ fn equal_time_passes(ctx: &Ctx, scene: &PathBuf) -> Result<Vec<(&'static str, u3
         .find(|(i, _)| *i == "pt")
         .map(|(_, c)| c * scale.max_passes as f64)
         .ok_or("pt is not in the registry")?;
-    Ok(cost
-        .into_iter()
-        .map(|(i, c)| {
-            let n = (budget / c).round();
-            let n = if n.is_finite() {
-                n.clamp(1.0, 1e6) as u32
-            } else {
-                1
-            };
-            (i, n, budget)
-        })
-        .collect())
+    Ok(Some(
+        cost.into_iter()
+            .map(|(i, c)| {
+                let n = (budget / c).round();
+                let n = if n.is_finite() {
+                    n.clamp(1.0, 1e6) as u32
+                } else {
+                    1
+                };
+                (i, n, budget)
+            })
+            .collect(),
+    ))
 }
 
-/// Every render of the study, timings permitting (see `fixed_specs`).
+/// Every render of the study whose pass counts the cache's timings fix (see `fixed_specs`);
+/// renders nothing itself: a scene whose convergence runs are not finished is left out.
 pub fn specs(ctx: &Ctx) -> Result<Vec<RunSpec>, String> {
     let mut v = fixed_specs(&ctx.scale);
     for scene in &ctx.scale.scenes {
-        for (i, n, _) in equal_time_passes(ctx, scene)? {
+        let Some(passes) = passes_from_timings(ctx, scene, false)? else {
+            continue;
+        };
+        for (i, n, _) in passes {
             v.push(RunSpec::new(scene, i, 1, n).resolution(film(&ctx.scale, scene).ok()));
         }
     }

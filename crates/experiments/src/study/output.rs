@@ -94,6 +94,13 @@ impl StudyOutput {
         rows: Vec<Vec<String>>,
         in_summary: bool,
     ) -> Result<(), String> {
+        if let Some(r) = rows.iter().find(|r| r.len() != columns.len()) {
+            return Err(format!(
+                "table {name}: a row has {} cells for {} columns: {r:?}",
+                r.len(),
+                columns.len()
+            ));
+        }
         let mut csv = columns.join(",");
         csv.push('\n');
         for r in &rows {

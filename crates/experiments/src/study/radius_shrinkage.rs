@@ -88,6 +88,36 @@ pub fn predicted(alpha: f64) -> (f64, f64, f64, f64) {
     (-alpha, b2, -alpha.min(2.0 * (1.0 - alpha)), alpha - 1.0)
 }
 
+/// The same rates at the pass counts measured, from Knaus & Zwicker's model with the schedule
+/// the integrator follows (s_i = (r_i / r_1)²): the mean of N passes has variance ∝
+/// (1/N²) Σ_{i≤N} 1/s_i and bias ∝ (1/N) Σ_{i≤N} s_i. Their log-log slopes over `tail` are what
+/// the measured slopes should match at this N; the asymptotic ones above are their limit.
+/// Returns (variance slope, bias² slope, MSE slope = the one of the two that dominates, taken as
+/// the asymptotic rule min(α, 2(1 − α))).
+pub fn predicted_at(integrator: &str, alpha: f64, tail: &[u32]) -> (f64, f64) {
+    let s = |i: u32| {
+        if integrator == "vcm" {
+            (i as f64).powf(alpha - 1.0)
+        } else {
+            lt_integrators::radius::global_scale2(i, alpha)
+        }
+    };
+    let xs: Vec<f64> = tail.iter().map(|&n| (n as f64).ln()).collect();
+    let (mut var, mut b2) = (Vec::new(), Vec::new());
+    for &n in tail {
+        let nf = n as f64;
+        var.push(((1..=n).map(|i| 1.0 / s(i)).sum::<f64>() / (nf * nf)).ln());
+        b2.push((2.0 * ((1..=n).map(s).sum::<f64>() / nf).ln()).max(f64::MIN));
+    }
+    let slope = |ys: &[f64]| lt_estimators::fit_line(&xs, ys, 0.95).map_or(f64::NAN, |f| f.slope);
+    (slope(&var), slope(&b2))
+}
+
+/// The snapshots a slope is fitted over: N ≥ 1/8 of the largest.
+pub fn tail_of(passes: &[u32], last: u32) -> Vec<u32> {
+    passes.iter().copied().filter(|&n| 8 * n >= last).collect()
+}
+
 /// One configuration's measured slopes over the asymptotic snapshots.
 pub struct Rates {
     pub integrator: String,
@@ -134,12 +164,7 @@ pub fn rates(
     );
     let entries = ctx.run_all(&specs)?;
     let last = scale.progressive_passes;
-    let tail: Vec<u32> = dec
-        .passes
-        .iter()
-        .copied()
-        .filter(|&n| 8 * n >= last)
-        .collect();
+    let tail = tail_of(&dec.passes, last);
     let images: Vec<Vec<_>> = tail
         .iter()
         .map(|&n| {
@@ -246,19 +271,25 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
     let mut r2_series = Vec::new();
     for integrator in INTEGRATORS {
         let mut decs = Vec::new();
+        // ppm: the variance at fixed visible points, the one K&Z describe.
+        let mut fixed_decs = Vec::new();
         for &alpha in &scale.alphas {
             let (r, dec) = rates(ctx, integrator, alpha, false)?;
             let (pv, pb, pm, pr) = predicted(alpha);
+            let tail = tail_of(&dec.passes, scale.progressive_passes);
+            let (fv, fb) = predicted_at(integrator, alpha, &tail);
+            // (quantity, asymptotic rate, rate at these N, measured)
             let mut quantities = vec![
-                ("variance", pv, r.slopes[0].clone()),
-                ("bias²", pb, r.slopes[1].clone()),
-                ("MSE", pm, r.slopes[2].clone()),
+                ("variance", pv, fv, r.slopes[0].clone()),
+                ("bias²", pb, fb, r.slopes[1].clone()),
+                ("MSE", pm, pm, r.slopes[2].clone()),
             ];
             if integrator == "ppm" {
-                let (f, _) = rates(ctx, integrator, alpha, true)?;
-                quantities.insert(1, ("variance at fixed points", pv, f.slopes[0].clone()));
+                let (f, fdec) = rates(ctx, integrator, alpha, true)?;
+                fixed_decs.push(fdec);
+                quantities.insert(1, ("variance at fixed points", pv, fv, f.slopes[0].clone()));
             }
-            for (name, pred, slope) in &quantities {
+            for (name, asymptotic, pred, slope) in &quantities {
                 let (m, ci, diff, inside) = match slope {
                     Ok(j) => (
                         num(j.estimate),
@@ -283,6 +314,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                     name.to_string(),
                     m,
                     ci,
+                    num(*asymptotic),
                     num(*pred),
                     diff,
                     inside,
@@ -297,6 +329,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                 num(r.r2_slope),
                 format!("schedule matched to {:.1e}", r.schedule_error),
                 num(pr),
+                "—".into(),
                 num(r.r2_slope - pr),
                 if r.schedule_error < SCHEDULE_TOLERANCE {
                     "yes"
@@ -329,7 +362,12 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
             ("bias²", |d| d.bias2.clone()),
             ("MSE", |d| d.mse.clone()),
         ] {
-            let series = decs
+            let source = if what == "variance" && !fixed_decs.is_empty() {
+                &fixed_decs
+            } else {
+                &decs
+            };
+            let series = source
                 .iter()
                 .map(|d| {
                     let iv = pick(d);
@@ -361,7 +399,14 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                     log_y: true,
                     series,
                 },
-                &format!("{integrator}: {what} of one run against passes for each α, jackknife intervals."),
+                &format!(
+                    "{integrator}: {what} of one run against passes for each α, jackknife intervals{}.",
+                    if what == "variance" && !fixed_decs.is_empty() {
+                        " (ppm: runs sharing their visible points, the variance at fixed points)"
+                    } else {
+                        ""
+                    }
+                ),
             )?;
         }
     }
@@ -380,9 +425,11 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
     out.table(
         "rates",
         "Measured against predicted slopes",
-        "Slope of ln(quantity) against ln N over the asymptotic tail, its jackknife interval, \
-         Knaus & Zwicker's prediction, the difference (± the interval's half-width) and whether \
-         the interval contains the prediction.",
+        "Slope of ln(quantity) against ln N over the tail, its jackknife interval, Knaus & \
+         Zwicker's asymptotic rate, the rate their model gives at these N with the integrator's \
+         own radius schedule (variance ∝ Σ 1/r_i² / N², bias ∝ Σ r_i² / N; for MSE the \
+         asymptotic rule), the difference of the measured slope from the latter (± the \
+         interval's half-width) and whether the interval contains it.",
         &[
             "integrator",
             "α",
@@ -390,6 +437,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
             "measured",
             "CI",
             "predicted",
+            "predicted at these N",
             "difference",
             "inside",
         ],
