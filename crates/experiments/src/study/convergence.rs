@@ -255,11 +255,12 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                 .map(|(&t, i)| (t, i.estimate))
                 .collect();
             let reach = match (time_to_mse(&curve, target), c.slope(true, conf)) {
-                (Some(s), _) => format!("{s:.3}"),
+                (Some(s), _) => num(s),
                 // Outside the measured range: along the fitted power law MSE ∝ t^slope, for
-                // unbiased estimators, whose law holds at every N.
-                (None, Ok(j)) if !c.consistent && j.estimate < 0.0 => {
-                    format!("≈{:.3}", t * (target / m).powf(1.0 / j.estimate))
+                // unbiased estimators, whose law holds at every N, and only when the slope is
+                // told from 0 (an estimator that misses some light has a flat curve).
+                (None, Ok(j)) if !c.consistent && j.interval.hi < 0.0 => {
+                    format!("≈{}", num(t * (target / m).powf(1.0 / j.estimate)))
                 }
                 (None, _) if m > target => "not reached".into(),
                 (None, _) => "below it at N = 1".into(),
