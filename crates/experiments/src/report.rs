@@ -20,14 +20,9 @@ use std::path::{Path, PathBuf};
 
 pub use html::{images_in_page, SELFCHECK_ID};
 
-/// The studies in the order the page shows them; any other study folder follows, by name.
-pub const ORDER: [&str; 5] = [
-    "convergence",
-    "unbiased-vs-consistent",
-    "radius-shrinkage",
-    "equal-time",
-    "per-length",
-];
+/// The studies in the order the page shows them (the order `lt study all` runs them); any other
+/// study folder follows, by name.
+pub const ORDER: [&str; 5] = crate::study::STUDIES;
 
 /// The page's file name inside the results folder.
 pub const INDEX_FILE: &str = "index.html";

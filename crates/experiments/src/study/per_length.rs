@@ -104,10 +104,21 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
             let mut v = v.clone();
             v.sort_by(|a, b| a.1.total_cmp(&b.1));
             if let (Some(best), Some(second)) = (v.first(), v.get(1)) {
+                // Equal errors (a deterministic image, or the same camera samples) are a tie.
+                let tied: Vec<&str> = v
+                    .iter()
+                    .filter(|(_, m)| *m == best.1)
+                    .map(|(i, _)| i.as_str())
+                    .collect();
+                let label = if tied.len() > 1 {
+                    format!("tie: {}", tied.join(", "))
+                } else {
+                    best.0.clone()
+                };
                 winners.push(vec![
                     name.clone(),
                     (d + 1).to_string(),
-                    best.0.clone(),
+                    label,
                     num(best.1),
                     second.0.clone(),
                     num(second.1),
