@@ -6,11 +6,11 @@ use super::ray::Ray;
 use super::sphere::intersect_sphere;
 use super::triangle::{intersect_triangle, ShearedRay};
 use crate::math::Vec3;
-use glam::Vec3A;
+use glam::{UVec2, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::builder::build_cwbvh;
 use obvhs::cwbvh::CwBvh;
-use obvhs::ray::RayHit;
+use obvhs::faststack::StackStack;
 use obvhs::{Boundable, BvhBuildParams};
 
 /// A primitive in the BVH. `shape` indexes the scene's shapes; `index` is the triangle within its mesh.
@@ -92,6 +92,56 @@ pub struct Accel {
     bounds: (Vec3, Vec3),
     /// Whether any primitive is a triangle: only triangles need the per-ray shear.
     has_triangles: bool,
+    /// Whether the tree is shallow enough for the small traversal stack (`SMALL_STACK`).
+    shallow: bool,
+}
+
+/// obvhs's own traversal state zeroes a 32-entry stack (256 bytes, a `memset` call) for every ray,
+/// which costs about as much as traversing a tree of a few nodes. Scenes whose tree is at most
+/// `SMALL_STACK - 2` levels deep (every Cornell-box variant) traverse with an 8-entry stack
+/// instead; deeper trees keep obvhs's 32. The traversal itself is obvhs's `traverse!` macro, so
+/// the nodes and primitives visited, their order and every result are the same either way.
+const SMALL_STACK: usize = 8;
+const FULL_STACK: usize = 32;
+
+/// The fields obvhs's `traverse!` macro reads and writes, with a stack of `N` entries (it holds
+/// `N − 1`: a push onto a full `StackStack` overwrites its last entry).
+struct Traversal<const N: usize> {
+    stack: StackStack<UVec2, N>,
+    current_group: UVec2,
+    primitive_group: UVec2,
+    oct_inv4: u32,
+    primitive_id: u32,
+    hitmask: u32,
+}
+
+impl<const N: usize> Traversal<N> {
+    /// Starts at the root (a tree with nodes), children visited in the order `d`'s octant gives.
+    #[inline(always)]
+    fn new(d: Vec3) -> Self {
+        // The octant code obvhs's node test expects: per axis, one bit in every byte when that
+        // component is non-negative (x 4, y 2, z 1).
+        let bit = |c: f32, b: u32| if c < 0.0 { 0 } else { b * 0x0101_0101 };
+        Traversal {
+            stack: StackStack::default(),
+            current_group: UVec2::new(0, 0x8000_0000),
+            primitive_group: UVec2::ZERO,
+            oct_inv4: bit(d.x, 4) | bit(d.y, 2) | bit(d.z, 1),
+            primitive_id: 0,
+            hitmask: 0,
+        }
+    }
+}
+
+/// Levels of inner nodes below and including `node` (a leaf-only node counts 1). The inner
+/// children of a node are stored contiguously from `child_base_idx`, one per set `imask` bit.
+fn tree_depth(bvh: &CwBvh, node: usize) -> usize {
+    let n = &bvh.nodes[node];
+    let base = n.child_base_idx as usize;
+    1 + (0..n.imask.count_ones() as usize)
+        .map(|k| tree_depth(bvh, base + k))
+        .max()
+        .unwrap_or(0)
 }
 
 impl Accel {
@@ -102,6 +152,7 @@ impl Accel {
                 prims,
                 bounds: (Vec3::ZERO, Vec3::ZERO),
                 has_triangles: false,
+                shallow: true,
             };
         }
         let mut build_time = Default::default();
@@ -117,8 +168,10 @@ impl Accel {
         let has_triangles = prims
             .iter()
             .any(|p| matches!(p, Primitive::Triangle { .. }));
+        let shallow = bvh.nodes.is_empty() || tree_depth(&bvh, 0) + 2 <= SMALL_STACK;
         Accel {
             has_triangles,
+            shallow,
             bvh,
             prims: ordered,
             bounds: (total.min.into(), total.max.into()),
@@ -165,19 +218,50 @@ impl Accel {
         if self.prims.is_empty() {
             return None;
         }
-        let mut hit = RayHit::none();
+        if self.shallow {
+            self.closest::<SMALL_STACK>(ray)
+        } else {
+            self.closest::<FULL_STACK>(ray)
+        }
+    }
+
+    /// `intersect` with a traversal stack of `N` entries: obvhs's `ray_traverse`, on our state.
+    #[inline(always)]
+    fn closest<const N: usize>(&self, ray: &Ray) -> Option<PrimHit> {
         let prims = &self.prims;
         let (o, d) = (ray.o, ray.d);
         let sheared = self.sheared(o, d);
-        let found = self
-            .bvh
-            .ray_traverse(Self::obvhs_ray(ray), &mut hit, |r, id| {
+        let mut traverse_ray = Self::obvhs_ray(ray);
+        let t_limit = traverse_ray.tmax;
+        let mut best = PrimHit {
+            t: f32::INFINITY,
+            prim: u32::MAX,
+        };
+        let mut state = Traversal::<N>::new(d);
+        let mut node;
+        obvhs::traverse!(
+            self.bvh,
+            node,
+            state,
+            node.intersect_ray(&traverse_ray, state.oct_inv4),
+            {
+                let id = state.primitive_id;
                 // Tested from the real origin; the result is reported in traversal-ray distance.
-                prims[id].intersect(&sheared, o, d, r.tmax - TRAVERSAL_BACKOFF) + TRAVERSAL_BACKOFF
-            });
-        found.then(|| PrimHit {
-            t: hit.t - TRAVERSAL_BACKOFF,
-            prim: hit.primitive_id,
+                let t = prims[id as usize].intersect(
+                    &sheared,
+                    o,
+                    d,
+                    traverse_ray.tmax - TRAVERSAL_BACKOFF,
+                ) + TRAVERSAL_BACKOFF;
+                if t < traverse_ray.tmax {
+                    best = PrimHit { t, prim: id };
+                    traverse_ray.tmax = t;
+                }
+            }
+        );
+        (best.t < t_limit).then_some(PrimHit {
+            t: best.t - TRAVERSAL_BACKOFF,
+            prim: best.prim,
         })
     }
 
@@ -187,12 +271,40 @@ impl Accel {
         if self.prims.is_empty() {
             return false;
         }
+        if self.shallow {
+            self.any_hit::<SMALL_STACK>(ray)
+        } else {
+            self.any_hit::<FULL_STACK>(ray)
+        }
+    }
+
+    /// `occluded` with a traversal stack of `N` entries: obvhs's `ray_traverse_miss`, negated.
+    #[inline(always)]
+    fn any_hit<const N: usize>(&self, ray: &Ray) -> bool {
         let prims = &self.prims;
         let (o, d, t_max) = (ray.o, ray.d, ray.t_max);
         let sheared = self.sheared(o, d);
-        !self.bvh.ray_traverse_miss(Self::obvhs_ray(ray), |_, id| {
-            prims[id].intersect(&sheared, o, d, t_max) + TRAVERSAL_BACKOFF
-        })
+        let traverse_ray = Self::obvhs_ray(ray);
+        let mut state = Traversal::<N>::new(d);
+        let mut node;
+        let mut hit = false;
+        'outer: {
+            obvhs::traverse!(
+                self.bvh,
+                node,
+                state,
+                node.intersect_ray(&traverse_ray, state.oct_inv4),
+                {
+                    let t = prims[state.primitive_id as usize].intersect(&sheared, o, d, t_max)
+                        + TRAVERSAL_BACKOFF;
+                    if t < traverse_ray.tmax {
+                        hit = true;
+                        break 'outer;
+                    }
+                }
+            );
+        }
+        hit
     }
 }
 
@@ -282,6 +394,46 @@ mod tests {
                 ),
             }
             assert_eq!(accel.occluded(&ray), expected.is_finite());
+        }
+    }
+
+    /// The small traversal stack and obvhs's full-size one visit the same nodes in the same
+    /// order, so closest hits and occlusion agree bit for bit.
+    #[test]
+    fn small_and_full_traversal_stacks_agree() {
+        let mut s = Sampler::new(2, 0, 0);
+        let prims: Vec<Primitive> = (0..300u32)
+            .map(|i| {
+                let c = (s.next_2d().extend(s.next_f32()) - 0.5) * 10.0;
+                let e1 = sample_uniform_sphere(s.next_2d());
+                let e2 = sample_uniform_sphere(s.next_2d());
+                Primitive::Quad {
+                    q: crate::geometry::quad::Parallelogram::new(c, e1, e2),
+                    shape: i,
+                    index: 0,
+                }
+            })
+            .collect();
+        let accel = Accel::build(prims);
+        assert!(accel.shallow, "depth {}", tree_depth(&accel.bvh, 0));
+        for _ in 0..4000 {
+            let o = (s.next_2d().extend(s.next_f32()) - 0.5) * 12.0;
+            let mut ray = Ray::new(o, sample_uniform_sphere(s.next_2d()));
+            if s.next_f32() < 0.5 {
+                ray.t_max = 4.0 * s.next_f32();
+            }
+            let (a, b) = (
+                accel.closest::<SMALL_STACK>(&ray),
+                accel.closest::<FULL_STACK>(&ray),
+            );
+            assert_eq!(
+                a.map(|h| (h.t.to_bits(), h.prim)),
+                b.map(|h| (h.t.to_bits(), h.prim))
+            );
+            assert_eq!(
+                accel.any_hit::<SMALL_STACK>(&ray),
+                accel.any_hit::<FULL_STACK>(&ray)
+            );
         }
     }
 
