@@ -16,16 +16,23 @@ pub struct Parallelogram {
     pub e2: Vec3,
     /// (e1 × e2) / |e1 × e2|²: the plane normal scaled so that the dual basis below is exact.
     n: Vec3,
+    /// The dual basis e2 × n, n × e1 (see `dual`), computed once here rather than per ray test:
+    /// the same operations on the same values, so every result keeps its bits.
+    a1: Vec3,
+    a2: Vec3,
 }
 
 impl Parallelogram {
     pub fn new(p0: Vec3, e1: Vec3, e2: Vec3) -> Parallelogram {
         let n = e1.cross(e2);
+        let n = n / n.length_squared();
         Parallelogram {
             p0,
             e1,
             e2,
-            n: n / n.length_squared(),
+            n,
+            a1: e2.cross(n),
+            a2: n.cross(e1),
         }
     }
 
@@ -46,7 +53,7 @@ impl Parallelogram {
     /// Dual basis: (u, v) = (q · a1, q · a2) for q = p − p0 in the plane.
     #[inline]
     fn dual(&self) -> (Vec3, Vec3) {
-        (self.e2.cross(self.n), self.n.cross(self.e1))
+        (self.a1, self.a2)
     }
 
     /// Parameters (u, v) of a point in the parallelogram's plane.
@@ -174,6 +181,25 @@ mod tests {
             }
         }
         assert!(hits > 5000, "{hits}");
+    }
+
+    #[test]
+    fn stored_dual_basis_is_the_computed_one_bit_for_bit() {
+        let mut s = Sampler::new(8, 0, 0);
+        for _ in 0..1000 {
+            let e1 = sample_uniform_sphere(s.next_2d()) * (10.0 * s.next_f32() + 1e-3);
+            let e2 = sample_uniform_sphere(s.next_2d()) * (10.0 * s.next_f32() + 1e-3);
+            let q = Parallelogram::new(Vec3::ZERO, e1, e2);
+            let (a1, a2) = q.dual();
+            assert_eq!(
+                a1.to_array().map(f32::to_bits),
+                e2.cross(q.n).to_array().map(f32::to_bits)
+            );
+            assert_eq!(
+                a2.to_array().map(f32::to_bits),
+                q.n.cross(e1).to_array().map(f32::to_bits)
+            );
+        }
     }
 
     #[test]
