@@ -43,8 +43,9 @@ impl Primitive {
         }
     }
 
-    /// Hit distance in (0, t_max) from the ray's true origin, or +∞.
-    #[inline]
+    /// Hit distance in (0, t_max) from the ray's true origin, or +∞. Always inlined into the
+    /// traversal loops: as a call it costs a few per cent of a path tracer's time.
+    #[inline(always)]
     pub fn intersect(&self, r: &ShearedRay, o: Vec3, d: Vec3, t_max: f32) -> f32 {
         match self {
             Primitive::Triangle { p, .. } => intersect_triangle(r, t_max, p).0,
