@@ -201,3 +201,47 @@ pub fn entry_times(plan: &Path) -> Vec<Option<std::time::SystemTime>> {
         })
         .collect()
 }
+
+/// The one-process render a collected plan must equal: `lt render SCENE --spp N --threads 2`
+/// into `out`. Returns its wall seconds.
+pub fn one_process_render(lt: &Path, scene: &Path, spp: u32, out: &Path) -> f64 {
+    let t = std::time::Instant::now();
+    let n = spp.to_string();
+    let args = [
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        &n,
+        "--threads",
+        "2",
+        "--quiet",
+        "-o",
+    ];
+    let mut all: Vec<&str> = args.to_vec();
+    all.push(out.to_str().unwrap());
+    lt_ok(lt, &all);
+    t.elapsed().as_secs_f64()
+}
+
+/// `lt plan render SCENE --spp N --shards K --threads 1 -o PLAN --cache CACHE`.
+pub fn plan_render(lt: &Path, scene: &Path, spp: u32, shards: u32, plan: &Path, cache: &Path) {
+    let (n, k) = (spp.to_string(), shards.to_string());
+    lt_ok(
+        lt,
+        &[
+            "plan",
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            &n,
+            "--shards",
+            &k,
+            "--threads",
+            "1",
+            "-o",
+            plan.to_str().unwrap(),
+            "--cache",
+            cache.to_str().unwrap(),
+        ],
+    );
+}

@@ -14,44 +14,12 @@ fn local_plan_collects_the_one_process_render_and_redoes_only_what_is_lost() {
     let dir = scratch("cluster-local");
     let lt = lt_binary(&dir);
     let scene = small_scene(&dir, 24, 16);
-    let s = scene.to_str().unwrap();
     let reference = dir.join("reference.exr");
-    let r = reference.to_str().unwrap();
-    lt_ok(
-        &lt,
-        &[
-            "render",
-            s,
-            "--spp",
-            "60",
-            "--threads",
-            "2",
-            "--quiet",
-            "-o",
-            r,
-        ],
-    );
+    one_process_render(&lt, &scene, 60, &reference);
     let plan = dir.join("plan");
     let cache = dir.join("cache");
-    let (p, c) = (plan.to_str().unwrap(), cache.to_str().unwrap());
-    lt_ok(
-        &lt,
-        &[
-            "plan",
-            "render",
-            s,
-            "--spp",
-            "60",
-            "--shards",
-            "3",
-            "--threads",
-            "1",
-            "-o",
-            p,
-            "--cache",
-            c,
-        ],
-    );
+    let p = plan.to_str().unwrap();
+    plan_render(&lt, &scene, 60, 3, &plan, &cache);
     assert_eq!(read(&plan.join("commands.txt")).lines().count(), 3);
 
     let e = lt_err(&lt, &["collect", p]);

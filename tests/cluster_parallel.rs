@@ -36,46 +36,12 @@ fn a_plan_on_gnu_parallel_with_a_shard_killed_midway_equals_the_local_render() {
     let dir = scratch("cluster-parallel");
     let lt = lt_binary(&dir);
     let scene = small_scene(&dir, 32, 32);
-    let s = scene.to_str().unwrap();
-    let t = Instant::now();
     let reference = dir.join("reference.exr");
-    let r = reference.to_str().unwrap();
-    lt_ok(
-        &lt,
-        &[
-            "render",
-            s,
-            "--spp",
-            "2000",
-            "--threads",
-            "2",
-            "--quiet",
-            "-o",
-            r,
-        ],
-    );
-    let t_local = t.elapsed().as_secs_f64();
+    let t_local = one_process_render(&lt, &scene, 2000, &reference);
     let plan = dir.join("plan");
     let p = plan.to_str().unwrap();
     let cache = dir.join("cache");
-    lt_ok(
-        &lt,
-        &[
-            "plan",
-            "render",
-            s,
-            "--spp",
-            "2000",
-            "--shards",
-            "4",
-            "--threads",
-            "1",
-            "-o",
-            p,
-            "--cache",
-            cache.to_str().unwrap(),
-        ],
-    );
+    plan_render(&lt, &scene, 2000, 4, &plan, &cache);
     let printed = lt_ok(&lt, &["submit", p, "--parallel", "--print"]);
     assert!(
         printed.contains("--joblog") && printed.contains("--resume-failed"),
