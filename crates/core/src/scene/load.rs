@@ -107,6 +107,30 @@ impl Ctx<'_> {
         }
     }
 
+    /// The bytes of the mesh file `file` names (relative to the scene file), with its path; a
+    /// missing or unreadable file is an error at the scene's `file` key.
+    pub fn read_mesh(
+        &self,
+        file: &super::format::S<String>,
+    ) -> Result<(PathBuf, Vec<u8>), SceneError> {
+        let path = self.base_dir.join(file.get_ref());
+        match std::fs::read(&path) {
+            Ok(b) => Ok((path, b)),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(self.at(
+                file.span(),
+                format!(
+                    "mesh file `{}` not found (looked for {})",
+                    file.get_ref(),
+                    path.display()
+                ),
+            )),
+            Err(e) => Err(self.at(
+                file.span(),
+                format!("cannot read mesh file {}: {e}", path.display()),
+            )),
+        }
+    }
+
     /// An error about the scene as a whole.
     pub fn whole(&self, message: impl Into<String>) -> SceneError {
         SceneError {

@@ -10,21 +10,14 @@ use crate::math::Vec3;
 
 /// Loads `file` (relative to the scene file). Errors point at the scene's `file` key.
 pub fn load_obj(ctx: &Ctx, file: &S<String>) -> Result<TriangleMesh, SceneError> {
-    let path = ctx.base_dir.join(file.get_ref());
+    let (path, bytes) = ctx.read_mesh(file)?;
     let shown = path.display();
-    let text = match std::fs::read_to_string(&path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(ctx.at(
-                file.span(),
-                format!(
-                    "mesh file `{}` not found (looked for {shown})",
-                    file.get_ref()
-                ),
-            ))
-        }
-        Err(e) => return Err(ctx.at(file.span(), format!("cannot read mesh file {shown}: {e}"))),
-    };
+    let text = String::from_utf8(bytes).map_err(|e| {
+        ctx.at(
+            file.span(),
+            format!("cannot read mesh file {shown}: not UTF-8 text: {e}"),
+        )
+    })?;
     let bad = |msg: String| ctx.at(file.span(), format!("malformed OBJ file {shown}: {msg}"));
     if let Some((line, what)) = precheck(&text) {
         return Err(bad(format!("line {line}: {what}")));

@@ -10,21 +10,8 @@ use ply_rs_bw::ply::{DefaultElement, Property};
 use toml::Spanned;
 
 pub(super) fn load_ply(ctx: &Ctx, file: &Spanned<String>) -> Result<TriangleMesh, SceneError> {
-    let path = ctx.base_dir.join(file.get_ref());
+    let (path, bytes) = ctx.read_mesh(file)?;
     let shown = path.display();
-    let bytes = match std::fs::read(&path) {
-        Ok(b) => b,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(ctx.at(
-                file.span(),
-                format!(
-                    "mesh file `{}` not found (looked for {shown})",
-                    file.get_ref()
-                ),
-            ))
-        }
-        Err(e) => return Err(ctx.at(file.span(), format!("cannot read mesh file {shown}: {e}"))),
-    };
     let bad = |msg: String| ctx.at(file.span(), format!("malformed PLY file {shown}: {msg}"));
     let parsed = std::panic::catch_unwind(|| {
         Parser::<DefaultElement>::new().read_ply(&mut bytes.as_slice())
