@@ -93,7 +93,7 @@ pub fn write_outputs(out: &Path, mean: &Image, std_error: Option<&Image>) -> Res
 }
 
 /// The mean over pixels and channels of a standard-error image (NaN-free pixels only).
-fn mean_of(img: &Image) -> f64 {
+pub fn mean_of(img: &Image) -> f64 {
     let (sum, n) = img
         .data
         .iter()

@@ -245,17 +245,6 @@ impl Executor {
     }
 }
 
-fn mean_of(img: &Image) -> f64 {
-    let v: Vec<f64> = img
-        .data
-        .iter()
-        .flatten()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
 /// Renders `spec` and writes its entry's files into `dir`.
 fn render_into(spec: &RunSpec, scene: &Scene, threads: usize, dir: &Path) -> Result<(), String> {
     if spec.passes == 0 || spec.runs == 0 {
@@ -320,7 +309,7 @@ fn render_into(spec: &RunSpec, scene: &Scene, threads: usize, dir: &Path) -> Res
         seconds,
         passes_done: result.runs.iter().map(|r| r.passes).sum(),
         invalid_samples: result.invalid_samples,
-        mean_std_error: se.as_ref().map(mean_of),
+        mean_std_error: se.as_ref().map(crate::render_cmd::mean_of),
         std_error_source: source.into(),
         radius_scale: log.map(|l| l.radius_scale.clone()).unwrap_or_default(),
         mean_radius: log.map(|l| l.mean_radius.clone()).unwrap_or_default(),

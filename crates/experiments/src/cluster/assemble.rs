@@ -12,17 +12,6 @@ use crate::image_io::{write_atomic, write_exr};
 use crate::runs::RunRecord;
 use lt_estimators::running::RunningImage;
 
-fn mean_of(img: &lt_estimators::Image) -> f64 {
-    let v: Vec<f64> = img
-        .data
-        .iter()
-        .flatten()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
 /// Builds the entry of `a` from its finished parts; `Ok(false)` if the entry already exists.
 pub fn assemble(plan: &Plan, a: &Assembly) -> Result<bool, String> {
     let cache = Cache::new(&a.cache);
@@ -101,7 +90,7 @@ pub fn assemble(plan: &Plan, a: &Assembly) -> Result<bool, String> {
             seconds,
             passes_done: spec.passes,
             invalid_samples: merged.invalid_samples,
-            mean_std_error: se.as_ref().map(mean_of),
+            mean_std_error: se.as_ref().map(crate::render_cmd::mean_of),
             std_error_source: if se.is_some() {
                 "spread of passes".into()
             } else {

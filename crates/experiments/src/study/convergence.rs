@@ -9,12 +9,11 @@
 //! 1/N (slope −1); a consistent one's falls more slowly, and a fixed-radius one's flattens at
 //! its bias².
 
-use super::metrics::{log_log_slope, mean_over, mse, rel_mse};
+use super::metrics::{log_log_slope, mean_of_runs, mean_over, mse, rel_mse};
 use super::output::{film, num, pct, stem, StudyOutput};
 use super::{Ctx, Scale};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
-use lt_estimators::bias_variance::mean_interval;
 use lt_estimators::{jackknife, time_to_mse, Interval};
 use std::path::PathBuf;
 
@@ -70,17 +69,10 @@ impl Curves {
         self.mse.first().map_or(0, |v| v.len())
     }
 
-    fn interval(&self, values: &[f64], confidence: f64) -> Interval {
-        let k = values.len() as f64;
-        let m = values.iter().sum::<f64>() / k;
-        let s2 = values.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (k - 1.0);
-        mean_interval(m, (s2 / k).sqrt(), k - 1.0, confidence)
-    }
-
     pub fn mean_mse(&self, confidence: f64) -> Vec<Interval> {
         self.mse
             .iter()
-            .map(|v| self.interval(v, confidence))
+            .map(|v| mean_of_runs(v, confidence))
             .collect()
     }
 

@@ -35,6 +35,13 @@ pub fn rel_mse(img: &Image, r: &Reference) -> f64 {
     s / (3 * img.data.len()).max(1) as f64
 }
 
+/// The mean of one value per independent run, with its t interval (K − 1 dof).
+pub fn mean_of_runs(values: &[f64], confidence: f64) -> lt_estimators::Interval {
+    let s = lt_estimators::RunningStat::from_slice(values);
+    let dof = (s.count() as f64 - 1.0).max(1.0);
+    lt_estimators::bias_variance::mean_interval(s.mean(), s.std_error(), dof, confidence)
+}
+
 /// Mean over `kept` runs of a per-run value.
 pub fn mean_over(kept: &[usize], values: &[f64]) -> f64 {
     kept.iter().map(|&i| values[i]).sum::<f64>() / kept.len().max(1) as f64

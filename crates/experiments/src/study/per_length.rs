@@ -8,12 +8,11 @@
 //! a minimum depth, and the difference of two independent renders would add both their noises.
 
 use super::convergence::integrators;
-use super::metrics::mse;
+use super::metrics::{mean_of_runs, mse};
 use super::output::{film, num, pct, stem, StudyOutput};
 use super::{Ctx, Scale};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
-use lt_estimators::bias_variance::mean_interval;
 use std::path::Path;
 
 pub const NAME: &str = "per-length";
@@ -77,10 +76,8 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                     .iter()
                     .map(|e| e.image().map(|img| mse(&img, &reference)))
                     .collect::<Result<_, _>>()?;
-                let n = errs.len() as f64;
-                let m = errs.iter().sum::<f64>() / n;
-                let s2 = errs.iter().map(|e| (e - m).powi(2)).sum::<f64>() / (n - 1.0);
-                let ci = mean_interval(m, (s2 / n).sqrt(), n - 1.0, scale.confidence);
+                let ci = mean_of_runs(&errs, scale.confidence);
+                let m = ci.estimate;
                 rows.push(vec![
                     name.clone(),
                     i.to_string(),
