@@ -127,9 +127,10 @@ fn unbiased_estimators_converge_at_slope_minus_one() {
             r["integrator"],
             r["slope vs N"]
         );
+        // Containing −1 means something only if the interval also tells the slope from 0.
         assert!(
-            hi - lo < 2.0,
-            "{}: interval [{lo}, {hi}] too wide to mean anything",
+            hi < 0.0,
+            "{}: interval [{lo}, {hi}] does not tell convergence from none",
             r["integrator"]
         );
         checked += 1;
