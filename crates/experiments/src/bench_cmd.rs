@@ -4,6 +4,7 @@ use crate::bench::{
     closest_hit_rate, incoherent_rays, integrator_rate, peak_memory_mib, shadow_rate,
 };
 use clap::Args;
+use lt_core::geometry::{set_ray_core, RayCore};
 use lt_core::scene::load_scene;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -24,9 +25,18 @@ pub struct BenchArgs {
     pub threads: usize,
     #[arg(long, default_value_t = 8)]
     pub max_depth: u32,
+    /// Ray cores to measure side by side (auto, bvh, flat, flat-scalar); each scene is loaded
+    /// once per core. Default: the global --ray-core.
+    #[arg(long, value_delimiter = ',', value_parser = parse_core)]
+    pub ray_cores: Vec<RayCore>,
     /// Write the table here as well as printing it.
     #[arg(long, short)]
     pub output: Option<PathBuf>,
+}
+
+fn parse_core(s: &str) -> Result<RayCore, String> {
+    RayCore::from_name(s)
+        .ok_or_else(|| format!("unknown ray core '{s}' (auto, bvh, flat, flat-scalar)"))
 }
 
 pub fn run(args: &BenchArgs) -> Result<String, String> {
@@ -49,10 +59,23 @@ pub fn run(args: &BenchArgs) -> Result<String, String> {
         args.max_depth
     )
     .unwrap();
-    writeln!(out, "| scene | primitives | closest hit Mrays/s (1 thread) | hit fraction | shadow Mrays/s (1 thread) |").unwrap();
-    writeln!(out, "|---|---:|---:|---:|---:|").unwrap();
+    writeln!(out, "| scene | ray core | primitives | closest hit Mrays/s (1 thread) | hit fraction | shadow Mrays/s (1 thread) |").unwrap();
+    writeln!(out, "|---|---|---:|---:|---:|---:|").unwrap();
     let mut scenes = Vec::new();
-    for path in &args.scenes {
+    // Each scene once per core; `None` keeps the global choice.
+    let cores: Vec<Option<RayCore>> = if args.ray_cores.is_empty() {
+        vec![None]
+    } else {
+        args.ray_cores.iter().copied().map(Some).collect()
+    };
+    for (path, core) in args
+        .scenes
+        .iter()
+        .flat_map(|p| cores.iter().map(move |c| (p, c)))
+    {
+        if let Some(core) = core {
+            set_ray_core(*core);
+        }
         let scene = load_scene(path).map_err(|e| e.to_string())?;
         let rays = incoherent_rays(&scene, 200_000, 1);
         let (rate, hit) = closest_hit_rate(&scene, &rays, 5);
@@ -64,7 +87,8 @@ pub fn run(args: &BenchArgs) -> Result<String, String> {
             .to_string();
         writeln!(
             out,
-            "| {name} | {} | {:.2} | {:.2} | {:.2} |",
+            "| {name} | {} | {} | {:.2} | {:.2} | {:.2} |",
+            scene.ray_core(),
             scene.primitive_count(),
             rate / 1e6,
             hit,
@@ -73,14 +97,15 @@ pub fn run(args: &BenchArgs) -> Result<String, String> {
         .unwrap();
         scenes.push((name, scene, rate));
     }
-    writeln!(out, "\n| scene | integrator | resolution | spp/s | Msamples/s | Mrays/s (all threads) | rays/s per thread vs raw closest hit | closest + shadow rays per sample |").unwrap();
-    writeln!(out, "|---|---|---|---:|---:|---:|---:|---|").unwrap();
+    writeln!(out, "\n| scene | ray core | integrator | resolution | spp/s | Msamples/s | Mrays/s (all threads) | rays/s per thread vs raw closest hit | closest + shadow rays per sample |").unwrap();
+    writeln!(out, "|---|---|---|---|---:|---:|---:|---:|---|").unwrap();
     for (name, scene, raw) in &scenes {
         for integ in &args.integrators {
             let r = integrator_rate(scene, integ, Some(args.max_depth), args.passes, threads)?;
             writeln!(
                 out,
-                "| {name} | {integ} | {}×{} | {:.1} | {:.2} | {:.2} | {:.0} % | {:.2} + {:.2} |",
+                "| {name} | {} | {integ} | {}×{} | {:.1} | {:.2} | {:.2} | {:.0} % | {:.2} + {:.2} |",
+                scene.ray_core(),
                 scene.camera.width,
                 scene.camera.height,
                 r.spp_per_second,

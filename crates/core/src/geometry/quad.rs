@@ -130,6 +130,123 @@ impl Parallelogram {
     }
 }
 
+/// Parallelograms in structure-of-arrays form, for the flat ray core (`flat.rs`), in chunks of
+/// `CHUNK` whose tests run in one fixed-length loop the compiler vectorises. Lane for lane it is
+/// `Parallelogram::intersect`'s distance bit for bit: the same operations in the same order, with
+/// the absolute values the test reads stored (which changes no bits) and no early outs.
+#[derive(Clone, Debug, Default)]
+pub struct QuadSoa {
+    /// Per chunk, p0, |p0|, n, |n|, a1, |a1|, a2, |a2| component by component: `[k][i]` is
+    /// component k % 3 of vector k / 3 of the chunk's parallelogram i.
+    chunks: Vec<[[f32; CHUNK]; 24]>,
+}
+
+/// Primitives per vectorised test: AVX-512's 16 f32 lanes, two AVX2 vectors, four SSE ones.
+pub const CHUNK: usize = 16;
+
+impl QuadSoa {
+    /// The parallelograms, the last chunk padded with NaN corners, which never hit (t is NaN).
+    pub fn new(quads: &[Parallelogram]) -> QuadSoa {
+        let chunks = quads
+            .chunks(CHUNK)
+            .map(|chunk| {
+                let mut f = [[f32::NAN; CHUNK]; 24];
+                for (i, q) in chunk.iter().enumerate() {
+                    let vectors = [
+                        q.p0,
+                        q.p0.abs(),
+                        q.n,
+                        q.n.abs(),
+                        q.a1,
+                        q.a1.abs(),
+                        q.a2,
+                        q.a2.abs(),
+                    ];
+                    for (k, v) in vectors.iter().enumerate() {
+                        for c in 0..3 {
+                            f[3 * k + c][i] = v[c];
+                        }
+                    }
+                }
+                f
+            })
+            .collect();
+        QuadSoa { chunks }
+    }
+
+    /// Parallelograms held, padding included (a multiple of `CHUNK`).
+    pub fn padded_len(&self) -> usize {
+        self.chunks.len() * CHUNK
+    }
+
+    /// Per parallelogram i in `start..start + W` (`start` a multiple of `W`, `W` dividing `CHUNK`),
+    /// `Parallelogram::intersect(o, d, t_max).0`. Always inlined, so it vectorises `W` wide with
+    /// the target features of the caller.
+    #[inline(always)]
+    pub fn distances<const W: usize>(
+        &self,
+        start: usize,
+        o: Vec3,
+        o_abs: Vec3,
+        d: Vec3,
+        t_max: f32,
+    ) -> [f32; W] {
+        let (f, lane0) = (&self.chunks[start / CHUNK], start % CHUNK);
+        let v = |k: usize, i: usize| {
+            Vec3::new(f[k][lane0 + i], f[k + 1][lane0 + i], f[k + 2][lane0 + i])
+        };
+        let mut out = [0.0; W];
+        for (i, t) in out.iter_mut().enumerate() {
+            *t = distance(
+                [
+                    v(0, i),
+                    v(3, i),
+                    v(6, i),
+                    v(9, i),
+                    v(12, i),
+                    v(15, i),
+                    v(18, i),
+                    v(21, i),
+                ],
+                o,
+                o_abs,
+                d,
+                t_max,
+            );
+        }
+        out
+    }
+}
+
+/// `Parallelogram::intersect`'s distance without branches, from [p0, |p0|, n, |n|, a1, |a1|, a2,
+/// |a2|]: every comparison is evaluated and combined with `&`/`|`, so a loop over many
+/// parallelograms vectorises. NaN compares false here exactly as in the branching version.
+#[inline(always)]
+fn distance(q: [Vec3; 8], o: Vec3, o_abs: Vec3, d: Vec3, t_max: f32) -> f32 {
+    let [p0, p0_abs, n, n_abs, a1, a1_abs, a2, a2_abs] = q;
+    let denom = d.dot(n);
+    let to = p0 - o;
+    let num = to.dot(n);
+    let t = num / denom;
+    let in_range = (t > 0.0) & (t < t_max);
+    let num_err = gamma(3) * (p0_abs + o_abs).dot(n_abs);
+    let leaves_plane = num.abs() <= num_err;
+    // `crossing`, expanded.
+    let dt = d * t;
+    let q = dt - to;
+    let q_err = (to.abs() + dt.abs()) * gamma(4);
+    let (u, v) = (q.dot(a1), q.dot(a2));
+    let q_abs = q.abs();
+    let eu = q_err.dot(a1_abs) + gamma(6) * (q_abs.dot(a1_abs) + 1.0);
+    let ev = q_err.dot(a2_abs) + gamma(6) * (q_abs.dot(a2_abs) + 1.0);
+    let outside = (u < -eu) | (u > 1.0 + eu) | (v < -ev) | (v > 1.0 + ev);
+    if in_range & !leaves_plane & !outside {
+        t
+    } else {
+        f32::INFINITY
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

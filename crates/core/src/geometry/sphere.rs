@@ -2,6 +2,7 @@
 //! when the ray starts far from a small sphere (Haines et al., "Precision Improvements for
 //! Ray/Sphere Intersection", Ray Tracing Gems ch. 7), and the hit is re-projected onto the sphere.
 
+use super::quad::CHUNK;
 use crate::math::{gamma, Vec3};
 
 /// Nearest hit distance in (0, t_max) of a unit-direction ray, or +∞.
@@ -25,6 +26,86 @@ pub fn intersect_sphere(o: Vec3, d: Vec3, t_max: f32, center: Vec3, radius: f32)
         t0
     } else if t1 > 0.0 && t1 < t_max {
         t1
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Spheres in structure-of-arrays form (centre x, y, z, radius) in chunks of `CHUNK`, for the
+/// flat ray core (`flat.rs`): `distances` runs `intersect_sphere` without branches over a chunk in
+/// one loop the compiler vectorises, bit for bit the scalar result.
+#[derive(Clone, Debug, Default)]
+pub struct SphereSoa {
+    chunks: Vec<[[f32; CHUNK]; 4]>,
+}
+
+impl SphereSoa {
+    /// The spheres (centre, radius), the last chunk padded with NaN centres, which never hit.
+    pub fn new(spheres: &[(Vec3, f32)]) -> SphereSoa {
+        let chunks = spheres
+            .chunks(CHUNK)
+            .map(|chunk| {
+                let mut f = [[f32::NAN; CHUNK]; 4];
+                for (i, &(c, r)) in chunk.iter().enumerate() {
+                    for (k, x) in [c.x, c.y, c.z, r].into_iter().enumerate() {
+                        f[k][i] = x;
+                    }
+                }
+                f
+            })
+            .collect();
+        SphereSoa { chunks }
+    }
+
+    /// Spheres held, padding included (a multiple of `CHUNK`).
+    pub fn padded_len(&self) -> usize {
+        self.chunks.len() * CHUNK
+    }
+
+    /// Per sphere i in `start..start + W` (as `QuadSoa::distances`), `intersect_sphere(o, d,
+    /// t_max, centre_i, radius_i)`.
+    #[inline(always)]
+    pub fn distances<const W: usize>(
+        &self,
+        start: usize,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+    ) -> [f32; W] {
+        let ([cx, cy, cz, r], l) = (&self.chunks[start / CHUNK], start % CHUNK);
+        let mut out = [0.0; W];
+        for (i, t) in out.iter_mut().enumerate() {
+            *t = distance(
+                o,
+                d,
+                t_max,
+                Vec3::new(cx[l + i], cy[l + i], cz[l + i]),
+                r[l + i],
+            );
+        }
+        out
+    }
+}
+
+/// `intersect_sphere` without branches: both roots and every comparison are evaluated, then
+/// selected, with NaN comparing false as in the branching version.
+#[inline(always)]
+fn distance(o: Vec3, d: Vec3, t_max: f32, center: Vec3, radius: f32) -> f32 {
+    let f = o - center;
+    let b = f.dot(d);
+    let l = f - b * d;
+    let disc = radius * radius - l.length_squared();
+    let c = f.length_squared() - radius * radius;
+    let q = -b - disc.sqrt().copysign(b);
+    let t0 = if q != 0.0 { c / q } else { 0.0 };
+    let t1 = q;
+    let swap = t0 > t1;
+    let (near, far) = if swap { (t1, t0) } else { (t0, t1) };
+    let near_ok = (near > 0.0) & (near < t_max);
+    let far_ok = (far > 0.0) & (far < t_max);
+    let t = if near_ok { near } else { far };
+    if !(disc < 0.0) & (near_ok | far_ok) {
+        t
     } else {
         f32::INFINITY
     }

@@ -94,8 +94,13 @@ impl Scene {
         &self.materials[id as usize]
     }
 
-    /// Number of primitives in the BVH (for benchmarks and reports).
+    /// Number of primitives (for benchmarks and reports).
     pub fn primitive_count(&self) -> usize {
         self.accel.primitive_count()
+    }
+
+    /// Which ray core answers this scene's queries ("bvh", "flat (avx512)", …; `--ray-core`).
+    pub fn ray_core(&self) -> String {
+        self.accel.describe()
     }
 }

@@ -18,6 +18,16 @@ struct Cli {
     /// List the parameters of an XML scene that were accepted but change nothing lt renders.
     #[arg(long, global = true)]
     verbose: bool,
+    /// How rays find primitives: auto (flat for scenes of at most 64 primitives, else bvh), bvh,
+    /// flat (every primitive tested, vectorised) or flat-scalar (the same, one at a time: the
+    /// reference). All give the same distances bit for bit; see results/bench.md.
+    #[arg(long, global = true, default_value = "auto", value_parser = parse_ray_core)]
+    ray_core: lt_core::geometry::RayCore,
+}
+
+fn parse_ray_core(s: &str) -> Result<lt_core::geometry::RayCore, String> {
+    lt_core::geometry::RayCore::from_name(s)
+        .ok_or_else(|| format!("unknown ray core '{s}' (auto, bvh, flat, flat-scalar)"))
 }
 
 #[derive(Subcommand)]
@@ -55,6 +65,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    lt_core::geometry::set_ray_core(cli.ray_core);
     lt_core::scene::set_default_load_options(lt_core::scene::LoadOptions {
         approximate: cli.approximate,
         verbose: cli.verbose,
