@@ -24,7 +24,8 @@ use std::sync::atomic::{AtomicU8, Ordering};
 /// box corner may be lost by obvhs's node test (tests in this file).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RayCore {
-    /// `Flat` for scenes of at most `FLAT_MAX_PRIMITIVES` primitives, `Bvh` above.
+    /// `Flat` for scenes of at most `FLAT_MAX_PRIMITIVES` parallelograms and spheres and no
+    /// triangles, `Bvh` otherwise.
     Auto,
     Bvh,
     /// Every primitive tested against every ray, in vectorised loops (`flat.rs`).
@@ -230,7 +231,9 @@ impl Accel {
             .iter()
             .any(|p| matches!(p, Primitive::Triangle { .. }));
         let core = match core {
-            RayCore::Auto if prims.len() <= FLAT_MAX_PRIMITIVES => RayCore::Flat,
+            // Triangles are tested one by one in the flat core, which made a Cornell box with an
+            // 8-triangle light 30 % slower than the BVH (results/bench.md).
+            RayCore::Auto if prims.len() <= FLAT_MAX_PRIMITIVES && !has_triangles => RayCore::Flat,
             RayCore::Auto => RayCore::Bvh,
             c => c,
         };
@@ -621,11 +624,22 @@ mod tests {
     }
 
     #[test]
-    fn auto_picks_flat_for_small_scenes_and_the_bvh_above() {
+    fn auto_picks_flat_for_small_scenes_without_triangles_and_the_bvh_otherwise() {
         let mut s = Sampler::new(5, 0, 0);
         let few = random_primitives(&mut s, FLAT_MAX_PRIMITIVES as u32, 1.0);
         let many = random_primitives(&mut s, FLAT_MAX_PRIMITIVES as u32 + 1, 1.0);
-        assert_eq!(Accel::build_with(few, RayCore::Auto).core(), RayCore::Flat);
+        assert_eq!(
+            Accel::build_with(few.clone(), RayCore::Auto).core(),
+            RayCore::Bvh
+        );
+        let no_triangles: Vec<Primitive> = few
+            .into_iter()
+            .filter(|p| !matches!(p, Primitive::Triangle { .. }))
+            .collect();
+        assert_eq!(
+            Accel::build_with(no_triangles, RayCore::Auto).core(),
+            RayCore::Flat
+        );
         assert_eq!(Accel::build_with(many, RayCore::Auto).core(), RayCore::Bvh);
         assert_eq!(
             Accel::build_with(Vec::new(), RayCore::Flat)

@@ -18,7 +18,8 @@ struct Cli {
     /// List the parameters of an XML scene that were accepted but change nothing lt renders.
     #[arg(long, global = true)]
     verbose: bool,
-    /// How rays find primitives: auto (flat for scenes of at most 64 primitives, else bvh), bvh,
+    /// How rays find primitives: auto (flat for scenes of at most 64 primitives and no triangles,
+    /// else bvh), bvh,
     /// flat (every primitive tested, vectorised) or flat-scalar (the same, one at a time: the
     /// reference). All give the same distances bit for bit; see results/bench.md.
     #[arg(long, global = true, default_value = "auto", value_parser = parse_ray_core)]
