@@ -1,7 +1,8 @@
 //! `cargo bench -p lt-core --bench ray_cores`: where the flat ray core stops beating the BVH.
 //! Closest hits and occlusion of 100 000 rays from inside a box of N parallelograms (its six
-//! walls plus N − 6 random ones inside: the shape of a Cornell box with more furniture), or of
-//! N/2 parallelograms and N/2 spheres, with each core (one thread). `FLAT_MAX_PRIMITIVES` in
+//! walls plus N − 6 random ones inside: the shape of a Cornell box with more furniture), of N/2
+//! parallelograms and N/2 spheres, or of N triangles (the walls as triangle pairs), with each
+//! core (one thread). `FLAT_MAX_PRIMITIVES` in
 //! `geometry/accel.rs` is set from this.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
@@ -32,9 +33,16 @@ fn direction(r: &mut Pcg32) -> Vec3 {
     }
 }
 
-/// The walls of [-1, 1]³ and `n − 6` random parallelograms (or, with `spheres`, half of them
-/// spheres) of size ~0.3 inside.
-fn scene(n: usize, spheres: bool, seed: u64) -> Vec<Primitive> {
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    Quads,
+    QuadsAndSpheres,
+    Triangles,
+}
+
+/// The walls of [-1, 1]³ and random primitives of size ~0.3 inside, `n` in all: parallelograms,
+/// every other one a sphere, or triangles (then the walls are triangle pairs too).
+fn scene(n: usize, kind: Kind, seed: u64) -> Vec<Primitive> {
     let mut r = Pcg32::new(seed, 0x5851_f42d_4c95_7f2d);
     let mut prims = Vec::new();
     for axis in 0..3 {
@@ -45,17 +53,31 @@ fn scene(n: usize, spheres: bool, seed: u64) -> Vec<Primitive> {
             let (mut e1, mut e2) = (Vec3::ZERO, Vec3::ZERO);
             e1[u] = 2.0;
             e2[v] = 2.0;
-            prims.push(Primitive::Quad {
-                q: Parallelogram::new(p0, e1, e2),
-                shape: prims.len() as u32,
-                index: 0,
-            });
+            let shape = prims.len() as u32;
+            if kind == Kind::Triangles {
+                for p in [[p0, p0 + e1, p0 + e1 + e2], [p0, p0 + e1 + e2, p0 + e2]] {
+                    prims.push(Primitive::Triangle { p, shape, index: 0 });
+                }
+            } else {
+                prims.push(Primitive::Quad {
+                    q: Parallelogram::new(p0, e1, e2),
+                    shape,
+                    index: 0,
+                });
+            }
         }
     }
     while prims.len() < n {
         let shape = prims.len() as u32;
         let c = point(&mut r, 0.8);
-        if spheres && shape % 2 == 0 {
+        if kind == Kind::Triangles {
+            let (a, b) = (direction(&mut r) * 0.3, direction(&mut r) * 0.3);
+            prims.push(Primitive::Triangle {
+                p: [c, c + a, c + b],
+                shape,
+                index: 0,
+            });
+        } else if kind == Kind::QuadsAndSpheres && shape % 2 == 0 {
             prims.push(Primitive::Sphere {
                 center: c,
                 radius: 0.05 + 0.1 * uniform(&mut r),
@@ -78,13 +100,16 @@ fn rays(seed: u64) -> Vec<Ray> {
 
 fn bench(c: &mut Criterion) {
     let rays = rays(2);
-    for spheres in [false, true] {
-        let kind = if spheres { "quads+spheres" } else { "quads" };
-        let mut group = c.benchmark_group(format!("closest_hit/{kind}"));
+    for (kind, name) in [
+        (Kind::Quads, "quads"),
+        (Kind::QuadsAndSpheres, "quads+spheres"),
+        (Kind::Triangles, "triangles"),
+    ] {
+        let mut group = c.benchmark_group(format!("closest_hit/{name}"));
         group.throughput(Throughput::Elements(RAYS as u64));
         for n in [8, 16, 32, 64, 128, 256] {
             for core in [RayCore::Bvh, RayCore::Flat] {
-                let accel = Accel::build_with(scene(n, spheres, 1), core);
+                let accel = Accel::build_with(scene(n, kind, 1), core);
                 group.bench_with_input(BenchmarkId::new(accel.describe(), n), &rays, |b, rays| {
                     b.iter(|| {
                         rays.iter()
@@ -95,11 +120,11 @@ fn bench(c: &mut Criterion) {
             }
         }
         group.finish();
-        let mut group = c.benchmark_group(format!("occluded/{kind}"));
+        let mut group = c.benchmark_group(format!("occluded/{name}"));
         group.throughput(Throughput::Elements(RAYS as u64));
         for n in [8, 16, 32, 64, 128, 256] {
             for core in [RayCore::Bvh, RayCore::Flat] {
-                let accel = Accel::build_with(scene(n, spheres, 1), core);
+                let accel = Accel::build_with(scene(n, kind, 1), core);
                 let short: Vec<Ray> = rays.iter().map(|r| Ray { t_max: 0.5, ..*r }).collect();
                 group.bench_with_input(BenchmarkId::new(accel.describe(), n), &short, |b, rays| {
                     b.iter(|| {

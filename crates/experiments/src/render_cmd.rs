@@ -284,6 +284,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         "run_seconds": result.runs.iter().map(|r| r.elapsed.as_secs_f64()).collect::<Vec<_>>(),
         "seed": args.seed,
         "threads": args.threads,
+        "ray_core": scene.ray_core(),
         "max_depth": args.integrator_args.max_depth.unwrap_or(scene.settings.max_depth),
         "params": params.pairs().iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>(),
         "seconds": secs,

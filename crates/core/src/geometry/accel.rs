@@ -457,11 +457,12 @@ mod tests {
             .collect()
     }
 
-    /// A closed box of six parallelograms around the origin and a smaller one inside: rays aimed
-    /// at their shared edges and corners hit two faces at exactly the same distance.
+    /// A closed box of six parallelograms around the origin, a smaller one inside and a third,
+    /// of triangle pairs, between them: rays aimed at their shared edges and corners hit two faces
+    /// at exactly the same distance, and make triangle edge functions exactly zero.
     fn boxes(scale: f32) -> Vec<Primitive> {
         let mut prims = Vec::new();
-        for (half, flip) in [(1.0f32, false), (0.3, true)] {
+        for (half, flip) in [(1.0f32, false), (0.3, true), (0.6, false)] {
             let h = half * scale;
             for axis in 0..3 {
                 for side in [-1.0f32, 1.0] {
@@ -473,11 +474,17 @@ mod tests {
                     e2[v] = 2.0 * h;
                     let (e1, e2) = if flip { (e2, e1) } else { (e1, e2) };
                     let shape = prims.len() as u32;
-                    prims.push(Primitive::Quad {
-                        q: Parallelogram::new(p0, e1, e2),
-                        shape,
-                        index: 0,
-                    });
+                    if half == 0.6 {
+                        for p in [[p0, p0 + e1, p0 + e1 + e2], [p0, p0 + e1 + e2, p0 + e2]] {
+                            prims.push(Primitive::Triangle { p, shape, index: 0 });
+                        }
+                    } else {
+                        prims.push(Primitive::Quad {
+                            q: Parallelogram::new(p0, e1, e2),
+                            shape,
+                            index: 0,
+                        });
+                    }
                 }
             }
         }
@@ -511,7 +518,7 @@ mod tests {
                 };
                 let d = if at_edges && k % 4 == 0 {
                     // A box edge or corner: two or three coordinates at ±half, scale 1 or 0.3.
-                    let half = if k % 8 == 0 { 1.0 } else { 0.3 } * scale;
+                    let half = [1.0, 0.3, 0.6][k / 4 % 3] * scale;
                     let mut target = (s.next_2d().extend(s.next_f32()) - 0.5) * 2.0 * half;
                     for axis in 0..3 {
                         if s.next_f32() < 0.7 {

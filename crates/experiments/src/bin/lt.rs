@@ -19,9 +19,8 @@ struct Cli {
     #[arg(long, global = true)]
     verbose: bool,
     /// How rays find primitives: auto (flat for scenes of at most 64 primitives and no triangles,
-    /// else bvh), bvh,
-    /// flat (every primitive tested, vectorised) or flat-scalar (the same, one at a time: the
-    /// reference). All give the same distances bit for bit; see results/bench.md.
+    /// else bvh), bvh, flat (every primitive tested, vectorised) or flat-scalar (the same, one at
+    /// a time: the reference, bit for bit the same hits). See results/bench.md.
     #[arg(long, global = true, default_value = "auto", value_parser = parse_ray_core)]
     ray_core: lt_core::geometry::RayCore,
 }
