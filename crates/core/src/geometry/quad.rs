@@ -6,6 +6,7 @@
 //! parallelograms (a box's faces) overlap by rounding-sized slivers instead of leaving cracks,
 //! and hits within the rounding bound of the origin's own plane are rejected (no self-hits).
 
+use super::flat::{soa_chunks, CHUNK};
 use crate::math::{gamma, Vec3};
 
 /// p0 + u·e1 + v·e2 for (u, v) in [0, 1]².
@@ -141,42 +142,23 @@ pub struct QuadSoa {
     chunks: Vec<[[f32; CHUNK]; 24]>,
 }
 
-/// Primitives per vectorised test: AVX-512's 16 f32 lanes, two AVX2 vectors, four SSE ones.
-pub const CHUNK: usize = 16;
-
 impl QuadSoa {
     /// The parallelograms, the last chunk padded with NaN corners, which never hit (t is NaN).
     pub fn new(quads: &[Parallelogram]) -> QuadSoa {
-        let chunks = quads
-            .chunks(CHUNK)
-            .map(|chunk| {
-                let mut f = [[f32::NAN; CHUNK]; 24];
-                for (i, q) in chunk.iter().enumerate() {
-                    let vectors = [
-                        q.p0,
-                        q.p0.abs(),
-                        q.n,
-                        q.n.abs(),
-                        q.a1,
-                        q.a1.abs(),
-                        q.a2,
-                        q.a2.abs(),
-                    ];
-                    for (k, v) in vectors.iter().enumerate() {
-                        for c in 0..3 {
-                            f[3 * k + c][i] = v[c];
-                        }
-                    }
-                }
-                f
-            })
-            .collect();
+        let chunks = soa_chunks(quads, |q| {
+            let v = [
+                q.p0,
+                q.p0.abs(),
+                q.n,
+                q.n.abs(),
+                q.a1,
+                q.a1.abs(),
+                q.a2,
+                q.a2.abs(),
+            ];
+            std::array::from_fn(|k| v[k / 3][k % 3])
+        });
         QuadSoa { chunks }
-    }
-
-    /// Parallelograms held, padding included (a multiple of `CHUNK`).
-    pub fn padded_len(&self) -> usize {
-        self.chunks.len() * CHUNK
     }
 
     /// Per parallelogram i in `start..start + W` (`start` a multiple of `W`, `W` dividing `CHUNK`),

@@ -2,7 +2,7 @@
 //! when the ray starts far from a small sphere (Haines et al., "Precision Improvements for
 //! Ray/Sphere Intersection", Ray Tracing Gems ch. 7), and the hit is re-projected onto the sphere.
 
-use super::quad::CHUNK;
+use super::flat::{soa_chunks, CHUNK};
 use crate::math::{gamma, Vec3};
 
 /// Nearest hit distance in (0, t_max) of a unit-direction ray, or +∞.
@@ -42,24 +42,8 @@ pub struct SphereSoa {
 impl SphereSoa {
     /// The spheres (centre, radius), the last chunk padded with NaN centres, which never hit.
     pub fn new(spheres: &[(Vec3, f32)]) -> SphereSoa {
-        let chunks = spheres
-            .chunks(CHUNK)
-            .map(|chunk| {
-                let mut f = [[f32::NAN; CHUNK]; 4];
-                for (i, &(c, r)) in chunk.iter().enumerate() {
-                    for (k, x) in [c.x, c.y, c.z, r].into_iter().enumerate() {
-                        f[k][i] = x;
-                    }
-                }
-                f
-            })
-            .collect();
+        let chunks = soa_chunks(spheres, |&(c, r)| [c.x, c.y, c.z, r]);
         SphereSoa { chunks }
-    }
-
-    /// Spheres held, padding included (a multiple of `CHUNK`).
-    pub fn padded_len(&self) -> usize {
-        self.chunks.len() * CHUNK
     }
 
     /// Per sphere i in `start..start + W` (as `QuadSoa::distances`), `intersect_sphere(o, d,
