@@ -77,7 +77,7 @@ fn scene(n: usize, kind: Kind, seed: u64) -> Vec<Primitive> {
                 shape,
                 index: 0,
             });
-        } else if kind == Kind::QuadsAndSpheres && shape % 2 == 0 {
+        } else if kind == Kind::QuadsAndSpheres && shape.is_multiple_of(2) {
             prims.push(Primitive::Sphere {
                 center: c,
                 radius: 0.05 + 0.1 * uniform(&mut r),
