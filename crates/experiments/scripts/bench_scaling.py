@@ -41,7 +41,7 @@ sys.dont_write_bytecode = True  # no __pycache__ beside the scripts in the repo
 sys.path.insert(0, HERE)
 from bench_vs_mitsuba import (  # noqa: E402
     REPO, Mitsuba, fmt_ratio_summary, header_lines, lt_convert, lt_render, mean_diff,
-    parse_int_list, parse_str_list, resolve_lt, uptime_line,
+    parse_int_list, parse_str_list, resolve_lt, uptime_line, write_report,
 )
 
 BASE_SCENE = os.path.join(REPO, "scenes", "cornell-box.toml")
@@ -219,10 +219,7 @@ def main():
     print("\n".join(tail), flush=True)
     out.extend(tail)
     if a.out:
-        os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
-        with open(a.out, "w") as f:
-            f.write("\n".join(out) + "\n")
-        print(f"\nwrote {a.out}")
+        write_report(a.out, out)
 
 
 if __name__ == "__main__":

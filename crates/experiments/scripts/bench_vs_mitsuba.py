@@ -316,6 +316,14 @@ def parse_str_list(values):
     return out
 
 
+def write_report(path, lines):
+    """The report's lines to `path` (folders made as needed)."""
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print(f"\nwrote {path}")
+
+
 def header_lines(args, lt, mitsuba, extra=()):
     lines = [
         f"Command: `{' '.join([os.path.relpath(sys.argv[0], REPO) if sys.argv[0].startswith(REPO) else sys.argv[0]] + sys.argv[1:])}`  ",
@@ -464,10 +472,7 @@ def main():
     print("\n".join(s), flush=True)
     out.extend(s)
     if a.out:
-        os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
-        with open(a.out, "w") as f:
-            f.write("\n".join(out) + "\n")
-        print(f"\nwrote {a.out}")
+        write_report(a.out, out)
     if tmp is not None:
         tmp.cleanup()
 

@@ -1,5 +1,6 @@
-//! How rays find primitives. Small scenes (every shipped one) test all their primitives at once,
-//! eight lanes wide (`flat.rs`); larger ones use one obvhs compressed-wide BVH over every primitive:
+//! How rays find primitives. Small scenes without triangles (every shipped one but the mesh-light
+//! box) test all their primitives at once in vectorised loops (`flat.rs`); the others use one
+//! obvhs compressed-wide BVH over every primitive:
 //! triangles, parallelograms and analytic spheres live in the same structure, so a scene pays only
 //! for the kinds it has. Either way the closest hit is the primitive's own distance, unrounded.
 
@@ -34,7 +35,8 @@ pub enum RayCore {
     FlatScalar,
 }
 
-/// Above this many primitives a BVH beats testing them all (results/bench.md, "flat or tree").
+/// Above this many primitives a BVH beats testing them all (`benches/ray_cores.rs`; results/bench.md,
+/// "The flat core against the BVH").
 pub const FLAT_MAX_PRIMITIVES: usize = 64;
 
 impl RayCore {

@@ -96,8 +96,9 @@ fn nearer(a: PrimHit, t: f32, prim: u32) -> PrimHit {
 }
 
 /// `best` becomes the nearest of itself and the lanes that hit: a mask of the hits is built
-/// without branches, then only its set bits are visited (a branch per lane mispredicts on every
-/// hit). A function, not a closure: a closure is not inlined into the target-feature functions.
+/// without branches, then only its set bits are visited (measured as fast as a branch per lane,
+/// with fewer instructions). A function, not a closure: a closure is not inlined into the
+/// target-feature functions.
 #[inline(always)]
 fn take_hits<const W: usize>(best: &mut PrimHit, ts: &[f32; W], ids: &[u32]) {
     let mut hits = ts
