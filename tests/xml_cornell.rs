@@ -11,10 +11,11 @@
 //! translation, coordinates ≤ 1) by at most 8 · 2⁻²⁴ ≈ 4.8e-7 — the bound held here.
 
 use lt_core::light::Light;
-use lt_core::scene::{load_scene, load_scene_with, LoadOptions, ShapeGeometry};
+use lt_core::scene::ShapeGeometry;
 use lt_core::Scene;
 use lt_estimators::agreement::agreement_t;
 use lt_integrators::IntegratorParams;
+use lt_scene_io::{load_scene, load_scene_with, LoadOptions};
 use lt_tests::{render_blocks, scenes_dir};
 use std::path::PathBuf;
 

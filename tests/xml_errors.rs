@@ -3,8 +3,9 @@
 //! includes, defaults and `$` substitution, the 0.6 name upgrade, OBJ and PLY (ASCII and
 //! binary) meshes, `--approximate` substitutions and the `--verbose` list of ignored parameters.
 
-use lt_core::scene::{load_scene_with, LoadOptions, LoadReport, SceneError, ShapeGeometry};
+use lt_core::scene::ShapeGeometry;
 use lt_core::Scene;
+use lt_scene_io::{load_scene_with, LoadOptions, LoadReport, SceneError};
 use std::path::{Path, PathBuf};
 
 /// A fresh folder for one test's files.
@@ -285,7 +286,7 @@ fn xml_approximations_are_refused_or_listed() {
     let (scene, _) = load_in(&d, "scene.xml", &unbounded, opts).unwrap();
     assert_eq!(
         scene.settings.max_depth,
-        lt_core::scene::xml::UNBOUNDED_DEPTH_SUBSTITUTE
+        lt_scene_io::xml::UNBOUNDED_DEPTH_SUBSTITUTE
     );
 
     let spectral = scene_xml("    <shape type=\"sphere\">\n        <bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0.2, 500:0.5, 600:0.8, 700:0.9\"/></bsdf>\n    </shape>");

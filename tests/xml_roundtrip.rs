@@ -4,8 +4,8 @@
 //! rounds to f32 once, as the TOML loader does). A scene with a finite-cone sun is refused by
 //! name: Mitsuba 3 has no such light.
 
-use lt_core::scene::{load_scene, load_scene_with, LoadOptions};
 use lt_core::{Scene, Vec2};
+use lt_scene_io::{load_scene, load_scene_with, LoadOptions};
 use lt_tests::{scenes_dir, shipped_scene_names};
 use std::path::PathBuf;
 

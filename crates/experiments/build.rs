@@ -1,5 +1,5 @@
 //! Computes the code version the cache keys carry: a hash of every source file that decides what
-//! a render produces (core and integrators, their manifests and the lock file). Editing a study
+//! a render produces (core, scene-io and integrators, their manifests and the lock file). Editing a study
 //! or the report does not invalidate finished renders; editing an integrator does.
 
 use std::path::{Path, PathBuf};
@@ -20,7 +20,11 @@ fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let inputs = [root.join("crates/core"), root.join("crates/integrators")];
+    let inputs = [
+        root.join("crates/core"),
+        root.join("crates/scene-io"),
+        root.join("crates/integrators"),
+    ];
     let mut files = Vec::new();
     for dir in &inputs {
         println!("cargo:rerun-if-changed={}", dir.display());

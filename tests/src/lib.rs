@@ -1,11 +1,11 @@
 //! Shared helpers of the workspace-level tests.
 
-use lt_core::scene::load_scene;
 use lt_core::Scene;
 use lt_estimators::blocks::{BlockEstimate, RunningBlocks};
 use lt_estimators::running::{RunningImage, RunningStat};
 use lt_estimators::Image;
 use lt_integrators::{make_integrator, render, IntegratorParams, Kind, RenderOptions};
+use lt_scene_io::load_scene;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 

@@ -12,8 +12,7 @@
 use crate::geometry::Ray;
 use crate::math::{Frame, Vec2, Vec3};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FovAxis {
     X,
     Y,

@@ -10,6 +10,7 @@ pub mod measure;
 pub mod path;
 pub mod sampling;
 pub mod scene;
+pub mod shape;
 pub mod spatial;
 pub mod testing;
 

@@ -2,9 +2,9 @@
 //! scenes. `lt bench` prints the same figures as a table for results/bench.md.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use lt_core::scene::load_scene;
 use lt_experiments::bench::incoherent_rays;
 use lt_integrators::{make_integrator, IntegratorParams};
+use lt_scene_io::load_scene;
 use std::path::Path;
 
 fn scene(name: &str) -> lt_core::Scene {

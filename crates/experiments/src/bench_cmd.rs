@@ -5,7 +5,7 @@ use crate::bench::{
 };
 use clap::Args;
 use lt_core::geometry::{set_ray_core, RayCore};
-use lt_core::scene::load_scene;
+use lt_scene_io::load_scene;
 use std::fmt::Write;
 use std::path::PathBuf;
 

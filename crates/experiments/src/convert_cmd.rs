@@ -22,7 +22,7 @@ pub fn run(args: &ConvertArgs) -> Result<(), String> {
     };
     std::fs::create_dir_all(&out_dir)
         .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
-    let xml = lt_core::scene::xml::write::to_mitsuba_xml(&args.scene, &out_dir)
+    let xml = lt_scene_io::xml::write::to_mitsuba_xml(&args.scene, &out_dir)
         .map_err(|e| e.to_string())?;
     // Written beside the target and renamed, so a failed write leaves no half file.
     let tmp = args.output.with_extension("xml.partial");

@@ -782,7 +782,7 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
     if matches!(args.integrator.as_str(), "vcm" | "bpm") {
         return crate::mis_check_vcm::run(args);
     }
-    let mut scene = lt_core::scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
     let integrator = Which::parse(&args.integrator)?;
     let mut opts = Options::new(&scene, integrator);
     if let Some(m) = &args.mis {

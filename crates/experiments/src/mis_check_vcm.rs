@@ -533,7 +533,7 @@ impl fmt::Display for VcmReport {
 
 /// `lt mis-check --integrator vcm|bpm`.
 pub fn run(args: &MisCheckArgs) -> Result<String, String> {
-    let mut scene = lt_core::scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
     let mut opts = VcmOptions::new(&scene, args.integrator == "vcm");
     if let Some(m) = &args.mis {
         opts.heuristic = Heuristic::parse(m)?;

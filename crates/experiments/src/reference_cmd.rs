@@ -33,7 +33,7 @@ pub struct ReferenceArgs {
 }
 
 pub fn run(args: &ReferenceArgs) -> Result<(), String> {
-    let scene = lt_core::scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
     let stem = crate::study::output::stem(&args.scene);
     let (default, why) = integrator_for(&stem);
     let integrator = args

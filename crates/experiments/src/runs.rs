@@ -9,10 +9,10 @@
 
 use crate::cache::{scene_hash, Cache};
 use crate::image_io::{read_exr, write_exr};
-use lt_core::scene::load_scene;
 use lt_core::Scene;
 use lt_estimators::Image;
 use lt_integrators::{make_integrator, render_runs, IntegratorParams, Kind, RenderOptions};
+use lt_scene_io::load_scene;
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};

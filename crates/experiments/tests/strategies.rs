@@ -2,7 +2,6 @@
 //! partition of the bdpt image (exactly, up to the stated rounding), each unweighted strategy
 //! alone estimates its length's image (against pt per block), and the files are written.
 
-use lt_core::scene::load_scene;
 use lt_core::Scene;
 use lt_estimators::agreement::agreement_t;
 use lt_estimators::{Image, RunningBlocks};
@@ -10,6 +9,7 @@ use lt_experiments::strategies::{
     make_bdpt, pyramid_pass, render_pyramid, strategies, strategy_index, write_pyramid, PyramidMeta,
 };
 use lt_integrators::{make_integrator, IntegratorParams, RenderOptions};
+use lt_scene_io::load_scene;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 

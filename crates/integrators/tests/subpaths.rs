@@ -6,10 +6,10 @@
 use lt_core::math::{Color, Vec2};
 use lt_core::path::{Path, PathVertex, VertexKind};
 use lt_core::sampling::{Domain, Sampler};
-use lt_core::scene::load_scene;
 use lt_core::Scene;
 use lt_integrators::connect::connect_to_camera;
 use lt_integrators::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
+use lt_scene_io::load_scene;
 use std::path::PathBuf;
 
 fn scene(name: &str) -> Scene {

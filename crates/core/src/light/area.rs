@@ -11,7 +11,7 @@ use crate::sampling::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere,
     sample_uniform_triangle, uniform_cone_pdf, Distribution1D,
 };
-use crate::scene::{ShapeGeometry, TriangleMesh};
+use crate::shape::{ShapeGeometry, TriangleMesh};
 
 /// A piece of an emitting mesh: a triangle, or a pair of triangles forming a parallelogram
 /// (sampled with two uniform variates, no square root; same uniform area density).

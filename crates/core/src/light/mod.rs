@@ -27,7 +27,31 @@ pub use sun::SunLight;
 use crate::geometry::Ray;
 use crate::math::{luminance, Color, Vec2, Vec3};
 use crate::sampling::Distribution1D;
-use crate::scene::{LightDesc, ShapeGeometry};
+use crate::shape::ShapeGeometry;
+
+/// Lights that are not shapes.
+#[derive(Clone, Debug)]
+pub enum LightDesc {
+    Point {
+        position: Vec3,
+        intensity: Color,
+    },
+    /// A distant disk light. `direction` points from the scene towards the sun.
+    Sun {
+        direction: Vec3,
+        solid_angle: f32,
+        radiance: Color,
+    },
+    /// A light delta in direction: `direction` (unit) points from the scene towards it, and
+    /// `irradiance` is what a surface facing it receives (W/m²). See `light::DirectionalLight`.
+    Directional {
+        direction: Vec3,
+        irradiance: Color,
+    },
+    Environment {
+        radiance: Color,
+    },
+}
 
 /// A direction towards a light from a shading point.
 #[derive(Clone, Copy, Debug)]

@@ -7,7 +7,7 @@ use crate::camera::Camera;
 use crate::light::{Light, LightLeSample, LightLiSample};
 use crate::math::{Color, Vec3};
 use crate::measure;
-use crate::scene::{Scene, SurfaceHit};
+use crate::scene::{ConnectionEnd, Scene, SurfaceHit};
 
 /// What a vertex lies on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -287,4 +287,16 @@ pub fn geometry(a: &PathVertex, b: &PathVertex) -> f32 {
     }
     let w = d / d2.sqrt();
     cos_at(a, w) * cos_at(b, w) / d2
+}
+
+impl From<&PathVertex> for ConnectionEnd {
+    /// What visibility needs of a vertex (for one at infinity, `p` is its direction).
+    fn from(v: &PathVertex) -> ConnectionEnd {
+        ConnectionEnd {
+            p: v.p,
+            p_err: v.p_err,
+            ng: v.ng,
+            infinite: v.is_infinite(),
+        }
+    }
 }

@@ -1,23 +1,18 @@
 //! The scene: shapes in one BVH, materials, lights and the camera, plus the queries integrators
-//! make (closest hit; visibility in `visibility.rs`). Scenes are read from TOML by `load` (format in
-//! `docs/scene-format.md`) or assembled in code with `SceneBuilder`.
+//! make (closest hit; visibility in `visibility.rs`). Scenes are assembled with `SceneBuilder`: by
+//! the file readers of `lt-scene-io` (TOML, Mitsuba XML) or in code by tests.
 
 mod builder;
-mod elements;
-mod format;
 mod hit;
-pub mod load;
-mod obj;
 pub mod ray_stats;
-mod transform;
 mod translated;
 mod visibility;
-pub mod xml;
 
-pub use builder::{LightDesc, SceneBuilder, ShapeGeometry, TriangleMesh};
+pub use crate::light::LightDesc;
+pub use crate::shape::{ShapeGeometry, TriangleMesh};
+pub use builder::SceneBuilder;
 pub use hit::SurfaceHit;
-pub use load::{load_scene, load_scene_str, load_scene_with, SceneError};
-pub use xml::{set_default_load_options, LoadOptions, LoadReport};
+pub use visibility::ConnectionEnd;
 
 use crate::bsdf::Material;
 use crate::camera::Camera;

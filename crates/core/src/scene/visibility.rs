@@ -8,7 +8,23 @@
 use super::{ray_stats, Scene, SurfaceHit};
 use crate::geometry::{offset_ray_origin, Ray};
 use crate::math::{gamma, Vec3};
-use crate::path::PathVertex;
+
+/// One end of a connection between two path vertices, as visibility needs it: a point with its
+/// per-axis error bound and geometric normal, or (`infinite`) a unit direction towards a light at
+/// infinity in `p`. The path module converts its vertices into these, so the scene knows no path.
+#[derive(Clone, Copy, Debug)]
+pub struct ConnectionEnd {
+    pub p: Vec3,
+    pub p_err: Vec3,
+    pub ng: Vec3,
+    pub infinite: bool,
+}
+
+impl From<&ConnectionEnd> for ConnectionEnd {
+    fn from(e: &ConnectionEnd) -> ConnectionEnd {
+        *e
+    }
+}
 
 /// One end of a shadow ray: a point, its per-axis error bound and its geometric normal (zero when
 /// it has none: a point light, a bare point).
@@ -109,8 +125,13 @@ impl Scene {
 
     /// Visibility between two path vertices, either of which may sit at infinity (then `p` is
     /// the unit direction towards the light). Two vertices at infinity are never connected.
-    pub fn connection_visible(&self, a: &PathVertex, b: &PathVertex) -> bool {
-        match (a.is_infinite(), b.is_infinite()) {
+    pub fn connection_visible(
+        &self,
+        a: impl Into<ConnectionEnd>,
+        b: impl Into<ConnectionEnd>,
+    ) -> bool {
+        let (a, b): (ConnectionEnd, ConnectionEnd) = (a.into(), b.into());
+        match (a.infinite, b.infinite) {
             (true, true) => false,
             (true, false) => self.ray_unoccluded(self.end(b.p, b.p_err, b.ng), a.p),
             (false, true) => self.ray_unoccluded(self.end(a.p, a.p_err, a.ng), b.p),
@@ -168,7 +189,6 @@ mod tests {
     use crate::bsdf::{Diffuse, Material};
     use crate::camera::{Camera, FovAxis};
     use crate::math::Color;
-    use crate::path::VertexKind;
     use crate::sampling::Sampler;
     use crate::scene::{RenderSettings, SceneBuilder, ShapeGeometry, TriangleMesh};
 
@@ -194,25 +214,28 @@ mod tests {
 
     /// The surface vertex where the ray from `from` towards `target` first hits, with the error
     /// bound the intersection code gives it (only the fields visibility reads matter here).
-    fn try_vertex(s: &Scene, from: Vec3, target: Vec3) -> Option<PathVertex> {
+    fn try_vertex(s: &Scene, from: Vec3, target: Vec3) -> Option<ConnectionEnd> {
         let h = s.intersect(&Ray::new(from, (target - from).normalize()))?;
-        Some(PathVertex {
-            kind: VertexKind::Surface { material: 0 },
+        Some(ConnectionEnd {
             p: h.p,
             p_err: h.p_err,
             ng: h.ng,
-            ns: h.ns,
-            ..at_infinity(Vec3::Z)
+            infinite: false,
         })
     }
 
-    fn vertex(s: &Scene, from: Vec3, target: Vec3) -> PathVertex {
+    fn vertex(s: &Scene, from: Vec3, target: Vec3) -> ConnectionEnd {
         try_vertex(s, from, target)
             .unwrap_or_else(|| panic!("{from} towards {target} hits nothing"))
     }
 
-    fn at_infinity(dir: Vec3) -> PathVertex {
-        PathVertex::light_escaped(0, dir, Color::ONE, 1.0)
+    fn at_infinity(dir: Vec3) -> ConnectionEnd {
+        ConnectionEnd {
+            p: dir,
+            p_err: Vec3::ZERO,
+            ng: Vec3::ZERO,
+            infinite: true,
+        }
     }
 
     #[test]

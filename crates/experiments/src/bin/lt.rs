@@ -66,7 +66,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     lt_core::geometry::set_ray_core(cli.ray_core);
-    lt_core::scene::set_default_load_options(lt_core::scene::LoadOptions {
+    lt_scene_io::set_default_load_options(lt_scene_io::LoadOptions {
         approximate: cli.approximate,
         verbose: cli.verbose,
     });

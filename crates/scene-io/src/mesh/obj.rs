@@ -2,11 +2,11 @@
 //! one). A light pre-check of `v`/`vn`/`vt`/`f` lines names the OBJ line of a malformed file,
 //! which tobj's errors do not.
 
-use super::builder::TriangleMesh;
-use super::format::S;
-use super::load::Ctx;
-use super::SceneError;
-use crate::math::Vec3;
+use crate::error::Ctx;
+use crate::format::S;
+use crate::SceneError;
+use lt_core::math::Vec3;
+use lt_core::scene::TriangleMesh;
 
 /// Loads `file` (relative to the scene file). Errors point at the scene's `file` key.
 pub fn load_obj(ctx: &Ctx, file: &S<String>) -> Result<TriangleMesh, SceneError> {

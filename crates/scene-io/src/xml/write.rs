@@ -9,10 +9,10 @@
 //! Refused: the `sun` light (Mitsuba 3 has no distant light of finite solid angle; a
 //! directional light or an environment map would change the image, so nothing is approximated).
 
-use super::super::format::{ColorDef, SceneFile, ShapeDef};
-use super::super::load::Ctx;
-use super::super::transform::shape_matrix;
-use super::super::SceneError;
+use crate::error::Ctx;
+use crate::format::{ColorDef, SceneFile, ShapeDef};
+use crate::transform::shape_matrix;
+use crate::SceneError;
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
 
@@ -37,7 +37,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
         });
     }
     // Everything checked exactly as for rendering.
-    let loaded = super::super::load_scene_str(&text, scene)?;
+    let loaded = crate::toml_file::load_scene_str(&text, scene)?;
     let ctx = Ctx {
         file: scene.display().to_string(),
         text: &text,
@@ -84,11 +84,11 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
         c.up.as_ref()
             .map(|u| *u.get_ref())
             .unwrap_or([0.0, 1.0, 0.0]);
-    let axis = match c.fov_axis.unwrap_or(crate::camera::FovAxis::X) {
-        crate::camera::FovAxis::X => "x",
-        crate::camera::FovAxis::Y => "y",
-        crate::camera::FovAxis::Smaller => "smaller",
-        crate::camera::FovAxis::Larger => "larger",
+    let axis = match c.fov_axis.map_or(lt_core::camera::FovAxis::X, Into::into) {
+        lt_core::camera::FovAxis::X => "x",
+        lt_core::camera::FovAxis::Y => "y",
+        lt_core::camera::FovAxis::Smaller => "smaller",
+        lt_core::camera::FovAxis::Larger => "larger",
     };
     let [w, h] = *c.resolution.get_ref();
     let _ = writeln!(x, "    <sensor type=\"perspective\">");
@@ -270,7 +270,7 @@ fn shape(
             // Without normals on every vertex our meshes shade flat; Mitsuba would compute
             // smooth vertex normals, so ask it for face normals then.
             let mesh =
-                super::super::obj::load_obj(ctx, d.file.as_ref().expect("checked by the load"))?;
+                crate::mesh::obj::load_obj(ctx, d.file.as_ref().expect("checked by the load"))?;
             if mesh.normals.is_none() {
                 let _ = writeln!(x, "        <boolean name=\"face_normals\" value=\"true\"/>");
             }

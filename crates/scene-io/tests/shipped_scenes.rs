@@ -5,8 +5,9 @@ use lt_core::geometry::quad::Parallelogram;
 use lt_core::geometry::Ray;
 use lt_core::light::{Light, SunLight};
 use lt_core::math::{Color, Vec3, PI};
-use lt_core::scene::{load_scene, ShapeGeometry, SurfaceHit};
+use lt_core::scene::{ShapeGeometry, SurfaceHit};
 use lt_core::Scene;
+use lt_scene_io::load_scene;
 use std::path::PathBuf;
 
 const SCENES: [&str; 11] = [

@@ -4,8 +4,8 @@
 //! when it reads a 0.6 file). Each element remembers its source file and byte range, so any later
 //! error can name the file, line and column.
 
-use super::super::load::Ctx;
-use super::super::SceneError;
+use crate::error::Ctx;
+use crate::SceneError;
 use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};

@@ -2,9 +2,9 @@
 //! Composed in f64 and rounded to f32 once, so quads and cubes placed with round numbers meet
 //! exactly at shared edges (rotations by multiples of 90° use exact sines and cosines).
 
-use super::format::{ShapeDef, S};
-use super::load::Ctx;
-use super::SceneError;
+use crate::error::Ctx;
+use crate::format::{ShapeDef, S};
+use crate::SceneError;
 use glam::{DMat3, DMat4, DVec3, Mat4};
 
 /// The shape's object-to-world matrix (identity when it gives no transform keys), with the span a

@@ -1,13 +1,9 @@
-//! Reading scenes from TOML (the format is documented in docs/scene-format.md). Every problem —
-//! syntax, unknown key, wrong type, missing key, bad value, missing or malformed mesh, undefined
-//! material, degenerate transform or camera, no light — becomes one `SceneError` that names the
-//! file, the line and column when there is one, and the problem. Nothing here panics on input.
+//! One error type for every scene file, and the context that turns a byte span into file:line:col.
 
-use super::format::{ColorDef, SceneFile, S, V3};
-use super::Scene;
-use crate::math::{Color, Vec3};
+use crate::format::{ColorDef, S, V3};
+use lt_core::math::{Color, Vec3};
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// One clear message naming the file, the place (line and column when known) and the problem.
 #[derive(Debug, Clone)]
@@ -30,63 +26,8 @@ impl std::fmt::Display for SceneError {
 
 impl std::error::Error for SceneError {}
 
-/// Reads a scene file, TOML or (by the `.xml` extension) Mitsuba XML, with the process's default
-/// `LoadOptions` (`xml::set_default_load_options`); an XML load's substitutions are printed to
-/// stderr, and with `verbose` its ignored parameters too.
-pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let opts = super::xml::default_load_options();
-    let (scene, report) = load_scene_with(path, &opts)?;
-    report.print(opts.verbose);
-    Ok(scene)
-}
-
-/// Reads a scene file with explicit options; the report lists what an XML load substituted and
-/// ignored (always empty for TOML).
-pub fn load_scene_with(
-    path: &Path,
-    opts: &super::xml::LoadOptions,
-) -> Result<(Scene, super::xml::LoadReport), SceneError> {
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
-    {
-        return super::xml::load_xml(path, opts);
-    }
-    Ok((load_toml(path)?, Default::default()))
-}
-
-fn load_toml(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
-        file: path.display().to_string(),
-        line: None,
-        column: None,
-        message: format!("cannot read the scene file: {e}"),
-    })?;
-    load_scene_str(&text, path)
-}
-
-/// Parses scene text; `path` names the file in errors and anchors relative mesh paths.
-pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
-    let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let ctx = Ctx {
-        file: path.display().to_string(),
-        text,
-        base_dir,
-    };
-    let file: SceneFile = toml::from_str(text).map_err(|e| match e.span() {
-        Some(span) => ctx.at(span, e.message().trim_end().to_string()),
-        None => ctx.whole(e.message().trim_end().to_string()),
-    })?;
-    let mut scene = super::elements::assemble(&ctx, &file)?;
-    let meshes = file.shapes.iter().filter_map(|s| s.get_ref().file.as_ref());
-    scene.source_files = std::iter::once(path.to_path_buf())
-        .chain(meshes.map(|f| ctx.base_dir.join(f.get_ref())))
-        .collect();
-    Ok(scene)
-}
-
 /// What error messages need: the file's name and text (for line numbers) and its directory.
-pub(super) struct Ctx<'a> {
+pub(crate) struct Ctx<'a> {
     pub file: String,
     pub text: &'a str,
     pub base_dir: PathBuf,
@@ -109,10 +50,7 @@ impl Ctx<'_> {
 
     /// The bytes of the mesh file `file` names (relative to the scene file), with its path; a
     /// missing or unreadable file is an error at the scene's `file` key.
-    pub fn read_mesh(
-        &self,
-        file: &super::format::S<String>,
-    ) -> Result<(PathBuf, Vec<u8>), SceneError> {
+    pub fn read_mesh(&self, file: &S<String>) -> Result<(PathBuf, Vec<u8>), SceneError> {
         let path = self.base_dir.join(file.get_ref());
         match std::fs::read(&path) {
             Ok(b) => Ok((path, b)),

@@ -5,8 +5,9 @@
 use lt_core::bsdf::Material;
 use lt_core::light::Light;
 use lt_core::math::{Color, Vec3, PI};
-use lt_core::scene::{load_scene, ShapeGeometry};
+use lt_core::scene::ShapeGeometry;
 use lt_core::Scene;
+use lt_scene_io::load_scene;
 use std::path::PathBuf;
 
 fn load(name: &str) -> Scene {

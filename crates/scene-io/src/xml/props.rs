@@ -6,9 +6,9 @@
 use super::doc::{Doc, Elem};
 use super::spectrum;
 use super::values::{number, numbers, transform, triple, Xform};
-use super::{LoadOptions, LoadReport};
-use crate::math::Color;
-use crate::scene::SceneError;
+use crate::SceneError;
+use crate::{LoadOptions, LoadReport};
+use lt_core::math::Color;
 use std::cell::Cell;
 
 /// Tags that are parameters (they carry `name`), as opposed to nested objects.

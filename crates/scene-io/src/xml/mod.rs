@@ -3,8 +3,7 @@
 //! In: `load_scene` reads a `.xml` file through `doc` (the XML tree with includes, defaults,
 //! `$` substitution and the 0.6 → 3 name upgrade), `values` (numbers, colours, transforms),
 //! `props` (each plugin's parameters, every one taken or reported) and `build` (the plugin subset,
-//! assembled through `SceneBuilder`). Meshes come from OBJ (the TOML path's reader) and PLY
-//! (`ply`). Out: `write::to_mitsuba_xml` writes one of our TOML scenes as Mitsuba 3 XML.
+//! assembled through `SceneBuilder`). Meshes come from `crate::mesh` (OBJ and PLY). Out: `write::to_mitsuba_xml` writes one of our TOML scenes as Mitsuba 3 XML.
 //!
 //! Where a file asks for something lt lacks but has a near equivalent of (Beckmann → GGX of the
 //! same α, a Gaussian or other pixel filter → the box, a spectrum → RGB, max_depth = -1 → 64),
@@ -14,63 +13,16 @@
 
 mod build;
 mod doc;
-mod ply;
 mod props;
 mod spectrum;
 mod values;
 pub mod write;
 
-use super::{Scene, SceneError};
+use crate::{LoadOptions, LoadReport, SceneError};
+use lt_core::Scene;
 use std::path::Path;
-use std::sync::OnceLock;
 
 pub use build::UNBOUNDED_DEPTH_SUBSTITUTE;
-
-/// How a scene file is read.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct LoadOptions {
-    /// Substitute the nearest feature lt has where a file asks for one it lacks (listed in the
-    /// report); without it such a file is refused.
-    pub approximate: bool,
-    /// Print the accepted-but-ignored parameters too (the command line's `--verbose`).
-    pub verbose: bool,
-}
-
-/// What a load changed or passed over, one line each, each starting with `file:line`.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct LoadReport {
-    /// Substitutions `--approximate` made (the image differs from Mitsuba's by these).
-    pub substitutions: Vec<String>,
-    /// Parameters accepted and ignored because they change nothing lt renders.
-    pub ignored: Vec<String>,
-}
-
-impl LoadReport {
-    /// Prints the substitutions (always) and the ignored parameters (when `verbose`) to stderr.
-    pub fn print(&self, verbose: bool) {
-        for s in &self.substitutions {
-            eprintln!("approximated: {s}");
-        }
-        if verbose {
-            for s in &self.ignored {
-                eprintln!("ignored: {s}");
-            }
-        }
-    }
-}
-
-static DEFAULT_OPTIONS: OnceLock<LoadOptions> = OnceLock::new();
-
-/// Sets the options `load_scene` uses (once per process: the command line's global flags).
-/// Returns false when they were already set.
-pub fn set_default_load_options(opts: LoadOptions) -> bool {
-    DEFAULT_OPTIONS.set(opts).is_ok()
-}
-
-/// The options `load_scene` uses: those set by `set_default_load_options`, else the defaults.
-pub fn default_load_options() -> LoadOptions {
-    DEFAULT_OPTIONS.get().copied().unwrap_or_default()
-}
 
 /// Reads a Mitsuba XML scene. `source_files` is the XML file, every included file, then every
 /// mesh file, in the order read.

@@ -1,7 +1,7 @@
 //! Bad scene files: each error class gives one message naming the file, the line (and column)
 //! when there is one, and the problem. Nothing panics.
 
-use lt_core::scene::{load_scene, load_scene_str, SceneError};
+use lt_scene_io::{load_scene, load_scene_str, SceneError};
 use std::path::{Path, PathBuf};
 
 const FILE: &str = "/nowhere/bad-scene.toml";

@@ -1,15 +1,14 @@
 //! Turns the parsed file into a `Scene` through `SceneBuilder`, checking each value on the way.
 
-use super::format::{CameraDef, LightDef, MaterialDef, SceneFile, ShapeDef, S};
-use super::load::Ctx;
-use super::transform::{check_quad, check_solid, shape_matrix};
-use super::{
-    LightDesc, RenderSettings, Scene, SceneBuilder, SceneError, ShapeGeometry, TriangleMesh,
-};
-use crate::bsdf::{Dielectric, Diffuse, Glossy, Material, Mirror};
-use crate::camera::{Camera, FovAxis};
-use crate::light::SunLight;
-use crate::math::{Color, Vec3, PI};
+use crate::error::Ctx;
+use crate::format::{CameraDef, LightDef, MaterialDef, SceneFile, ShapeDef, S};
+use crate::transform::{check_quad, check_solid, shape_matrix};
+use crate::SceneError;
+use lt_core::bsdf::{Dielectric, Diffuse, Glossy, Material, Mirror};
+use lt_core::camera::{Camera, FovAxis};
+use lt_core::light::SunLight;
+use lt_core::math::{Color, Vec3, PI};
+use lt_core::scene::{LightDesc, RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
 use std::collections::HashMap;
 
 /// GGX α below this is numerically a mirror; use `mirror` instead.
@@ -55,8 +54,16 @@ fn camera(ctx: &Ctx, c: &S<CameraDef>) -> Result<Camera, SceneError> {
             .unwrap_or(Vec3::Y);
     let fov = ctx.num(&d.fov, "fov")?;
     let [w, h] = *d.resolution.get_ref();
-    Camera::look_at(eye, target, up, fov, d.fov_axis.unwrap_or(FovAxis::X), w, h)
-        .map_err(|e| ctx.at(c.span(), format!("degenerate camera: {e}")))
+    Camera::look_at(
+        eye,
+        target,
+        up,
+        fov,
+        d.fov_axis.map_or(FovAxis::X, FovAxis::from),
+        w,
+        h,
+    )
+    .map_err(|e| ctx.at(c.span(), format!("degenerate camera: {e}")))
 }
 
 fn render(ctx: &Ctx, file: &SceneFile) -> Result<RenderSettings, SceneError> {
@@ -192,7 +199,7 @@ fn shape(
             let file = ctx.need(&d.file, "file", &def.span(), &what)?;
             let (m, span) = shape_matrix(ctx, d)?;
             check_solid(ctx, &m, span, "mesh")?;
-            let mesh = super::obj::load_obj(ctx, file)?.transformed(&m);
+            let mesh = crate::mesh::obj::load_obj(ctx, file)?.transformed(&m);
             if !((0..mesh.indices.len())
                 .map(|i| mesh.triangle_area(i))
                 .sum::<f32>()

@@ -3,8 +3,8 @@
 //! the result of the earlier ones). Transforms are composed in f64 and rounded to f32 once, like
 //! the TOML path, with exact sines and cosines at multiples of 90°.
 
-use super::super::SceneError;
 use super::doc::{Doc, Elem};
+use crate::SceneError;
 use glam::{DMat3, DMat4, DVec3};
 
 /// A number as Mitsuba writes it (surrounding spaces allowed).

@@ -2,14 +2,15 @@
 //! `nx ny nz` (kept as shading normals), and faces as `vertex_indices` (or `vertex_index`) lists,
 //! fan-triangulated. Errors point at the scene's `filename`.
 
-use crate::math::Vec3;
-use crate::scene::load::Ctx;
-use crate::scene::{SceneError, TriangleMesh};
+use crate::error::Ctx;
+use crate::SceneError;
+use lt_core::math::Vec3;
+use lt_core::scene::TriangleMesh;
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
 use toml::Spanned;
 
-pub(super) fn load_ply(ctx: &Ctx, file: &Spanned<String>) -> Result<TriangleMesh, SceneError> {
+pub(crate) fn load_ply(ctx: &Ctx, file: &Spanned<String>) -> Result<TriangleMesh, SceneError> {
     let (path, bytes) = ctx.read_mesh(file)?;
     let shown = path.display();
     let bad = |msg: String| ctx.at(file.span(), format!("malformed PLY file {shown}: {msg}"));

@@ -4,15 +4,15 @@
 use super::doc::{Doc, Elem};
 use super::props::{textures_refused, ColorUse, Ids, Plugin};
 use super::values::Xform;
-use super::{ply, LoadOptions, LoadReport};
-use crate::bsdf::{Dielectric, Diffuse, Glossy, Material, Mirror};
-use crate::camera::{Camera, FovAxis};
-use crate::math::Color;
-use crate::scene::transform::{check_quad, check_solid};
-use crate::scene::{
-    LightDesc, RenderSettings, Scene, SceneBuilder, SceneError, ShapeGeometry, TriangleMesh,
-};
+use crate::mesh::ply;
+use crate::transform::{check_quad, check_solid};
+use crate::SceneError;
+use crate::{LoadOptions, LoadReport};
 use glam::{DMat4, DVec3, DVec4, Mat4};
+use lt_core::bsdf::{Dielectric, Diffuse, Glossy, Material, Mirror};
+use lt_core::camera::{Camera, FovAxis};
+use lt_core::math::Color;
+use lt_core::scene::{LightDesc, RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
 use std::collections::HashMap;
 use std::path::PathBuf;
 
@@ -678,7 +678,7 @@ impl<'a> Loader<'a> {
                 let spanned = toml::Spanned::new(fe.range.clone(), file.to_string());
                 let path = ctx.base_dir.join(file);
                 let mut mesh = if p.kind == "obj" {
-                    crate::scene::obj::load_obj(&ctx, &spanned)?
+                    crate::mesh::obj::load_obj(&ctx, &spanned)?
                 } else {
                     ply::load_ply(&ctx, &spanned)?
                 };

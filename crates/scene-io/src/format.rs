@@ -3,7 +3,7 @@
 //! name the line. Shapes, materials and lights are flat structs with a `type` key rather than
 //! tagged enums: serde buffers tagged enums, which would lose the spans.
 
-use crate::camera::FovAxis;
+use lt_core::camera::FovAxis;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -26,6 +26,27 @@ pub struct SceneFile {
     pub lights: Vec<S<LightDef>>,
 }
 
+/// `fov_axis` as the file spells it (the core's `FovAxis` knows no file format).
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FovAxisName {
+    X,
+    Y,
+    Smaller,
+    Larger,
+}
+
+impl From<FovAxisName> for FovAxis {
+    fn from(n: FovAxisName) -> FovAxis {
+        match n {
+            FovAxisName::X => FovAxis::X,
+            FovAxisName::Y => FovAxis::Y,
+            FovAxisName::Smaller => FovAxis::Smaller,
+            FovAxisName::Larger => FovAxis::Larger,
+        }
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDef {
@@ -33,7 +54,7 @@ pub struct CameraDef {
     pub target: S<V3>,
     pub up: Option<S<V3>>,
     pub fov: S<f64>,
-    pub fov_axis: Option<FovAxis>,
+    pub fov_axis: Option<FovAxisName>,
     pub resolution: S<[u32; 2]>,
 }
 

@@ -1,0 +1,109 @@
+//! Shapes as a scene describes them, in world space: triangle meshes (with Mitsuba's rectangle
+//! and cube as meshes) and exact spheres. The scene indexes them for ray queries; area lights
+//! sample them.
+
+use crate::math::Vec3;
+
+/// A triangle mesh in world space.
+#[derive(Clone, Debug, Default)]
+pub struct TriangleMesh {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals (same length as `positions`), if the mesh has them.
+    pub normals: Option<Vec<Vec3>>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+impl TriangleMesh {
+    pub fn triangle(&self, i: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[i];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+
+    pub fn triangle_area(&self, i: usize) -> f32 {
+        let [a, b, c] = self.triangle(i);
+        0.5 * (b - a).cross(c - a).length()
+    }
+
+    /// Interpolated shading normal, if the mesh has normals and they do not cancel out.
+    pub fn shading_normal(&self, i: usize, b0: f32, b1: f32, b2: f32) -> Option<Vec3> {
+        let normals = self.normals.as_ref()?;
+        let [a, b, c] = self.indices[i];
+        let n = b0 * normals[a as usize] + b1 * normals[b as usize] + b2 * normals[c as usize];
+        (n.length_squared() > 0.0).then(|| n.normalize())
+    }
+
+    /// An axis-aligned unit square [-1,1]² in the z = 0 plane with normal +z (Mitsuba's rectangle).
+    pub fn unit_rectangle() -> TriangleMesh {
+        TriangleMesh {
+            positions: vec![
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::new(1.0, -1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(-1.0, 1.0, 0.0),
+            ],
+            normals: None,
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    /// The cube [-1,1]³ with outward normals (Mitsuba's cube).
+    pub fn unit_cube() -> TriangleMesh {
+        let mut positions = Vec::new();
+        let mut indices = Vec::new();
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                let n =
+                    Vec3::from_array(std::array::from_fn(|k| if k == axis { sign } else { 0.0 }));
+                let u = Vec3::from_array(std::array::from_fn(|k| {
+                    if k == (axis + 1) % 3 {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                }));
+                let v = n.cross(u);
+                let base = positions.len() as u32;
+                for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    positions.push(n + u * a + v * b);
+                }
+                indices.push([base, base + 1, base + 2]);
+                indices.push([base, base + 2, base + 3]);
+            }
+        }
+        TriangleMesh {
+            positions,
+            normals: None,
+            indices,
+        }
+    }
+
+    /// Applies a point transform (and its normal transform) to the mesh.
+    pub fn transformed(mut self, m: &glam::Mat4) -> TriangleMesh {
+        for p in &mut self.positions {
+            *p = m.transform_point3(*p);
+        }
+        if let Some(ns) = &mut self.normals {
+            let nm = m.inverse().transpose();
+            for n in ns.iter_mut() {
+                *n = nm.transform_vector3(*n).normalize_or_zero();
+            }
+        }
+        // A mirroring transform turns the winding inside out; keep normals where they were.
+        if m.determinant() < 0.0 {
+            for t in &mut self.indices {
+                t.swap(1, 2);
+            }
+        }
+        self
+    }
+}
+
+#[derive(Clone, Debug)]
+pub enum ShapeGeometry {
+    Mesh(TriangleMesh),
+    Sphere { center: Vec3, radius: f32 },
+}

@@ -1,0 +1,38 @@
+//! The TOML scene format (docs/scene-format.md): text → `SceneFile` (format.rs) → `Scene`
+//! (elements.rs).
+
+use crate::error::Ctx;
+use crate::format::SceneFile;
+use crate::SceneError;
+use lt_core::Scene;
+use std::path::Path;
+
+pub(crate) fn load_toml(path: &Path) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        file: path.display().to_string(),
+        line: None,
+        column: None,
+        message: format!("cannot read the scene file: {e}"),
+    })?;
+    load_scene_str(&text, path)
+}
+
+/// Parses scene text; `path` names the file in errors and anchors relative mesh paths.
+pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let ctx = Ctx {
+        file: path.display().to_string(),
+        text,
+        base_dir,
+    };
+    let file: SceneFile = toml::from_str(text).map_err(|e| match e.span() {
+        Some(span) => ctx.at(span, e.message().trim_end().to_string()),
+        None => ctx.whole(e.message().trim_end().to_string()),
+    })?;
+    let mut scene = crate::elements::assemble(&ctx, &file)?;
+    let meshes = file.shapes.iter().filter_map(|s| s.get_ref().file.as_ref());
+    scene.source_files = std::iter::once(path.to_path_buf())
+        .chain(meshes.map(|f| ctx.base_dir.join(f.get_ref())))
+        .collect();
+    Ok(scene)
+}
