@@ -1,10 +1,11 @@
 //! Smooth dielectric (glass): specular reflection with probability F (exact unpolarised Fresnel)
 //! and specular refraction with probability 1 − F. Both lobes are deltas.
 //!
-//! Radiance mode divides refracted throughput by η² (η = η_wi-side / η_wo-side), because radiance
-//! is compressed into the narrower cone on entering the denser medium; importance is not
-//! (pbrt-v4's convention, Veach 1997 §5.2).
+//! Refracted throughput takes `refraction::refracted_throughput_scale` (1/η² for radiance, 1 for
+//! importance).
 
+use super::fresnel::fresnel_dielectric;
+use super::refraction::refracted_throughput_scale;
 use super::{LocalBsdf, LocalSample, TransportMode};
 use crate::math::{Color, Vec2, Vec3};
 
@@ -12,21 +13,6 @@ use crate::math::{Color, Vec2, Vec3};
 pub struct Dielectric {
     /// Index of refraction inside relative to outside (the side the normal points to).
     pub ior: f32,
-}
-
-/// Unpolarised Fresnel reflectance for light meeting the interface at `cos_i` (> 0) with relative
-/// IOR `eta` = η_t / η_i. Returns (F, cos θt); F = 1 and cos θt = 0 under total internal reflection.
-pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> (f32, f32) {
-    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
-    let sin2_t = sin2_i / (eta * eta);
-    if sin2_t >= 1.0 {
-        return (1.0, 0.0);
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    // Amplitude coefficients with both numerator and denominator divided by η_i.
-    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    (0.5 * (r_perp * r_perp + r_par * r_par), cos_t)
 }
 
 impl Dielectric {
@@ -60,10 +46,7 @@ impl LocalBsdf for Dielectric {
             });
         }
         let wi = Vec3::new(-wo.x / eta, -wo.y / eta, -cos_t.copysign(wo.z));
-        let scale = match mode {
-            TransportMode::Radiance => 1.0 / (eta * eta),
-            TransportMode::Importance => 1.0,
-        };
+        let scale = refracted_throughput_scale(eta, mode);
         // Fresnel is symmetric (F(θt, 1/η) = F(θi, η)), so the reverse refraction has the same 1 − F.
         let t = 1.0 - f;
         Some(LocalSample {

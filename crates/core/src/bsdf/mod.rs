@@ -13,15 +13,24 @@
 //!   given `wi`. For a delta lobe both are the discrete probability of choosing that lobe and
 //!   `delta` is set; `eval` and `pdf` return zero for delta lobes.
 
+mod conductor;
+pub mod conductor_ior;
 mod dielectric;
 mod diffuse;
+pub mod fresnel;
 mod glossy;
+pub mod microfacet;
 mod mirror;
+mod quadrature;
+pub mod refraction;
+mod rough_conductor;
 
+pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use glossy::Glossy;
 pub use mirror::Mirror;
+pub use rough_conductor::RoughConductor;
 
 use crate::math::{Color, Frame, Vec2, Vec3};
 
@@ -102,6 +111,8 @@ pub enum Material {
     Mirror(Mirror),
     Dielectric(Dielectric),
     Glossy(Glossy),
+    Conductor(Conductor),
+    RoughConductor(RoughConductor),
 }
 
 impl Material {
@@ -112,6 +123,8 @@ impl Material {
             Material::Mirror(m) => m,
             Material::Dielectric(m) => m,
             Material::Glossy(m) => m,
+            Material::Conductor(m) => m,
+            Material::RoughConductor(m) => m,
         }
     }
 
@@ -214,6 +227,15 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
         })
     };
     let glass = |ior| Material::Dielectric(Dielectric { ior });
+    let gold = conductor_ior::named_conductor("Au").expect("Mitsuba names gold Au");
+    let rough_gold = |kind, alpha_u, alpha_v, sample_visible| {
+        Material::RoughConductor(RoughConductor {
+            distribution: microfacet::Microfacet::new(kind, alpha_u, alpha_v, sample_visible),
+            ior: gold,
+            specular_reflectance: Color::new(1.0, 0.8, 0.9),
+        })
+    };
+    use microfacet::MicrofacetType::{Beckmann, Ggx};
     vec![
         ("diffuse", Material::Diffuse(Diffuse { albedo: c })),
         ("mirror", Material::Mirror(Mirror { reflectance: c })),
@@ -224,5 +246,38 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
         ("glass-1.5", glass(1.5)),
         ("glass-1/1.5", glass(1.0 / 1.5)),
         ("glass-2.4", glass(2.4)),
+        (
+            "conductor-Au",
+            Material::Conductor(Conductor {
+                ior: gold,
+                specular_reflectance: Color::new(1.0, 0.8, 0.9),
+            }),
+        ),
+        (
+            "roughconductor-beckmann-0.05",
+            rough_gold(Beckmann, 0.05, 0.05, true),
+        ),
+        (
+            "roughconductor-beckmann-0.3",
+            rough_gold(Beckmann, 0.3, 0.3, true),
+        ),
+        (
+            "roughconductor-beckmann-0.1x0.4",
+            rough_gold(Beckmann, 0.1, 0.4, true),
+        ),
+        (
+            "roughconductor-beckmann-0.3-all",
+            rough_gold(Beckmann, 0.3, 0.3, false),
+        ),
+        ("roughconductor-ggx-0.05", rough_gold(Ggx, 0.05, 0.05, true)),
+        ("roughconductor-ggx-0.3", rough_gold(Ggx, 0.3, 0.3, true)),
+        (
+            "roughconductor-ggx-0.4x0.1",
+            rough_gold(Ggx, 0.4, 0.1, true),
+        ),
+        (
+            "roughconductor-ggx-0.2x0.5-all",
+            rough_gold(Ggx, 0.2, 0.5, false),
+        ),
     ]
 }
