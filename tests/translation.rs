@@ -65,3 +65,78 @@ fn mean(b: &lt_estimators::blocks::RunningBlocks) -> f64 {
     let e = b.estimate();
     e.mean.iter().flatten().sum::<f64>() / (3 * e.regions()) as f64
 }
+
+/// The same scene *file* placed far from the origin: the XML Cornell box with every shape's and
+/// the sensor's `to_world` followed by a translation of `offset` on every axis. The loader
+/// composes and applies transforms in f64 and subtracts the scene's origin before its one
+/// rounding to f32, so the geometry it builds is the geometry at the origin, merely moved; a
+/// loader that rounded world coordinates first moves vertices by up to half an f32 spacing
+/// (≈ 5e-4 at 1e4, ≈ 3e-2 at 1e6) and the light grows or shrinks with them.
+fn cornell_file_at(offset: f64, dir: &std::path::Path) -> lt_core::Scene {
+    let src = lt_tests::scenes_dir().join("xml/cornell-box.xml");
+    let text = std::fs::read_to_string(&src).unwrap().replace(
+        r#"<default name="res" value="256"/>"#,
+        r#"<default name="res" value="64"/>"#,
+    );
+    let o = format!("{offset:?}");
+    // The sensor's look-at moves by hand; every shape's to_world gains a translate.
+    let (sensor, shapes) = text.split_at(text.find("</sensor>").unwrap());
+    let sensor = sensor.replace(
+        r#"<lookat origin="0, 0, 3.9" target="0, 0, 0" up="0, 1, 0"/>"#,
+        &format!(
+            r#"<lookat origin="{o}, {o}, {:?}" target="{o}, {o}, {o}" up="0, 1, 0"/>"#,
+            offset + 3.9
+        ),
+    );
+    let shapes = shapes.replace(
+        "</transform>",
+        &format!(r#"<translate value="{o}, {o}, {o}"/></transform>"#),
+    );
+    let moved = sensor + &shapes;
+    assert!(
+        offset == 0.0 || moved.matches("<translate value").count() >= 8,
+        "{moved}"
+    );
+    let path = dir.join(format!("cornell-{offset:e}.xml"));
+    std::fs::write(&path, moved).unwrap();
+    let (scene, _) =
+        lt_scene_io::load_scene_with(&path, &Default::default()).unwrap_or_else(|e| panic!("{e}"));
+    scene
+}
+
+#[test]
+fn cornell_box_file_translated_far_away_renders_the_same() {
+    let dir = std::env::temp_dir().join(format!("lt-translation-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let base_scene = cornell_file_at(0.0, &dir);
+    assert_eq!(base_scene.origin, Vec3::ZERO);
+    let mut failures = Vec::new();
+    for name in CHECKED {
+        let n = passes(name);
+        let (_, base) = render_blocks(&base_scene, name, IntegratorParams::default(), n, 31, 8);
+        for offset in [1e4, 1e6] {
+            let moved = cornell_file_at(offset, &dir);
+            assert_ne!(
+                moved.origin,
+                Vec3::ZERO,
+                "the loader recentres at {offset:e}"
+            );
+            let (r, blocks) = render_blocks(&moved, name, IntegratorParams::default(), n, 32, 8);
+            assert_eq!(
+                r.invalid_samples, 0,
+                "{name}: invalid samples at {offset:e}"
+            );
+            let (m0, m1) = (mean(&base), mean(&blocks));
+            let result = agreement_t(&base, &blocks, 1e-3);
+            eprintln!(
+                "file, {name} at {offset:e}: image mean ratio {:.5}, {result}",
+                m1 / m0
+            );
+            if !result.passed() {
+                failures.push(format!("file translated by {offset:e}, {name}: {result}"));
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

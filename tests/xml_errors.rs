@@ -552,3 +552,30 @@ fn xml_version_0_6_names_are_upgraded() {
     assert_eq!((a.o, a.d), (b.o, b.d));
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Geometry that overflows f32 (or is not finite) is one clear error at the shape's transform,
+/// not a panic inside the BVH builder (a `to_world` entry of 1e38 once panicked in obvhs).
+#[test]
+fn xml_overflowing_geometry_is_one_clear_error() {
+    let d = dir("overflow");
+    for (entry, what) in [("1e38", "1e38"), ("3e18", "3e18")] {
+        let text = scene_xml(&format!(
+            "    <shape type=\"rectangle\">\n        <transform name=\"to_world\">\n            <matrix value=\"1 0 0 {entry}  0 1 0 0  0 0 1 0  0 0 0 1\"/>\n        </transform>\n    </shape>"
+        ));
+        fails(
+            &d,
+            &text,
+            line_of(&text, "rectangle") + 1,
+            &["world coordinates", "finite", what],
+        );
+    }
+    let text = scene_xml(
+        "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"0, 2e18, 0\"/>\n    </shape>",
+    );
+    fails(
+        &d,
+        &text,
+        line_of(&text, "sphere"),
+        &["the sphere", "world coordinates"],
+    );
+}

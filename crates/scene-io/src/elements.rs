@@ -3,21 +3,24 @@
 use crate::error::Ctx;
 use crate::format::{CameraDef, LightDef, MaterialDef, SceneFile, ShapeDef, S};
 use crate::transform::{check_quad, check_solid, shape_matrix};
+use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
 use crate::SceneError;
+use glam::DVec3;
 use lt_core::bsdf::{Dielectric, Diffuse, Glossy, Material, Mirror};
 use lt_core::camera::{Camera, FovAxis};
 use lt_core::light::SunLight;
-use lt_core::math::{Color, Vec3, PI};
-use lt_core::scene::{LightDesc, RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
+use lt_core::math::{Color, PI};
+use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
 use std::collections::HashMap;
 
 /// GGX α below this is numerically a mirror; use `mirror` instead.
 const MIN_ROUGHNESS: f32 = 1e-4;
 
 pub fn assemble(ctx: &Ctx, file: &SceneFile) -> Result<Scene, SceneError> {
-    let camera = camera(ctx, &file.camera)?;
+    // Checked here, at the origin, so that a degenerate camera is the error reported first.
+    camera(ctx, &file.camera, DVec3::ZERO)?;
     let settings = render(ctx, file)?;
-    let mut b = SceneBuilder::new(camera, settings);
+    let mut b = WorldBuilder::new(settings);
     let mut ids = HashMap::new();
     // In file order, so ids and the first error reported follow the file.
     let mut materials: Vec<_> = file.materials.iter().collect();
@@ -30,39 +33,40 @@ pub fn assemble(ctx: &Ctx, file: &SceneFile) -> Result<Scene, SceneError> {
         emitters += shape(ctx, def, &ids, &mut b)? as usize;
     }
     for def in &file.lights {
-        if let Some(l) = light(ctx, def)? {
-            b.add_light(l);
-            emitters += 1;
+        match light(ctx, def)? {
+            Some(Placed::At(position, intensity)) => b.add_point_light(position, intensity),
+            Some(Placed::Anywhere(l)) => b.add_light(l),
+            None => continue,
         }
+        emitters += 1;
     }
     if emitters == 0 {
         return Err(ctx.whole(
             "the scene has no light: give a shape a non-zero `emission` or add a [[lights]] entry",
         ));
     }
-    Ok(b.build())
+    b.build(|origin| camera(ctx, &file.camera, origin))
 }
 
-fn camera(ctx: &Ctx, c: &S<CameraDef>) -> Result<Camera, SceneError> {
+/// The camera as the file places it, with its eye and target as world − `origin`.
+fn camera(ctx: &Ctx, c: &S<CameraDef>, origin: DVec3) -> Result<Camera, SceneError> {
     let d = c.get_ref();
-    let eye = ctx.vec3(&d.eye, "eye")?;
-    let target = ctx.vec3(&d.target, "target")?;
     let up =
         d.up.as_ref()
-            .map(|u| ctx.vec3(u, "up"))
+            .map(|u| ctx.dvec3(u, "up"))
             .transpose()?
-            .unwrap_or(Vec3::Y);
-    let fov = ctx.num(&d.fov, "fov")?;
-    let [w, h] = *d.resolution.get_ref();
-    Camera::look_at(
-        eye,
-        target,
+            .unwrap_or(DVec3::Y);
+    let [width, height] = *d.resolution.get_ref();
+    LookAt {
+        eye: ctx.dvec3(&d.eye, "eye")?,
+        target: ctx.dvec3(&d.target, "target")?,
         up,
-        fov,
-        d.fov_axis.map_or(FovAxis::X, FovAxis::from),
-        w,
-        h,
-    )
+        fov_deg: ctx.num(&d.fov, "fov")?,
+        fov_axis: d.fov_axis.map_or(FovAxis::X, FovAxis::from),
+        width,
+        height,
+    }
+    .at(origin)
     .map_err(|e| ctx.at(c.span(), format!("degenerate camera: {e}")))
 }
 
@@ -156,7 +160,7 @@ fn shape(
     ctx: &Ctx,
     def: &S<ShapeDef>,
     ids: &HashMap<&str, u32>,
-    b: &mut SceneBuilder,
+    b: &mut WorldBuilder,
 ) -> Result<bool, SceneError> {
     let d = def.get_ref();
     let kind = d.kind.get_ref().as_str();
@@ -174,20 +178,27 @@ fn shape(
     let geometry = match kind {
         "sphere" => {
             ctx.only(&given, &["center", "radius"], &what)?;
-            let center = ctx.vec3(ctx.need(&d.center, "center", &def.span(), &what)?, "center")?;
+            let center = ctx.dvec3(ctx.need(&d.center, "center", &def.span(), &what)?, "center")?;
             let radius =
                 ctx.positive(ctx.need(&d.radius, "radius", &def.span(), &what)?, "radius")?;
-            ShapeGeometry::Sphere { center, radius }
+            WorldGeometry::Sphere {
+                center,
+                radius: radius.into(),
+            }
         }
         "quad" | "cube" => {
             ctx.only(&given, &PLACED, &what)?;
             let (m, span) = shape_matrix(ctx, d)?;
             if kind == "quad" {
-                check_quad(ctx, &m, span)?;
-                ShapeGeometry::Mesh(TriangleMesh::unit_rectangle().transformed(&m))
+                check_quad(ctx, &m, span.clone())?;
+                placed(
+                    ctx,
+                    span,
+                    WorldMesh::place(&TriangleMesh::unit_rectangle(), &m),
+                )?
             } else {
-                check_solid(ctx, &m, span, "cube")?;
-                ShapeGeometry::Mesh(TriangleMesh::unit_cube().transformed(&m))
+                check_solid(ctx, &m, span.clone(), "cube")?;
+                placed(ctx, span, WorldMesh::place(&TriangleMesh::unit_cube(), &m))?
             }
         }
         "mesh" => {
@@ -198,19 +209,16 @@ fn shape(
             )?;
             let file = ctx.need(&d.file, "file", &def.span(), &what)?;
             let (m, span) = shape_matrix(ctx, d)?;
-            check_solid(ctx, &m, span, "mesh")?;
-            let mesh = crate::mesh::obj::load_obj(ctx, file)?.transformed(&m);
-            if !((0..mesh.indices.len())
-                .map(|i| mesh.triangle_area(i))
-                .sum::<f32>()
-                > 0.0)
-            {
+            check_solid(ctx, &m, span.clone(), "mesh")?;
+            let local = crate::mesh::obj::load_obj(ctx, file)?;
+            let mesh = placed(ctx, span, WorldMesh::place(&local, &m))?;
+            if !matches!(&mesh, WorldGeometry::Mesh(m) if m.area() > 0.0) {
                 return Err(ctx.at(
                     file.span(),
                     "the mesh has zero area (every triangle is degenerate)",
                 ));
             }
-            ShapeGeometry::Mesh(mesh)
+            mesh
         }
         other => {
             return Err(ctx.at(
@@ -244,8 +252,26 @@ fn shape(
     Ok(emits)
 }
 
+/// A mesh placed in the world whose every vertex is in range, else an error at `span`.
+fn placed(
+    ctx: &Ctx,
+    span: std::ops::Range<usize>,
+    mesh: WorldMesh,
+) -> Result<WorldGeometry, SceneError> {
+    match mesh.out_of_range() {
+        Some(p) => Err(ctx.at(span, out_of_range_message("the transformed shape", p))),
+        None => Ok(WorldGeometry::Mesh(mesh)),
+    }
+}
+
+/// A light with a world position (kept in f64 until the one rounding) or without one.
+enum Placed {
+    At(DVec3, Color),
+    Anywhere(LightDesc),
+}
+
 /// The light, or None when it emits nothing.
-fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<LightDesc>, SceneError> {
+fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
     let d = def.get_ref();
     let kind = d.kind.get_ref().as_str();
     let what = format!("a {kind} light");
@@ -262,16 +288,13 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<LightDesc>, SceneError> 
         "point" => {
             ctx.only(&given, &["position", "intensity"], &what)?;
             let position =
-                ctx.vec3(ctx.need(&d.position, "position", &span, &what)?, "position")?;
+                ctx.dvec3(ctx.need(&d.position, "position", &span, &what)?, "position")?;
             let intensity = ctx.color(
                 ctx.need(&d.intensity, "intensity", &span, &what)?,
                 "intensity",
                 false,
             )?;
-            LightDesc::Point {
-                position,
-                intensity,
-            }
+            return Ok((intensity.max_element() > 0.0).then_some(Placed::At(position, intensity)));
         }
         "sun" => {
             ctx.only(
@@ -381,5 +404,5 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<LightDesc>, SceneError> 
         | LightDesc::Directional { irradiance: c, .. }
         | LightDesc::Environment { radiance: c } => c.max_element(),
     };
-    Ok((power > 0.0).then_some(desc))
+    Ok((power > 0.0).then_some(Placed::Anywhere(desc)))
 }

@@ -1,6 +1,7 @@
 //! One error type for every scene file, and the context that turns a byte span into file:line:col.
 
 use crate::format::{ColorDef, S, V3};
+use glam::DVec3;
 use lt_core::math::{Color, Vec3};
 use std::ops::Range;
 use std::path::PathBuf;
@@ -116,6 +117,18 @@ impl Ctx<'_> {
             ));
         }
         Ok(Vec3::from_array(a))
+    }
+
+    /// A world position, kept in f64 until `world.rs` rounds it once; finite and within range.
+    pub fn dvec3(&self, v: &S<V3>, key: &str) -> Result<DVec3, SceneError> {
+        let p = DVec3::from_array(*v.get_ref());
+        if !crate::world::in_range(p) {
+            return Err(self.at(
+                v.span(),
+                crate::world::out_of_range_message(&format!("`{key}`"), p),
+            ));
+        }
+        Ok(p)
     }
 
     /// A finite, non-negative colour; with `at_most_one`, a reflectance that conserves energy.

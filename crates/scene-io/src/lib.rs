@@ -12,6 +12,7 @@ mod mesh;
 mod options;
 mod toml_file;
 mod transform;
+mod world;
 pub mod xml;
 
 pub use error::SceneError;

@@ -1,18 +1,19 @@
 //! Shape transforms: Mitsuba's `to_world` matrix, or `scale`, then `rotate`, then `translate`.
-//! Composed in f64 and rounded to f32 once, so quads and cubes placed with round numbers meet
-//! exactly at shared edges (rotations by multiples of 90° use exact sines and cosines).
+//! Composed and applied in f64 (`world.rs` rounds each position once), so quads and cubes placed
+//! with round numbers meet exactly at shared edges (rotations by multiples of 90° use exact sines
+//! and cosines).
 
 use crate::error::Ctx;
 use crate::format::{ShapeDef, S};
 use crate::SceneError;
-use glam::{DMat3, DMat4, DVec3, Mat4};
+use glam::{DMat3, DMat4, DVec3};
 
 /// The shape's object-to-world matrix (identity when it gives no transform keys), with the span a
 /// degenerate-transform error should point at (`to_world` or `scale`, else the shape's `type`).
 pub fn shape_matrix(
     ctx: &Ctx,
     def: &ShapeDef,
-) -> Result<(Mat4, std::ops::Range<usize>), SceneError> {
+) -> Result<(DMat4, std::ops::Range<usize>), SceneError> {
     if let Some(m) = &def.to_world {
         let trs = [
             def.translate.as_ref().map(S::span),
@@ -36,10 +37,7 @@ pub fn shape_matrix(
             ));
         }
         // Rows as written, acting on column vectors (Mitsuba's convention).
-        return Ok((
-            DMat4::from_cols_array_2d(rows).transpose().as_mat4(),
-            m.span(),
-        ));
+        return Ok((DMat4::from_cols_array_2d(rows).transpose(), m.span()));
     }
     let mut m = DMat4::IDENTITY;
     let mut span = def.kind.span();
@@ -69,7 +67,7 @@ pub fn shape_matrix(
         }
         m = DMat4::from_translation(v) * m;
     }
-    Ok((m.as_mat4(), span))
+    Ok((m, span))
 }
 
 /// Rodrigues' rotation about a unit axis, counter-clockwise by `deg` degrees.
@@ -97,11 +95,8 @@ fn sin_cos_deg(deg: f64) -> (f64, f64) {
 }
 
 /// Rejects transforms that squash a quad to zero area (only the quad's own plane matters).
-pub fn check_quad(ctx: &Ctx, m: &Mat4, span: std::ops::Range<usize>) -> Result<(), SceneError> {
-    let (u, v) = (
-        m.x_axis.truncate().as_dvec3(),
-        m.y_axis.truncate().as_dvec3(),
-    );
+pub fn check_quad(ctx: &Ctx, m: &DMat4, span: std::ops::Range<usize>) -> Result<(), SceneError> {
+    let (u, v) = (m.x_axis.truncate(), m.y_axis.truncate());
     let area = u.cross(v).length();
     if !(area > 1e-9 * u.length() * v.length()) || !(area > 0.0) {
         return Err(ctx.at(span, "degenerate transform: the quad has zero area"));
@@ -112,11 +107,11 @@ pub fn check_quad(ctx: &Ctx, m: &Mat4, span: std::ops::Range<usize>) -> Result<(
 /// Rejects transforms that flatten a solid (a cube or a mesh) onto a plane, line or point.
 pub fn check_solid(
     ctx: &Ctx,
-    m: &Mat4,
+    m: &DMat4,
     span: std::ops::Range<usize>,
     what: &str,
 ) -> Result<(), SceneError> {
-    let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.truncate().as_dvec3());
+    let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.truncate());
     let det = DMat3::from_cols(cols[0], cols[1], cols[2]).determinant();
     let scale = cols[0].length() * cols[1].length() * cols[2].length();
     if !(det.abs() > 1e-9 * scale) || !(scale > 0.0) {

@@ -80,6 +80,8 @@ pub struct SceneBuilder {
     materials: Vec<Material>,
     shapes: Vec<(ShapeGeometry, u32, Option<Color>, bool)>,
     lights: Vec<LightDesc>,
+    /// Set by a loader that recentred in f64 itself (`set_origin`).
+    origin: Option<Vec3>,
 }
 
 impl SceneBuilder {
@@ -90,7 +92,15 @@ impl SceneBuilder {
             materials: Vec::new(),
             shapes: Vec::new(),
             lights: Vec::new(),
+            origin: None,
         }
+    }
+
+    /// Declares every position given (shapes, point lights, the camera eye) to be world − `origin`
+    /// already: a file loader that subtracted the origin in f64 before its one rounding to f32
+    /// (`lt-scene-io`'s `WorldBuilder`). `build` then keeps the geometry exactly as given.
+    pub fn set_origin(&mut self, origin: Vec3) {
+        self.origin = Some(origin);
     }
 
     /// Returns the material's id for `add_shape`.
@@ -119,8 +129,8 @@ impl SceneBuilder {
     /// and the camera eye are stored as world − origin (see `Scene::origin`); directions (sun,
     /// directional light, environment, shading normals) are unchanged.
     pub fn build(mut self) -> Scene {
-        let origin = scene_origin(&self.shapes);
-        if origin != Vec3::ZERO {
+        let origin = self.origin.unwrap_or_else(|| scene_origin(&self.shapes));
+        if self.origin.is_none() && origin != Vec3::ZERO {
             for (geometry, ..) in &mut self.shapes {
                 match geometry {
                     ShapeGeometry::Mesh(m) => m.positions.iter_mut().for_each(|p| *p -= origin),

@@ -6,13 +6,14 @@ use super::props::{textures_refused, ColorUse, Ids, Plugin};
 use super::values::Xform;
 use crate::mesh::ply;
 use crate::transform::{check_quad, check_solid};
+use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
 use crate::SceneError;
 use crate::{LoadOptions, LoadReport};
-use glam::{DMat4, DVec3, DVec4, Mat4};
+use glam::{DMat4, DVec3, DVec4};
 use lt_core::bsdf::{Dielectric, Diffuse, Glossy, Material, Mirror};
-use lt_core::camera::{Camera, FovAxis};
+use lt_core::camera::FovAxis;
 use lt_core::math::Color;
-use lt_core::scene::{LightDesc, RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
+use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
 use std::collections::HashMap;
 use std::path::PathBuf;
 
@@ -142,7 +143,7 @@ pub(super) fn load(
         rr_depth,
         spp,
     };
-    let mut b = SceneBuilder::new(camera, settings);
+    let mut b = WorldBuilder::new(settings);
     // Top-level BSDFs first, in document order, so each is checked even when unused.
     for c in by_tag("bsdf") {
         l.material(c, &mut b)?;
@@ -152,10 +153,17 @@ pub(super) fn load(
         match c.tag.as_str() {
             "shape" => emitters += l.shape(c, &mut b)? as usize,
             "emitter" => {
-                if let Some(desc) = l.emitter(c)? {
-                    b.add_light(desc);
-                    emitters += 1;
+                match l.emitter(c)? {
+                    Some((desc, Some(position))) => {
+                        let LightDesc::Point { intensity, .. } = desc else {
+                            unreachable!("only point lights carry a position")
+                        };
+                        b.add_point_light(position, intensity);
+                    }
+                    Some((desc, None)) => b.add_light(desc),
+                    None => continue,
                 }
+                emitters += 1;
             }
             _ => {}
         }
@@ -167,7 +175,12 @@ pub(super) fn load(
         ));
     }
     let Loader { report, meshes, .. } = l;
-    Ok((b.build(), report, meshes))
+    let scene = b.build(|origin| {
+        camera
+            .at(origin)
+            .map_err(|m| doc.err(sensor, format!("degenerate camera: {m}")))
+    })?;
+    Ok((scene, report, meshes))
 }
 
 impl<'a> Loader<'a> {
@@ -197,7 +210,7 @@ impl<'a> Loader<'a> {
 
     // ---------------------------------------------------------------- sensor, film, sampler
 
-    fn sensor(&mut self, e: &'a Elem) -> Result<(Camera, u32), SceneError> {
+    fn sensor(&mut self, e: &'a Elem) -> Result<(LookAt, u32), SceneError> {
         let p = self.plugin(e)?;
         if p.kind != "perspective" {
             return Err(p.err(
@@ -281,8 +294,18 @@ impl<'a> Loader<'a> {
             )) => (o, t, u),
             Some((Xform { m, .. }, te)) => camera_frame(&p, &m, te)?,
         };
-        let f32v = |v: DVec3| v.as_vec3();
-        let camera = Camera::look_at(f32v(eye), f32v(target), f32v(up), fov as f32, axis, w, h)
+        let camera = LookAt {
+            eye,
+            target,
+            up,
+            fov_deg: fov as f32,
+            fov_axis: axis,
+            width: w,
+            height: h,
+        };
+        // Checked at the world origin now, so that a degenerate camera is reported in file order.
+        camera
+            .at(DVec3::ZERO)
             .map_err(|m| p.err(e, format!("degenerate camera: {m}")))?;
         p.finish(&SENSOR_IGNORED, &mut self.report)?;
         Ok((camera, spp))
@@ -446,7 +469,7 @@ impl<'a> Loader<'a> {
     // ---------------------------------------------------------------- BSDFs
 
     /// The material id of a BSDF element (converted once, however often it is referenced).
-    fn material(&mut self, e: &'a Elem, b: &mut SceneBuilder) -> Result<u32, SceneError> {
+    fn material(&mut self, e: &'a Elem, b: &mut WorldBuilder) -> Result<u32, SceneError> {
         let key = e as *const Elem;
         if let Some(&id) = self.materials.get(&key) {
             return Ok(id);
@@ -620,7 +643,7 @@ impl<'a> Loader<'a> {
     // ---------------------------------------------------------------- shapes
 
     /// Adds the shape; returns whether it emits.
-    fn shape(&mut self, e: &'a Elem, b: &mut SceneBuilder) -> Result<bool, SceneError> {
+    fn shape(&mut self, e: &'a Elem, b: &mut WorldBuilder) -> Result<bool, SceneError> {
         let p = self.plugin(e)?;
         let doc = self.doc;
         let xform = p.transform("to_world")?;
@@ -630,15 +653,18 @@ impl<'a> Loader<'a> {
             Some((x, te)) => (x.m, te.range.clone()),
             None => (DMat4::IDENTITY, e.range.clone()),
         };
-        let m32: Mat4 = m.as_mat4();
+        let placed = |mesh: WorldMesh, span: std::ops::Range<usize>| match mesh.out_of_range() {
+            Some(p) => Err(ctx.at(span, out_of_range_message("the transformed shape", p))),
+            None => Ok(WorldGeometry::Mesh(mesh)),
+        };
         let geometry = match p.kind {
             "rectangle" => {
-                check_quad(&ctx, &m32, span)?;
-                ShapeGeometry::Mesh(TriangleMesh::unit_rectangle().transformed(&m32))
+                check_quad(&ctx, &m, span.clone())?;
+                placed(WorldMesh::place(&TriangleMesh::unit_rectangle(), &m), span)?
             }
             "cube" => {
-                check_solid(&ctx, &m32, span, "cube")?;
-                ShapeGeometry::Mesh(TriangleMesh::unit_cube().transformed(&m32))
+                check_solid(&ctx, &m, span.clone(), "cube")?;
+                placed(WorldMesh::place(&TriangleMesh::unit_cube(), &m), span)?
             }
             "sphere" => {
                 let c = DVec3::from_array(p.vec3("center")?.unwrap_or([0.0; 3]));
@@ -655,26 +681,26 @@ impl<'a> Loader<'a> {
                         (x.m.transform_point3(c), r * s)
                     }
                 };
-                ShapeGeometry::Sphere {
-                    center: center.as_vec3(),
-                    radius: radius as f32,
+                if !crate::world::in_range(center) || !(radius as f32).is_finite() {
+                    return Err(p.err(e, out_of_range_message("the sphere", center + radius)));
                 }
+                WorldGeometry::Sphere { center, radius }
             }
             "disk" => {
-                check_quad(&ctx, &m32, span)?;
+                check_quad(&ctx, &m, span.clone())?;
                 self.substitute(
                     e,
                     "the analytic disk is not supported (lt has no disk primitive)".into(),
                     format!("use a {DISK_SIDES}-gon inscribed in it (area {:.1e} smaller)", disk_area_deficit()),
                 )?;
-                ShapeGeometry::Mesh(unit_disk_fan().transformed(&m32))
+                placed(WorldMesh::place(&unit_disk_fan(), &m), span)?
             }
             "obj" | "ply" => {
                 let Some((file, fe)) = p.string("filename")? else {
                     return Err(p.err(e, format!("shape `{}` needs a `filename`", p.kind)));
                 };
                 let face_normals = p.boolean("face_normals")?.unwrap_or(false);
-                check_solid(&ctx, &m32, span, "mesh")?;
+                check_solid(&ctx, &m, span.clone(), "mesh")?;
                 let spanned = toml::Spanned::new(fe.range.clone(), file.to_string());
                 let path = ctx.base_dir.join(file);
                 let mut mesh = if p.kind == "obj" {
@@ -689,11 +715,11 @@ impl<'a> Loader<'a> {
                     // Mitsuba shades a mesh without normals smoothly, with normals it computes.
                     mesh.normals = Some(vertex_normals(&mesh));
                 }
-                let mesh = mesh.transformed(&m32);
-                if !((0..mesh.indices.len()).map(|i| mesh.triangle_area(i)).sum::<f32>() > 0.0) {
+                let mesh = WorldMesh::place(&mesh, &m);
+                if !(mesh.area() > 0.0) {
                     return Err(p.err(fe, "the mesh has zero area (every triangle is degenerate)"));
                 }
-                ShapeGeometry::Mesh(mesh)
+                placed(mesh, span)?
             }
             other => {
                 return Err(p.err(
@@ -748,7 +774,8 @@ impl<'a> Loader<'a> {
 
     // ---------------------------------------------------------------- emitters
 
-    fn emitter(&mut self, e: &'a Elem) -> Result<Option<LightDesc>, SceneError> {
+    /// The light and, for a point light, its world position in f64 (`WorldBuilder` rounds it).
+    fn emitter(&mut self, e: &'a Elem) -> Result<Option<(LightDesc, Option<DVec3>)>, SceneError> {
         let p = self.plugin(e)?;
         let opts = self.opts;
         let desc = match p.kind {
@@ -766,10 +793,16 @@ impl<'a> Loader<'a> {
                     (None, Some((x, _))) => x.m.transform_point3(DVec3::ZERO),
                     (None, None) => DVec3::ZERO,
                 };
-                LightDesc::Point {
-                    position: position.as_vec3(),
-                    intensity,
+                if !crate::world::in_range(position) {
+                    return Err(p.err(e, out_of_range_message("the point light", position)));
                 }
+                return Ok((intensity.max_element() > 0.0).then_some((
+                    LightDesc::Point {
+                        position: glam::Vec3::ZERO,
+                        intensity,
+                    },
+                    Some(position),
+                )));
             }
             "constant" => LightDesc::Environment {
                 radiance: p
@@ -817,7 +850,7 @@ impl<'a> Loader<'a> {
             | LightDesc::Environment { radiance: c }
             | LightDesc::Sun { radiance: c, .. } => c.max_element(),
         };
-        Ok((power > 0.0).then_some(desc))
+        Ok((power > 0.0).then_some((desc, None)))
     }
 }
 

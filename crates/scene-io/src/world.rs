@@ -1,0 +1,245 @@
+//! The one rounding to f32. Both loaders describe the scene in f64 world coordinates — numbers
+//! parsed in f64, transforms composed and applied in f64 — and `WorldBuilder::build` picks the
+//! scene's origin in f64 and rounds every position once, as world − origin. A scene translated
+//! far from the world origin is therefore the same scene to the last bit of its f32 geometry:
+//! rounding a far world coordinate first (at 1e4 an f32 has ~1e-3 absolute spacing) would have
+//! moved every vertex by up to that much, growing or shrinking lights by a measurable fraction.
+
+use crate::SceneError;
+use glam::{DMat3, DMat4, DVec3};
+use lt_core::bsdf::Material;
+use lt_core::camera::{Camera, FovAxis};
+use lt_core::light::LightDesc;
+use lt_core::math::{Color, Vec3};
+use lt_core::scene::{RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
+
+/// Largest world coordinate a scene may hold. f32 products of two coordinates (squared distances,
+/// cross products for areas and normals) overflow beyond ~1.8e19; keep a margin of ten.
+pub const MAX_COORDINATE: f64 = 1e18;
+
+/// A triangle mesh placed in the world, positions in f64.
+#[derive(Clone, Debug)]
+pub struct WorldMesh {
+    pub positions: Vec<DVec3>,
+    /// Unit shading normals (directions need no recentring; they are rounded once here).
+    pub normals: Option<Vec<Vec3>>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+impl WorldMesh {
+    /// `local` (object space, as read from its file) under the object-to-world matrix `m`: points
+    /// by `m`, normals by its inverse transpose, all in f64. A mirroring `m` turns the winding
+    /// inside out, so triangles are flipped back to keep normals where the file put them.
+    pub fn place(local: &TriangleMesh, m: &DMat4) -> WorldMesh {
+        let positions = local
+            .positions
+            .iter()
+            .map(|p| m.transform_point3(p.as_dvec3()))
+            .collect();
+        let normals = local.normals.as_ref().map(|ns| {
+            let nm = DMat3::from_mat4(*m).inverse().transpose();
+            ns.iter()
+                .map(|n| (nm * n.as_dvec3()).normalize_or_zero().as_vec3())
+                .collect()
+        });
+        let mut indices = local.indices.clone();
+        if m.determinant() < 0.0 {
+            indices.iter_mut().for_each(|t| t.swap(1, 2));
+        }
+        WorldMesh {
+            positions,
+            normals,
+            indices,
+        }
+    }
+
+    /// Total area in f64 (a mesh of only degenerate triangles has none).
+    pub fn area(&self) -> f64 {
+        self.indices
+            .iter()
+            .map(|&[a, b, c]| {
+                let [a, b, c] = [a, b, c].map(|i| self.positions[i as usize]);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+
+    /// The first position outside ±`MAX_COORDINATE` (or not finite), if any.
+    pub fn out_of_range(&self) -> Option<DVec3> {
+        self.positions.iter().copied().find(|p| !in_range(*p))
+    }
+}
+
+/// True when every coordinate is finite and within ±`MAX_COORDINATE`.
+pub fn in_range(p: DVec3) -> bool {
+    p.is_finite() && p.abs().max_element() <= MAX_COORDINATE
+}
+
+/// One-line message for a position `in_range` rejects.
+pub fn out_of_range_message(what: &str, p: DVec3) -> String {
+    format!(
+        "{what} reaches {p:?} in world coordinates: every coordinate must be finite and within \
+         ±{MAX_COORDINATE:e} (f32 distances and areas overflow beyond)"
+    )
+}
+
+#[derive(Clone, Debug)]
+pub enum WorldGeometry {
+    Mesh(WorldMesh),
+    Sphere { center: DVec3, radius: f64 },
+}
+
+struct WorldShape {
+    geometry: WorldGeometry,
+    material: u32,
+    emission: Option<Color>,
+    flip_normals: bool,
+}
+
+/// The scene as the loaders describe it, before the one rounding. Mirrors `SceneBuilder`.
+pub struct WorldBuilder {
+    settings: RenderSettings,
+    materials: Vec<Material>,
+    shapes: Vec<WorldShape>,
+    /// Lights not made of shapes, each with its world position in f64 when it has one.
+    lights: Vec<(LightDesc, Option<DVec3>)>,
+}
+
+impl WorldBuilder {
+    pub fn new(settings: RenderSettings) -> WorldBuilder {
+        WorldBuilder {
+            settings,
+            materials: Vec::new(),
+            shapes: Vec::new(),
+            lights: Vec::new(),
+        }
+    }
+
+    /// Returns the material's id for `add_shape`.
+    pub fn add_material(&mut self, m: Material) -> u32 {
+        self.materials.push(m);
+        (self.materials.len() - 1) as u32
+    }
+
+    pub fn add_shape(
+        &mut self,
+        geometry: WorldGeometry,
+        material: u32,
+        emission: Option<Color>,
+        flip_normals: bool,
+    ) {
+        self.shapes.push(WorldShape {
+            geometry,
+            material,
+            emission,
+            flip_normals,
+        });
+    }
+
+    /// A light without a position (sun, directional, environment).
+    pub fn add_light(&mut self, light: LightDesc) {
+        self.lights.push((light, None));
+    }
+
+    /// A point light at a world position given in f64.
+    pub fn add_point_light(&mut self, position: DVec3, intensity: Color) {
+        let light = LightDesc::Point {
+            position: Vec3::ZERO,
+            intensity,
+        };
+        self.lights.push((light, Some(position)));
+    }
+
+    /// The scene's origin, rounded once per position, indexed. `camera` makes the camera from its
+    /// world description given the origin (it subtracts the origin from its eye and target in
+    /// f64); a loader calls it once with `DVec3::ZERO` beforehand so that a degenerate camera is
+    /// reported in file order.
+    pub fn build(
+        self,
+        camera: impl FnOnce(DVec3) -> Result<Camera, SceneError>,
+    ) -> Result<Scene, SceneError> {
+        let origin = self.origin();
+        let mut b = SceneBuilder::new(camera(origin)?, self.settings);
+        b.set_origin(origin.as_vec3());
+        for m in self.materials {
+            b.add_material(m);
+        }
+        let local = |p: DVec3| (p - origin).as_vec3();
+        for s in self.shapes {
+            let geometry = match s.geometry {
+                WorldGeometry::Mesh(m) => ShapeGeometry::Mesh(TriangleMesh {
+                    positions: m.positions.into_iter().map(local).collect(),
+                    normals: m.normals,
+                    indices: m.indices,
+                }),
+                WorldGeometry::Sphere { center, radius } => ShapeGeometry::Sphere {
+                    center: local(center),
+                    radius: radius as f32,
+                },
+            };
+            b.add_shape(geometry, s.material, s.emission, s.flip_normals);
+        }
+        for (mut light, at) in self.lights {
+            if let (LightDesc::Point { position, .. }, Some(p)) = (&mut light, at) {
+                *position = local(p);
+            }
+            b.add_light(light);
+        }
+        Ok(b.build())
+    }
+
+    /// Per axis, the centre of the geometry's bounding box when it lies more than two box
+    /// diagonals from 0, else 0 (a scene modelled around the origin keeps its coordinates as
+    /// given). Rounded to f32, so that `Scene::origin` holds it exactly and world − origin is
+    /// computed from the same number the scene reports.
+    fn origin(&self) -> DVec3 {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for s in &self.shapes {
+            match &s.geometry {
+                WorldGeometry::Mesh(m) => {
+                    for &p in &m.positions {
+                        (lo, hi) = (lo.min(p), hi.max(p));
+                    }
+                }
+                &WorldGeometry::Sphere { center, radius } => {
+                    (lo, hi) = (lo.min(center - radius), hi.max(center + radius));
+                }
+            }
+        }
+        let center = 0.5 * (lo + hi);
+        let diagonal = (hi - lo).length();
+        if !center.is_finite() || !diagonal.is_finite() {
+            return DVec3::ZERO;
+        }
+        let far = center.abs().cmpgt(DVec3::splat(2.0 * diagonal));
+        DVec3::select(far, center, DVec3::ZERO).as_vec3().as_dvec3()
+    }
+}
+
+/// A camera as a file describes it, in world coordinates (f64), made once the origin is known.
+#[derive(Clone, Copy, Debug)]
+pub struct LookAt {
+    pub eye: DVec3,
+    pub target: DVec3,
+    /// A direction: needs no recentring.
+    pub up: DVec3,
+    pub fov_deg: f32,
+    pub fov_axis: FovAxis,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl LookAt {
+    /// The camera with its eye and target as world − `origin`, subtracted in f64 and rounded once.
+    pub fn at(&self, origin: DVec3) -> Result<Camera, String> {
+        Camera::look_at(
+            (self.eye - origin).as_vec3(),
+            (self.target - origin).as_vec3(),
+            self.up.as_vec3(),
+            self.fov_deg,
+            self.fov_axis,
+            self.width,
+            self.height,
+        )
+    }
+}
