@@ -60,6 +60,7 @@ fn roughness(m: &Material) -> Option<f32> {
     match m {
         Material::Glossy(g) => Some(g.roughness),
         Material::RoughConductor(c) => Some(c.distribution.max_alpha()),
+        Material::TwoSided(t) => roughness(&t.inner),
         _ => None,
     }
 }

@@ -6,7 +6,12 @@ use crate::transform::{check_quad, check_solid, shape_matrix};
 use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
 use crate::SceneError;
 use glam::DVec3;
-use lt_core::bsdf::{Dielectric, Diffuse, Glossy, Material, Mirror};
+use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor, PERFECT_MIRROR};
+use lt_core::bsdf::fresnel::ComplexIor;
+use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
+use lt_core::bsdf::{
+    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TwoSided,
+};
 use lt_core::camera::{Camera, FovAxis};
 use lt_core::light::SunLight;
 use lt_core::math::{Color, PI};
@@ -101,6 +106,12 @@ fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, Sce
         ("reflectance", d.reflectance.as_ref().map(S::span)),
         ("ior", d.ior.as_ref().map(S::span)),
         ("roughness", d.roughness.as_ref().map(S::span)),
+        ("material", d.material.as_ref().map(S::span)),
+        ("eta", d.eta.as_ref().map(S::span)),
+        ("k", d.k.as_ref().map(S::span)),
+        ("distribution", d.distribution.as_ref().map(S::span)),
+        ("alpha", d.alpha.as_ref().map(S::span)),
+        ("twosided", d.twosided.as_ref().map(S::span)),
     ];
     let reflectance = |default: f32| {
         d.reflectance
@@ -144,15 +155,110 @@ fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, Sce
                 roughness,
             })
         }
+        "conductor" | "roughconductor" => {
+            const SMOOTH: [&str; 5] = ["reflectance", "material", "eta", "k", "twosided"];
+            const ROUGH: [&str; 7] = [
+                "reflectance",
+                "material",
+                "eta",
+                "k",
+                "twosided",
+                "distribution",
+                "alpha",
+            ];
+            ctx.only(&given, if kind == "conductor" { &SMOOTH } else { &ROUGH }, &what)?;
+            let ior = complex_ior(ctx, d, def)?;
+            let specular_reflectance = reflectance(1.0)?;
+            let one_sided = if kind == "conductor" {
+                Material::Conductor(Conductor {
+                    ior,
+                    specular_reflectance,
+                })
+            } else {
+                Material::RoughConductor(RoughConductor {
+                    distribution: microfacet(ctx, d)?,
+                    ior,
+                    specular_reflectance,
+                })
+            };
+            if d.twosided.as_ref().is_some_and(|t| *t.get_ref()) {
+                Material::TwoSided(TwoSided {
+                    inner: Box::new(one_sided),
+                })
+            } else {
+                one_sided
+            }
+        }
         other => {
             return Err(ctx.at(
                 d.kind.span(),
                 format!(
-                "unknown material type `{other}` (expected diffuse, mirror, dielectric or glossy)"
+                "unknown material type `{other}` (expected diffuse, mirror, dielectric, glossy, conductor or roughconductor)"
             ),
             ))
         }
     })
+}
+
+/// A conductor's complex IOR: a `material` name Mitsuba knows (default "none": a perfect mirror)
+/// or `eta` and `k` together.
+fn complex_ior(ctx: &Ctx, d: &MaterialDef, def: &S<MaterialDef>) -> Result<ComplexIor, SceneError> {
+    match (&d.material, &d.eta, &d.k) {
+        (None, None, None) => Ok(PERFECT_MIRROR),
+        (Some(name), None, None) => named_conductor(name.get_ref()).ok_or_else(|| {
+            let names: Vec<&str> = conductor_names().collect();
+            ctx.at(
+                name.span(),
+                format!(
+                    "conductor material `{}` is not one Mitsuba knows (known: {})",
+                    name.get_ref(),
+                    names.join(", ")
+                ),
+            )
+        }),
+        (None, Some(eta), Some(k)) => Ok(ComplexIor {
+            eta: ctx.color(eta, "eta", false)?,
+            k: ctx.color(k, "k", false)?,
+        }),
+        (Some(name), _, _) => Err(ctx.at(
+            name.span(),
+            "give a conductor `material` or `eta` and `k`, not both",
+        )),
+        _ => Err(ctx.at(
+            def.span(),
+            "a conductor's `eta` and `k` go together: give both",
+        )),
+    }
+}
+
+/// A rough conductor's microfacet distribution: `distribution` (beckmann, the default, or ggx)
+/// and `alpha` (default 0.1, at least 1e-4), isotropic, sampling visible normals (Mitsuba's
+/// defaults).
+fn microfacet(ctx: &Ctx, d: &MaterialDef) -> Result<Microfacet, SceneError> {
+    let kind = match &d.distribution {
+        None => MicrofacetType::Beckmann,
+        Some(s) => match s.get_ref().as_str() {
+            "beckmann" => MicrofacetType::Beckmann,
+            "ggx" => MicrofacetType::Ggx,
+            other => {
+                return Err(ctx.at(
+                    s.span(),
+                    format!("`distribution` must be beckmann or ggx, got `{other}`"),
+                ))
+            }
+        },
+    };
+    let alpha = match &d.alpha {
+        None => 0.1,
+        Some(a) => {
+            let x = ctx.num(a, "alpha")?;
+            if !(x >= MIN_ROUGHNESS) {
+                return Err(ctx.at(a.span(), format!("`alpha` must be at least {MIN_ROUGHNESS}, got {x} (use a conductor for a perfectly smooth surface)")));
+            }
+            x
+        }
+    };
+    Ok(Microfacet::isotropic(kind, alpha))
 }
 
 /// Adds the shape; returns whether it emits.

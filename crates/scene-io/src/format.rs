@@ -75,6 +75,15 @@ pub struct MaterialDef {
     pub reflectance: Option<S<ColorDef>>,
     pub ior: Option<S<f64>>,
     pub roughness: Option<S<f64>>,
+    /// Conductors: Mitsuba's named complex IOR ("Au", "Cu", …, "none").
+    pub material: Option<S<String>>,
+    pub eta: Option<S<ColorDef>>,
+    pub k: Option<S<ColorDef>>,
+    /// Rough conductors: "beckmann" (default) or "ggx", and α.
+    pub distribution: Option<S<String>>,
+    pub alpha: Option<S<f64>>,
+    /// One-sided materials (conductors) reflect on both sides when true.
+    pub twosided: Option<S<bool>>,
 }
 
 #[derive(Deserialize)]

@@ -24,6 +24,7 @@ mod mirror;
 mod quadrature;
 pub mod refraction;
 mod rough_conductor;
+mod two_sided;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
@@ -31,6 +32,7 @@ pub use diffuse::Diffuse;
 pub use glossy::Glossy;
 pub use mirror::Mirror;
 pub use rough_conductor::RoughConductor;
+pub use two_sided::TwoSided;
 
 use crate::math::{Color, Frame, Vec2, Vec3};
 
@@ -113,6 +115,8 @@ pub enum Material {
     Glossy(Glossy),
     Conductor(Conductor),
     RoughConductor(RoughConductor),
+    /// Mitsuba's `twosided` around a one-sided material (conductors, plastics, …).
+    TwoSided(TwoSided),
 }
 
 impl Material {
@@ -125,6 +129,7 @@ impl Material {
             Material::Glossy(m) => m,
             Material::Conductor(m) => m,
             Material::RoughConductor(m) => m,
+            Material::TwoSided(m) => m,
         }
     }
 
@@ -278,6 +283,12 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
         (
             "roughconductor-ggx-0.2x0.5-all",
             rough_gold(Ggx, 0.2, 0.5, false),
+        ),
+        (
+            "twosided-roughconductor-ggx-0.3",
+            Material::TwoSided(TwoSided {
+                inner: Box::new(rough_gold(Ggx, 0.3, 0.3, true)),
+            }),
         ),
     ]
 }

@@ -10,7 +10,7 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
-    /// Where a Mitsuba XML scene asks for something lt lacks (Beckmann roughness, a Gaussian pixel
+    /// Where a Mitsuba XML scene asks for something lt lacks (a Gaussian pixel
     /// filter, spectra, unbounded max_depth), substitute the nearest it has and list each
     /// substitution, instead of refusing the scene.
     #[arg(long, global = true)]

@@ -10,7 +10,12 @@ use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, Wo
 use crate::SceneError;
 use crate::{LoadOptions, LoadReport};
 use glam::{DMat4, DVec3, DVec4};
-use lt_core::bsdf::{Dielectric, Diffuse, Glossy, Material, Mirror};
+use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor, PERFECT_MIRROR};
+use lt_core::bsdf::fresnel::ComplexIor;
+use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
+use lt_core::bsdf::{
+    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TwoSided,
+};
 use lt_core::camera::FovAxis;
 use lt_core::math::Color;
 use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
@@ -529,27 +534,49 @@ impl<'a> Loader<'a> {
                 Material::Dielectric(Dielectric { ior: ior as f32 })
             }
             "conductor" | "roughconductor" => {
-                if let Some((name, me)) = p.string("material")? {
-                    if name != "none" {
-                        return Err(p.err(me, format!("conductor material `{name}` (a complex IOR) is not supported: lt has only material=\"none\" with a constant specular_reflectance")));
-                    }
-                }
-                for k in ["eta", "k"] {
-                    if let Some(ke) = p.take_elem(k) {
-                        return Err(p.err(ke, format!("`{k}` (a complex IOR) is not supported: lt's conductors are material=\"none\" with a constant specular_reflectance")));
-                    }
-                }
-                let reflectance = p
+                let ior = self.complex_ior(&p)?;
+                let specular_reflectance = p
                     .color("specular_reflectance", ColorUse::Reflectance, opts, &mut self.report)?
                     .unwrap_or(Color::ONE);
-                if p.kind == "conductor" {
-                    Material::Mirror(Mirror { reflectance })
-                } else {
-                    let roughness = self.roughness(&p)?;
-                    Material::Glossy(Glossy {
-                        reflectance,
-                        roughness,
+                let one_sided = if p.kind == "conductor" {
+                    Material::Conductor(Conductor {
+                        ior,
+                        specular_reflectance,
                     })
+                } else {
+                    Material::RoughConductor(RoughConductor {
+                        distribution: self.microfacet(&p)?,
+                        ior,
+                        specular_reflectance,
+                    })
+                };
+                // Mitsuba's conductors reflect on the front only; `twosided` gives them a back.
+                // Two-sided and with material "none" (Fresnel = 1), a smooth conductor is lt's
+                // mirror and an isotropic GGX one sampling visible normals is lt's glossy: the
+                // same BSDFs, kept as those so scenes written by `lt convert` read back exactly.
+                let ideal = ior == PERFECT_MIRROR;
+                if in_twosided && ideal {
+                    match &one_sided {
+                        Material::Conductor(_) => {
+                            return self.finished(p, Material::Mirror(Mirror { reflectance: specular_reflectance }));
+                        }
+                        Material::RoughConductor(r)
+                            if r.distribution.kind == MicrofacetType::Ggx
+                                && r.distribution.alpha_u == r.distribution.alpha_v
+                                && r.distribution.sample_visible =>
+                        {
+                            let roughness = r.distribution.alpha_u;
+                            return self.finished(p, Material::Glossy(Glossy { reflectance: specular_reflectance, roughness }));
+                        }
+                        _ => {}
+                    }
+                }
+                if in_twosided {
+                    Material::TwoSided(TwoSided {
+                        inner: Box::new(one_sided),
+                    })
+                } else {
+                    one_sided
                 }
             }
             other => {
@@ -559,12 +586,12 @@ impl<'a> Loader<'a> {
                 ))
             }
         };
-        let ignored: &[&str] = if p.kind == "roughconductor" {
-            &["sample_visible"]
-        } else {
-            &[]
-        };
-        p.finish(ignored, &mut self.report)?;
+        self.finished(p, m)
+    }
+
+    /// The BSDF once every parameter of its element is taken (the rest reported or refused).
+    fn finished(&mut self, p: Plugin<'a>, m: Material) -> Result<Material, SceneError> {
+        p.finish(&[], &mut self.report)?;
         Ok(m)
     }
 
@@ -601,25 +628,20 @@ impl<'a> Loader<'a> {
         Ok(x)
     }
 
-    fn roughness(&mut self, p: &Plugin<'a>) -> Result<f32, SceneError> {
+    /// Mitsuba's microfacet parameters: `distribution` (beckmann, the default, or ggx), `alpha` or
+    /// `alpha_u` and `alpha_v` (default 0.1), `sample_visible` (default true).
+    fn microfacet(&mut self, p: &Plugin<'a>) -> Result<Microfacet, SceneError> {
         let e = p.elem;
-        let dist = p.string("distribution")?;
-        match dist {
-            Some(("ggx", _)) => {}
-            Some(("beckmann", de)) => self.substitute(
-                de,
-                "the Beckmann distribution is not supported (lt's rough conductor is GGX)".into(),
-                "use GGX of the same α".into(),
-            )?,
-            None => self.substitute(
-                e,
-                "roughconductor's default Beckmann distribution is not supported (lt's rough conductor is GGX; give distribution=\"ggx\")".into(),
-                "use GGX of the same α".into(),
-            )?,
+        let kind = match p.string("distribution")? {
+            None | Some(("beckmann", _)) => MicrofacetType::Beckmann,
+            Some(("ggx", _)) => MicrofacetType::Ggx,
             Some((other, de)) => {
-                return Err(p.err(de, format!("`distribution` must be ggx or beckmann, got `{other}`")))
+                return Err(p.err(
+                    de,
+                    format!("`distribution` must be ggx or beckmann, got `{other}`"),
+                ))
             }
-        }
+        };
         let alpha = p.float("alpha")?;
         let (au, av) = (p.float("alpha_u")?, p.float("alpha_v")?);
         let a = match (alpha, au, av) {
@@ -629,7 +651,7 @@ impl<'a> Loader<'a> {
             (None, Some(_), Some(_)) => {
                 return Err(p.err(
                     e,
-                    "an anisotropic roughness (alpha_u ≠ alpha_v) is not supported",
+                    "an anisotropic roughness (alpha_u ≠ alpha_v) is not supported yet: it needs the surface's texture-space tangents, which lt's shapes do not carry",
                 ))
             }
             _ => return Err(p.err(e, "give `alpha`, or both `alpha_u` and `alpha_v`")),
@@ -637,7 +659,35 @@ impl<'a> Loader<'a> {
         if !(a >= MIN_ROUGHNESS) || !(a.is_finite()) {
             return Err(p.err(e, format!("`alpha` must be at least {MIN_ROUGHNESS}, got {a} (use a conductor for a mirror)")));
         }
-        Ok(a as f32)
+        let sample_visible = p.boolean("sample_visible")?.unwrap_or(true);
+        Ok(Microfacet::new(kind, a as f32, a as f32, sample_visible))
+    }
+
+    /// A conductor's complex IOR: Mitsuba's `material` name (default "none", a perfect mirror), or
+    /// `eta` and `k` given together (RGB, spectrum or float).
+    fn complex_ior(&mut self, p: &Plugin<'a>) -> Result<ComplexIor, SceneError> {
+        let opts = self.opts;
+        let eta = p.color("eta", ColorUse::Emission, opts, &mut self.report)?;
+        let k = p.color("k", ColorUse::Emission, opts, &mut self.report)?;
+        let named = p.string("material")?;
+        match (named, eta, k) {
+            (None, None, None) => Ok(named_conductor("none").expect("none is a conductor")),
+            (Some((name, me)), None, None) => named_conductor(name).ok_or_else(|| {
+                let names: Vec<&str> = conductor_names().collect();
+                p.err(
+                    me,
+                    format!(
+                        "conductor material `{name}` is not one Mitsuba knows (known: {})",
+                        names.join(", ")
+                    ),
+                )
+            }),
+            (None, Some(eta), Some(k)) => Ok(ComplexIor { eta, k }),
+            (Some((_, me)), _, _) => {
+                Err(p.err(me, "give a conductor `material` or `eta` and `k`, not both"))
+            }
+            _ => Err(p.err(p.elem, "a conductor's `eta` and `k` go together: give both")),
+        }
     }
 
     // ---------------------------------------------------------------- shapes

@@ -5,8 +5,7 @@
 //! `props` (each plugin's parameters, every one taken or reported) and `build` (the plugin subset,
 //! assembled through `SceneBuilder`). Meshes come from `crate::mesh` (OBJ and PLY). Out: `write::to_mitsuba_xml` writes one of our TOML scenes as Mitsuba 3 XML.
 //!
-//! Where a file asks for something lt lacks but has a near equivalent of (Beckmann → GGX of the
-//! same α, a Gaussian or other pixel filter → the box, a spectrum → RGB, max_depth = -1 → 64),
+//! Where a file asks for something lt lacks but has a near equivalent of (a Gaussian or other pixel filter → the box, a spectrum → RGB, max_depth = -1 → 64),
 //! the load is refused unless `LoadOptions::approximate`, and every substitution made is listed
 //! in the `LoadReport`. Parameters Mitsuba writes by default that change nothing lt renders
 //! (`near_clip`, a film's `pixel_format`, a `ref`'s `name`, …) are accepted and listed too.
