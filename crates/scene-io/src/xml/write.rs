@@ -138,6 +138,30 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                 d.roughness.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(0.0),
                 rgb(&d.reflectance, 1.0)
             ),
+            "conductor" | "roughconductor" => {
+                let kind = d.kind.get_ref();
+                let mut inner = String::new();
+                match (&d.material, &d.eta, &d.k) {
+                    (Some(m), _, _) => {
+                        let _ = write!(inner, "\n            <string name=\"material\" value=\"{}\"/>", esc(m.get_ref()));
+                    }
+                    (None, Some(_), Some(_)) => {
+                        let _ = write!(inner, "\n            <rgb name=\"eta\" value=\"{}\"/>\n            <rgb name=\"k\" value=\"{}\"/>", rgb(&d.eta, 0.0), rgb(&d.k, 0.0));
+                    }
+                    _ => {}
+                }
+                if kind == "roughconductor" {
+                    let dist = d.distribution.as_ref().map_or("beckmann", |s| s.get_ref().as_str());
+                    let alpha = d.alpha.as_ref().map_or(0.1, |a| *a.get_ref() as f32);
+                    let _ = write!(inner, "\n            <string name=\"distribution\" value=\"{}\"/>\n            <float name=\"alpha\" value=\"{alpha}\"/>", esc(dist));
+                }
+                let _ = write!(inner, "\n            <rgb name=\"specular_reflectance\" value=\"{}\"/>", rgb(&d.reflectance, 1.0));
+                if d.twosided.as_ref().is_some_and(|t| *t.get_ref()) {
+                    format!("<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"{kind}\">{inner}\n        </bsdf>\n    </bsdf>")
+                } else {
+                    format!("<bsdf type=\"{kind}\" id=\"{id}\">{}\n    </bsdf>", inner.replace("\n            ", "\n        "))
+                }
+            }
             "dielectric" => format!(
                 "<bsdf type=\"dielectric\" id=\"{id}\">\n        <float name=\"int_ior\" value=\"{}\"/>\n        <float name=\"ext_ior\" value=\"1\"/>\n    </bsdf>",
                 d.ior.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(1.0)
