@@ -215,6 +215,14 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_env() {
     per_depth("cornell-env", 1..=5);
 }
 
+/// Mitsuba's conductors: a rough (Beckmann) gold sphere, a nearly smooth one-sided copper sphere
+/// and a two-sided rough GGX aluminium wall: coloured Fresnel on glossy and delta lobes, in both
+/// transport modes.
+#[test]
+fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_conductors() {
+    per_depth("cornell-conductors", 1..=5);
+}
+
 /// At max_depth 1 the camera does not see the sun (it is not in view), so every estimator's image
 /// is exactly black there (z = 0 by definition); the sunlit floor patch appears at depth 2.
 #[test]
