@@ -223,6 +223,13 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_conductors() {
     per_depth("cornell-conductors", 1..=5);
 }
 
+/// Textures (checkerboard floor, bitmap wall, a rough conductor whose colour and α vary): every
+/// estimator must read the same parameters at the same uv, in both transport modes.
+#[test]
+fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_textured() {
+    per_depth("cornell-textured", 1..=5);
+}
+
 /// At max_depth 1 the camera does not see the sun (it is not in view), so every estimator's image
 /// is exactly black there (z = 0 by definition); the sunlit floor patch appears at depth 2.
 #[test]

@@ -102,16 +102,15 @@ fn xml_bad_files_give_one_clear_error() {
         &["shape `cylinder` is not supported"],
     );
 
-    // Textures, inline and referenced.
+    // A texture whose image is missing: named as resolved, at the filename; an unknown texture.
     let text = scene_xml(
         "    <shape type=\"sphere\">\n        <bsdf type=\"diffuse\">\n            <texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"a.png\"/></texture>\n        </bsdf>\n    </shape>",
     );
-    fails(
-        &d,
-        &text,
-        line_of(&text, "bitmap"),
-        &["textures are not supported: bitmap"],
+    fails(&d, &text, line_of(&text, "a.png"), &["cannot read image", "a.png"]);
+    let text = scene_xml(
+        "    <shape type=\"sphere\">\n        <bsdf type=\"diffuse\">\n            <texture type=\"voronoi\" name=\"reflectance\"/>\n        </bsdf>\n    </shape>",
     );
+    fails(&d, &text, line_of(&text, "voronoi"), &["texture `voronoi` is not supported"]);
 
     // A missing mesh file: named as written and as resolved, at the filename.
     let text = scene_xml("    <shape type=\"obj\">\n        <string name=\"filename\" value=\"meshes/nope.obj\"/>\n    </shape>");

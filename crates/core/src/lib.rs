@@ -13,6 +13,7 @@ pub mod scene;
 pub mod shape;
 pub mod spatial;
 pub mod testing;
+pub mod texture;
 
 pub use math::{Color, Vec2, Vec3};
 pub use scene::Scene;

@@ -2,7 +2,7 @@
 //! and cube as meshes) and exact spheres. The scene indexes them for ray queries; area lights
 //! sample them.
 
-use crate::math::Vec3;
+use crate::math::{Vec2, Vec3};
 
 /// A triangle mesh in world space.
 #[derive(Clone, Debug, Default)]
@@ -10,6 +10,9 @@ pub struct TriangleMesh {
     pub positions: Vec<Vec3>,
     /// Per-vertex shading normals (same length as `positions`), if the mesh has them.
     pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates, if the mesh has them (Mitsuba's convention: v already
+    /// flipped for OBJ files, so that v = 0 is the image's top row).
+    pub uvs: Option<Vec<Vec2>>,
     pub indices: Vec<[u32; 3]>,
 }
 
@@ -36,6 +39,18 @@ impl TriangleMesh {
         (n.length_squared() > 0.0).then(|| n.normalize())
     }
 
+    /// Texture coordinates at barycentrics (b0, b1, b2) of triangle `i`: interpolated from the
+    /// mesh's, or (b1, b2) when it has none (Mitsuba's parameterisation of a bare mesh).
+    pub fn uv(&self, i: usize, b0: f32, b1: f32, b2: f32) -> Vec2 {
+        match &self.uvs {
+            Some(uvs) => {
+                let [a, b, c] = self.indices[i];
+                b0 * uvs[a as usize] + b1 * uvs[b as usize] + b2 * uvs[c as usize]
+            }
+            None => Vec2::new(b1, b2),
+        }
+    }
+
     /// An axis-aligned unit square [-1,1]² in the z = 0 plane with normal +z (Mitsuba's rectangle).
     pub fn unit_rectangle() -> TriangleMesh {
         TriangleMesh {
@@ -46,6 +61,13 @@ impl TriangleMesh {
                 Vec3::new(-1.0, 1.0, 0.0),
             ],
             normals: None,
+            // Mitsuba's rectangle: uv = ((x + 1)/2, (y + 1)/2).
+            uvs: Some(vec![
+                Vec2::new(0.0, 0.0),
+                Vec2::new(1.0, 0.0),
+                Vec2::new(1.0, 1.0),
+                Vec2::new(0.0, 1.0),
+            ]),
             indices: vec![[0, 1, 2], [0, 2, 3]],
         }
     }
@@ -53,6 +75,7 @@ impl TriangleMesh {
     /// The cube [-1,1]³ with outward normals (Mitsuba's cube).
     pub fn unit_cube() -> TriangleMesh {
         let mut positions = Vec::new();
+        let mut uvs = Vec::new();
         let mut indices = Vec::new();
         for axis in 0..3 {
             for sign in [-1.0f32, 1.0] {
@@ -69,6 +92,9 @@ impl TriangleMesh {
                 let base = positions.len() as u32;
                 for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
                     positions.push(n + u * a + v * b);
+                    // Each face its own [0, 1]² (Mitsuba's cube mesh has per-face uvs too; its
+                    // orientation per face is not checked against Mitsuba's).
+                    uvs.push(Vec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0)));
                 }
                 indices.push([base, base + 1, base + 2]);
                 indices.push([base, base + 2, base + 3]);
@@ -77,6 +103,7 @@ impl TriangleMesh {
         TriangleMesh {
             positions,
             normals: None,
+            uvs: Some(uvs),
             indices,
         }
     }

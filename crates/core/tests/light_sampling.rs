@@ -54,6 +54,7 @@ fn quad_scene() -> Scene {
     let mesh = TriangleMesh {
         positions: vec![a, b, c, d],
         normals: None,
+        uvs: None,
         indices: vec![[0, 2, 1], [0, 3, 2]],
     };
     build(
@@ -76,6 +77,7 @@ fn parallelogram_scene() -> Scene {
     let mesh = TriangleMesh {
         positions: vec![c, c + e1, c + e1 + e2, c + e2],
         normals: None,
+        uvs: None,
         indices: vec![[0, 1, 2], [0, 2, 3]],
     };
     build(

@@ -32,7 +32,7 @@ pub fn eval_towards(
     let VertexKind::Surface { material } = v.kind else {
         return None;
     };
-    let sf = ShadingFrame::new(v.ng, v.ns);
+    let sf = ShadingFrame::new(v.ng, v.ns).with_uv(v.uv);
     Some(scene.material(material).eval(&sf, v.wo, wi, mode))
 }
 

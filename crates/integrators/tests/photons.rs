@@ -203,6 +203,7 @@ fn flux_cases() -> Vec<Case> {
             Vec3::new(0.0, 0.0, tc),
         ],
         normals: None,
+        uvs: None,
         indices: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
     };
     let (a, b, c) = (ta as f64, tb as f64, tc as f64);

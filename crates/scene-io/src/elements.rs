@@ -9,8 +9,10 @@ use glam::DVec3;
 use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor, PERFECT_MIRROR};
 use lt_core::bsdf::fresnel::ComplexIor;
 use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
+use lt_core::bsdf::textured::set_parameter;
 use lt_core::bsdf::{
-    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TwoSided,
+    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TextureSlot,
+    Textured, TwoSided,
 };
 use lt_core::camera::{Camera, FovAxis};
 use lt_core::light::SunLight;
@@ -99,6 +101,50 @@ fn render(ctx: &Ctx, file: &SceneFile) -> Result<RenderSettings, SceneError> {
 
 fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, SceneError> {
     let d = def.get_ref();
+    let base = plain_material(ctx, name, def)?;
+    let mut slots = Vec::new();
+    for (tex, slot, key) in [
+        (
+            &d.albedo_texture,
+            TextureSlot::Reflectance,
+            "albedo_texture",
+        ),
+        (
+            &d.reflectance_texture,
+            TextureSlot::SpecularReflectance,
+            "reflectance_texture",
+        ),
+        (&d.alpha_texture, TextureSlot::Alpha, "alpha_texture"),
+    ] {
+        let Some(t) = tex else { continue };
+        let texture = crate::texture_def::texture(ctx, t)?;
+        if slot != TextureSlot::Alpha && texture.max_value() > 1.0 {
+            return Err(ctx.at(
+                t.span(),
+                format!(
+                    "`{key}` reaches {} (a reflectance must be at most 1)",
+                    texture.max_value()
+                ),
+            ));
+        }
+        if !set_parameter(&mut base.clone(), slot, Color::ZERO) {
+            return Err(ctx.at(
+                t.span(),
+                format!("`{key}` does not apply to a {} material", d.kind.get_ref()),
+            ));
+        }
+        slots.push((slot, texture));
+    }
+    Ok(if slots.is_empty() {
+        base
+    } else {
+        Material::Textured(Box::new(Textured { base, slots }))
+    })
+}
+
+/// The material with its untextured parameters (a textured key leaves the default in place).
+fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, SceneError> {
+    let d = def.get_ref();
     let kind = d.kind.get_ref().as_str();
     let what = format!("material `{name}` of type {kind}");
     let given = [
@@ -112,6 +158,12 @@ fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, Sce
         ("distribution", d.distribution.as_ref().map(S::span)),
         ("alpha", d.alpha.as_ref().map(S::span)),
         ("twosided", d.twosided.as_ref().map(S::span)),
+        ("albedo_texture", d.albedo_texture.as_ref().map(S::span)),
+        (
+            "reflectance_texture",
+            d.reflectance_texture.as_ref().map(S::span),
+        ),
+        ("alpha_texture", d.alpha_texture.as_ref().map(S::span)),
     ];
     let reflectance = |default: f32| {
         d.reflectance
@@ -122,14 +174,18 @@ fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, Sce
     };
     Ok(match kind {
         "diffuse" => {
-            ctx.only(&given, &["albedo"], &what)?;
-            Material::Diffuse(Diffuse {
-                albedo: ctx.color(
-                    ctx.need(&d.albedo, "albedo", &def.span(), &what)?,
-                    "albedo",
-                    true,
-                )?,
-            })
+            ctx.only(&given, &["albedo", "albedo_texture"], &what)?;
+            let albedo = match (&d.albedo, &d.albedo_texture) {
+                (Some(a), None) => ctx.color(a, "albedo", true)?,
+                (None, Some(_)) => Color::splat(0.5),
+                (Some(_), Some(t)) => {
+                    return Err(ctx.at(t.span(), "give `albedo` or `albedo_texture`, not both"))
+                }
+                (None, None) => {
+                    return Err(ctx.at(def.span(), format!("missing required key `albedo` (or `albedo_texture`) for {what}")))
+                }
+            };
+            Material::Diffuse(Diffuse { albedo })
         }
         "mirror" => {
             ctx.only(&given, &["reflectance"], &what)?;
@@ -156,8 +212,15 @@ fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, Sce
             })
         }
         "conductor" | "roughconductor" => {
-            const SMOOTH: [&str; 5] = ["reflectance", "material", "eta", "k", "twosided"];
-            const ROUGH: [&str; 7] = [
+            const SMOOTH: [&str; 6] = [
+                "reflectance",
+                "material",
+                "eta",
+                "k",
+                "twosided",
+                "reflectance_texture",
+            ];
+            const ROUGH: [&str; 9] = [
                 "reflectance",
                 "material",
                 "eta",
@@ -165,6 +228,8 @@ fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, Sce
                 "twosided",
                 "distribution",
                 "alpha",
+                "reflectance_texture",
+                "alpha_texture",
             ];
             ctx.only(&given, if kind == "conductor" { &SMOOTH } else { &ROUGH }, &what)?;
             let ior = complex_ior(ctx, d, def)?;

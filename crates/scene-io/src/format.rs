@@ -84,6 +84,28 @@ pub struct MaterialDef {
     pub alpha: Option<S<f64>>,
     /// One-sided materials (conductors) reflect on both sides when true.
     pub twosided: Option<S<bool>>,
+    /// Textures in place of `albedo`, `reflectance` (the colour factor) and `alpha`.
+    pub albedo_texture: Option<S<TextureDef>>,
+    pub reflectance_texture: Option<S<TextureDef>>,
+    pub alpha_texture: Option<S<TextureDef>>,
+}
+
+/// A texture: `type = "bitmap"` with `file` (PNG, JPEG, BMP, HDR or EXR, relative to the scene
+/// file), `filter` ("bilinear" or "nearest"), `wrap` ("repeat", "mirror" or "clamp") and `raw`
+/// (keep 8-bit values as they are instead of decoding sRGB); or `type = "checkerboard"` with
+/// `color0`, `color1`. Both take `scale` (uv multiplied by it first, default 1).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureDef {
+    #[serde(rename = "type")]
+    pub kind: S<String>,
+    pub file: Option<S<String>>,
+    pub filter: Option<S<String>>,
+    pub wrap: Option<S<String>>,
+    pub raw: Option<S<bool>>,
+    pub color0: Option<S<ColorDef>>,
+    pub color1: Option<S<ColorDef>>,
+    pub scale: Option<S<f64>>,
 }
 
 #[derive(Deserialize)]

@@ -8,8 +8,10 @@
 mod elements;
 mod error;
 mod format;
+mod image_file;
 mod mesh;
 mod options;
+mod texture_def;
 mod toml_file;
 mod transform;
 mod world;

@@ -31,7 +31,18 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
     })?;
     let mut scene = crate::elements::assemble(&ctx, &file)?;
     let meshes = file.shapes.iter().filter_map(|s| s.get_ref().file.as_ref());
+    // Texture files in material order (as the XML loader meets them: BSDFs before shapes).
+    let mut materials: Vec<_> = file.materials.values().collect();
+    materials.sort_by_key(|m| m.span().start);
+    let textures = materials.into_iter().flat_map(|m| {
+        let m = m.get_ref();
+        [&m.albedo_texture, &m.reflectance_texture, &m.alpha_texture]
+            .into_iter()
+            .flatten()
+            .filter_map(|t| t.get_ref().file.as_ref())
+    });
     scene.source_files = std::iter::once(path.to_path_buf())
+        .chain(textures.map(|f| ctx.base_dir.join(f.get_ref())))
         .chain(meshes.map(|f| ctx.base_dir.join(f.get_ref())))
         .collect();
     Ok(scene)

@@ -23,6 +23,8 @@ pub struct WorldMesh {
     pub positions: Vec<DVec3>,
     /// Unit shading normals (directions need no recentring; they are rounded once here).
     pub normals: Option<Vec<Vec3>>,
+    /// Texture coordinates: no transform touches them.
+    pub uvs: Option<Vec<lt_core::math::Vec2>>,
     pub indices: Vec<[u32; 3]>,
 }
 
@@ -49,6 +51,7 @@ impl WorldMesh {
         WorldMesh {
             positions,
             normals,
+            uvs: local.uvs.clone(),
             indices,
         }
     }
@@ -170,6 +173,7 @@ impl WorldBuilder {
                 WorldGeometry::Mesh(m) => ShapeGeometry::Mesh(TriangleMesh {
                     positions: m.positions.into_iter().map(local).collect(),
                     normals: m.normals,
+                    uvs: m.uvs,
                     indices: m.indices,
                 }),
                 WorldGeometry::Sphere { center, radius } => ShapeGeometry::Sphere {

@@ -24,6 +24,7 @@ mod mirror;
 mod quadrature;
 pub mod refraction;
 mod rough_conductor;
+pub mod textured;
 mod two_sided;
 
 pub use conductor::Conductor;
@@ -32,6 +33,7 @@ pub use diffuse::Diffuse;
 pub use glossy::Glossy;
 pub use mirror::Mirror;
 pub use rough_conductor::RoughConductor;
+pub use textured::{TextureSlot, Textured};
 pub use two_sided::TwoSided;
 
 use crate::math::{Color, Frame, Vec2, Vec3};
@@ -50,6 +52,8 @@ pub struct ShadingFrame {
     pub ng: Vec3,
     /// Orthonormal frame around the shading normal.
     pub frame: Frame,
+    /// Texture coordinates of the point (textured materials read their parameters there).
+    pub uv: Vec2,
 }
 
 impl ShadingFrame {
@@ -57,7 +61,14 @@ impl ShadingFrame {
         ShadingFrame {
             ng,
             frame: Frame::from_z(ns),
+            uv: Vec2::ZERO,
         }
+    }
+
+    /// The same frame at texture coordinates `uv`.
+    #[inline]
+    pub fn with_uv(self, uv: Vec2) -> ShadingFrame {
+        ShadingFrame { uv, ..self }
     }
     #[inline]
     pub fn ns(&self) -> Vec3 {
@@ -117,6 +128,8 @@ pub enum Material {
     RoughConductor(RoughConductor),
     /// Mitsuba's `twosided` around a one-sided material (conductors, plastics, …).
     TwoSided(TwoSided),
+    /// Parameters read from textures at the shading point's uv.
+    Textured(Box<Textured>),
 }
 
 impl Material {
@@ -130,6 +143,7 @@ impl Material {
             Material::Conductor(m) => m,
             Material::RoughConductor(m) => m,
             Material::TwoSided(m) => m,
+            Material::Textured(t) => t.base.local(),
         }
     }
 
@@ -145,6 +159,9 @@ impl Material {
         u: Vec2,
         mode: TransportMode,
     ) -> Option<BsdfSample> {
+        if let Material::Textured(t) = self {
+            return t.resolve(sf.uv).sample(sf, wo, u_lobe, u, mode);
+        }
         let wo_l = sf.frame.to_local(wo);
         if wo_l.z == 0.0 {
             return None;
@@ -165,6 +182,9 @@ impl Material {
     }
 
     pub fn eval(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3, mode: TransportMode) -> BsdfEval {
+        if let Material::Textured(t) = self {
+            return t.resolve(sf.uv).eval(sf, wo, wi, mode);
+        }
         let wo_l = sf.frame.to_local(wo);
         let wi_l = sf.frame.to_local(wi);
         if wo_l.z == 0.0 || !consistent_sides(sf, wo, wi, wo_l.z, wi_l.z) {
@@ -182,6 +202,9 @@ impl Material {
 
     /// Solid-angle pdf of sampling wi given wo.
     pub fn pdf(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3) -> f32 {
+        if let Material::Textured(t) = self {
+            return t.resolve(sf.uv).pdf(sf, wo, wi);
+        }
         let wo_l = sf.frame.to_local(wo);
         let wi_l = sf.frame.to_local(wi);
         if !consistent_sides(sf, wo, wi, wo_l.z, wi_l.z) {
@@ -283,6 +306,16 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
         (
             "roughconductor-ggx-0.2x0.5-all",
             rough_gold(Ggx, 0.2, 0.5, false),
+        ),
+        (
+            "textured-diffuse",
+            Material::Textured(Box::new(Textured {
+                base: Material::Diffuse(Diffuse { albedo: c }),
+                slots: vec![(
+                    TextureSlot::Reflectance,
+                    crate::texture::Texture::Constant(Color::new(0.2, 0.7, 0.4)),
+                )],
+            })),
         ),
         (
             "twosided-roughconductor-ggx-0.3",

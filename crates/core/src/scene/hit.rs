@@ -6,7 +6,7 @@ use crate::geometry::ray::barycentric_error;
 use crate::geometry::sphere::refine_sphere_hit;
 use crate::geometry::triangle::{intersect_triangle, ShearedRay};
 use crate::geometry::{offset_ray_origin, PrimHit, Primitive, Ray, SHADOW_EPSILON};
-use crate::math::Vec3;
+use crate::math::{Vec2, Vec3, PI};
 
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceHit {
@@ -18,6 +18,8 @@ pub struct SurfaceHit {
     /// Shading normal, unit, on the same side as `ng`.
     pub ns: Vec3,
     pub t: f32,
+    /// Texture coordinates (Mitsuba's parameterisation of each shape).
+    pub uv: Vec2,
     pub shape: u32,
     pub material: u32,
     /// Index into `Scene::lights` when the surface emits.
@@ -28,7 +30,7 @@ impl SurfaceHit {
     pub(crate) fn new(scene: &Scene, ray: &Ray, h: PrimHit) -> SurfaceHit {
         let prim = *scene.accel.primitive(h.prim);
         let shape = &scene.shapes[prim.shape() as usize];
-        let (p, p_err, mut ng, mut ns) = match prim {
+        let (p, p_err, mut ng, mut ns, uv) = match prim {
             Primitive::Triangle {
                 p: [p0, p1, p2],
                 index,
@@ -39,13 +41,14 @@ impl SurfaceHit {
                 let p = b0 * p0 + b1 * p1 + b2 * p2;
                 let err = barycentric_error([b0, b1, b2], [p0, p1, p2]);
                 let ng = (p1 - p0).cross(p2 - p0).normalize();
-                let ns = match &shape.geometry {
-                    ShapeGeometry::Mesh(m) => {
-                        m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng)
-                    }
-                    ShapeGeometry::Sphere { .. } => ng,
+                let (ns, uv) = match &shape.geometry {
+                    ShapeGeometry::Mesh(m) => (
+                        m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng),
+                        m.uv(index as usize, b0, b1, b2),
+                    ),
+                    ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
                 };
-                (p, err, ng, ns)
+                (p, err, ng, ns, uv)
             }
             Primitive::Quad { q, index, .. } => {
                 let (p, err, u, v) = q.hit_point(ray.o, ray.d, h.t);
@@ -56,18 +59,20 @@ impl SurfaceHit {
                 } else {
                     (index + 1, [1.0 - v, u, v - u])
                 };
-                let ns = match &shape.geometry {
-                    ShapeGeometry::Mesh(m) => m
-                        .shading_normal(tri as usize, b[0], b[1], b[2])
-                        .unwrap_or(ng),
-                    ShapeGeometry::Sphere { .. } => ng,
+                let (ns, uv) = match &shape.geometry {
+                    ShapeGeometry::Mesh(m) => (
+                        m.shading_normal(tri as usize, b[0], b[1], b[2])
+                            .unwrap_or(ng),
+                        m.uv(tri as usize, b[0], b[1], b[2]),
+                    ),
+                    ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
                 };
-                (p, err, ng, ns)
+                (p, err, ng, ns, uv)
             }
             Primitive::Sphere { center, radius, .. } => {
                 let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
                 let n = (p - center).normalize();
-                (p, err, n, n)
+                (p, err, n, n, sphere_uv(n))
             }
         };
         if shape.flip_normals {
@@ -84,6 +89,7 @@ impl SurfaceHit {
             ng,
             ns,
             t: h.t,
+            uv,
             shape: prim.shape(),
             material: shape.material,
             light: shape.light,
@@ -92,7 +98,7 @@ impl SurfaceHit {
 
     #[inline]
     pub fn shading_frame(&self) -> ShadingFrame {
-        ShadingFrame::new(self.ng, self.ns)
+        ShadingFrame::new(self.ng, self.ns).with_uv(self.uv)
     }
 
     /// A ray leaving the surface in direction `dir`, started safely off the surface.
@@ -113,4 +119,12 @@ impl SurfaceHit {
             t_max: len * (1.0 - SHADOW_EPSILON),
         }
     }
+}
+
+/// Mitsuba's sphere parameterisation from the unit outward normal (object frame = world axes:
+/// a sphere's rotation is not kept): u = φ / 2π with φ = atan2(y, x) in [0, 2π), v = θ / π.
+fn sphere_uv(n: Vec3) -> Vec2 {
+    let phi = n.y.atan2(n.x);
+    let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+    Vec2::new(phi / (2.0 * PI), n.z.clamp(-1.0, 1.0).acos() / PI)
 }

@@ -205,6 +205,7 @@ mod tests {
             let mesh = TriangleMesh {
                 positions: vec![p0, p0 + e1, p0 + e1 + e2, p0 + e2],
                 normals: None,
+                uvs: None,
                 indices: vec![[0, 1, 2], [0, 2, 3]],
             };
             b.add_shape(ShapeGeometry::Mesh(mesh), m, None, false);

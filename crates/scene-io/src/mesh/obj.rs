@@ -5,7 +5,7 @@
 use crate::error::Ctx;
 use crate::format::S;
 use crate::SceneError;
-use lt_core::math::Vec3;
+use lt_core::math::{Vec2, Vec3};
 use lt_core::scene::TriangleMesh;
 
 /// Loads `file` (relative to the scene file). Errors point at the scene's `file` key.
@@ -43,6 +43,7 @@ pub fn load_obj(ctx: &Ctx, file: &S<String>) -> Result<TriangleMesh, SceneError>
     };
     let mut mesh = TriangleMesh {
         normals: Some(Vec::new()),
+        uvs: Some(Vec::new()),
         ..Default::default()
     };
     for m in &models {
@@ -63,6 +64,19 @@ pub fn load_obj(ctx: &Ctx, file: &S<String>) -> Result<TriangleMesh, SceneError>
             }
         } else {
             mesh.normals = None;
+        }
+        // Texture coordinates with v flipped, Mitsuba's default for OBJ (`flip_tex_coords`):
+        // OBJ puts v = 0 at the image's bottom, Mitsuba's textures at its top row.
+        if 2 * p.len() == m.texcoords.len() {
+            if let Some(uvs) = &mut mesh.uvs {
+                uvs.extend(
+                    m.texcoords
+                        .chunks_exact(2)
+                        .map(|c| Vec2::new(c[0], 1.0 - c[1])),
+                );
+            }
+        } else {
+            mesh.uvs = None;
         }
         mesh.positions.extend(p);
         mesh.indices.extend(

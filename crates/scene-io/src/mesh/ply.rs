@@ -4,7 +4,7 @@
 
 use crate::error::Ctx;
 use crate::SceneError;
-use lt_core::math::Vec3;
+use lt_core::math::{Vec2, Vec3};
 use lt_core::scene::TriangleMesh;
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
@@ -28,6 +28,7 @@ pub(crate) fn load_ply(ctx: &Ctx, file: &Spanned<String>) -> Result<TriangleMesh
     let scalar = |v: &DefaultElement, k: &str| v.get(k).and_then(Property::to_f32_lossy);
     let mut positions = Vec::with_capacity(vertices.len());
     let mut normals = Some(Vec::with_capacity(vertices.len()));
+    let mut uvs = Some(Vec::with_capacity(vertices.len()));
     for (i, v) in vertices.iter().enumerate() {
         let (Some(x), Some(y), Some(z)) = (scalar(v, "x"), scalar(v, "y"), scalar(v, "z")) else {
             return Err(bad(format!("vertex {i} lacks a numeric x, y or z")));
@@ -40,6 +41,18 @@ pub(crate) fn load_ply(ctx: &Ctx, file: &Spanned<String>) -> Result<TriangleMesh
                 }
             }
             _ => normals = None,
+        }
+        // Texture coordinates under any of the names PLY writers use, v flipped as for OBJ.
+        let uv = [("u", "v"), ("s", "t"), ("texture_u", "texture_v")]
+            .iter()
+            .find_map(|(a, b)| Some((scalar(v, a)?, scalar(v, b)?)));
+        match uv {
+            Some((a, b)) => {
+                if let Some(t) = &mut uvs {
+                    t.push(Vec2::new(a, 1.0 - b));
+                }
+            }
+            None => uvs = None,
         }
     }
     let n = positions.len();
@@ -89,6 +102,7 @@ pub(crate) fn load_ply(ctx: &Ctx, file: &Spanned<String>) -> Result<TriangleMesh
     Ok(TriangleMesh {
         positions,
         normals,
+        uvs,
         indices,
     })
 }

@@ -4,6 +4,7 @@
 use super::doc::{Doc, Elem};
 use super::props::{textures_refused, ColorUse, Ids, Plugin};
 use super::values::Xform;
+use crate::image_file::{read_rgb, srgb_to_linear};
 use crate::mesh::ply;
 use crate::transform::{check_quad, check_solid};
 use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
@@ -16,11 +17,14 @@ use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TwoSided,
 };
+use lt_core::bsdf::{TextureSlot, Textured};
 use lt_core::camera::FovAxis;
 use lt_core::math::Color;
 use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
+use lt_core::texture::{Bitmap, FilterType, Texture, UvTransform, WrapMode};
 use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// GGX α below this is numerically a mirror (the TOML loader's bound).
 const MIN_ROUGHNESS: f64 = 1e-4;
@@ -111,7 +115,8 @@ pub(super) fn load(
     for c in &root.children {
         match c.tag.as_str() {
             "sensor" | "integrator" | "bsdf" | "shape" | "emitter" => {}
-            "texture" => return Err(textures_refused(doc, c)),
+            // Read where they are referenced.
+            "texture" => {}
             "medium" | "phase" => {
                 return Err(doc.err(
                     c,
@@ -488,10 +493,13 @@ impl<'a> Loader<'a> {
     fn bsdf(&mut self, e: &'a Elem, in_twosided: bool) -> Result<Material, SceneError> {
         let p = self.plugin(e)?;
         let opts = self.opts;
+        // Parameters given as textures: the material is built with their defaults and the
+        // textures set them at each shading point.
+        let mut slots: Vec<(TextureSlot, Texture)> = Vec::new();
         let m = match p.kind {
             "diffuse" => {
-                let albedo = p
-                    .color("reflectance", ColorUse::Reflectance, opts, &mut self.report)?
+                let albedo = self
+                    .color_or_texture(&p, "reflectance", TextureSlot::Reflectance, &mut slots)?
                     .unwrap_or(Color::splat(0.5));
                 Material::Diffuse(Diffuse { albedo })
             }
@@ -535,8 +543,8 @@ impl<'a> Loader<'a> {
             }
             "conductor" | "roughconductor" => {
                 let ior = self.complex_ior(&p)?;
-                let specular_reflectance = p
-                    .color("specular_reflectance", ColorUse::Reflectance, opts, &mut self.report)?
+                let specular_reflectance = self
+                    .color_or_texture(&p, "specular_reflectance", TextureSlot::SpecularReflectance, &mut slots)?
                     .unwrap_or(Color::ONE);
                 let one_sided = if p.kind == "conductor" {
                     Material::Conductor(Conductor {
@@ -545,7 +553,7 @@ impl<'a> Loader<'a> {
                     })
                 } else {
                     Material::RoughConductor(RoughConductor {
-                        distribution: self.microfacet(&p)?,
+                        distribution: self.microfacet(&p, &mut slots)?,
                         ior,
                         specular_reflectance,
                     })
@@ -554,29 +562,26 @@ impl<'a> Loader<'a> {
                 // Two-sided and with material "none" (Fresnel = 1), a smooth conductor is lt's
                 // mirror and an isotropic GGX one sampling visible normals is lt's glossy: the
                 // same BSDFs, kept as those so scenes written by `lt convert` read back exactly.
-                let ideal = ior == PERFECT_MIRROR;
-                if in_twosided && ideal {
-                    match &one_sided {
-                        Material::Conductor(_) => {
-                            return self.finished(p, Material::Mirror(Mirror { reflectance: specular_reflectance }));
-                        }
-                        Material::RoughConductor(r)
-                            if r.distribution.kind == MicrofacetType::Ggx
-                                && r.distribution.alpha_u == r.distribution.alpha_v
-                                && r.distribution.sample_visible =>
-                        {
-                            let roughness = r.distribution.alpha_u;
-                            return self.finished(p, Material::Glossy(Glossy { reflectance: specular_reflectance, roughness }));
-                        }
-                        _ => {}
+                let ideal = in_twosided && ior == PERFECT_MIRROR;
+                match one_sided {
+                    Material::Conductor(_) if ideal => Material::Mirror(Mirror {
+                        reflectance: specular_reflectance,
+                    }),
+                    Material::RoughConductor(r)
+                        if ideal
+                            && r.distribution.kind == MicrofacetType::Ggx
+                            && r.distribution.alpha_u == r.distribution.alpha_v
+                            && r.distribution.sample_visible =>
+                    {
+                        Material::Glossy(Glossy {
+                            reflectance: specular_reflectance,
+                            roughness: r.distribution.alpha_u,
+                        })
                     }
-                }
-                if in_twosided {
-                    Material::TwoSided(TwoSided {
+                    one_sided if in_twosided => Material::TwoSided(TwoSided {
                         inner: Box::new(one_sided),
-                    })
-                } else {
-                    one_sided
+                    }),
+                    one_sided => one_sided,
                 }
             }
             other => {
@@ -586,13 +591,136 @@ impl<'a> Loader<'a> {
                 ))
             }
         };
-        self.finished(p, m)
+        p.finish(&[], &mut self.report)?;
+        Ok(if slots.is_empty() {
+            m
+        } else {
+            Material::Textured(Box::new(Textured { base: m, slots }))
+        })
     }
 
-    /// The BSDF once every parameter of its element is taken (the rest reported or refused).
-    fn finished(&mut self, p: Plugin<'a>, m: Material) -> Result<Material, SceneError> {
-        p.finish(&[], &mut self.report)?;
-        Ok(m)
+    /// A colour parameter that may be a texture: a texture goes to `slots` (and None is returned,
+    /// so the material keeps its default there); a plain colour is returned.
+    fn color_or_texture(
+        &mut self,
+        p: &Plugin<'a>,
+        name: &str,
+        slot: TextureSlot,
+        slots: &mut Vec<(TextureSlot, Texture)>,
+    ) -> Result<Option<Color>, SceneError> {
+        if let Some(t) = p.texture(name) {
+            let texture = self.texture(t)?;
+            if slot != TextureSlot::Alpha && texture.max_value() > 1.0 {
+                return Err(p.err(
+                    t,
+                    format!(
+                        "the texture of `{name}` reaches {} (a reflectance must be at most 1)",
+                        texture.max_value()
+                    ),
+                ));
+            }
+            slots.push((slot, texture));
+            return Ok(None);
+        }
+        let usage = if slot == TextureSlot::Alpha {
+            ColorUse::Emission
+        } else {
+            ColorUse::Reflectance
+        };
+        p.color(name, usage, self.opts, &mut self.report)
+    }
+
+    /// A `<texture>`: Mitsuba's `bitmap` (`filename`, `filter_type` bilinear or nearest, `wrap_mode`
+    /// repeat, mirror or clamp, `raw`, `to_uv`) or `checkerboard` (`color0` 0.4, `color1` 0.2,
+    /// `to_uv`).
+    fn texture(&mut self, e: &'a Elem) -> Result<Texture, SceneError> {
+        let p = self.plugin(e)?;
+        let to_uv = match p.transform("to_uv")? {
+            None => UvTransform::IDENTITY,
+            Some((x, _)) => {
+                let m = x.m;
+                // A 2-D affine map given as a 4×4 (Mitsuba builds it with translate/scale/rotate
+                // about z): its upper-left 2×2 and the translation's x, y.
+                UvTransform {
+                    m: [
+                        [m.x_axis.x as f32, m.y_axis.x as f32],
+                        [m.x_axis.y as f32, m.y_axis.y as f32],
+                    ],
+                    t: glam::Vec2::new(m.w_axis.x as f32, m.w_axis.y as f32),
+                }
+            }
+        };
+        let texture = match p.kind {
+            "bitmap" => {
+                let Some((file, fe)) = p.string("filename")? else {
+                    return Err(p.err(e, "a bitmap texture needs a `filename`"));
+                };
+                let path = self.doc.ctx(e.src).base_dir.join(file);
+                let img = read_rgb(&path).map_err(|m| p.err(fe, m))?;
+                let raw = p.boolean("raw")?.unwrap_or(false);
+                let decode = img.srgb_encoded && !raw;
+                let texels = img
+                    .texels
+                    .iter()
+                    .map(|c| if decode { c.map(srgb_to_linear) } else { *c })
+                    .collect();
+                let filter = match p.string("filter_type")? {
+                    None | Some(("bilinear", _)) => FilterType::Bilinear,
+                    Some(("nearest", _)) => FilterType::Nearest,
+                    Some((other, fe)) => {
+                        return Err(p.err(
+                            fe,
+                            format!("`filter_type` must be bilinear or nearest, got `{other}`"),
+                        ))
+                    }
+                };
+                let wrap = match p.string("wrap_mode")? {
+                    None | Some(("repeat", _)) => WrapMode::Repeat,
+                    Some(("mirror", _)) => WrapMode::Mirror,
+                    Some(("clamp", _)) => WrapMode::Clamp,
+                    Some((other, we)) => {
+                        return Err(p.err(
+                            we,
+                            format!("`wrap_mode` must be repeat, mirror or clamp, got `{other}`"),
+                        ))
+                    }
+                };
+                self.meshes.push(path);
+                p.finish(&["format"], &mut self.report)?;
+                Texture::Bitmap(Arc::new(Bitmap {
+                    width: img.width,
+                    height: img.height,
+                    texels,
+                    filter,
+                    wrap,
+                    to_uv,
+                }))
+            }
+            "checkerboard" => {
+                let opts = self.opts;
+                let color0 = p
+                    .color("color0", ColorUse::Emission, opts, &mut self.report)?
+                    .unwrap_or(Color::splat(0.4));
+                let color1 = p
+                    .color("color1", ColorUse::Emission, opts, &mut self.report)?
+                    .unwrap_or(Color::splat(0.2));
+                p.finish(&[], &mut self.report)?;
+                Texture::Checkerboard {
+                    color0,
+                    color1,
+                    to_uv,
+                }
+            }
+            other => {
+                return Err(p.err(
+                    e,
+                    format!(
+                        "texture `{other}` is not supported (lt reads bitmap and checkerboard)"
+                    ),
+                ))
+            }
+        };
+        Ok(texture)
     }
 
     /// An IOR given as a number or by one of Mitsuba's names.
@@ -630,7 +758,11 @@ impl<'a> Loader<'a> {
 
     /// Mitsuba's microfacet parameters: `distribution` (beckmann, the default, or ggx), `alpha` or
     /// `alpha_u` and `alpha_v` (default 0.1), `sample_visible` (default true).
-    fn microfacet(&mut self, p: &Plugin<'a>) -> Result<Microfacet, SceneError> {
+    fn microfacet(
+        &mut self,
+        p: &Plugin<'a>,
+        slots: &mut Vec<(TextureSlot, Texture)>,
+    ) -> Result<Microfacet, SceneError> {
         let e = p.elem;
         let kind = match p.string("distribution")? {
             None | Some(("beckmann", _)) => MicrofacetType::Beckmann,
@@ -642,7 +774,15 @@ impl<'a> Loader<'a> {
                 ))
             }
         };
-        let alpha = p.float("alpha")?;
+        // A texture of α: the distribution keeps the default 0.1 until a point sets it.
+        let alpha = match p.texture("alpha") {
+            Some(t) => {
+                let texture = self.texture(t)?;
+                slots.push((TextureSlot::Alpha, texture));
+                None
+            }
+            None => p.float("alpha")?,
+        };
         let (au, av) = (p.float("alpha_u")?, p.float("alpha_v")?);
         let a = match (alpha, au, av) {
             (Some(a), None, None) => a,
@@ -926,6 +1066,7 @@ fn unit_disk_fan() -> TriangleMesh {
     TriangleMesh {
         positions,
         normals: None,
+        uvs: None,
         indices,
     }
 }
@@ -1011,6 +1152,7 @@ mod tests {
                 glam::Vec3::Z,
             ],
             normals: None,
+            uvs: None,
             indices: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
         };
         let n = vertex_normals(&m);

@@ -67,7 +67,12 @@ impl<'a> Plugin<'a> {
                     return Err(doc.err(c, format!("reference to an undefined id `{id}`")));
                 };
                 if target.tag == "texture" {
-                    return Err(textures_refused(doc, target));
+                    // A named reference to a texture is a parameter of that name.
+                    let Some(name) = c.attr("name") else {
+                        return Err(doc.err(c, format!("a <ref> to the texture `{id}` needs the `name` of the parameter it sets")));
+                    };
+                    params.push((name, target, Cell::new(false)));
+                    continue;
                 }
                 if let Some(name) = c.attr("name") {
                     report.ignored.push(format!(
@@ -118,6 +123,17 @@ impl<'a> Plugin<'a> {
 
     pub fn has(&self, name: &str) -> bool {
         self.params.iter().any(|(n, ..)| *n == name)
+    }
+
+    /// The `<texture>` a parameter is given as (nested or through a `<ref>`), marked as taken;
+    /// None when the parameter is absent or a plain value.
+    pub fn texture(&self, name: &str) -> Option<&'a Elem> {
+        let (_, e, used) = self.params.iter().find(|(n, ..)| *n == name)?;
+        if e.tag != "texture" {
+            return None;
+        }
+        used.set(true);
+        Some(*e)
     }
 
     /// The element of a parameter, marked as taken (for callers that read it themselves).

@@ -170,6 +170,39 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                 return Err(ctx.at(d.kind.span(), format!("material type `{other}` has no Mitsuba counterpart here")))
             }
         };
+        // Textured parameters become nested <texture>s of the innermost BSDF.
+        let mut textures = String::new();
+        for (t, name) in [
+            (&d.albedo_texture, "reflectance"),
+            (&d.reflectance_texture, "specular_reflectance"),
+            (&d.alpha_texture, "alpha"),
+        ] {
+            if let Some(t) = t {
+                textures.push_str(&texture_xml(&ctx, t.get_ref(), name, out_dir));
+            }
+        }
+        // A textured parameter's plain value (the default the writer filled in) goes.
+        let body: String = body
+            .split_inclusive('\n')
+            .filter(|line| {
+                ![
+                    (&d.albedo_texture, "name=\"reflectance\""),
+                    (&d.reflectance_texture, "name=\"specular_reflectance\""),
+                    (&d.alpha_texture, "name=\"alpha\""),
+                ]
+                .iter()
+                .any(|(t, key)| t.is_some() && line.contains(key) && !line.contains("<texture"))
+            })
+            .collect();
+        // The innermost BSDF closes first: its textures go on the lines before that.
+        let body = match body.find("</bsdf>") {
+            Some(close) if !textures.is_empty() => {
+                let line_start = body[..close].rfind('\n').map_or(0, |n| n + 1);
+                let (a, b) = body.split_at(line_start);
+                format!("{a}{textures}{b}")
+            }
+            _ => body,
+        };
         let _ = writeln!(x, "    {body}");
     }
     for def in &file.shapes {
@@ -351,6 +384,56 @@ fn relative(path: &Path, dir: &Path) -> PathBuf {
 }
 
 /// Escapes text for an XML attribute value.
+/// A TOML texture as Mitsuba's `<texture name=…>` (uv scale as `to_uv`).
+fn texture_xml(ctx: &Ctx, t: &crate::format::TextureDef, name: &str, out_dir: &Path) -> String {
+    let mut x = format!(
+        "            <texture type=\"{}\" name=\"{name}\">\n",
+        esc(t.kind.get_ref())
+    );
+    if let Some(s) = &t.scale {
+        let _ = writeln!(
+            x,
+            "                <transform name=\"to_uv\"><scale value=\"{}\"/></transform>",
+            *s.get_ref() as f32
+        );
+    }
+    if let Some(f) = &t.file {
+        let rel = relative(&ctx.base_dir.join(f.get_ref()), out_dir);
+        let _ = writeln!(
+            x,
+            "                <string name=\"filename\" value=\"{}\"/>",
+            esc(&rel.to_string_lossy())
+        );
+    }
+    for (key, xml_key) in [(&t.filter, "filter_type"), (&t.wrap, "wrap_mode")] {
+        if let Some(k) = key {
+            let _ = writeln!(
+                x,
+                "                <string name=\"{xml_key}\" value=\"{}\"/>",
+                esc(k.get_ref())
+            );
+        }
+    }
+    if let Some(r) = &t.raw {
+        let _ = writeln!(
+            x,
+            "                <boolean name=\"raw\" value=\"{}\"/>",
+            r.get_ref()
+        );
+    }
+    for (c, key) in [(&t.color0, "color0"), (&t.color1, "color1")] {
+        if let Some(c) = c {
+            let [r, g, b] = c.get_ref().0;
+            let _ = writeln!(
+                x,
+                "                <rgb name=\"{key}\" value=\"{r}, {g}, {b}\"/>"
+            );
+        }
+    }
+    x.push_str("            </texture>\n");
+    x
+}
+
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")

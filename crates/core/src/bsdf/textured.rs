@@ -1,0 +1,57 @@
+//! A material some of whose parameters vary over the surface (Mitsuba's nested `<texture>`s):
+//! resolved at the point's texture coordinates into the plain material, which is then sampled or
+//! evaluated as usual. Untextured materials never come here, so they keep their bits and speed.
+
+use super::microfacet::Microfacet;
+use super::Material;
+use crate::math::{Color, Vec2};
+use crate::texture::Texture;
+
+/// Which parameter a texture drives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TextureSlot {
+    /// Diffuse albedo (Mitsuba's `reflectance` of `diffuse`).
+    Reflectance,
+    /// The colour factor of mirrors and conductors (`specular_reflectance`).
+    SpecularReflectance,
+    /// Microfacet roughness α (`alpha`), read from the texture's first channel.
+    Alpha,
+}
+
+#[derive(Clone, Debug)]
+pub struct Textured {
+    /// The material with its untextured parameters (used where no point is known: `is_delta`).
+    pub base: Material,
+    pub slots: Vec<(TextureSlot, Texture)>,
+}
+
+impl Textured {
+    /// The plain material at texture coordinates `uv`.
+    pub fn resolve(&self, uv: Vec2) -> Material {
+        let mut m = self.base.clone();
+        for (slot, texture) in &self.slots {
+            set_parameter(&mut m, *slot, texture.eval(uv));
+        }
+        m
+    }
+}
+
+/// Sets one parameter of `m`; false when `m` has no such parameter (the loader asks first).
+pub fn set_parameter(m: &mut Material, slot: TextureSlot, value: Color) -> bool {
+    use TextureSlot::*;
+    match (m, slot) {
+        (Material::Diffuse(d), Reflectance) => d.albedo = value,
+        (Material::Mirror(x), SpecularReflectance) => x.reflectance = value,
+        (Material::Glossy(g), SpecularReflectance) => g.reflectance = value,
+        (Material::Glossy(g), Alpha) => g.roughness = value.x.max(super::microfacet::MIN_ALPHA),
+        (Material::Conductor(c), SpecularReflectance) => c.specular_reflectance = value,
+        (Material::RoughConductor(r), SpecularReflectance) => r.specular_reflectance = value,
+        (Material::RoughConductor(r), Alpha) => {
+            let d = r.distribution;
+            r.distribution = Microfacet::new(d.kind, value.x, value.x, d.sample_visible);
+        }
+        (Material::TwoSided(t), slot) => return set_parameter(&mut t.inner, slot, value),
+        _ => return false,
+    }
+    true
+}

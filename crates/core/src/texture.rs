@@ -1,0 +1,211 @@
+//! Textures: a colour (or a scalar, read from the first channel) that varies over a surface with
+//! its (u, v) parameterisation, as Mitsuba 3 defines them: `bitmap` (an image, linear RGB texels,
+//! looked up with `filter_type` nearest or bilinear and a `wrap_mode`), `checkerboard`, and the
+//! constant case every untextured parameter is. Decoding image files is not the core's job
+//! (`lt-scene-io` hands a `Bitmap` its texels).
+//!
+//! Conventions (Mitsuba 3's): `to_uv` maps the surface's uv first; uv (0, 0) is the top-left
+//! corner of the image's first row of texels and v grows downwards through the rows; texel
+//! centres sit at half-integer positions of uv · (width, height).
+
+use crate::math::{Color, Vec2};
+use std::sync::Arc;
+
+/// How coordinates outside [0, 1) are brought back (Mitsuba's `wrap_mode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WrapMode {
+    Repeat,
+    Mirror,
+    Clamp,
+}
+
+/// How a bitmap is read between texel centres (Mitsuba's `filter_type`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FilterType {
+    Nearest,
+    Bilinear,
+}
+
+/// A 2-D affine map of texture coordinates (Mitsuba's `to_uv`): uv' = m · uv + t.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    /// Rows of the 2 × 2 linear part.
+    pub m: [[f32; 2]; 2],
+    pub t: Vec2,
+}
+
+impl UvTransform {
+    pub const IDENTITY: UvTransform = UvTransform {
+        m: [[1.0, 0.0], [0.0, 1.0]],
+        t: Vec2::ZERO,
+    };
+
+    #[inline]
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        Vec2::new(
+            self.m[0][0] * uv.x + self.m[0][1] * uv.y + self.t.x,
+            self.m[1][0] * uv.x + self.m[1][1] * uv.y + self.t.y,
+        )
+    }
+}
+
+/// An image of linear RGB texels, row by row from the top.
+#[derive(Clone, Debug)]
+pub struct Bitmap {
+    pub width: usize,
+    pub height: usize,
+    pub texels: Vec<Color>,
+    pub filter: FilterType,
+    pub wrap: WrapMode,
+    pub to_uv: UvTransform,
+}
+
+impl Bitmap {
+    /// The texel at integer coordinates, wrapped into the image.
+    #[inline]
+    fn texel(&self, x: i64, y: i64) -> Color {
+        let x = wrap_index(x, self.width, self.wrap);
+        let y = wrap_index(y, self.height, self.wrap);
+        self.texels[y * self.width + x]
+    }
+
+    pub fn eval(&self, uv: Vec2) -> Color {
+        let uv = self.to_uv.apply(uv);
+        // Continuous texel coordinates whose integer + ½ points are texel centres.
+        let (x, y) = (
+            uv.x as f64 * self.width as f64,
+            uv.y as f64 * self.height as f64,
+        );
+        match self.filter {
+            FilterType::Nearest => self.texel(x.floor() as i64, y.floor() as i64),
+            FilterType::Bilinear => {
+                let (fx, fy) = (x - 0.5, y - 0.5);
+                let (x0, y0) = (fx.floor(), fy.floor());
+                let (tx, ty) = ((fx - x0) as f32, (fy - y0) as f32);
+                let (x0, y0) = (x0 as i64, y0 as i64);
+                let top = self.texel(x0, y0) * (1.0 - tx) + self.texel(x0 + 1, y0) * tx;
+                let bottom = self.texel(x0, y0 + 1) * (1.0 - tx) + self.texel(x0 + 1, y0 + 1) * tx;
+                top * (1.0 - ty) + bottom * ty
+            }
+        }
+    }
+
+    /// Mean of the texels (a light's power, a material's average albedo).
+    pub fn mean(&self) -> Color {
+        let sum: glam::DVec3 = self.texels.iter().map(|c| c.as_dvec3()).sum();
+        (sum / self.texels.len().max(1) as f64).as_vec3()
+    }
+}
+
+/// An integer coordinate brought into [0, n) by the wrap mode.
+#[inline]
+fn wrap_index(i: i64, n: usize, wrap: WrapMode) -> usize {
+    let n = n as i64;
+    let j = match wrap {
+        WrapMode::Repeat => i.rem_euclid(n),
+        WrapMode::Clamp => i.clamp(0, n - 1),
+        WrapMode::Mirror => {
+            let k = i.rem_euclid(2 * n);
+            if k < n {
+                k
+            } else {
+                2 * n - 1 - k
+            }
+        }
+    };
+    j as usize
+}
+
+#[derive(Clone, Debug)]
+pub enum Texture {
+    Constant(Color),
+    Bitmap(Arc<Bitmap>),
+    /// Mitsuba's `checkerboard`: `color0` where ⌊2u⌋ + ⌊2v⌋ is even (after `to_uv`), else `color1`.
+    Checkerboard {
+        color0: Color,
+        color1: Color,
+        to_uv: UvTransform,
+    },
+}
+
+impl Texture {
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> Color {
+        match self {
+            Texture::Constant(c) => *c,
+            Texture::Bitmap(b) => b.eval(uv),
+            Texture::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            } => {
+                let uv = to_uv.apply(uv);
+                let (a, b) = ((uv.x * 2.0).floor() as i64, (uv.y * 2.0).floor() as i64);
+                if (a + b).rem_euclid(2) == 0 {
+                    *color0
+                } else {
+                    *color1
+                }
+            }
+        }
+    }
+
+    /// The largest value the texture takes (for checks such as reflectance ≤ 1).
+    pub fn max_value(&self) -> f32 {
+        match self {
+            Texture::Constant(c) => c.max_element(),
+            Texture::Bitmap(b) => b.texels.iter().map(|c| c.max_element()).fold(0.0, f32::max),
+            Texture::Checkerboard { color0, color1, .. } => {
+                color0.max_element().max(color1.max_element())
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bitmap(filter: FilterType, wrap: WrapMode) -> Bitmap {
+        // 2 × 2: top row red, green; bottom row blue, white.
+        Bitmap {
+            width: 2,
+            height: 2,
+            texels: vec![Color::X, Color::Y, Color::Z, Color::ONE],
+            filter,
+            wrap,
+            to_uv: UvTransform::IDENTITY,
+        }
+    }
+
+    #[test]
+    fn nearest_reads_the_texel_under_uv_from_the_top_row() {
+        let b = bitmap(FilterType::Nearest, WrapMode::Repeat);
+        assert_eq!(b.eval(Vec2::new(0.25, 0.25)), Color::X);
+        assert_eq!(b.eval(Vec2::new(0.75, 0.25)), Color::Y);
+        assert_eq!(b.eval(Vec2::new(0.25, 0.75)), Color::Z);
+        assert_eq!(b.eval(Vec2::new(1.25, -0.25)), Color::Z); // repeat
+    }
+
+    #[test]
+    fn bilinear_is_exact_at_centres_and_halfway_between() {
+        let b = bitmap(FilterType::Bilinear, WrapMode::Clamp);
+        assert_eq!(b.eval(Vec2::new(0.25, 0.25)), Color::X);
+        assert_eq!(b.eval(Vec2::new(0.5, 0.25)), Color::new(0.5, 0.5, 0.0));
+        assert_eq!(b.eval(Vec2::new(0.0, 0.25)), Color::X); // clamped edge
+        let m = bitmap(FilterType::Nearest, WrapMode::Mirror);
+        assert_eq!(m.eval(Vec2::new(1.25, 0.25)), Color::Y); // mirrored back into the last column
+    }
+
+    #[test]
+    fn checkerboard_alternates_in_quarters() {
+        let t = Texture::Checkerboard {
+            color0: Color::ZERO,
+            color1: Color::ONE,
+            to_uv: UvTransform::IDENTITY,
+        };
+        assert_eq!(t.eval(Vec2::new(0.1, 0.1)), Color::ZERO);
+        assert_eq!(t.eval(Vec2::new(0.6, 0.1)), Color::ONE);
+        assert_eq!(t.eval(Vec2::new(0.6, 0.6)), Color::ZERO);
+    }
+}

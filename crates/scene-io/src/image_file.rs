@@ -1,0 +1,75 @@
+//! Image files for textures and environment maps: PNG, JPEG and BMP through the `image` crate,
+//! Radiance HDR through it too, OpenEXR through `exr`. Returns texels row by row from the top and
+//! says whether they are display-encoded (8- or 16-bit sRGB files) or linear (HDR, EXR), so the
+//! caller can decode sRGB unless the scene asks for the raw values.
+
+use lt_core::math::Color;
+use std::path::Path;
+
+pub struct RgbImage {
+    pub width: usize,
+    pub height: usize,
+    pub texels: Vec<Color>,
+    /// The values are sRGB-encoded display values in [0, 1] (else linear radiometric values).
+    pub srgb_encoded: bool,
+}
+
+/// Reads `path` by its extension; the error names the file and what went wrong.
+pub fn read_rgb(path: &Path) -> Result<RgbImage, String> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    if ext == "exr" {
+        return read_exr(path);
+    }
+    let img =
+        image::open(path).map_err(|e| format!("cannot read image {}: {e}", path.display()))?;
+    let (width, height) = (img.width() as usize, img.height() as usize);
+    let linear = matches!(ext.as_str(), "hdr");
+    let rgb = img.into_rgb32f();
+    let texels = rgb
+        .pixels()
+        .map(|p| Color::new(p.0[0], p.0[1], p.0[2]))
+        .collect();
+    Ok(RgbImage {
+        width,
+        height,
+        texels,
+        srgb_encoded: !linear,
+    })
+}
+
+fn read_exr(path: &Path) -> Result<RgbImage, String> {
+    use exr::prelude::read_first_rgba_layer_from_file;
+    let img = read_first_rgba_layer_from_file(
+        path,
+        |size, _| {
+            (
+                size.width(),
+                vec![Color::ZERO; size.width() * size.height()],
+            )
+        },
+        |(w, texels): &mut (usize, Vec<Color>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            texels[pos.y() * *w + pos.x()] = Color::new(r, g, b);
+        },
+    )
+    .map_err(|e| format!("cannot read EXR {}: {e}", path.display()))?;
+    let (width, texels) = img.layer_data.channel_data.pixels;
+    Ok(RgbImage {
+        width,
+        height: texels.len() / width.max(1),
+        texels,
+        srgb_encoded: false,
+    })
+}
+
+/// The sRGB transfer function inverted (IEC 61966-2-1): display value → linear.
+pub fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
