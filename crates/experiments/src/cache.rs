@@ -38,7 +38,8 @@ pub fn key_of(material: &Value) -> Key {
 }
 
 /// The content hash of a scene: every file it was read from (`Scene::source_files`), names
-/// excluded, so a moved or copied scene keeps its hash and an edited mesh changes it.
+/// excluded, so a moved or copied scene keeps its hash and an edited mesh changes it; and the
+/// load options that change what is read (`-D` definitions, `--approximate`), when given.
 pub fn scene_hash(files: &[PathBuf]) -> Result<String, String> {
     if files.is_empty() {
         return Err("the scene names no source files, so it has no content hash".into());
@@ -49,6 +50,10 @@ pub fn scene_hash(files: &[PathBuf]) -> Result<String, String> {
             std::fs::read(f).map_err(|e| format!("cannot read {} to hash it: {e}", f.display()))?;
         h.update(&(bytes.len() as u64).to_le_bytes());
         h.update(&bytes);
+    }
+    let opts = lt_scene_io::default_load_options();
+    if opts.approximate || !opts.defines.is_empty() {
+        h.update(format!("load {} {:?}", opts.approximate, opts.defines).as_bytes());
     }
     Ok(h.finalize().to_hex()[..32].to_string())
 }

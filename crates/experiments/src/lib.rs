@@ -10,6 +10,7 @@ pub mod flip;
 pub mod gallery;
 pub mod image_io;
 pub mod integrator_args;
+pub mod load_args;
 pub mod manifest;
 pub mod mis_check;
 pub mod mis_check_vcm;

@@ -43,5 +43,13 @@ pub fn load_scene_with(path: &Path, opts: &LoadOptions) -> Result<(Scene, LoadRe
     {
         return xml::load_xml(path, opts);
     }
+    if let Some((k, _)) = opts.defines.first() {
+        return Err(SceneError {
+            file: path.display().to_string(),
+            line: None,
+            column: None,
+            message: format!("-D {k}=…: definitions apply to Mitsuba XML scenes only (a TOML scene has no $parameters)"),
+        });
+    }
     Ok((toml_file::load_toml(path)?, Default::default()))
 }

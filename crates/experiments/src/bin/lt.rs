@@ -10,14 +10,8 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
-    /// Where a Mitsuba XML scene asks for something lt lacks (a Gaussian pixel
-    /// filter, spectra, unbounded max_depth), substitute the nearest it has and list each
-    /// substitution, instead of refusing the scene.
-    #[arg(long, global = true)]
-    approximate: bool,
-    /// List the parameters of an XML scene that were accepted but change nothing lt renders.
-    #[arg(long, global = true)]
-    verbose: bool,
+    #[command(flatten)]
+    load: x::load_args::LoadArgs,
     /// How rays find primitives: auto (flat for scenes of at most 64 primitives and no triangles,
     /// else bvh), bvh, flat (every primitive tested, vectorised) or flat-scalar (the same, one at
     /// a time: the reference, bit for bit the same hits). See results/bench.md.
@@ -66,10 +60,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     lt_core::geometry::set_ray_core(cli.ray_core);
-    lt_scene_io::set_default_load_options(lt_scene_io::LoadOptions {
-        approximate: cli.approximate,
-        verbose: cli.verbose,
-    });
+    lt_scene_io::set_default_load_options(cli.load.options());
     let result = match &cli.command {
         Command::Render(a) => x::render_cmd::run(a),
         Command::Compare(a) => x::compare::run(a).map(|report| print!("{report}")),

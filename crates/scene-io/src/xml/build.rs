@@ -3,7 +3,9 @@
 
 use super::doc::{Doc, Elem};
 use super::props::{textures_refused, ColorUse, Ids, Plugin};
+use super::resolve::Resolver;
 use super::values::Xform;
+use crate::error::Ctx;
 use crate::image_file::{read_rgb, srgb_to_linear};
 use crate::mesh::ply;
 use crate::transform::{check_quad, check_solid};
@@ -434,10 +436,12 @@ impl<'a> Loader<'a> {
                 let p = self.plugin(e)?;
                 match p.kind {
                     "path" | "volpath" | "volpathmis" | "ptracer" => {}
+                    "moment" => return self.moment(&p, root),
+                    "direct" => return self.direct(&p),
                     other => {
                         return Err(p.err(
                             e,
-                            format!("integrator `{other}` is not supported (lt reads path, volpath, volpathmis and ptracer for their max_depth; the estimator is chosen on lt's command line)"),
+                            format!("integrator `{other}` is not supported (lt reads path, volpath, volpathmis, ptracer, direct and moment for their max_depth; the estimator is chosen on lt's command line); where the file writes type=\"$integrator\", -D integrator=path renders it"),
                         ))
                     }
                 }
@@ -474,6 +478,49 @@ impl<'a> Loader<'a> {
             ));
         }
         Ok((depth, rr as u32))
+    }
+
+    /// Mitsuba's `moment` renders its inner integrator and adds the second moment as extra
+    /// channels; lt's renders carry their own variance, so the inner integrator is what counts.
+    fn moment(&mut self, p: &Plugin<'a>, root: &Elem) -> Result<(u32, u32), SceneError> {
+        let inner = p.nested(&["integrator"]);
+        p.finish(&[], &mut self.report)?;
+        match inner[..] {
+            [i] => self.integrator(Some(i), root),
+            [] => Err(p.err(
+                p.elem,
+                "integrator `moment` needs the integrator it wraps inside it",
+            )),
+            [_, second, ..] => Err(p.err(
+                second,
+                "a second integrator inside `moment`: lt renders one estimator per image",
+            )),
+        }
+    }
+
+    /// Mitsuba's `direct`: emitters seen directly plus direct illumination at the first hit,
+    /// emitter and BSDF samples joined by MIS. Its expectation is every path of at most two
+    /// segments — lt's `max_depth = 2` (camera segment included), which every estimator renders
+    /// (`pt` with next-event estimation and MIS is the same estimator). The sample counts change
+    /// only the noise while both are positive; a zero count drops a whole class of paths (lights
+    /// reached through a mirror, point lights), so it is refused.
+    fn direct(&mut self, p: &Plugin<'a>) -> Result<(u32, u32), SceneError> {
+        if p.boolean("hide_emitters")? == Some(true) {
+            return Err(p.err(p.elem, "`hide_emitters` = true is not supported"));
+        }
+        for key in ["emitter_samples", "bsdf_samples", "shading_samples"] {
+            if let Some(n) = p.integer(key)? {
+                if n < 1 {
+                    return Err(p.err(p.elem, format!("`{key}` = {n} of integrator `direct`: lt renders every path of two segments, a count below 1 leaves some out")));
+                }
+                self.report.ignored.push(format!(
+                    "{}: `{key}` = {n} of integrator `direct` accepted and ignored (it changes the noise, not the expectation)",
+                    self.doc.place(p.elem)
+                ));
+            }
+        }
+        p.finish(&[], &mut self.report)?;
+        Ok((2, 5))
     }
 
     // ---------------------------------------------------------------- BSDFs
@@ -655,7 +702,9 @@ impl<'a> Loader<'a> {
                 let Some((file, fe)) = p.string("filename")? else {
                     return Err(p.err(e, "a bitmap texture needs a `filename`"));
                 };
-                let path = self.doc.ctx(e.src).base_dir.join(file);
+                let path = self.doc.resolver.resolve(file).map_err(|looked| {
+                    p.err(fe, Resolver::not_found("texture file", file, &looked))
+                })?;
                 let img = read_rgb(&path).map_err(|m| p.err(fe, m))?;
                 let raw = p.boolean("raw")?.unwrap_or(false);
                 let decode = img.srgb_encoded && !raw;
@@ -807,8 +856,8 @@ impl<'a> Loader<'a> {
     /// `eta` and `k` given together (RGB, spectrum or float).
     fn complex_ior(&mut self, p: &Plugin<'a>) -> Result<ComplexIor, SceneError> {
         let opts = self.opts;
-        let eta = p.color("eta", ColorUse::Emission, opts, &mut self.report)?;
-        let k = p.color("k", ColorUse::Emission, opts, &mut self.report)?;
+        let eta = p.color("eta", ColorUse::Unbounded, opts, &mut self.report)?;
+        let k = p.color("k", ColorUse::Unbounded, opts, &mut self.report)?;
         let named = p.string("material")?;
         match (named, eta, k) {
             (None, None, None) => Ok(named_conductor("none").expect("none is a conductor")),
@@ -891,12 +940,18 @@ impl<'a> Loader<'a> {
                 };
                 let face_normals = p.boolean("face_normals")?.unwrap_or(false);
                 check_solid(&ctx, &m, span.clone(), "mesh")?;
-                let spanned = toml::Spanned::new(fe.range.clone(), file.to_string());
-                let path = ctx.base_dir.join(file);
+                let path = doc.resolver.resolve(file).map_err(|looked| {
+                    p.err(fe, Resolver::not_found("mesh file", file, &looked))
+                })?;
+                // The mesh readers join their context's folder with the name: give them the
+                // resolved path and no folder.
+                let resolved = Ctx { base_dir: PathBuf::new(), ..doc.ctx(e.src) };
+                let spanned =
+                    toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
                 let mut mesh = if p.kind == "obj" {
-                    crate::mesh::obj::load_obj(&ctx, &spanned)?
+                    crate::mesh::obj::load_obj(&resolved, &spanned)?
                 } else {
-                    ply::load_ply(&ctx, &spanned)?
+                    ply::load_ply(&resolved, &spanned)?
                 };
                 self.meshes.push(path);
                 if face_normals {

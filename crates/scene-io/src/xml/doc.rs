@@ -2,8 +2,11 @@
 //! spliced in, every `default` applied, every `$name` substituted and, in files older than
 //! version 2, every parameter name upgraded from camelCase to snake_case (what Mitsuba 3 does
 //! when it reads a 0.6 file). Each element remembers its source file and byte range, so any later
-//! error can name the file, line and column.
+//! error can name the file, line and column. `<path>` elements feed the file resolver
+//! (`resolve`), through which includes here and meshes later are found; definitions given on the
+//! command line (`-D key=value`) come before every `<default>`, so they win.
 
+use super::resolve::Resolver;
 use crate::error::Ctx;
 use crate::SceneError;
 use std::collections::HashMap;
@@ -46,6 +49,8 @@ pub(super) struct Doc {
     pub sources: Vec<Source>,
     /// The `<scene>` element of the scene file, includes spliced in.
     pub root: Elem,
+    /// The scene file's folder and every `<path>` folder.
+    pub resolver: Resolver,
 }
 
 impl Doc {
@@ -74,23 +79,30 @@ impl Doc {
     }
 }
 
-/// Reads the scene file and everything it includes.
-pub(super) fn read(path: &Path) -> Result<Doc, SceneError> {
+/// Reads the scene file and everything it includes; `defines` are the command line's
+/// `-D key=value` definitions.
+pub(super) fn read(path: &Path, defines: &[(String, String)]) -> Result<Doc, SceneError> {
     let mut r = Reader {
         sources: Vec::new(),
         params: HashMap::new(),
+        resolver: Resolver::new(path),
     };
+    for (k, v) in defines {
+        r.params.entry(k.clone()).or_insert_with(|| v.clone());
+    }
     let root = r.file(path, path.display().to_string(), 0, None)?;
     Ok(Doc {
         sources: r.sources,
         root,
+        resolver: r.resolver,
     })
 }
 
 struct Reader {
     sources: Vec<Source>,
-    /// `default` values and, in time, command-line definitions (first definition wins).
+    /// Command-line definitions, then `default` values (first definition wins).
     params: HashMap<String, String>,
+    resolver: Resolver,
 }
 
 impl Reader {
@@ -231,6 +243,16 @@ impl Reader {
                 self.params.entry(name).or_insert(value);
                 return Ok(Vec::new());
             }
+            "path" => {
+                let Some(value) = get("value") else {
+                    return Err(err(
+                        self,
+                        "<path> needs a `value` (a folder to look for files in)".into(),
+                    ));
+                };
+                self.resolver.add(&value);
+                return Ok(Vec::new());
+            }
             "include" => {
                 let Some(file) = get("filename") else {
                     return Err(err(self, "<include> needs a `filename`".into()));
@@ -241,8 +263,9 @@ impl Reader {
                         format!("includes nested more than {MAX_INCLUDE_DEPTH} deep (a cycle?)"),
                     ));
                 }
-                let base = self.sources[src].path.parent().map(Path::to_path_buf);
-                let path = base.unwrap_or_default().join(&file);
+                let path = self.resolver.resolve(&file).map_err(|looked| {
+                    err(self, Resolver::not_found("included file", &file, &looked))
+                })?;
                 let s = &self.sources[src];
                 let from = Source {
                     path: s.path.clone(),

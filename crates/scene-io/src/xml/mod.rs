@@ -5,14 +5,20 @@
 //! `props` (each plugin's parameters, every one taken or reported) and `build` (the plugin subset,
 //! assembled through `SceneBuilder`). Meshes come from `crate::mesh` (OBJ and PLY). Out: `write::to_mitsuba_xml` writes one of our TOML scenes as Mitsuba 3 XML.
 //!
-//! Where a file asks for something lt lacks but has a near equivalent of (a Gaussian or other pixel filter → the box, a spectrum → RGB, max_depth = -1 → 64),
+//! Relative file names go through `resolve` (Mitsuba's resolver: the scene's folder, then each
+//! `<path>`); spectra become RGB exactly as Mitsuba's RGB variants convert them (`spectrum`,
+//! with the tables in `cie_table`).
+//!
+//! Where a file asks for something lt lacks but has a near equivalent of (a Gaussian or other pixel filter → the box, max_depth = -1 → 64),
 //! the load is refused unless `LoadOptions::approximate`, and every substitution made is listed
 //! in the `LoadReport`. Parameters Mitsuba writes by default that change nothing lt renders
 //! (`near_clip`, a film's `pixel_format`, a `ref`'s `name`, …) are accepted and listed too.
 
 mod build;
+mod cie_table;
 mod doc;
 mod props;
+mod resolve;
 mod spectrum;
 mod values;
 pub mod write;
@@ -26,7 +32,7 @@ pub use build::UNBOUNDED_DEPTH_SUBSTITUTE;
 /// Reads a Mitsuba XML scene. `source_files` is the XML file, every included file, then every
 /// mesh file, in the order read.
 pub fn load_xml(path: &Path, opts: &LoadOptions) -> Result<(Scene, LoadReport), SceneError> {
-    let doc = doc::read(path)?;
+    let doc = doc::read(path, &opts.defines)?;
     let (mut scene, report, meshes) = build::load(&doc, opts)?;
     scene.source_files = doc
         .sources

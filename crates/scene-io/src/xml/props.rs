@@ -45,8 +45,20 @@ pub(super) type Ids<'a> = std::collections::HashMap<&'a str, &'a Elem>;
 pub(super) enum ColorUse {
     /// In [0, 1].
     Reflectance,
-    /// ≥ 0 (radiance, intensity, irradiance).
+    /// ≥ 0, a surface's other spectra (a conductor's η and k).
+    Unbounded,
+    /// ≥ 0, inside an emitter (radiance, intensity, irradiance).
     Emission,
+}
+
+impl ColorUse {
+    fn spectrum(self) -> spectrum::SpectrumUse {
+        match self {
+            ColorUse::Reflectance => spectrum::SpectrumUse::Bounded,
+            ColorUse::Unbounded => spectrum::SpectrumUse::Unbounded,
+            ColorUse::Emission => spectrum::SpectrumUse::Emission,
+        }
+    }
 }
 
 impl<'a> Plugin<'a> {
@@ -245,14 +257,15 @@ impl<'a> Plugin<'a> {
         Ok(Some((transform(self.doc, e)?, e)))
     }
 
-    /// A colour: `<rgb>`, a `<float>` (grey), or a `<spectrum>` (one value is grey; a list of
-    /// wavelength:value pairs is converted to RGB only with `--approximate`).
+    /// A colour: `<rgb>`, a `<float>` (grey), or a `<spectrum>` (one value or wavelength:value
+    /// pairs, converted to RGB as Mitsuba's RGB variants do: `spectrum`).
     pub fn color(
         &self,
         name: &str,
         usage: ColorUse,
-        opts: &LoadOptions,
-        report: &mut LoadReport,
+        // Unused since spectra convert exactly; kept so every caller reads the same.
+        _opts: &LoadOptions,
+        _report: &mut LoadReport,
     ) -> Result<Option<Color>, SceneError> {
         let Some(e) = self.take(name) else {
             return Ok(None);
@@ -287,27 +300,13 @@ impl<'a> Plugin<'a> {
                 if !v.contains(':') {
                     let n = numbers(self.doc, e, v, &what)?;
                     match n[..] {
-                        [g] => [g; 3],
+                        [c] => spectrum::constant_to_rgb(c, usage.spectrum()),
                         _ => return Err(self.err(e, format!("{what}: a <spectrum> is one number or wavelength:value pairs, got `{v}`"))),
                     }
                 } else {
                     let pairs = spectrum::parse_pairs(v)
                         .map_err(|m| self.err(e, format!("{what}: {m}")))?;
-                    if !opts.approximate {
-                        return Err(self.err(
-                            e,
-                            format!("{what}: spectral values are not supported (lt renders RGB); pass --approximate to convert it to RGB as Mitsuba's RGB variants do, or give an <rgb>"),
-                        ));
-                    }
-                    let c = spectrum::to_rgb(&pairs, usage == ColorUse::Reflectance);
-                    report.substitutions.push(format!(
-                        "{}: {what}: spectrum converted to RGB ({:.6}, {:.6}, {:.6})",
-                        self.doc.place(e),
-                        c[0],
-                        c[1],
-                        c[2]
-                    ));
-                    c
+                    spectrum::pairs_to_rgb(&pairs, usage.spectrum())
                 }
             }
             "blackbody" => {
