@@ -163,7 +163,7 @@ pub(super) fn load(
     let mut emitters = 0;
     for c in &root.children {
         match c.tag.as_str() {
-            "shape" => emitters += l.shape(c, &mut b)? as usize,
+            "shape" => emitters += l.shape_or_instance(c, &mut b)?,
             "emitter" => {
                 match l.emitter(c)? {
                     Some((desc, Some(position))) => {
@@ -882,10 +882,80 @@ impl<'a> Loader<'a> {
     // ---------------------------------------------------------------- shapes
 
     /// Adds the shape; returns whether it emits.
-    fn shape(&mut self, e: &'a Elem, b: &mut WorldBuilder) -> Result<bool, SceneError> {
+    /// A top-level `<shape>`: a shape, a `shapegroup` (nothing until instanced) or an `instance`
+    /// of one, which adds a copy of each of the group's shapes under the instance's `to_world`
+    /// (flattened: lt's ray core has no instancing, the geometry is repeated). Returns how many
+    /// emitting shapes it added.
+    fn shape_or_instance(
+        &mut self,
+        e: &'a Elem,
+        b: &mut WorldBuilder,
+    ) -> Result<usize, SceneError> {
+        match e.attr("type").unwrap_or("") {
+            "shapegroup" => {
+                let p = self.plugin(e)?;
+                for s in p.nested(&["shape"]) {
+                    if matches!(s.attr("type"), Some("shapegroup" | "instance")) {
+                        return Err(p.err(s, "a shapegroup holds shapes, not groups or instances"));
+                    }
+                }
+                p.finish(&[], &mut self.report)?;
+                Ok(0)
+            }
+            "instance" => {
+                let p = self.plugin(e)?;
+                let parent = p
+                    .transform("to_world")?
+                    .map_or(DMat4::IDENTITY, |(x, _)| x.m);
+                let groups = p.nested(&["shape"]);
+                let group = match groups[..] {
+                    [g] if g.attr("type") == Some("shapegroup") => g,
+                    _ => {
+                        return Err(p.err(e, "an instance needs exactly one <ref> to a shapegroup"))
+                    }
+                };
+                p.finish(&[], &mut self.report)?;
+                let gp = self.plugin(group)?;
+                let members = gp.nested(&["shape"]);
+                let mut emitters = 0;
+                for s in members {
+                    emitters += self.shape(s, b, parent)? as usize;
+                }
+                Ok(emitters)
+            }
+            _ => Ok(self.shape(e, b, DMat4::IDENTITY)? as usize),
+        }
+    }
+
+    /// Adds the shape, placed by `parent` (an instance's transform) after its own `to_world`;
+    /// returns whether it emits.
+    fn shape(
+        &mut self,
+        e: &'a Elem,
+        b: &mut WorldBuilder,
+        parent: DMat4,
+    ) -> Result<bool, SceneError> {
         let p = self.plugin(e)?;
         let doc = self.doc;
-        let xform = p.transform("to_world")?;
+        let xform = p.transform("to_world")?.map(|(x, te)| {
+            (
+                Xform {
+                    m: parent * x.m,
+                    ..x
+                },
+                te,
+            )
+        });
+        let xform = match xform {
+            None if parent != DMat4::IDENTITY => Some((
+                Xform {
+                    m: parent,
+                    lookat: None,
+                },
+                e,
+            )),
+            x => x,
+        };
         let flip = p.boolean("flip_normals")?.unwrap_or(false);
         let ctx = doc.ctx(e.src);
         let (m, span) = match &xform {
