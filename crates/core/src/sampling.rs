@@ -29,6 +29,9 @@ pub enum Domain {
     Light = 1,
     /// Next-event and other samples drawn apart from a subpath.
     Aux = 2,
+    /// Lens points of light-tracing connections drawn apart from their subpath (VCM's stored
+    /// light paths), one stream per light path.
+    Lens = 3,
 }
 
 /// Items are pixel or path indices, far below 2⁵⁶: the top byte is free for the domain.

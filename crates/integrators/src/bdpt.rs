@@ -24,6 +24,7 @@ use crate::connect::{
     connect_to_camera, emission_densities, join, nee_density, next_event, Joined, NextEvent,
 };
 use crate::params::ParamReader;
+use crate::pixel::{pixel_sample, weighted};
 use crate::record::{Completed, NoRecord, Recorder};
 use crate::splat::{splat_pass_with, Splats};
 use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
@@ -151,11 +152,11 @@ pub fn mis_weight(scene: &Scene, split: Split, evals: EndEvals, h: Heuristic, ra
             }
         }
         (_, 1) => {
-            // x_{k−1} = y_{s−1} joined to the pinhole.
+            // x_{k−1} = y_{s−1} joined to the lens point z[0].
             let yv = &y[s - 1];
             let cam = &z[0];
             let dir = cam.dir_to(yv);
-            camera[k - 1] = reverse_density(yv, cam, scene.camera.pdf_dir(dir)) as f64;
+            camera[k - 1] = reverse_density(yv, cam, scene.camera.pdf_dir(cam.p, dir)) as f64;
             if s >= 2 {
                 let ev = evals.light_end.expect("a surface connected to the camera");
                 camera[k - 2] = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
@@ -256,10 +257,10 @@ impl Bdpt {
                 if !connectable(scene, yv) {
                     continue;
                 }
-                let Some(c) = connect_to_camera(scene, yv) else {
+                let Some(c) = connect_to_camera(scene, yv, &mut ls) else {
                     continue;
                 };
-                let camera_only = [PathVertex::camera(cam, Color::ONE)];
+                let camera_only = [c.camera];
                 let split = Split {
                     light: &y[..s],
                     camera: &camera_only,
@@ -282,7 +283,7 @@ impl Bdpt {
                     });
                 }
                 if w > 0.0 {
-                    splats.add(c.raster, c.value * (w as f32 * scale));
+                    splats.add_filtered(cam.film(), c.raster, c.value * (w as f32 * scale));
                 }
             }
         }
@@ -290,13 +291,12 @@ impl Bdpt {
             return Color::ZERO;
         };
 
-        // The camera subpath through a box-filtered position in the pixel.
-        let w = cam.width as u64;
+        // The camera subpath through a filtered position of the pixel (weighted at the end).
         let mut cs = Sampler::for_item(Domain::Camera, seed, pixel, pass as u64);
-        let raster = Vec2::new(
-            (pixel % w) as f32 + cs.next_f32(),
-            (pixel / w) as f32 + cs.next_f32(),
-        );
+        let Some(film) = pixel_sample(scene, pixel, &mut cs) else {
+            return Color::ZERO;
+        };
+        let raster = film.raster;
         camera_subpath(
             scene,
             raster,
@@ -395,7 +395,7 @@ impl Bdpt {
                 }
             }
         }
-        l
+        weighted(l, film.weight)
     }
 
     /// Strategy s = 0: the camera walk `camera` (camera first) reached light endpoint `x0`

@@ -1,23 +1,26 @@
 //! Connections shared by the bidirectional estimators and owned by none of them: a light-subpath
-//! vertex joined to the pinhole (t = 1, light tracing), and the BSDF of a subpath vertex evaluated
+//! vertex joined to the lens (t = 1, light tracing), and the BSDF of a subpath vertex evaluated
 //! towards another vertex. Visibility is always `Scene::connection_visible`, which offsets both
 //! ends by their error bounds.
 
 use lt_core::bsdf::{BsdfEval, ShadingFrame, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::path::{PathVertex, VertexKind};
+use lt_core::sampling::Sampler;
 use lt_core::Scene;
 
 /// A light-subpath vertex seen by the camera.
 #[derive(Clone, Copy, Debug)]
 pub struct CameraConnection {
     pub raster: Vec2,
-    /// Unit direction from the eye to the vertex.
+    /// Unit direction from the lens point to the vertex.
     pub dir: Vec3,
     /// β · f_cos · We · cos θ_camera / d²: the splat before the 1/M of M light subpaths.
     pub value: Color,
     /// The vertex's BSDF towards the camera (importance mode); `None` at x0 on a light.
     pub eval: Option<BsdfEval>,
+    /// The camera vertex the connection sampled (the eye, or a point of a thin lens).
+    pub camera: PathVertex,
 }
 
 /// The BSDF of surface vertex `v` between its stored incoming direction `v.wo` and the direction
@@ -36,55 +39,57 @@ pub fn eval_towards(
     Some(scene.material(material).eval(&sf, v.wo, wi, mode))
 }
 
-/// Joins light-subpath vertex `y` (x0 on a light, or a non-delta surface) to the pinhole.
-/// `None` when it is off the film, faces away, is occluded or contributes nothing. A point light
-/// (delta position) cannot be seen and returns `None`; so does a directional light (delta
-/// direction: `escaped` is zero towards any camera ray, and `scatter::connectable` already
-/// refuses its x0).
-pub fn connect_to_camera(scene: &Scene, y: &PathVertex) -> Option<CameraConnection> {
+/// Joins light-subpath vertex `y` (x0 on a light, or a non-delta surface) to a point of the lens
+/// (the pinhole's eye; a thin lens's aperture point, two numbers from `sampler`). `None` when it
+/// is off the film, faces away, contributes nothing, or the segment to that lens point is
+/// blocked — a partly blocked aperture darkens splats as it darkens camera rays (pbrt-v4 #458).
+/// A point light (delta position) cannot be seen and returns `None`; so does a directional light
+/// (delta direction: `escaped` is zero towards any camera ray, and `scatter::connectable` already
+/// refuses its x0), and so does every vertex for an orthographic camera (a delta in direction).
+pub fn connect_to_camera(
+    scene: &Scene,
+    y: &PathVertex,
+    sampler: &mut Sampler,
+) -> Option<CameraConnection> {
     let cam = &scene.camera;
-    let camera = PathVertex::camera(cam, Color::ONE);
-    let (dir, dist2, value, eval) = match y.kind {
+    let (lens, value, eval) = match y.kind {
         VertexKind::Light { light, infinite } => {
             // x0 from `Light::sample_le`: its pdf_fwd is pmf · pdf_pos (pmf · pdf_dir at infinity),
             // and the radiance towards the camera replaces the one along the sampled ray.
             let l = &scene.lights[light as usize];
             if infinite {
                 // The camera looks along y.p, towards the light; there is no cosine at x0.
-                (y.p, 1.0, l.escaped(y.p) / y.pdf_fwd, None)
+                let lens = cam.connect_direction(y.p, sampler)?;
+                (lens, l.escaped(y.p) / y.pdf_fwd, None)
             } else if !y.on_surface() {
                 return None;
             } else {
-                let d = y.p - cam.eye;
-                let dist2 = d.length_squared();
-                let dir = d / dist2.sqrt();
+                let lens = cam.connect(y.p, sampler)?;
+                let dir = lens.dir;
                 let le = l.emitted(y.ng, -dir) * y.ng.dot(dir).abs();
-                (dir, dist2, le / y.pdf_fwd, None)
+                (lens, le / y.pdf_fwd, None)
             }
         }
         VertexKind::Surface { .. } => {
-            let d = y.p - cam.eye;
-            let dist2 = d.length_squared();
-            let dir = d / dist2.sqrt();
-            let ev = eval_towards(scene, y, -dir, TransportMode::Importance)?;
-            (dir, dist2, y.beta * ev.f_cos, Some(ev))
+            let lens = cam.connect(y.p, sampler)?;
+            let ev = eval_towards(scene, y, -lens.dir, TransportMode::Importance)?;
+            (lens, y.beta * ev.f_cos, Some(ev))
         }
         VertexKind::Camera => return None,
     };
     if value == Color::ZERO {
         return None;
     }
-    let raster = cam.raster_of(dir)?;
-    let we = cam.importance(dir);
-    let cos_c = cam.forward().dot(dir);
+    let camera = PathVertex::camera_at(cam, lens.origin, Color::ONE);
     if !scene.connection_visible(y, &camera) {
         return None;
     }
     Some(CameraConnection {
-        raster,
-        dir,
-        value: value * (we * cos_c / dist2),
+        raster: lens.raster,
+        dir: lens.dir,
+        value: value * (lens.importance * lens.cos_lens / lens.distance_squared),
         eval,
+        camera,
     })
 }
 
@@ -164,11 +169,7 @@ pub struct NextEvent {
     pub value: Color,
 }
 
-pub fn next_event(
-    scene: &Scene,
-    z: &PathVertex,
-    sampler: &mut lt_core::sampling::Sampler,
-) -> Option<NextEvent> {
+pub fn next_event(scene: &Scene, z: &PathVertex, sampler: &mut Sampler) -> Option<NextEvent> {
     let (li, pmf, _) = scene.light_sampler.sample(sampler.next_f32())?;
     let u = sampler.next_2d();
     let ls = scene.lights[li].sample_li(z.p, u)?;

@@ -19,6 +19,7 @@ use crate::connect::{
     connect_to_camera, emission_densities, join, nee_density, next_event, Joined, NextEvent,
 };
 use crate::params::ParamReader;
+use crate::pixel::{pixel_sample, weighted};
 use crate::radius::InitialRadius;
 use crate::record::{Completed, Merged, NoRecord, Recorder};
 use crate::splat::{splat_pass_with, Splats};
@@ -372,7 +373,9 @@ impl<'a> Engine<'a> {
         let m = setup.light_paths;
         let light = lights.path((i % m) as usize);
         if i < m && self.params.connections {
-            self.splat_light_path(setup, light, splats, rec);
+            // A thin lens draws its lens points from the light path's own lens stream.
+            let mut lens = Sampler::for_item(Domain::Lens, seed, i, pass as u64);
+            self.splat_light_path(setup, light, &mut lens, splats, rec);
         }
         if i < n {
             let l = self.camera_sample(setup, lights, light, seed, pass, i, scratch, rec);
@@ -385,6 +388,7 @@ impl<'a> Engine<'a> {
         &self,
         setup: &PassSetup,
         (y, ly): (&[PathVertex], &[LightMis]),
+        lens: &mut Sampler,
         splats: &mut Splats,
         rec: &mut R,
     ) {
@@ -396,11 +400,11 @@ impl<'a> Engine<'a> {
             if !connectable(scene, yv) {
                 continue;
             }
-            let Some(c) = connect_to_camera(scene, yv) else {
+            let Some(c) = connect_to_camera(scene, yv, lens) else {
                 continue;
             };
-            let camera = PathVertex::camera(cam, Color::ONE);
-            let c_y = reverse_density(yv, &camera, cam.pdf_dir(camera.dir_to(yv))) as f64;
+            let camera = c.camera;
+            let c_y = reverse_density(yv, &camera, cam.pdf_dir(camera.p, camera.dir_to(yv))) as f64;
             let w = if s == 1 {
                 setup.mis.light_tracing_origin(&ly[0], c_y)
             } else {
@@ -420,7 +424,7 @@ impl<'a> Engine<'a> {
                 });
             }
             if w > 0.0 {
-                splats.add(c.raster, c.value * (w as f32 * scale));
+                splats.add_filtered(cam.film(), c.raster, c.value * (w as f32 * scale));
             }
         }
     }
@@ -439,15 +443,13 @@ impl<'a> Engine<'a> {
         rec: &mut R,
     ) -> Color {
         let scene = self.scene;
-        let cam = &scene.camera;
         let max_k = self.params.max_depth as usize;
         let mis = &setup.mis;
-        let w = cam.width as u64;
         let mut cs = Sampler::for_item(Domain::Camera, seed, pixel, pass as u64);
-        let raster = Vec2::new(
-            (pixel % w) as f32 + cs.next_f32(),
-            (pixel / w) as f32 + cs.next_f32(),
-        );
+        let Some(film) = pixel_sample(scene, pixel, &mut cs) else {
+            return Color::ZERO;
+        };
+        let raster = film.raster;
         camera_subpath(
             scene,
             raster,
@@ -516,7 +518,7 @@ impl<'a> Engine<'a> {
                 }
             }
         }
-        l
+        weighted(l, film.weight)
     }
 
     /// Weight of s = 0: the camera walk `camera` (camera first, ending at x1) reached light

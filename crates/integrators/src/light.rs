@@ -1,6 +1,7 @@
 //! `light` — light tracing (Veach 1997, §10.2 with t = 1; the seed's "splat to the image at each
 //! vertex"): light subpaths are traced in importance mode and every vertex that can be connected —
-//! x0 on an emitter included — is joined to the pinhole and splatted to the pixel it lands in.
+//! x0 on an emitter included — is joined to the lens (the pinhole, or a sampled point of a thin
+//! lens) and splatted through the pixel filter to the pixels around where it lands.
 //!
 //! One technique only, so no MIS: each splat is β · f · We · cos θ_c / d² over the M light
 //! subpaths of the pass. It cannot render what the camera sees through a delta surface (a mirror
@@ -73,8 +74,8 @@ impl Integrator for LightTracer {
                 if !connectable(scene, y) {
                     continue;
                 }
-                if let Some(c) = connect_to_camera(scene, y) {
-                    splats.add(c.raster, c.value * scale);
+                if let Some(c) = connect_to_camera(scene, y, &mut sampler) {
+                    splats.add_filtered(cam.film(), c.raster, c.value * scale);
                 }
             }
         })

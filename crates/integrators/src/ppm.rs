@@ -24,11 +24,12 @@
 //! | `visible_seed` | u64 | the run's seed | seed of the one camera pass: runs that share it share their visible points and differ in photons only, so their spread is the variance at fixed points that Knaus & Zwicker's rates describe |
 
 use crate::params::ParamReader;
+use crate::pixel::pixel_sample;
 use crate::progressive::{ProgressiveParams, ProgressiveState};
 use crate::visible::{next_event, trace_visible_point, CameraPrefix, Direct};
 use crate::{ProgressLog, Progressive, ProgressiveRun};
 use lt_core::sampling::{Domain, Sampler};
-use lt_core::{Scene, Vec2};
+use lt_core::Scene;
 use lt_estimators::Image;
 use rayon::prelude::*;
 
@@ -81,16 +82,18 @@ impl ProgressiveRun for PpmRun<'_> {
     fn pass(&mut self, pass: u32) -> u64 {
         let (scene, p, seed) = (self.scene, self.params, self.seed);
         let visible_seed = self.visible_seed;
-        let w = scene.camera.width as usize;
         if self.fixed.is_empty() {
             // The one camera pass, from the pixels' streams of pass 0.
             self.fixed = (0..scene.camera.pixel_count())
                 .into_par_iter()
                 .map(|j| {
                     let mut s = Sampler::for_item(Domain::Camera, visible_seed, j as u64, 0);
-                    let raster =
-                        Vec2::new((j % w) as f32 + s.next_f32(), (j / w) as f32 + s.next_f32());
-                    trace_visible_point(scene, raster, &mut s, p.max_depth, p.direct)
+                    let film = pixel_sample(scene, j as u64, &mut s);
+                    CameraPrefix::weighted(film.map(|f| {
+                        let prefix =
+                            trace_visible_point(scene, f.raster, &mut s, p.max_depth, p.direct);
+                        (prefix, f.weight)
+                    }))
                 })
                 .collect();
         }

@@ -187,18 +187,18 @@ impl Pt {
         rec: &mut R,
     ) -> Color {
         let nee = self.params.techniques != Techniques::Bsdf;
-        let mut ray = scene.camera.generate_ray(raster);
+        let mut ray = scene.camera.sample_ray(raster, sampler);
         let mut beta = Color::ONE;
         let mut l = Color::ZERO;
         // The previous vertex's BSDF pdf (solid angle) and whether it was a delta lobe; the camera
         // counts as a delta so emitters seen directly get full weight.
-        let mut prev_pdf_w = scene.camera.pdf_dir(ray.d);
+        let mut prev_pdf_w = scene.camera.pdf_dir(ray.o, ray.d);
         let mut prev_delta = true;
         let mut prev_p = ray.o;
         // The camera subpath so far, only kept for a recorder.
         let mut verts: Vec<PathVertex> = Vec::new();
         if R::ACTIVE {
-            verts.push(PathVertex::camera(&scene.camera, Color::ONE));
+            verts.push(PathVertex::camera_at(&scene.camera, ray.o, Color::ONE));
         }
         for depth in 1..=self.params.max_depth {
             let Some(hit) = scene.intersect(&ray) else {

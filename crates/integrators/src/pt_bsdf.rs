@@ -40,7 +40,7 @@ pub struct PtBsdf {
 
 impl PtBsdf {
     pub fn radiance(&self, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> Color {
-        let mut ray = scene.camera.generate_ray(raster);
+        let mut ray = scene.camera.sample_ray(raster, sampler);
         let mut beta = Color::ONE;
         let mut l = Color::ZERO;
         for depth in 1..=self.params.max_depth {

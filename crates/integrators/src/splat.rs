@@ -1,8 +1,9 @@
 //! Deterministic splatting for estimators that scatter to arbitrary pixels (light tracing, BDPT's
-//! t = 1 strategy). Work is cut into fixed chunks independent of the thread count; each chunk
+//! t = 1 strategy), each splat spread over the pixels its filter reaches. Work is cut into fixed chunks independent of the thread count; each chunk
 //! records its splats in order and the chunks are applied in chunk order, so the floating-point sum
 //! in every pixel is the same however many threads ran.
 
+use lt_core::camera::FilmFilter;
 use lt_core::math::is_valid_color;
 use lt_core::{Color, Vec2};
 use lt_estimators::Image;
@@ -37,6 +38,20 @@ impl Splats {
         if value != Color::ZERO {
             self.entries.push((index, value));
         }
+    }
+
+    /// Adds `value` at raster point `raster` through the film's pixel filter: to every pixel whose
+    /// support covers it, weighted f(raster − c_j) / Z_j (`lt_core::camera::filter`), in a fixed
+    /// pixel order. The box of one pixel is `add`.
+    pub fn add_filtered(&mut self, film: &FilmFilter, raster: Vec2, value: Color) {
+        if film.filter.is_pixel_box() {
+            return self.add(raster, value);
+        }
+        if !is_valid_color(value) {
+            self.invalid += 1;
+            return;
+        }
+        film.for_each_splat(raster, |i, w| self.entries.push((i, value * w)));
     }
 
     /// Adds `value` to the pixel containing `raster`; invalid values are dropped and counted.

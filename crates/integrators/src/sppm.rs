@@ -18,11 +18,12 @@
 //! | `direct` | nee/photons | nee | direct light by next-event estimation or from photons |
 
 use crate::params::ParamReader;
+use crate::pixel::pixel_sample;
 use crate::progressive::{ProgressiveParams, ProgressiveState};
 use crate::visible::{trace_visible_point, CameraPrefix};
 use crate::{ProgressLog, Progressive, ProgressiveRun};
 use lt_core::sampling::{Domain, Sampler};
-use lt_core::{Scene, Vec2};
+use lt_core::Scene;
 use lt_estimators::Image;
 use rayon::prelude::*;
 
@@ -66,14 +67,16 @@ struct SppmRun<'a> {
 impl ProgressiveRun for SppmRun<'_> {
     fn pass(&mut self, pass: u32) -> u64 {
         let (scene, p, seed) = (self.scene, self.params, self.seed);
-        let w = scene.camera.width as usize;
         (0..scene.camera.pixel_count())
             .into_par_iter()
             .map(|j| {
                 let mut s = Sampler::for_item(Domain::Camera, seed, j as u64, pass as u64);
-                let raster =
-                    Vec2::new((j % w) as f32 + s.next_f32(), (j / w) as f32 + s.next_f32());
-                trace_visible_point(scene, raster, &mut s, p.max_depth, p.direct)
+                let film = pixel_sample(scene, j as u64, &mut s);
+                CameraPrefix::weighted(film.map(|f| {
+                    let prefix =
+                        trace_visible_point(scene, f.raster, &mut s, p.max_depth, p.direct);
+                    (prefix, f.weight)
+                }))
             })
             .collect_into_vec(&mut self.prefixes);
         self.state.pass(scene, p, seed, pass, &self.prefixes)

@@ -55,6 +55,23 @@ pub struct CameraPrefix {
 }
 
 impl CameraPrefix {
+    /// The prefix of a camera sample weighted by the pixel filter (`pixel::pixel_sample`): its
+    /// throughput, emission and next-event estimate scaled alike, so every photon gathered at it
+    /// is too. An off-film sample (`None`) finds nothing.
+    pub fn weighted(sample: Option<(Self, f32)>) -> CameraPrefix {
+        let Some((mut p, w)) = sample else {
+            return CameraPrefix::default();
+        };
+        if w != 1.0 {
+            p.emitted *= w;
+            p.nee *= w;
+            if let Some(vp) = p.vp.as_mut() {
+                vp.gp.beta *= w;
+            }
+        }
+        p
+    }
+
     /// Everything but the photons' share.
     pub fn direct(&self) -> Color {
         self.emitted + self.nee
@@ -70,7 +87,7 @@ pub fn trace_visible_point(
     max_depth: u32,
     direct: Direct,
 ) -> CameraPrefix {
-    let mut ray = scene.camera.generate_ray(raster);
+    let mut ray = scene.camera.sample_ray(raster, sampler);
     let mut beta = Color::ONE;
     let mut out = CameraPrefix::default();
     let mut length = 0.0;

@@ -125,7 +125,8 @@ impl Subpath {
     }
 }
 
-/// Traces a camera subpath through `raster`: z0 = the pinhole, then the surfaces the walk meets
+/// Traces a camera subpath through `raster`: z0 = the lens point (the pinhole's eye, or a thin
+/// lens's aperture sample: two numbers from `sampler`), then the surfaces the walk meets
 /// (radiance mode). The primary ray's density is the film-wide `Camera::pdf_dir`, so β starts at
 /// 1 (see `lt_core::path` on image normalisation).
 pub fn camera_subpath(
@@ -137,13 +138,13 @@ pub fn camera_subpath(
 ) {
     out.vertices.clear();
     out.escape = None;
-    let ray = scene.camera.generate_ray(raster);
+    let ray = scene.camera.sample_ray(raster, sampler);
     out.vertices
-        .push(PathVertex::camera(&scene.camera, Color::ONE));
+        .push(PathVertex::camera_at(&scene.camera, ray.o, Color::ONE));
     if limits.max_vertices < 2 {
         return;
     }
-    let pdf = scene.camera.pdf_dir(ray.d);
+    let pdf = scene.camera.pdf_dir(ray.o, ray.d);
     random_walk(
         scene,
         ray,

@@ -3,8 +3,8 @@
 //! and `pdf_rev` the walk filled equals the oracle's per-vertex density of that path
 //! (`Path::densities`: `light[i]`, `camera[i]`).
 
-use lt_core::math::{Color, Vec2};
-use lt_core::path::{Path, PathVertex, VertexKind};
+use lt_core::math::Vec2;
+use lt_core::path::{Path, VertexKind};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
 use lt_integrators::connect::connect_to_camera;
@@ -68,12 +68,13 @@ fn check(scene: &Scene, n: u64, loose: f64) -> (usize, f64, usize) {
         let y = &sub.vertices;
         for len in 1..=y.len() {
             if matches!(y[len - 1].kind, VertexKind::Surface { material } if scene.material(material).is_delta())
-                || connect_to_camera(scene, &y[len - 1]).is_none()
             {
                 continue;
             }
-            let cam = PathVertex::camera(&scene.camera, Color::ONE);
-            let path = Path::from_subpaths(&y[..len], &[cam]);
+            let Some(c) = connect_to_camera(scene, &y[len - 1], &mut s) else {
+                continue;
+            };
+            let path = Path::from_subpaths(&y[..len], &[c.camera]);
             let d = path.densities(scene);
             for (i, v) in y.iter().enumerate().take(len) {
                 note(v.pdf_fwd, d.light[i]);

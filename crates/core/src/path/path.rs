@@ -193,7 +193,7 @@ impl Path {
             };
             f *= fs.as_dvec3() * geometry(&v[i], &v[i + 1]) as f64;
         }
-        f * scene.camera.importance(v[k].dir_to(&v[k - 1])) as f64
+        f * scene.camera.importance(v[k].p, v[k].dir_to(&v[k - 1])) as f64
     }
 
     /// The per-vertex densities of both walks (see `Densities`).
@@ -234,7 +234,7 @@ impl Path {
         // Camera subpath: the pinhole, x_{k−1} from the film-wide direction pdf, then BSDFs.
         let mut pc = vec![0.0f64; k + 1];
         pc[k] = 1.0;
-        let pdf_dir = scene.camera.pdf_dir(v[k].dir_to(&v[k - 1]));
+        let pdf_dir = scene.camera.pdf_dir(v[k].p, v[k].dir_to(&v[k - 1]));
         pc[k - 1] = v[k].convert_density(pdf_dir, &v[k - 1]) as f64;
         for i in (0..k.saturating_sub(1)).rev() {
             let pdf_w = self

@@ -130,6 +130,7 @@ pub fn connectable(scene: &Scene, v: &PathVertex) -> bool {
     match v.kind {
         VertexKind::Surface { material } => !scene.material(material).is_delta(),
         VertexKind::Light { light, .. } => !scene.lights[light as usize].delta_direction(),
-        VertexKind::Camera => true,
+        // An orthographic camera is a delta in direction (`PathVertex::camera_at`).
+        VertexKind::Camera => !v.delta,
     }
 }

@@ -81,9 +81,19 @@ impl PathVertex {
         }
     }
 
-    /// The pinhole: a delta position, so its density is the discrete 1.
+    /// The camera at the centre of its lens (the pinhole's eye). Its density is 1: the pinhole's
+    /// delta position, or a thin lens's aperture sample, which every technique draws alike
+    /// (`camera` module docs).
     pub fn camera(camera: &Camera, beta: Color) -> PathVertex {
-        PathVertex::endpoint(VertexKind::Camera, camera.eye, camera.forward(), beta, 1.0)
+        PathVertex::camera_at(camera, camera.eye, beta)
+    }
+
+    /// The camera vertex at lens point `origin` (a primary ray's origin, or a lens connection's).
+    /// An orthographic camera's vertex is a delta in direction (`delta` set): nothing joins it.
+    pub fn camera_at(camera: &Camera, origin: Vec3, beta: Color) -> PathVertex {
+        let mut v = PathVertex::endpoint(VertexKind::Camera, origin, camera.forward(), beta, 1.0);
+        v.delta = camera.is_delta_direction();
+        v
     }
 
     /// A surface the walk reached from `prev` along a ray of direction −`wo`, with density `pdf` —

@@ -45,10 +45,10 @@ pub fn camera_walk(
         raster.unwrap_or_else(|| rng.next_2d() * Vec2::new(cam.width as f32, cam.height as f32));
     let mut ray = cam.generate_ray(raster);
     let mut verts = vec![PathVertex::camera(cam, Color::ONE)];
-    let mut pdf_w = cam.pdf_dir(ray.d);
+    let mut pdf_w = cam.pdf_dir(ray.o, ray.d);
     // The pinhole's discrete 1; We times the camera's cosine (G's camera end).
     let mut pdf = 1.0f64;
-    let mut f = DVec3::splat((cam.importance(ray.d) * cam.forward().dot(ray.d)) as f64);
+    let mut f = DVec3::splat((cam.importance(ray.o, ray.d) * cam.forward().dot(ray.d)) as f64);
     let mut beta = DVec3::ONE;
     for k in 1..=max_k {
         let prev = *verts.last().unwrap();
@@ -206,7 +206,7 @@ pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
         };
         if let Some((d, dist)) = towards_cam {
             let dir_from_cam = -d;
-            let imp = cam.importance(dir_from_cam);
+            let imp = cam.importance(cam.eye, dir_from_cam);
             let le_cam = if infinite {
                 light.escaped(dir_from_cam)
             } else {
