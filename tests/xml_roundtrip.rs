@@ -39,6 +39,11 @@ fn assert_same(name: &str, a: &Scene, b: &Scene) {
     assert_eq!(a.infinite_lights, b.infinite_lights, "{name}");
     let (ca, cb) = (&a.camera, &b.camera);
     assert_eq!((ca.width, ca.height), (cb.width, cb.height), "{name}");
+    assert_eq!(
+        (ca.lens(), ca.filter().shape(), ca.principal_point_offset()),
+        (cb.lens(), cb.filter().shape(), cb.principal_point_offset()),
+        "{name}: lens, pixel filter, principal point"
+    );
     for j in 0..=6 {
         for i in 0..=6 {
             let r = Vec2::new(

@@ -64,6 +64,14 @@ impl VcmParams {
         connections: bool,
         merging: bool,
     ) -> Result<VcmParams, String> {
+        if scene.camera.is_delta_direction() {
+            // Its MIS records count light tracing as a technique; with a camera that no
+            // connection reaches, that share would be lost.
+            return Err(format!(
+                "{who} cannot render through an orthographic camera (a delta in direction: no \
+                 light-tracing connection reaches it); use pt or bdpt"
+            ));
+        }
         let alpha = r.get::<f64>("alpha")?.unwrap_or(DEFAULT_ALPHA);
         if !(alpha > 0.0 && alpha <= 1.0) {
             return Err(format!("{who}: alpha must be in (0, 1], got {alpha}"));

@@ -36,6 +36,13 @@ pub struct LightParams {
 
 impl LightParams {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<LightParams, String> {
+        if scene.camera.is_delta_direction() {
+            return Err(
+                "light tracing cannot see through an orthographic camera (a delta in \
+                        direction: no connection reaches it); use pt or bdpt"
+                    .into(),
+            );
+        }
         Ok(LightParams {
             max_depth: r.max_depth(scene)?,
             rr_depth: r.rr_depth(scene)?,

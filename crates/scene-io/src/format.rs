@@ -50,12 +50,42 @@ impl From<FovAxisName> for FovAxis {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDef {
+    /// Mitsuba's sensor type: `perspective` (default), `thinlens`, `orthographic`.
+    #[serde(rename = "type")]
+    pub kind: Option<S<String>>,
     pub eye: S<V3>,
     pub target: S<V3>,
     pub up: Option<S<V3>>,
-    pub fov: S<f64>,
+    /// Required by `perspective` and `thinlens`.
+    pub fov: Option<S<f64>>,
     pub fov_axis: Option<FovAxisName>,
     pub resolution: S<[u32; 2]>,
+    /// `thinlens`.
+    pub aperture_radius: Option<S<f64>>,
+    pub focus_distance: Option<S<f64>>,
+    /// `orthographic`: half the film rectangle's width in world units (Mitsuba's `to_world` x
+    /// scale; default 1).
+    pub half_width: Option<S<f64>>,
+    /// Mitsuba's `principal_point_offset_x/y`, in fractions of the film's width and height.
+    pub principal_point_offset: Option<S<[f64; 2]>>,
+    /// The pixel filter (Mitsuba's `<rfilter>`); the box of one pixel when absent.
+    pub filter: Option<S<FilterDef>>,
+}
+
+/// `[camera.filter]`: Mitsuba's reconstruction filters and their parameters.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilterDef {
+    /// `box`, `tent`, `gaussian`, `mitchell`, `catmullrom`, `lanczos`.
+    #[serde(rename = "type")]
+    pub kind: S<String>,
+    pub radius: Option<S<f64>>,
+    pub stddev: Option<S<f64>>,
+    #[serde(rename = "B")]
+    pub b: Option<S<f64>>,
+    #[serde(rename = "C")]
+    pub c: Option<S<f64>>,
+    pub lobes: Option<S<u32>>,
 }
 
 #[derive(Deserialize)]

@@ -539,6 +539,32 @@ mod tests {
     }
 
     #[test]
+    fn a_thin_lens_ray_maps_back_to_its_raster_position() {
+        let c = cam()
+            .thin_lens(0.2, 3.0)
+            .unwrap()
+            .with_principal_point_offset(Vec2::new(0.05, -0.03))
+            .unwrap();
+        let mut s = Sampler::new(5, 0, 0);
+        for r in [
+            Vec2::new(0.5, 0.5),
+            Vec2::new(63.2, 1.7),
+            Vec2::new(31.9, 47.1),
+        ] {
+            for _ in 0..8 {
+                let ray = c.sample_ray(r, &mut s);
+                let back = c.raster_from(ray.o, ray.d).unwrap();
+                assert!((back - r).length() < 1e-3, "{r} -> {back}");
+                // The lens connection of a point on that ray finds the same raster position
+                // from the same lens point.
+                let p = ray.at(2.0);
+                let lc = c.raster_from(ray.o, (p - ray.o).normalize()).unwrap();
+                assert!((lc - r).length() < 1e-3);
+            }
+        }
+    }
+
+    #[test]
     fn image_right_is_world_plus_x_for_the_cornell_view() {
         let c = cam();
         assert!(c.generate_ray(Vec2::new(63.0, 24.0)).d.x > 0.0);

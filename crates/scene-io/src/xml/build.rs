@@ -20,8 +20,8 @@ use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TwoSided,
 };
 use lt_core::bsdf::{TextureSlot, Textured};
-use lt_core::camera::FovAxis;
-use lt_core::math::Color;
+use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
+use lt_core::math::{Color, Vec2};
 use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
 use lt_core::texture::{Bitmap, FilterType, Texture, UvTransform, WrapMode};
 use std::collections::HashMap;
@@ -187,9 +187,11 @@ pub(super) fn load(
         ));
     }
     let Loader { report, meshes, .. } = l;
+    let (camera, optics) = camera;
     let scene = b.build(|origin| {
         camera
             .at(origin)
+            .and_then(|c| optics.apply(c))
             .map_err(|m| doc.err(sensor, format!("degenerate camera: {m}")))
     })?;
     Ok((scene, report, meshes))
@@ -222,32 +224,39 @@ impl<'a> Loader<'a> {
 
     // ---------------------------------------------------------------- sensor, film, sampler
 
-    fn sensor(&mut self, e: &'a Elem) -> Result<(LookAt, u32), SceneError> {
+    fn sensor(&mut self, e: &'a Elem) -> Result<((LookAt, Optics), u32), SceneError> {
         let p = self.plugin(e)?;
-        if p.kind != "perspective" {
+        if !matches!(p.kind, "perspective" | "thinlens") {
             return Err(p.err(
                 e,
                 format!(
-                    "sensor `{}` is not supported (lt has a pinhole camera: perspective)",
+                    "sensor `{}` is not supported (lt reads perspective and thinlens; \
+                     orthographic cameras are built in code only, its to_world scale is not read)",
                     p.kind
                 ),
             ));
         }
-        for k in ["principal_point_offset_x", "principal_point_offset_y"] {
-            if let Some(v) = p.float(k)? {
-                if v != 0.0 {
-                    return Err(p.err(
-                        e,
-                        format!("`{k}` = {v}: an off-centre principal point is not supported"),
-                    ));
-                }
-            }
-        }
+        let principal = Vec2::new(
+            p.float("principal_point_offset_x")?.unwrap_or(0.0) as f32,
+            p.float("principal_point_offset_y")?.unwrap_or(0.0) as f32,
+        );
+        let lens = if p.kind == "thinlens" {
+            let (Some(r), Some(fd)) = (p.float("aperture_radius")?, p.float("focus_distance")?)
+            else {
+                return Err(p.err(
+                    e,
+                    "a thinlens sensor needs `aperture_radius` and `focus_distance`",
+                ));
+            };
+            Some((r as f32, fd as f32))
+        } else {
+            None
+        };
         if p.has("srf") {
             return Err(p.err(e, "a sensor response function (`srf`) is not supported"));
         }
         let film = p.one_nested(&["film"], "film")?;
-        let (w, h) = self.film(film, e)?;
+        let (w, h, filter) = self.film(film, e)?;
         let spp = match p.one_nested(&["sampler"], "sampler")? {
             Some(s) => self.sampler(s)?,
             None => 4,
@@ -315,23 +324,32 @@ impl<'a> Loader<'a> {
             width: w,
             height: h,
         };
+        let optics = Optics {
+            lens,
+            principal,
+            filter,
+        };
         // Checked at the world origin now, so that a degenerate camera is reported in file order.
         camera
             .at(DVec3::ZERO)
+            .and_then(|c| optics.apply(c))
             .map_err(|m| p.err(e, format!("degenerate camera: {m}")))?;
         p.finish(&SENSOR_IGNORED, &mut self.report)?;
-        Ok((camera, spp))
+        Ok(((camera, optics), spp))
     }
 
-    /// Width and height; the reconstruction filter must be a one-pixel box.
-    fn film(&mut self, film: Option<&'a Elem>, sensor: &Elem) -> Result<(u32, u32), SceneError> {
+    /// Width, height and the pixel filter.
+    fn film(
+        &mut self,
+        film: Option<&'a Elem>,
+        sensor: &Elem,
+    ) -> Result<(u32, u32, PixelFilter), SceneError> {
         let Some(f) = film else {
-            self.substitute(
-                sensor,
-                "the sensor has no <film>, and Mitsuba's default hdrfilm (768 × 576) reconstructs with a Gaussian filter, which lt does not have".into(),
-                "use lt's one-pixel box filter".into(),
-            )?;
-            return Ok((768, 576));
+            // Mitsuba's default hdrfilm: 768 × 576, Gaussian filter of stddev 0.5.
+            let _ = sensor;
+            let gaussian = PixelFilter::new(FilterShape::Gaussian { stddev: 0.5 })
+                .expect("Mitsuba's default filter is valid");
+            return Ok((768, 576, gaussian));
         };
         let p = self.plugin(f)?;
         if p.kind != "hdrfilm" {
@@ -372,40 +390,58 @@ impl<'a> Loader<'a> {
         if p.boolean("sample_border")? == Some(true) {
             return Err(p.err(f, "`sample_border` = true is not supported"));
         }
-        match p.one_nested(&["rfilter"], "rfilter")? {
-            None => self.substitute(
-                f,
-                "hdrfilm's default reconstruction filter is a Gaussian, which lt does not have (give <rfilter type=\"box\"/>)".into(),
-                "use lt's one-pixel box filter".into(),
-            )?,
-            Some(r) => {
-                let rp = self.plugin(r)?;
-                if rp.kind == "box" {
-                    if let Some(rad) = rp.float("radius")? {
-                        if rad != 0.5 {
-                            self.substitute(
-                                r,
-                                format!("a box filter of radius {rad} px (lt's box is one pixel, radius 0.5)"),
-                                "use the one-pixel box".into(),
-                            )?;
-                        }
-                    }
-                } else {
-                    self.substitute(
-                        r,
-                        format!("reconstruction filter `{}` is not supported (lt has only the one-pixel box)", rp.kind),
-                        "use the box filter".into(),
-                    )?;
-                    // The approximation replaces the whole filter: its parameters go with it.
-                    for k in ["radius", "stddev", "b", "c", "lobes"] {
-                        let _ = rp.take_elem(k);
-                    }
-                }
-                rp.finish(&[], &mut self.report)?;
-            }
-        }
+        // Mitsuba's hdrfilm reconstructs with a Gaussian (stddev 0.5) unless told otherwise.
+        let filter = match p.one_nested(&["rfilter"], "rfilter")? {
+            None => PixelFilter::new(FilterShape::Gaussian { stddev: 0.5 })
+                .expect("Mitsuba's default filter is valid"),
+            Some(r) => self.rfilter(r)?,
+        };
         p.finish(&FILM_IGNORED, &mut self.report)?;
-        Ok((w, h))
+        Ok((w, h, filter))
+    }
+
+    /// `<rfilter>`: Mitsuba's filters with their parameters and defaults.
+    fn rfilter(&mut self, r: &'a Elem) -> Result<PixelFilter, SceneError> {
+        let rp = self.plugin(r)?;
+        let num =
+            |k: &str, d: f64| -> Result<f32, SceneError> { Ok(rp.float(k)?.unwrap_or(d) as f32) };
+        let shape = match rp.kind {
+            "box" => FilterShape::Box {
+                radius: num("radius", 0.5)?,
+            },
+            "tent" => FilterShape::Tent {
+                radius: num("radius", 1.0)?,
+            },
+            "gaussian" => FilterShape::Gaussian {
+                stddev: num("stddev", 0.5)?,
+            },
+            "mitchell" => FilterShape::Mitchell {
+                b: num("B", 1.0 / 3.0)?,
+                c: num("C", 1.0 / 3.0)?,
+            },
+            "catmullrom" => FilterShape::CatmullRom,
+            "lanczos" => {
+                let lobes = rp.integer("lobes")?.unwrap_or(3);
+                if !(1..=64).contains(&lobes) {
+                    return Err(rp.err(r, format!("lanczos `lobes` must be 1 to 64, got {lobes}")));
+                }
+                FilterShape::Lanczos {
+                    lobes: lobes as u32,
+                }
+            }
+            other => {
+                return Err(rp.err(
+                    r,
+                    format!(
+                        "reconstruction filter `{other}` is not supported (known: box, tent, \
+                         gaussian, mitchell, catmullrom, lanczos)"
+                    ),
+                ))
+            }
+        };
+        let filter = PixelFilter::new(shape).map_err(|m| rp.err(r, m))?;
+        rp.finish(&[], &mut self.report)?;
+        Ok(filter)
     }
 
     fn sampler(&mut self, s: &'a Elem) -> Result<u32, SceneError> {
@@ -1231,6 +1267,26 @@ fn similarity_scale(m: &DMat4) -> Option<f64> {
         && cols[0].dot(cols[2]).abs() <= tol * s
         && cols[1].dot(cols[2]).abs() <= tol * s;
     ok.then_some(s)
+}
+
+/// What a sensor adds to its look-at: a thin lens (aperture radius, focus distance), the
+/// principal point offset and the film's pixel filter.
+struct Optics {
+    lens: Option<(f32, f32)>,
+    principal: Vec2,
+    filter: PixelFilter,
+}
+
+impl Optics {
+    fn apply(&self, camera: Camera) -> Result<Camera, String> {
+        let mut camera = camera
+            .with_principal_point_offset(self.principal)?
+            .with_filter(self.filter.clone());
+        if let Some((r, fd)) = self.lens {
+            camera = camera.thin_lens(r, fd)?;
+        }
+        Ok(camera)
+    }
 }
 
 /// Eye, target and up of a camera `to_world` matrix (Mitsuba's camera looks along local +z with

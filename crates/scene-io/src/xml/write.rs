@@ -13,6 +13,7 @@ use crate::error::Ctx;
 use crate::format::{ColorDef, SceneFile, ShapeDef};
 use crate::transform::shape_matrix;
 use crate::SceneError;
+use lt_core::camera::{FilterShape, Lens};
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
 
@@ -91,16 +92,48 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
         lt_core::camera::FovAxis::Larger => "larger",
     };
     let [w, h] = *c.resolution.get_ref();
-    let _ = writeln!(x, "    <sensor type=\"perspective\">");
+    let cam = &loaded.camera;
+    let kind = match cam.lens() {
+        Lens::Pinhole => "perspective",
+        Lens::ThinLens { .. } => "thinlens",
+        Lens::Orthographic { .. } => "orthographic",
+    };
+    let _ = writeln!(x, "    <sensor type=\"{kind}\">");
+    if let Some(fov) = &c.fov {
+        let _ = writeln!(
+            x,
+            "        <float name=\"fov\" value=\"{}\"/>",
+            *fov.get_ref() as f32
+        );
+        let _ = writeln!(x, "        <string name=\"fov_axis\" value=\"{axis}\"/>");
+    }
+    if let Lens::ThinLens {
+        aperture_radius,
+        focus_distance,
+    } = cam.lens()
+    {
+        let _ = writeln!(
+            x,
+            "        <float name=\"aperture_radius\" value=\"{aperture_radius}\"/>\n        <float name=\"focus_distance\" value=\"{focus_distance}\"/>"
+        );
+    }
+    let ppo = cam.principal_point_offset();
+    if ppo != lt_core::Vec2::ZERO {
+        let _ = writeln!(
+            x,
+            "        <float name=\"principal_point_offset_x\" value=\"{}\"/>\n        <float name=\"principal_point_offset_y\" value=\"{}\"/>",
+            ppo.x, ppo.y
+        );
+    }
+    let scale = match cam.lens() {
+        Lens::Orthographic { half_width } => {
+            format!("\n            <scale x=\"{half_width}\" y=\"{half_width}\"/>")
+        }
+        _ => String::new(),
+    };
     let _ = writeln!(
         x,
-        "        <float name=\"fov\" value=\"{}\"/>",
-        *c.fov.get_ref() as f32
-    );
-    let _ = writeln!(x, "        <string name=\"fov_axis\" value=\"{axis}\"/>");
-    let _ = writeln!(
-        x,
-        "        <transform name=\"to_world\">\n            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>\n        </transform>",
+        "        <transform name=\"to_world\">{scale}\n            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>\n        </transform>",
         v(c.eye.get_ref()),
         v(c.target.get_ref()),
         v(&up)
@@ -112,7 +145,8 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
     );
     let _ = writeln!(
         x,
-        "        <film type=\"hdrfilm\">\n            <integer name=\"width\" value=\"{w}\"/>\n            <integer name=\"height\" value=\"{h}\"/>\n            <rfilter type=\"box\"/>\n        </film>\n    </sensor>"
+        "        <film type=\"hdrfilm\">\n            <integer name=\"width\" value=\"{w}\"/>\n            <integer name=\"height\" value=\"{h}\"/>\n            {}\n        </film>\n    </sensor>",
+        rfilter_xml(cam.filter().shape())
     );
     // Materials, in file order, by name.
     let mut mats: Vec<_> = file.materials.iter().collect();
@@ -439,4 +473,25 @@ fn esc(s: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
+}
+
+/// Mitsuba's `<rfilter>` of a pixel filter, with its parameters.
+fn rfilter_xml(shape: FilterShape) -> String {
+    let f =
+        |name: &str, v: f32| format!("\n                <float name=\"{name}\" value=\"{v}\"/>");
+    let (kind, params) = match shape {
+        FilterShape::Box { radius } => ("box", f("radius", radius)),
+        FilterShape::Tent { radius } => ("tent", f("radius", radius)),
+        FilterShape::Gaussian { stddev } => ("gaussian", f("stddev", stddev)),
+        FilterShape::Mitchell { b, c } => ("mitchell", f("B", b) + &f("C", c)),
+        FilterShape::CatmullRom => ("catmullrom", String::new()),
+        FilterShape::Lanczos { lobes } => (
+            "lanczos",
+            format!("\n                <integer name=\"lobes\" value=\"{lobes}\"/>"),
+        ),
+    };
+    if shape == FilterShape::default() {
+        return "<rfilter type=\"box\"/>".into();
+    }
+    format!("<rfilter type=\"{kind}\">{params}\n            </rfilter>")
 }
