@@ -3,6 +3,7 @@
 //! includes, defaults and `$` substitution, the 0.6 name upgrade, OBJ and PLY (ASCII and
 //! binary) meshes, `--approximate` substitutions and the `--verbose` list of ignored parameters.
 
+use lt_core::camera::{FilterShape, Lens};
 use lt_core::scene::ShapeGeometry;
 use lt_core::Scene;
 use lt_scene_io::{load_scene_with, LoadOptions, LoadReport, SceneError};
@@ -263,21 +264,62 @@ fn xml_approximations_are_refused_or_listed() {
         "{m}"
     );
 
-    let gauss = scene_xml("").replace("<rfilter type=\"box\"/>", "<rfilter type=\"gaussian\"/>");
-    fails(
-        &d,
-        &gauss,
-        line_of(&gauss, "gaussian"),
-        &["reconstruction filter `gaussian`", "--approximate"],
+    // Mitsuba's pixel filters load as they are, and hdrfilm's default (no rfilter) is its
+    // Gaussian of stddev 0.5: nothing to approximate any more.
+    let gauss = scene_xml("").replace(
+        "<rfilter type=\"box\"/>",
+        "<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"0.25\"/></rfilter>",
     );
-    let (_, report) = load_in(&d, "scene.xml", &gauss, opts.clone()).unwrap();
-    assert!(report.substitutions[0].contains("box"), "{report:?}");
+    let (scene, report) = load_in(&d, "scene.xml", &gauss, LoadOptions::default()).unwrap();
+    assert!(report.substitutions.is_empty(), "{report:?}");
+    assert_eq!(
+        scene.camera.filter().shape(),
+        FilterShape::Gaussian { stddev: 0.25 }
+    );
     let nofilter = scene_xml("").replace("<rfilter type=\"box\"/>", "");
+    let (scene, report) = load_in(&d, "scene.xml", &nofilter, LoadOptions::default()).unwrap();
+    assert!(report.substitutions.is_empty(), "{report:?}");
+    assert_eq!(
+        scene.camera.filter().shape(),
+        FilterShape::Gaussian { stddev: 0.5 }
+    );
+    let mitchell = scene_xml("").replace(
+        "<rfilter type=\"box\"/>",
+        "<rfilter type=\"mitchell\"><float name=\"B\" value=\"0.5\"/></rfilter>",
+    );
+    let (scene, _) = load_in(&d, "scene.xml", &mitchell, LoadOptions::default()).unwrap();
+    assert_eq!(
+        scene.camera.filter().shape(),
+        FilterShape::Mitchell {
+            b: 0.5,
+            c: 1.0 / 3.0
+        }
+    );
+    let thin = scene_xml("").replace(
+        "<sensor type=\"perspective\">",
+        "<sensor type=\"thinlens\"><float name=\"aperture_radius\" value=\"0.1\"/>\
+         <float name=\"focus_distance\" value=\"3\"/>\
+         <float name=\"principal_point_offset_x\" value=\"0.25\"/>",
+    );
+    let (scene, report) = load_in(&d, "scene.xml", &thin, LoadOptions::default()).unwrap();
+    assert!(report.substitutions.is_empty(), "{report:?}");
+    assert_eq!(
+        scene.camera.lens(),
+        Lens::ThinLens {
+            aperture_radius: 0.1,
+            focus_distance: 3.0
+        }
+    );
+    assert_eq!(
+        scene.camera.principal_point_offset(),
+        lt_core::Vec2::new(0.25, 0.0)
+    );
+    let unknown = scene_xml("").replace("<rfilter type=\"box\"/>", "<rfilter type=\"sinc\"/>");
     fails(
         &d,
-        &nofilter,
-        line_of(&nofilter, "hdrfilm"),
-        &["Gaussian", "--approximate"],
+        &unknown,
+        line_of(&unknown, "sinc"),
+        &["reconstruction filter `sinc` is not supported"],
     );
 
     let unbounded = scene_xml("").replace("<integer name=\"max_depth\" value=\"5\"/>", "");
