@@ -403,6 +403,8 @@ mod tests {
     use crate::math::Vec2;
     use crate::sampling::Sampler;
 
+    type TestFn = Box<dyn Fn(f64) -> f64>;
+
     fn all_shapes() -> Vec<FilterShape> {
         vec![
             FilterShape::Box { radius: 0.5 },
@@ -452,7 +454,7 @@ mod tests {
         for shape in all_shapes() {
             let f = PixelFilter::new(shape).unwrap();
             let r = f.radius() as f64;
-            let tests: [(&str, Box<dyn Fn(f64) -> f64>); 4] = [
+            let tests: [(&str, TestFn); 4] = [
                 ("1", Box::new(|_| 1.0)),
                 ("x", Box::new(|x| x)),
                 ("x²", Box::new(|x| x * x)),
