@@ -14,6 +14,7 @@ pub mod load_args;
 pub mod manifest;
 pub mod mis_check;
 pub mod mis_check_vcm;
+pub mod mitsuba_suite;
 pub mod plot;
 pub mod reference_cmd;
 pub mod render_cmd;

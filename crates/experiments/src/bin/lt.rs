@@ -53,6 +53,9 @@ enum Command {
     Submit(x::cluster::SubmitArgs),
     /// Merge a plan's finished shards into its render or study outputs.
     Collect(x::cluster::CollectArgs),
+    /// Render Mitsuba 3's render-test suite (mitsuba-data's tests/scenes) and judge each scene
+    /// against its reference: results/mitsuba-render-tests.md.
+    MitsubaSuite(x::mitsuba_suite::SuiteArgs),
     /// List the integrators.
     List,
 }
@@ -75,6 +78,7 @@ fn main() -> ExitCode {
         Command::RunShard(a) => x::cluster::run_shard(a),
         Command::Submit(a) => x::cluster::submit(a),
         Command::Collect(a) => x::cluster::collect(a),
+        Command::MitsubaSuite(a) => x::mitsuba_suite::run(a),
         Command::List => {
             for i in lt_integrators::INTEGRATORS {
                 println!("{:10} {}", i.name, i.about);

@@ -1,0 +1,228 @@
+//! `lt mitsuba-suite DIR`: Mitsuba 3's render-test suite (mitsuba-data's `tests/scenes`, with
+//! its reference images) run as a peer's test suite. `cases` finds the scenes and the estimators
+//! their names imply, this module loads and renders each under a stated budget, `judge` applies
+//! Mitsuba's rule with lt's own standard errors, `table` writes the scoreboard.
+
+pub mod cases;
+pub mod judge;
+pub mod table;
+
+use crate::image_io::{read_exr, write_atomic};
+use cases::Case;
+use judge::Judgement;
+use lt_core::Scene;
+use lt_estimators::running::RunningImage;
+use lt_estimators::Image;
+use lt_integrators::render::{render, RenderOptions};
+use lt_integrators::{make_integrator, IntegratorParams};
+use lt_scene_io::{load_scene_with, LoadOptions};
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+#[derive(clap::Args, Debug)]
+pub struct SuiteArgs {
+    /// A copy of mitsuba-data (the folder holding tests/scenes), e.g. ../shared/mitsuba-render-tests.
+    pub dir: PathBuf,
+    /// Independent passes per estimator (their spread gives the standard errors).
+    #[arg(long, default_value_t = 32)]
+    pub passes: u32,
+    /// Samples per pixel in each pass.
+    #[arg(long, default_value_t = 8)]
+    pub spp: u32,
+    /// Time budget per scene in seconds, shared by its estimators; an estimator stops at its share
+    /// with the passes it finished (at least 2 are needed).
+    #[arg(long, default_value_t = 12.0)]
+    pub time_per_scene: f64,
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Where the table is written (atomically).
+    #[arg(long, default_value = "results/mitsuba-render-tests.md")]
+    pub out: PathBuf,
+}
+
+/// What every render of the suite may spend.
+#[derive(Clone, Debug)]
+pub struct Budget {
+    pub passes: u32,
+    pub spp_per_pass: u32,
+    pub time_per_estimator: Duration,
+    pub threads: usize,
+    pub seed: u64,
+}
+
+/// One estimator's result on one scene.
+#[derive(Clone, Debug)]
+pub enum Outcome {
+    Judged {
+        judgement: Judgement,
+        spp: u64,
+    },
+    /// It could not render or be judged (named).
+    Error(String),
+}
+
+impl Outcome {
+    pub fn passes(&self) -> bool {
+        matches!(self, Outcome::Judged { judgement, .. } if judgement.passes())
+    }
+}
+
+/// One scene's row of the scoreboard.
+#[derive(Clone, Debug)]
+pub struct Row {
+    pub name: String,
+    /// The load error's message, when the scene is refused.
+    pub refusal: Option<String>,
+    /// (estimator, outcome), for the estimators the file name implies (none when refused).
+    pub outcomes: Vec<(&'static str, Outcome)>,
+}
+
+/// Loads, renders and judges every scene of the suite in `dir`.
+pub fn run_suite(dir: &Path, budget: &Budget) -> Result<Vec<Row>, String> {
+    let shown_dir = format!("{}/", dir.display());
+    let cases = cases::discover(dir)?;
+    let mut rows = Vec::new();
+    for case in &cases {
+        let row = match load_scene_with(&case.xml, &LoadOptions::default()) {
+            // Messages name files relative to the suite's folder, so the table reads the same
+            // wherever the suite lives.
+            Err(e) => Row {
+                name: case.name.clone(),
+                refusal: Some(e.to_string().replace(&shown_dir, "")),
+                outcomes: Vec::new(),
+            },
+            Ok((scene, _)) => Row {
+                name: case.name.clone(),
+                refusal: None,
+                outcomes: case
+                    .estimators
+                    .iter()
+                    .map(|&e| (e, render_and_judge(&scene, e, case, budget)))
+                    .collect(),
+            },
+        };
+        eprintln!("{}: {}", row.name, summary(&row));
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+fn summary(row: &Row) -> String {
+    match &row.refusal {
+        Some(r) => format!("refused: {r}"),
+        None => row
+            .outcomes
+            .iter()
+            .map(|(e, o)| format!("{e} {}", if o.passes() { "pass" } else { "FAIL" }))
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
+}
+
+fn render_and_judge(scene: &Scene, estimator: &str, case: &Case, budget: &Budget) -> Outcome {
+    let judged = || -> Result<Outcome, String> {
+        let reference = read_exr(&case.reference)?;
+        let reference_var = read_exr(&case.reference_var)?;
+        let (batches, spp) = render_batches(scene, estimator, budget)?;
+        let judgement = judge::judge(
+            &batches.mean(),
+            &batches.std_error(),
+            spp as f64,
+            &reference,
+            &reference_var,
+        )?;
+        Ok(Outcome::Judged { judgement, spp })
+    };
+    judged().unwrap_or_else(Outcome::Error)
+}
+
+/// Renders `passes` batches of `spp_per_pass` lt passes (one sample per pixel each) and keeps the
+/// batch means: the independent passes the standard errors come from.
+fn render_batches(
+    scene: &Scene,
+    estimator: &str,
+    budget: &Budget,
+) -> Result<(RunningImage, u64), String> {
+    let est = make_integrator(estimator, scene, &IntegratorParams::new())?;
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let k = budget.spp_per_pass.max(1);
+    let opts = RenderOptions {
+        passes: budget.passes * k,
+        time_limit: Some(budget.time_per_estimator),
+        seed: budget.seed,
+        threads: budget.threads,
+    };
+    let mut batches = RunningImage::new(w, h);
+    let mut batch = Image::new(w, h);
+    let mut in_batch = 0;
+    let mut unbiased = true;
+    render(scene, &est, &opts, |report| {
+        let Some(pass) = report.pass_image() else {
+            unbiased = false;
+            return ControlFlow::Break(());
+        };
+        for (b, p) in batch.data.iter_mut().zip(&pass.data) {
+            for c in 0..3 {
+                b[c] += p[c] / k as f64;
+            }
+        }
+        in_batch += 1;
+        if in_batch == k {
+            batches.add(&batch);
+            batch = Image::new(w, h);
+            in_batch = 0;
+        }
+        ControlFlow::Continue(())
+    })?;
+    if !unbiased {
+        return Err(format!(
+            "{estimator} has no independent passes to take errors from"
+        ));
+    }
+    if batches.count() < 2 {
+        return Err(format!(
+            "the time budget ({:.0} s) allowed {} pass(es) of {k} spp; standard errors need 2",
+            budget.time_per_estimator.as_secs_f64(),
+            batches.count()
+        ));
+    }
+    let spp = batches.count() * k as u64;
+    Ok((batches, spp))
+}
+
+/// The command: runs the suite, prints the table and writes it to `args.out` atomically.
+pub fn run(args: &SuiteArgs) -> Result<(), String> {
+    if args.passes < 2 {
+        return Err("--passes must be at least 2 (standard errors come from their spread)".into());
+    }
+    if !(args.time_per_scene > 0.0) {
+        return Err(format!(
+            "--time-per-scene must be positive, got {}",
+            args.time_per_scene
+        ));
+    }
+    let budget = Budget {
+        passes: args.passes,
+        spp_per_pass: args.spp.max(1),
+        time_per_estimator: Duration::from_secs_f64(args.time_per_scene / 2.0),
+        threads: args.threads,
+        seed: 0,
+    };
+    let rows = run_suite(&args.dir, &budget)?;
+    let command = format!(
+        "lt mitsuba-suite {} --passes {} --spp {} --time-per-scene {}",
+        args.dir.display(),
+        args.passes,
+        args.spp,
+        args.time_per_scene
+    );
+    let md = table::markdown(&rows, &budget, &command);
+    print!("{md}");
+    if let Some(parent) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .map_err(|e| format!("cannot create {}: {e}", parent.display()))?;
+    }
+    write_atomic(&args.out, md.as_bytes())
+}
