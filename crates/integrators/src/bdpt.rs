@@ -252,12 +252,15 @@ impl Bdpt {
         // t = 1: every connectable light vertex joined to the pinhole.
         if splat_light {
             let scale = 1.0 / self.light_paths(scene) as f32;
+            // A thin lens draws its lens points from the light path's own lens stream (as vcm
+            // does, so vcm without merging takes bdpt's paths).
+            let mut lens = Sampler::for_item(Domain::Lens, seed, light_index, pass as u64);
             for s in 1..=y.len().min(max_k) {
                 let yv = &y[s - 1];
                 if !connectable(scene, yv) {
                     continue;
                 }
-                let Some(c) = connect_to_camera(scene, yv, &mut ls) else {
+                let Some(c) = connect_to_camera(scene, yv, &mut lens) else {
                     continue;
                 };
                 let camera_only = [c.camera];
