@@ -159,59 +159,92 @@ impl Material {
         u: Vec2,
         mode: TransportMode,
     ) -> Option<BsdfSample> {
-        if let Material::Textured(t) = self {
-            return t.resolve(sf.uv).sample(sf, wo, u_lobe, u, mode);
+        match self {
+            Material::Textured(t) => {
+                t.with_local(sf.uv, |m| sample_local(m, sf, wo, u_lobe, u, mode))
+            }
+            _ => sample_local(self.local(), sf, wo, u_lobe, u, mode),
         }
-        let wo_l = sf.frame.to_local(wo);
-        if wo_l.z == 0.0 {
-            return None;
-        }
-        let s = self.local().sample(wo_l, u_lobe, u, mode)?;
-        let wi = sf.frame.to_world(s.wi);
-        if !consistent_sides(sf, wo, wi, wo_l.z, s.wi.z) {
-            return None;
-        }
-        let weight = s.weight * adjoint_correction(sf, wo, wi, wo_l.z, mode);
-        (s.pdf_w > 0.0 && weight.is_finite()).then_some(BsdfSample {
-            wi,
-            weight,
-            pdf_w: s.pdf_w,
-            pdf_rev_w: s.pdf_rev_w,
-            delta: s.delta,
-        })
     }
 
     pub fn eval(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3, mode: TransportMode) -> BsdfEval {
-        if let Material::Textured(t) = self {
-            return t.resolve(sf.uv).eval(sf, wo, wi, mode);
-        }
-        let wo_l = sf.frame.to_local(wo);
-        let wi_l = sf.frame.to_local(wi);
-        if wo_l.z == 0.0 || !consistent_sides(sf, wo, wi, wo_l.z, wi_l.z) {
-            return BsdfEval::default();
-        }
-        let m = self.local();
-        let f = m.eval(wo_l, wi_l, mode);
-        let f_cos = f * wi_l.z.abs() * adjoint_correction(sf, wo, wi, wo_l.z, mode);
-        BsdfEval {
-            f_cos,
-            pdf_w: m.pdf(wo_l, wi_l),
-            pdf_rev_w: m.pdf(wi_l, wo_l),
+        match self {
+            Material::Textured(t) => t.with_local(sf.uv, |m| eval_local(m, sf, wo, wi, mode)),
+            _ => eval_local(self.local(), sf, wo, wi, mode),
         }
     }
 
     /// Solid-angle pdf of sampling wi given wo.
     pub fn pdf(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3) -> f32 {
-        if let Material::Textured(t) = self {
-            return t.resolve(sf.uv).pdf(sf, wo, wi);
+        match self {
+            Material::Textured(t) => t.with_local(sf.uv, |m| pdf_local(m, sf, wo, wi)),
+            _ => pdf_local(self.local(), sf, wo, wi),
         }
-        let wo_l = sf.frame.to_local(wo);
-        let wi_l = sf.frame.to_local(wi);
-        if !consistent_sides(sf, wo, wi, wo_l.z, wi_l.z) {
-            return 0.0;
-        }
-        self.local().pdf(wo_l, wi_l)
     }
+}
+
+/// `Material::sample` for a material's local BSDF: to the shading frame and back, the side
+/// check and the adjoint correction.
+#[inline]
+fn sample_local(
+    m: &dyn LocalBsdf,
+    sf: &ShadingFrame,
+    wo: Vec3,
+    u_lobe: f32,
+    u: Vec2,
+    mode: TransportMode,
+) -> Option<BsdfSample> {
+    let wo_l = sf.frame.to_local(wo);
+    if wo_l.z == 0.0 {
+        return None;
+    }
+    let s = m.sample(wo_l, u_lobe, u, mode)?;
+    let wi = sf.frame.to_world(s.wi);
+    if !consistent_sides(sf, wo, wi, wo_l.z, s.wi.z) {
+        return None;
+    }
+    let weight = s.weight * adjoint_correction(sf, wo, wi, wo_l.z, mode);
+    (s.pdf_w > 0.0 && weight.is_finite()).then_some(BsdfSample {
+        wi,
+        weight,
+        pdf_w: s.pdf_w,
+        pdf_rev_w: s.pdf_rev_w,
+        delta: s.delta,
+    })
+}
+
+/// `Material::eval` for a material's local BSDF.
+#[inline]
+fn eval_local(
+    m: &dyn LocalBsdf,
+    sf: &ShadingFrame,
+    wo: Vec3,
+    wi: Vec3,
+    mode: TransportMode,
+) -> BsdfEval {
+    let wo_l = sf.frame.to_local(wo);
+    let wi_l = sf.frame.to_local(wi);
+    if wo_l.z == 0.0 || !consistent_sides(sf, wo, wi, wo_l.z, wi_l.z) {
+        return BsdfEval::default();
+    }
+    let f = m.eval(wo_l, wi_l, mode);
+    let f_cos = f * wi_l.z.abs() * adjoint_correction(sf, wo, wi, wo_l.z, mode);
+    BsdfEval {
+        f_cos,
+        pdf_w: m.pdf(wo_l, wi_l),
+        pdf_rev_w: m.pdf(wi_l, wo_l),
+    }
+}
+
+/// `Material::pdf` for a material's local BSDF.
+#[inline]
+fn pdf_local(m: &dyn LocalBsdf, sf: &ShadingFrame, wo: Vec3, wi: Vec3) -> f32 {
+    let wo_l = sf.frame.to_local(wo);
+    let wi_l = sf.frame.to_local(wi);
+    if !consistent_sides(sf, wo, wi, wo_l.z, wi_l.z) {
+        return 0.0;
+    }
+    m.pdf(wo_l, wi_l)
 }
 
 /// Rejects directions that the shading normal and the geometric normal place on different sides;

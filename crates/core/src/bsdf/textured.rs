@@ -3,7 +3,8 @@
 //! evaluated as usual. Untextured materials never come here, so they keep their bits and speed.
 
 use super::microfacet::Microfacet;
-use super::Material;
+use super::two_sided::FrontFacing;
+use super::{LocalBsdf, Material};
 use crate::math::{Color, Vec2};
 use crate::texture::Texture;
 
@@ -26,9 +27,22 @@ pub struct Textured {
 }
 
 impl Textured {
-    /// The plain material at texture coordinates `uv`.
-    pub fn resolve(&self, uv: Vec2) -> Material {
-        let mut m = self.base.clone();
+    /// Calls `f` with the plain local BSDF at texture coordinates `uv`. The resolved material
+    /// lives on the stack: a two-sided base is resolved as its inner material (no `Box` cloned
+    /// per shading query) and seen from both sides through `FrontFacing`.
+    #[inline]
+    pub(super) fn with_local<R>(&self, uv: Vec2, f: impl FnOnce(&dyn LocalBsdf) -> R) -> R {
+        match &self.base {
+            Material::TwoSided(t) => {
+                let inner = self.resolved((*t.inner).clone(), uv);
+                f(&FrontFacing(inner.local()))
+            }
+            base => f(self.resolved(base.clone(), uv).local()),
+        }
+    }
+
+    /// `m` with every textured parameter set from its texture at `uv`.
+    fn resolved(&self, mut m: Material, uv: Vec2) -> Material {
         for (slot, texture) in &self.slots {
             set_parameter(&mut m, *slot, texture.eval(uv));
         }

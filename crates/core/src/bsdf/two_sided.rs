@@ -21,13 +21,15 @@ fn front(v: Vec3, back: bool) -> Vec3 {
     }
 }
 
-impl LocalBsdf for TwoSided {
+/// Any local BSDF seen from both sides: the front's lobes mirrored through the surface for a
+/// `wo` below it. `TwoSided` is this around its inner material; a textured two-sided material
+/// puts it around its resolved inner material on the stack.
+pub(super) struct FrontFacing<'a>(pub &'a dyn LocalBsdf);
+
+impl LocalBsdf for FrontFacing<'_> {
     fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<LocalSample> {
         let back = wo.z < 0.0;
-        let s = self
-            .inner
-            .local()
-            .sample(front(wo, back), u_lobe, u, mode)?;
+        let s = self.0.sample(front(wo, back), u_lobe, u, mode)?;
         Some(LocalSample {
             wi: front(s.wi, back),
             ..s
@@ -36,14 +38,30 @@ impl LocalBsdf for TwoSided {
 
     fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Color {
         let back = wo.z < 0.0;
-        self.inner
-            .local()
-            .eval(front(wo, back), front(wi, back), mode)
+        self.0.eval(front(wo, back), front(wi, back), mode)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let back = wo.z < 0.0;
-        self.inner.local().pdf(front(wo, back), front(wi, back))
+        self.0.pdf(front(wo, back), front(wi, back))
+    }
+
+    fn is_delta(&self) -> bool {
+        self.0.is_delta()
+    }
+}
+
+impl LocalBsdf for TwoSided {
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<LocalSample> {
+        FrontFacing(self.inner.local()).sample(wo, u_lobe, u, mode)
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Color {
+        FrontFacing(self.inner.local()).eval(wo, wi, mode)
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        FrontFacing(self.inner.local()).pdf(wo, wi)
     }
 
     fn is_delta(&self) -> bool {
