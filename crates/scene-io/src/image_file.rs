@@ -4,6 +4,7 @@
 //! caller can decode sRGB unless the scene asks for the raw values.
 
 use lt_core::math::Color;
+use lt_core::texture::{Bitmap, FilterType, UvTransform, WrapMode};
 use std::path::Path;
 
 pub struct RgbImage {
@@ -72,4 +73,48 @@ pub fn srgb_to_linear(v: f32) -> f32 {
     } else {
         ((v + 0.055) / 1.055).powf(2.4)
     }
+}
+
+/// Mitsuba's `filter_type` by name (absent: bilinear); the error says what is accepted.
+pub fn filter_type_named(name: Option<&str>) -> Result<FilterType, String> {
+    match name {
+        None | Some("bilinear") => Ok(FilterType::Bilinear),
+        Some("nearest") => Ok(FilterType::Nearest),
+        Some(other) => Err(format!("must be bilinear or nearest, got `{other}`")),
+    }
+}
+
+/// Mitsuba's `wrap_mode` by name (absent: repeat); the error says what is accepted.
+pub fn wrap_mode_named(name: Option<&str>) -> Result<WrapMode, String> {
+    match name {
+        None | Some("repeat") => Ok(WrapMode::Repeat),
+        Some("mirror") => Ok(WrapMode::Mirror),
+        Some("clamp") => Ok(WrapMode::Clamp),
+        Some(other) => Err(format!("must be repeat, mirror or clamp, got `{other}`")),
+    }
+}
+
+/// A bitmap texture from an image file: sRGB-encoded files are decoded to linear unless `raw`.
+pub fn read_bitmap(
+    path: &Path,
+    raw: bool,
+    filter: FilterType,
+    wrap: WrapMode,
+    to_uv: UvTransform,
+) -> Result<Bitmap, String> {
+    let img = read_rgb(path)?;
+    let decode = img.srgb_encoded && !raw;
+    let texels = img
+        .texels
+        .iter()
+        .map(|c| if decode { c.map(srgb_to_linear) } else { *c })
+        .collect();
+    Ok(Bitmap {
+        width: img.width,
+        height: img.height,
+        texels,
+        filter,
+        wrap,
+        to_uv,
+    })
 }

@@ -2,10 +2,10 @@
 
 use crate::error::Ctx;
 use crate::format::{TextureDef, S};
-use crate::image_file::{read_rgb, srgb_to_linear};
+use crate::image_file::{filter_type_named, read_bitmap, wrap_mode_named};
 use crate::SceneError;
 use lt_core::math::Vec2;
-use lt_core::texture::{Bitmap, FilterType, Texture, UvTransform, WrapMode};
+use lt_core::texture::{Texture, UvTransform};
 use std::sync::Arc;
 
 pub fn texture(ctx: &Ctx, def: &S<TextureDef>) -> Result<Texture, SceneError> {
@@ -34,42 +34,12 @@ pub fn texture(ctx: &Ctx, def: &S<TextureDef>) -> Result<Texture, SceneError> {
             ctx.only(&given, &["file", "filter", "wrap", "raw", "scale"], &what)?;
             let file = ctx.need(&d.file, "file", &def.span(), &what)?;
             let path = ctx.base_dir.join(file.get_ref());
-            let img = read_rgb(&path).map_err(|m| ctx.at(file.span(), m))?;
-            let decode = img.srgb_encoded && !d.raw.as_ref().is_some_and(|r| *r.get_ref());
-            let texels = img
-                .texels
-                .iter()
-                .map(|c| if decode { c.map(srgb_to_linear) } else { *c })
-                .collect();
-            let filter = match d.filter.as_ref().map(|f| (f.get_ref().as_str(), f.span())) {
-                None | Some(("bilinear", _)) => FilterType::Bilinear,
-                Some(("nearest", _)) => FilterType::Nearest,
-                Some((other, span)) => {
-                    return Err(ctx.at(
-                        span,
-                        format!("`filter` must be bilinear or nearest, got `{other}`"),
-                    ))
-                }
-            };
-            let wrap = match d.wrap.as_ref().map(|w| (w.get_ref().as_str(), w.span())) {
-                None | Some(("repeat", _)) => WrapMode::Repeat,
-                Some(("mirror", _)) => WrapMode::Mirror,
-                Some(("clamp", _)) => WrapMode::Clamp,
-                Some((other, span)) => {
-                    return Err(ctx.at(
-                        span,
-                        format!("`wrap` must be repeat, mirror or clamp, got `{other}`"),
-                    ))
-                }
-            };
-            Ok(Texture::Bitmap(Arc::new(Bitmap {
-                width: img.width,
-                height: img.height,
-                texels,
-                filter,
-                wrap,
-                to_uv,
-            })))
+            let raw = d.raw.as_ref().is_some_and(|r| *r.get_ref());
+            let filter = named(ctx, def, &d.filter, "filter", filter_type_named)?;
+            let wrap = named(ctx, def, &d.wrap, "wrap", wrap_mode_named)?;
+            let bitmap =
+                read_bitmap(&path, raw, filter, wrap, to_uv).map_err(|m| ctx.at(file.span(), m))?;
+            Ok(Texture::Bitmap(Arc::new(bitmap)))
         }
         "checkerboard" => {
             ctx.only(&given, &["color0", "color1", "scale"], &what)?;
@@ -90,4 +60,21 @@ pub fn texture(ctx: &Ctx, def: &S<TextureDef>) -> Result<Texture, SceneError> {
             format!("unknown texture type `{other}` (expected bitmap or checkerboard)"),
         )),
     }
+}
+
+/// A name-valued key parsed by `parse`, its error placed at the key (or at the texture when the
+/// key is absent).
+fn named<T>(
+    ctx: &Ctx,
+    def: &S<TextureDef>,
+    v: &Option<S<String>>,
+    key: &str,
+    parse: fn(Option<&str>) -> Result<T, String>,
+) -> Result<T, SceneError> {
+    parse(v.as_ref().map(|v| v.get_ref().as_str())).map_err(|m| {
+        ctx.at(
+            v.as_ref().map_or(def.span(), S::span),
+            format!("`{key}` {m}"),
+        )
+    })
 }

@@ -6,7 +6,7 @@ use super::props::{textures_refused, ColorUse, Ids, Plugin};
 use super::resolve::Resolver;
 use super::values::Xform;
 use crate::error::Ctx;
-use crate::image_file::{read_rgb, srgb_to_linear};
+use crate::image_file::{filter_type_named, read_bitmap, wrap_mode_named};
 use crate::mesh::ply;
 use crate::transform::{check_quad, check_solid};
 use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
@@ -23,7 +23,7 @@ use lt_core::bsdf::{TextureSlot, Textured};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::math::{Color, Vec2};
 use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
-use lt_core::texture::{Bitmap, FilterType, Texture, UvTransform, WrapMode};
+use lt_core::texture::{Texture, UvTransform};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -741,45 +741,14 @@ impl<'a> Loader<'a> {
                 let path = self.doc.resolver.resolve(file).map_err(|looked| {
                     p.err(fe, Resolver::not_found("texture file", file, &looked))
                 })?;
-                let img = read_rgb(&path).map_err(|m| p.err(fe, m))?;
                 let raw = p.boolean("raw")?.unwrap_or(false);
-                let decode = img.srgb_encoded && !raw;
-                let texels = img
-                    .texels
-                    .iter()
-                    .map(|c| if decode { c.map(srgb_to_linear) } else { *c })
-                    .collect();
-                let filter = match p.string("filter_type")? {
-                    None | Some(("bilinear", _)) => FilterType::Bilinear,
-                    Some(("nearest", _)) => FilterType::Nearest,
-                    Some((other, fe)) => {
-                        return Err(p.err(
-                            fe,
-                            format!("`filter_type` must be bilinear or nearest, got `{other}`"),
-                        ))
-                    }
-                };
-                let wrap = match p.string("wrap_mode")? {
-                    None | Some(("repeat", _)) => WrapMode::Repeat,
-                    Some(("mirror", _)) => WrapMode::Mirror,
-                    Some(("clamp", _)) => WrapMode::Clamp,
-                    Some((other, we)) => {
-                        return Err(p.err(
-                            we,
-                            format!("`wrap_mode` must be repeat, mirror or clamp, got `{other}`"),
-                        ))
-                    }
-                };
+                let filter = parse_named(&p, e, "filter_type", filter_type_named)?;
+                let wrap = parse_named(&p, e, "wrap_mode", wrap_mode_named)?;
+                let bitmap =
+                    read_bitmap(&path, raw, filter, wrap, to_uv).map_err(|m| p.err(fe, m))?;
                 self.meshes.push(path);
                 p.finish(&["format"], &mut self.report)?;
-                Texture::Bitmap(Arc::new(Bitmap {
-                    width: img.width,
-                    height: img.height,
-                    texels,
-                    filter,
-                    wrap,
-                    to_uv,
-                }))
+                Texture::Bitmap(Arc::new(bitmap))
             }
             "checkerboard" => {
                 let opts = self.opts;
@@ -1342,4 +1311,17 @@ mod tests {
         let k = -(1.0f32 / 3.0).sqrt();
         assert!((n[0] - glam::Vec3::splat(k)).abs().max_element() < 1e-6);
     }
+}
+
+/// A string parameter parsed by `parse`, its error placed at the parameter (or at the element
+/// `e` when the parameter is absent).
+fn parse_named<T>(
+    p: &Plugin,
+    e: &Elem,
+    key: &str,
+    parse: fn(Option<&str>) -> Result<T, String>,
+) -> Result<T, SceneError> {
+    let given = p.string(key)?;
+    parse(given.map(|(name, _)| name))
+        .map_err(|m| p.err(given.map_or(e, |(_, ke)| ke), format!("`{key}` {m}")))
 }
