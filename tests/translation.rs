@@ -41,23 +41,31 @@ fn translated_cornell_box_renders_the_same() {
         );
         for offset in [1e3f32, 1e4] {
             let moved = scene.translated(Vec3::splat(offset));
-            let (r, blocks) = render_blocks(&moved, name, IntegratorParams::default(), n, 22, 8);
-            assert_eq!(
-                r.invalid_samples, 0,
-                "{name}: invalid samples at {offset:e}"
-            );
-            let (m0, m1) = (mean(&base), mean(&blocks));
-            let result = agreement_t(&base, &blocks, 1e-3);
-            eprintln!(
-                "{name} at {offset:e}: image mean ratio {:.5}, {result}",
-                m1 / m0
-            );
-            if !result.passed() {
-                failures.push(format!("{name} translated by {offset:e}: {result}"));
-            }
+            let what = format!("{name} translated by {offset:e}");
+            failures.extend(moved_agrees(&base, &moved, name, n, 22, &what));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Renders the moved scene and holds its blocks against `base` (the scene where it was),
+/// within Šidák-corrected standard errors; the failure's description when they disagree.
+fn moved_agrees(
+    base: &lt_estimators::blocks::RunningBlocks,
+    moved: &lt_core::Scene,
+    name: &str,
+    passes: u32,
+    seed: u64,
+    what: &str,
+) -> Option<String> {
+    let (r, blocks) = render_blocks(moved, name, IntegratorParams::default(), passes, seed, 8);
+    assert_eq!(r.invalid_samples, 0, "{what}: invalid samples");
+    let result = agreement_t(base, &blocks, 1e-3);
+    eprintln!(
+        "{what}: image mean ratio {:.5}, {result}",
+        mean(&blocks) / mean(base)
+    );
+    (!result.passed()).then(|| format!("{what}: {result}"))
 }
 
 /// Mean over blocks and channels (for the diagnostic ratio printed above).
@@ -121,20 +129,8 @@ fn cornell_box_file_translated_far_away_renders_the_same() {
                 Vec3::ZERO,
                 "the loader recentres at {offset:e}"
             );
-            let (r, blocks) = render_blocks(&moved, name, IntegratorParams::default(), n, 32, 8);
-            assert_eq!(
-                r.invalid_samples, 0,
-                "{name}: invalid samples at {offset:e}"
-            );
-            let (m0, m1) = (mean(&base), mean(&blocks));
-            let result = agreement_t(&base, &blocks, 1e-3);
-            eprintln!(
-                "file, {name} at {offset:e}: image mean ratio {:.5}, {result}",
-                m1 / m0
-            );
-            if !result.passed() {
-                failures.push(format!("file translated by {offset:e}, {name}: {result}"));
-            }
+            let what = format!("file translated by {offset:e}, {name}");
+            failures.extend(moved_agrees(&base, &moved, name, n, 32, &what));
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
