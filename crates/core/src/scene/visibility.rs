@@ -20,12 +20,6 @@ pub struct ConnectionEnd {
     pub infinite: bool,
 }
 
-impl From<&ConnectionEnd> for ConnectionEnd {
-    fn from(e: &ConnectionEnd) -> ConnectionEnd {
-        *e
-    }
-}
-
 /// One end of a shadow ray: a point, its per-axis error bound and its geometric normal (zero when
 /// it has none: a point light, a bare point).
 #[derive(Clone, Copy, Debug)]
@@ -256,17 +250,17 @@ mod tests {
                 let a = vertex(sc, mid, Vec3::new(x, 0.0, z));
                 let b = vertex(sc, mid_high, Vec3::new(1.0 - x, 1.0, 1.0 - z));
                 let expect = std::ptr::eq(sc, &open);
-                assert_eq!(sc.connection_visible(&a, &b), expect, "{a:?} {b:?}");
-                assert_eq!(sc.connection_visible(&b, &a), expect);
+                assert_eq!(sc.connection_visible(a, b), expect, "{a:?} {b:?}");
+                assert_eq!(sc.connection_visible(b, a), expect);
                 // Straight up from the floor: the ceiling always blocks, nothing below it.
-                assert!(!sc.connection_visible(&a, &at_infinity(Vec3::Y)));
-                assert!(!sc.connection_visible(&at_infinity(Vec3::Y), &a));
+                assert!(!sc.connection_visible(a, at_infinity(Vec3::Y)));
+                assert!(!sc.connection_visible(at_infinity(Vec3::Y), a));
             }
         }
         // Without a ceiling the sky is visible from the floor.
         let floor_only = scene(&[floor]);
         let a = vertex(&floor_only, mid, Vec3::new(0.5, 0.0, 0.5));
-        assert!(floor_only.connection_visible(&a, &at_infinity(Vec3::Y)));
+        assert!(floor_only.connection_visible(a, at_infinity(Vec3::Y)));
     }
 
     /// A floor and a wall sharing an edge, and a second wall touching the floor only at a corner;
@@ -305,7 +299,6 @@ mod tests {
             let on_corner_wall = try_vertex(&sc, p(0.5, 0.5, -0.5), p(0.0, d2, -d1));
             for pair in [(on_floor, on_wall), (near_corner, on_corner_wall)] {
                 let (Some(a), Some(b)) = pair else { continue };
-                let (a, b) = (&a, &b);
                 // Only pairs the rays put on two different surfaces count.
                 if a.ng.dot(b.ng).abs() > 0.5 {
                     continue;
