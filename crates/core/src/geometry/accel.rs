@@ -315,10 +315,16 @@ impl Accel {
     /// which would cull every box closer than 1e-4 scene units — at millimetre scale, whole walls.
     /// Traversal therefore starts `TRAVERSAL_BACKOFF` behind the real origin, so every true hit is
     /// at least that far along the traversal ray; primitive tests subtract it again.
+    ///
+    /// The direction's signed zeros become +0: obvhs inverts a zero component to ±1/ε by its sign
+    /// bit but picks the slab's near side by `d < 0`, so a −0 component (a negated axis vector, as
+    /// a shadow ray towards a directional light along an axis) swapped near and far and missed
+    /// every box.
     #[inline]
     fn obvhs_ray(ray: &Ray) -> obvhs::ray::Ray {
         let o = ray.o - ray.d * TRAVERSAL_BACKOFF;
-        obvhs::ray::Ray::new(o.into(), ray.d.into(), 0.0, ray.t_max + TRAVERSAL_BACKOFF)
+        let d = ray.d + Vec3::ZERO; // −0 + +0 = +0; every other value unchanged
+        obvhs::ray::Ray::new(o.into(), d.into(), 0.0, ray.t_max + TRAVERSAL_BACKOFF)
     }
 
     /// Closest hit along the ray within (0, t_max).
@@ -528,6 +534,10 @@ mod tests {
                         }
                     }
                     (target - o).normalize()
+                } else if k % 7 == 3 && k % 3 != 2 {
+                    // Along an axis, with signed zeros as negating an axis vector gives them (from
+                    // random origins: from a box face, an axis ray grazes the face's edges).
+                    [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z][k / 7 % 6]
                 } else {
                     sample_uniform_sphere(s.next_2d())
                 };

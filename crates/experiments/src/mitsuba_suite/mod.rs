@@ -37,10 +37,19 @@ pub struct SuiteArgs {
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Where the table is written (atomically).
-    #[arg(long, default_value = "results/mitsuba-render-tests.md")]
-    pub out: PathBuf,
+    /// Only the scenes whose name (`folder/file` without `.xml`) contains one of these strings
+    /// (repeatable). A partial run prints its table but writes it only where `--out` says, so the
+    /// committed scoreboard is never overwritten by a part of it.
+    #[arg(long)]
+    pub only: Vec<String>,
+    /// Where the table is written (atomically); default results/mitsuba-render-tests.md for a
+    /// full run, nowhere for a partial one.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }
+
+/// The scoreboard's home, written by a full run.
+const DEFAULT_OUT: &str = "results/mitsuba-render-tests.md";
 
 /// What every render of the suite may spend.
 #[derive(Clone, Debug)]
@@ -81,10 +90,16 @@ pub struct Row {
 
 /// Loads, renders and judges every scene of the suite in `dir`.
 pub fn run_suite(dir: &Path, budget: &Budget) -> Result<Vec<Row>, String> {
+    run_suite_only(dir, budget, &[])
+}
+
+/// `run_suite` for the scenes whose name contains one of `only` (all when it is empty).
+pub fn run_suite_only(dir: &Path, budget: &Budget, only: &[String]) -> Result<Vec<Row>, String> {
     let shown_dir = format!("{}/", dir.display());
     let cases = cases::discover(dir)?;
+    let chosen = |name: &str| only.is_empty() || only.iter().any(|o| name.contains(o.as_str()));
     let mut rows = Vec::new();
-    for case in &cases {
+    for case in cases.iter().filter(|c| chosen(&c.name)) {
         let row = match load_scene_with(&case.xml, &LoadOptions::default()) {
             // Messages name files relative to the suite's folder, so the table reads the same
             // wherever the suite lives.
@@ -210,19 +225,34 @@ pub fn run(args: &SuiteArgs) -> Result<(), String> {
         threads: args.threads,
         seed: 0,
     };
-    let rows = run_suite(&args.dir, &budget)?;
-    let command = format!(
+    let rows = run_suite_only(&args.dir, &budget, &args.only)?;
+    if rows.is_empty() {
+        return Err(format!(
+            "no scene of {} matches --only {}",
+            args.dir.display(),
+            args.only.join(", ")
+        ));
+    }
+    let mut command = format!(
         "lt mitsuba-suite {} --passes {} --spp {} --time-per-scene {}",
         args.dir.display(),
         args.passes,
         args.spp,
         args.time_per_scene
     );
+    for o in &args.only {
+        command += &format!(" --only {o}");
+    }
     let md = table::markdown(&rows, &budget, &command);
     print!("{md}");
-    if let Some(parent) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+    let out = match (&args.out, args.only.is_empty()) {
+        (Some(out), _) => out.clone(),
+        (None, true) => PathBuf::from(DEFAULT_OUT),
+        (None, false) => return Ok(()),
+    };
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent)
             .map_err(|e| format!("cannot create {}: {e}", parent.display()))?;
     }
-    write_atomic(&args.out, md.as_bytes())
+    write_atomic(&out, md.as_bytes())
 }
