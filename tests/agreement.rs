@@ -554,3 +554,12 @@ fn light_agrees_with_pt_off_axis() {
         block_name(&a, worst)
     );
 }
+
+/// Normal and bump maps (a bump-mapped floor, a normal-mapped wall and rough copper sphere, with
+/// Mitsuba's flipped invalid normals and shadowing term): the perturbed normal is every vertex's
+/// shading normal, so importance transport's shading-normal correction must hold on it, and the
+/// flip and shadowing must be the same function of (camera side, light side) in both modes.
+#[test]
+fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_bumped() {
+    per_depth("cornell-bumped", 1..=5);
+}

@@ -11,8 +11,8 @@ use lt_core::bsdf::fresnel::ComplexIor;
 use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::textured::set_parameter;
 use lt_core::bsdf::{
-    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TextureSlot,
-    Textured, TwoSided,
+    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, NormalSource, Perturbed,
+    RoughConductor, TextureSlot, Textured, TwoSided,
 };
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::light::SunLight;
@@ -228,6 +228,56 @@ fn render(ctx: &Ctx, file: &SceneFile) -> Result<RenderSettings, SceneError> {
 }
 
 fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, SceneError> {
+    let m = textured_material(ctx, name, def)?;
+    perturbed(ctx, def, m)
+}
+
+/// `m` under the material's `normal_map` or `bump_map`, if it has one.
+fn perturbed(ctx: &Ctx, def: &S<MaterialDef>, m: Material) -> Result<Material, SceneError> {
+    let d = def.get_ref();
+    let source = match (&d.normal_map, &d.bump_map) {
+        (None, None) => {
+            let stray = [
+                ("bump_scale", d.bump_scale.as_ref().map(S::span)),
+                (
+                    "flip_invalid_normals",
+                    d.flip_invalid_normals.as_ref().map(S::span),
+                ),
+                ("bump_shadowing", d.bump_shadowing.as_ref().map(S::span)),
+            ];
+            if let Some((key, Some(span))) = stray.into_iter().find(|(_, s)| s.is_some()) {
+                return Err(ctx.at(span, format!("`{key}` needs a `normal_map` or `bump_map`")));
+            }
+            return Ok(m);
+        }
+        (Some(_), Some(b)) => {
+            return Err(ctx.at(b.span(), "give `normal_map` or `bump_map`, not both"));
+        }
+        (Some(n), None) => {
+            if let Some(s) = &d.bump_scale {
+                return Err(ctx.at(s.span(), "`bump_scale` applies to a `bump_map`"));
+            }
+            NormalSource::NormalMap(crate::texture_def::texture(ctx, n)?)
+        }
+        (None, Some(b)) => NormalSource::BumpMap {
+            height: crate::texture_def::texture(ctx, b)?,
+            scale: match &d.bump_scale {
+                None => 1.0,
+                Some(s) => ctx.num(s, "bump_scale")?,
+            },
+        },
+    };
+    let flag = |v: &Option<S<bool>>| v.as_ref().is_none_or(|v| *v.get_ref());
+    Ok(Material::Perturbed(Box::new(Perturbed {
+        source,
+        inner: m,
+        flip_invalid_normals: flag(&d.flip_invalid_normals),
+        shadowing: flag(&d.bump_shadowing),
+    })))
+}
+
+/// The material with its textured parameters (`*_texture`).
+fn textured_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, SceneError> {
     let d = def.get_ref();
     let base = plain_material(ctx, name, def)?;
     let mut slots = Vec::new();

@@ -118,6 +118,15 @@ pub struct MaterialDef {
     pub albedo_texture: Option<S<TextureDef>>,
     pub reflectance_texture: Option<S<TextureDef>>,
     pub alpha_texture: Option<S<TextureDef>>,
+    /// Mitsuba's `normalmap` around the material: a texture of tangent-space normals ((x+1)/2;
+    /// give `raw = true` for 8-bit files), or `bumpmap`: a height texture times `bump_scale`
+    /// (default 1). `flip_invalid_normals` and `bump_shadowing` (Mitsuba's
+    /// `use_shadowing_function`) default to true, as in Mitsuba.
+    pub normal_map: Option<S<TextureDef>>,
+    pub bump_map: Option<S<TextureDef>>,
+    pub bump_scale: Option<S<f64>>,
+    pub flip_invalid_normals: Option<S<bool>>,
+    pub bump_shadowing: Option<S<bool>>,
 }
 
 /// A texture: `type = "bitmap"` with `file` (PNG, JPEG, BMP, HDR or EXR, relative to the scene

@@ -36,10 +36,16 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
     materials.sort_by_key(|m| m.span().start);
     let textures = materials.into_iter().flat_map(|m| {
         let m = m.get_ref();
-        [&m.albedo_texture, &m.reflectance_texture, &m.alpha_texture]
-            .into_iter()
-            .flatten()
-            .filter_map(|t| t.get_ref().file.as_ref())
+        [
+            &m.albedo_texture,
+            &m.reflectance_texture,
+            &m.alpha_texture,
+            &m.normal_map,
+            &m.bump_map,
+        ]
+        .into_iter()
+        .flatten()
+        .filter_map(|t| t.get_ref().file.as_ref())
     });
     scene.source_files = std::iter::once(path.to_path_buf())
         .chain(textures.map(|f| ctx.base_dir.join(f.get_ref())))

@@ -21,6 +21,7 @@ pub mod fresnel;
 mod glossy;
 pub mod microfacet;
 mod mirror;
+pub mod perturbed;
 mod quadrature;
 pub mod refraction;
 mod rough_conductor;
@@ -32,6 +33,7 @@ pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use glossy::Glossy;
 pub use mirror::Mirror;
+pub use perturbed::{NormalSource, Perturbed};
 pub use rough_conductor::RoughConductor;
 pub use textured::{TextureSlot, Textured};
 pub use two_sided::TwoSided;
@@ -130,6 +132,8 @@ pub enum Material {
     TwoSided(TwoSided),
     /// Parameters read from textures at the shading point's uv.
     Textured(Box<Textured>),
+    /// A material under a normal or bump map (Mitsuba's `normalmap`, `bumpmap`).
+    Perturbed(Box<Perturbed>),
 }
 
 impl Material {
@@ -144,6 +148,17 @@ impl Material {
             Material::RoughConductor(m) => m,
             Material::TwoSided(m) => m,
             Material::Textured(t) => t.base.local(),
+            Material::Perturbed(p) => p.inner.local(),
+        }
+    }
+
+    /// The normal or bump map the material is under, if any: the hit replaces its shading
+    /// normal by the perturbed one (`Perturbed::normal`).
+    #[inline]
+    pub fn perturbation(&self) -> Option<&Perturbed> {
+        match self {
+            Material::Perturbed(p) => Some(p),
+            _ => None,
         }
     }
 
@@ -163,6 +178,7 @@ impl Material {
             Material::Textured(t) => {
                 t.with_local(sf.uv, |m| sample_local(m, sf, wo, u_lobe, u, mode))
             }
+            Material::Perturbed(p) => p.sample(sf, wo, u_lobe, u, mode),
             _ => sample_local(self.local(), sf, wo, u_lobe, u, mode),
         }
     }
@@ -170,6 +186,7 @@ impl Material {
     pub fn eval(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3, mode: TransportMode) -> BsdfEval {
         match self {
             Material::Textured(t) => t.with_local(sf.uv, |m| eval_local(m, sf, wo, wi, mode)),
+            Material::Perturbed(p) => p.eval(sf, wo, wi, mode),
             _ => eval_local(self.local(), sf, wo, wi, mode),
         }
     }
@@ -178,6 +195,7 @@ impl Material {
     pub fn pdf(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             Material::Textured(t) => t.with_local(sf.uv, |m| pdf_local(m, sf, wo, wi)),
+            Material::Perturbed(p) => p.pdf(sf, wo, wi),
             _ => pdf_local(self.local(), sf, wo, wi),
         }
     }

@@ -30,7 +30,8 @@ impl SurfaceHit {
     pub(crate) fn new(scene: &Scene, ray: &Ray, h: PrimHit) -> SurfaceHit {
         let prim = *scene.accel.primitive(h.prim);
         let shape = &scene.shapes[prim.shape() as usize];
-        let (p, p_err, mut ng, mut ns, uv) = match prim {
+        // `tri`: the mesh triangle holding the point (a parallelogram's source triangle).
+        let (p, p_err, mut ng, mut ns, uv, tri) = match prim {
             Primitive::Triangle {
                 p: [p0, p1, p2],
                 index,
@@ -48,7 +49,7 @@ impl SurfaceHit {
                     ),
                     ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
                 };
-                (p, err, ng, ns, uv)
+                (p, err, ng, ns, uv, index)
             }
             Primitive::Quad { q, index, .. } => {
                 let (p, err, u, v) = q.hit_point(ray.o, ray.d, h.t);
@@ -67,12 +68,12 @@ impl SurfaceHit {
                     ),
                     ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
                 };
-                (p, err, ng, ns, uv)
+                (p, err, ng, ns, uv, tri)
             }
             Primitive::Sphere { center, radius, .. } => {
                 let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
                 let n = (p - center).normalize();
-                (p, err, n, n, sphere_uv(n))
+                (p, err, n, n, sphere_uv(n), 0)
             }
         };
         if shape.flip_normals {
@@ -82,6 +83,11 @@ impl SurfaceHit {
         // Interpolated normals may face the other way than the geometry; keep them on ng's side.
         if ns.dot(ng) < 0.0 {
             ns = -ns;
+        }
+        // A normal or bump map replaces the shading normal (only such materials need tangents).
+        if let Some(perturbed) = scene.material(shape.material).perturbation() {
+            let (dpdu, dpdv) = tangents(&shape.geometry, &prim, tri as usize, p, ng);
+            ns = perturbed.normal(ng, ns, dpdu, dpdv, uv);
         }
         SurfaceHit {
             p,
@@ -118,6 +124,56 @@ impl SurfaceHit {
             d: d / len,
             t_max: len * (1.0 - SHADOW_EPSILON),
         }
+    }
+}
+
+/// ∂p/∂u and ∂p/∂v at `p` on a primitive, in the parameterisation `uv` comes from: a mesh
+/// triangle's from its vertex uvs (Mitsuba's (b1, b2) without them), solved from the triangle's
+/// edges (pbrt-v4 §6.5.1, Mitsuba's mesh); a sphere's analytically. Where the uvs are degenerate,
+/// any two tangents orthogonal to the normal (Mitsuba does the same).
+fn tangents(
+    geometry: &ShapeGeometry,
+    prim: &Primitive,
+    tri: usize,
+    p: Vec3,
+    ng: Vec3,
+) -> (Vec3, Vec3) {
+    let fallback = || {
+        let f = crate::math::Frame::from_z(ng);
+        (f.x, f.y)
+    };
+    match (prim, geometry) {
+        (Primitive::Triangle { .. } | Primitive::Quad { .. }, ShapeGeometry::Mesh(m)) => {
+            let [p0, p1, p2] = m.triangle(tri);
+            let [uv0, uv1, uv2] = match &m.uvs {
+                Some(uvs) => m.indices[tri].map(|k| uvs[k as usize]),
+                None => [Vec2::ZERO, Vec2::X, Vec2::Y],
+            };
+            let (d1, d2) = (uv1 - uv0, uv2 - uv0);
+            let (e1, e2) = (p1 - p0, p2 - p0);
+            let det = d1.x * d2.y - d1.y * d2.x;
+            let dpdu = (e1 * d2.y - e2 * d1.y) / det;
+            let dpdv = (e2 * d1.x - e1 * d2.x) / det;
+            if det != 0.0 && dpdu.is_finite() && dpdv.is_finite() {
+                (dpdu, dpdv)
+            } else {
+                fallback()
+            }
+        }
+        (Primitive::Sphere { center, radius, .. }, _) => {
+            // p(u, v) = c + r (sin θ cos φ, sin θ sin φ, cos θ), φ = 2πu, θ = πv.
+            let d = p - *center;
+            let (sin_t, cos_t) = ((d.x * d.x + d.y * d.y).sqrt() / radius, d.z / radius);
+            let phi = d.y.atan2(d.x);
+            let dpdu = Vec3::new(-d.y, d.x, 0.0) * (2.0 * PI);
+            let dpdv = Vec3::new(cos_t * phi.cos(), cos_t * phi.sin(), -sin_t) * (PI * radius);
+            if dpdu.length_squared() > 0.0 {
+                (dpdu, dpdv)
+            } else {
+                fallback() // at a pole
+            }
+        }
+        _ => fallback(),
     }
 }
 

@@ -19,7 +19,7 @@ use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TwoSided,
 };
-use lt_core::bsdf::{TextureSlot, Textured};
+use lt_core::bsdf::{NormalSource, Perturbed, TextureSlot, Textured};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::math::{Color, Vec2};
 use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
@@ -667,10 +667,44 @@ impl<'a> Loader<'a> {
                     one_sided => one_sided,
                 }
             }
+            "normalmap" | "bumpmap" => {
+                let inner = match p.nested(&["bsdf"])[..] {
+                    [one] => self.bsdf(one, in_twosided)?,
+                    [] => return Err(p.err(e, format!("{} needs a nested BSDF", p.kind))),
+                    [_, second, ..] => {
+                        return Err(p.err(second, format!("{} takes one nested BSDF, this is a second one", p.kind)))
+                    }
+                };
+                let source = if p.kind == "normalmap" {
+                    let Some(t) = p.texture("normalmap") else {
+                        return Err(p.err(e, "normalmap needs a texture named `normalmap`"));
+                    };
+                    NormalSource::NormalMap(self.texture(t)?)
+                } else {
+                    let height = match p.any_textures()[..] {
+                        [one] => self.texture(one)?,
+                        [] => return Err(p.err(e, "bumpmap needs a nested height texture")),
+                        [_, second, ..] => {
+                            return Err(p.err(second, "bumpmap takes one texture, this is a second one"))
+                        }
+                    };
+                    let scale = p.float("scale")?.unwrap_or(1.0) as f32;
+                    if !scale.is_finite() {
+                        return Err(p.err(e, format!("bumpmap `scale` = {scale} is not a finite number")));
+                    }
+                    NormalSource::BumpMap { height, scale }
+                };
+                Material::Perturbed(Box::new(Perturbed {
+                    source,
+                    inner,
+                    flip_invalid_normals: p.boolean("flip_invalid_normals")?.unwrap_or(true),
+                    shadowing: p.boolean("use_shadowing_function")?.unwrap_or(true),
+                }))
+            }
             other => {
                 return Err(p.err(
                     e,
-                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, conductor, roughconductor and twosided)"),
+                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, conductor, roughconductor, twosided, normalmap and bumpmap)"),
                 ))
             }
         };
@@ -1286,6 +1320,19 @@ fn camera_frame(p: &Plugin, m: &DMat4, te: &Elem) -> Result<(DVec3, DVec3, DVec3
     Ok((eye, eye + fnn, un))
 }
 
+/// A string parameter parsed by `parse`, its error placed at the parameter (or at the element
+/// `e` when the parameter is absent).
+fn parse_named<T>(
+    p: &Plugin,
+    e: &Elem,
+    key: &str,
+    parse: fn(Option<&str>) -> Result<T, String>,
+) -> Result<T, SceneError> {
+    let given = p.string(key)?;
+    parse(given.map(|(name, _)| name))
+        .map_err(|m| p.err(given.map_or(e, |(_, ke)| ke), format!("`{key}` {m}")))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1311,17 +1358,4 @@ mod tests {
         let k = -(1.0f32 / 3.0).sqrt();
         assert!((n[0] - glam::Vec3::splat(k)).abs().max_element() < 1e-6);
     }
-}
-
-/// A string parameter parsed by `parse`, its error placed at the parameter (or at the element
-/// `e` when the parameter is absent).
-fn parse_named<T>(
-    p: &Plugin,
-    e: &Elem,
-    key: &str,
-    parse: fn(Option<&str>) -> Result<T, String>,
-) -> Result<T, SceneError> {
-    let given = p.string(key)?;
-    parse(given.map(|(name, _)| name))
-        .map_err(|m| p.err(given.map_or(e, |(_, ke)| ke), format!("`{key}` {m}")))
 }

@@ -148,6 +148,21 @@ impl<'a> Plugin<'a> {
         Some(*e)
     }
 
+    /// Every `<texture>` given, under any name or none (marked as taken): Mitsuba's `bumpmap`
+    /// takes its one texture whatever it is called.
+    pub fn any_textures(&self) -> Vec<&'a Elem> {
+        let named = self.params.iter().filter(|(_, e, _)| e.tag == "texture");
+        let unnamed = self.nested.iter().filter(|(_, e, _)| e.tag == "texture");
+        named
+            .map(|(_, e, used)| (*e, used))
+            .chain(unnamed.map(|(_, e, used)| (*e, used)))
+            .map(|(e, used)| {
+                used.set(true);
+                e
+            })
+            .collect()
+    }
+
     /// The element of a parameter, marked as taken (for callers that read it themselves).
     pub fn take_elem(&self, name: &str) -> Option<&'a Elem> {
         self.take(name)

@@ -237,6 +237,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
             }
             _ => body,
         };
+        let body = perturbation_xml(&ctx, d, &id, body, out_dir);
         let _ = writeln!(x, "    {body}");
     }
     for def in &file.shapes {
@@ -419,6 +420,51 @@ fn relative(path: &Path, dir: &Path) -> PathBuf {
 
 /// Escapes text for an XML attribute value.
 /// A TOML texture as Mitsuba's `<texture name=…>` (uv scale as `to_uv`).
+/// `body` (a BSDF with `id`) inside Mitsuba's `normalmap` or `bumpmap` when the material has one;
+/// the wrapper takes the id.
+fn perturbation_xml(
+    ctx: &Ctx,
+    d: &crate::format::MaterialDef,
+    id: &str,
+    body: String,
+    out_dir: &Path,
+) -> String {
+    let (kind, texture, mut params) = match (&d.normal_map, &d.bump_map) {
+        (Some(t), _) => (
+            "normalmap",
+            texture_xml(ctx, t.get_ref(), "normalmap", out_dir),
+            String::new(),
+        ),
+        (None, Some(t)) => (
+            "bumpmap",
+            texture_xml(ctx, t.get_ref(), "height", out_dir),
+            format!(
+                "        <float name=\"scale\" value=\"{}\"/>\n",
+                d.bump_scale.as_ref().map_or(1.0, |s| *s.get_ref() as f32)
+            ),
+        ),
+        (None, None) => return body,
+    };
+    for (flag, key) in [
+        (&d.flip_invalid_normals, "flip_invalid_normals"),
+        (&d.bump_shadowing, "use_shadowing_function"),
+    ] {
+        if let Some(f) = flag {
+            let _ = writeln!(
+                params,
+                "        <boolean name=\"{key}\" value=\"{}\"/>",
+                f.get_ref()
+            );
+        }
+    }
+    let inner = body.replacen(&format!(" id=\"{id}\""), "", 1);
+    let texture = texture.replace("\n            ", "\n        ");
+    format!(
+        "<bsdf type=\"{kind}\" id=\"{id}\">\n{}{params}    {inner}\n    </bsdf>",
+        texture.trim_start_matches("    ")
+    )
+}
+
 fn texture_xml(ctx: &Ctx, t: &crate::format::TextureDef, name: &str, out_dir: &Path) -> String {
     let mut x = format!(
         "            <texture type=\"{}\" name=\"{name}\">\n",
