@@ -226,12 +226,11 @@ impl<'a> Loader<'a> {
 
     fn sensor(&mut self, e: &'a Elem) -> Result<((LookAt, Optics), u32), SceneError> {
         let p = self.plugin(e)?;
-        if !matches!(p.kind, "perspective" | "thinlens") {
+        if !matches!(p.kind, "perspective" | "thinlens" | "orthographic") {
             return Err(p.err(
                 e,
                 format!(
-                    "sensor `{}` is not supported (lt reads perspective and thinlens; \
-                     orthographic cameras are built in code only, its to_world scale is not read)",
+                    "sensor `{}` is not supported (lt reads perspective, thinlens and orthographic)",
                     p.kind
                 ),
             ));
@@ -304,7 +303,21 @@ impl<'a> Loader<'a> {
             };
             (fov, a)
         };
-        let (eye, target, up) = match p.transform("to_world")? {
+        let to_world = p.transform("to_world")?;
+        // An orthographic sensor's film spans [-1, 1] across x and ±1/aspect in y in camera
+        // space (Mitsuba's `orthographic_projection`), scaled by to_world: the x column's length.
+        let ortho_half_width = match (&to_world, p.kind) {
+            (_, kind) if kind != "orthographic" => None,
+            (Some((Xform { m, lookat: None }, te)), _) => {
+                let (sx, sy) = (m.x_axis.truncate().length(), m.y_axis.truncate().length());
+                if !((sx - sy).abs() <= 1e-6 * sx.max(sy)) {
+                    return Err(p.err(*te, format!("an orthographic sensor scaled unequally in x ({sx}) and y ({sy}) is not supported")));
+                }
+                Some(sx as f32)
+            }
+            _ => Some(1.0),
+        };
+        let (eye, target, up) = match to_world {
             None => (DVec3::ZERO, DVec3::Z, DVec3::Y),
             Some((
                 Xform {
@@ -326,6 +339,7 @@ impl<'a> Loader<'a> {
         };
         let optics = Optics {
             lens,
+            ortho_half_width,
             principal,
             filter,
         };
@@ -1276,6 +1290,8 @@ fn similarity_scale(m: &DMat4) -> Option<f64> {
 /// principal point offset and the film's pixel filter.
 struct Optics {
     lens: Option<(f32, f32)>,
+    /// An orthographic sensor's film half width at the eye.
+    ortho_half_width: Option<f32>,
     principal: Vec2,
     filter: PixelFilter,
 }
@@ -1287,6 +1303,9 @@ impl Optics {
             .with_filter(self.filter.clone());
         if let Some((r, fd)) = self.lens {
             camera = camera.thin_lens(r, fd)?;
+        }
+        if let Some(hw) = self.ortho_half_width {
+            camera = camera.orthographic(hw)?;
         }
         Ok(camera)
     }
