@@ -631,6 +631,9 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
         ("solid_angle", d.solid_angle.as_ref().map(S::span)),
         ("radiance", d.radiance.as_ref().map(S::span)),
         ("irradiance", d.irradiance.as_ref().map(S::span)),
+        ("file", d.file.as_ref().map(S::span)),
+        ("scale", d.scale.as_ref().map(S::span)),
+        ("rotate", d.rotate.as_ref().map(S::span)),
     ];
     let span = def.span();
     let desc = match kind {
@@ -738,11 +741,29 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
                 )?,
             }
         }
+        "envmap" => {
+            ctx.only(&given, &["file", "scale", "rotate"], &what)?;
+            let file = ctx.need(&d.file, "file", &span, &what)?;
+            let scale = match &d.scale {
+                None => 1.0,
+                Some(s) => ctx.num(s, "scale")?,
+            };
+            let to_world = match &d.rotate {
+                None => glam::Mat3::IDENTITY,
+                Some(r) => crate::transform::rotate_def(ctx, r)?.as_mat3(),
+            };
+            let path = ctx.base_dir.join(file.get_ref());
+            let map = crate::image_file::read_environment_map(&path, scale, to_world)
+                .map_err(|m| ctx.at(file.span(), m))?;
+            LightDesc::EnvironmentMap {
+                map: std::sync::Arc::new(map),
+            }
+        }
         other => {
             return Err(ctx.at(
                 d.kind.span(),
                 format!(
-                    "unknown light type `{other}` (expected point, sun, directional or environment)"
+                    "unknown light type `{other}` (expected point, sun, directional, environment or envmap)"
                 ),
             ))
         }
@@ -752,6 +773,7 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
         | LightDesc::Sun { radiance: c, .. }
         | LightDesc::Directional { irradiance: c, .. }
         | LightDesc::Environment { radiance: c } => c.max_element(),
+        LightDesc::EnvironmentMap { map } => map.integral(),
     };
     Ok((power > 0.0).then_some(Placed::Anywhere(desc)))
 }

@@ -187,6 +187,11 @@ pub struct LightDef {
     pub solid_angle: Option<S<f64>>,
     pub radiance: Option<S<ColorDef>>,
     pub irradiance: Option<S<ColorDef>>,
+    /// `envmap`: a latitude–longitude image (relative to the scene file), its `scale` (default
+    /// 1) and a `rotate` of its local frame (Mitsuba's convention: +y is the image's top row).
+    pub file: Option<S<String>>,
+    pub scale: Option<S<f64>>,
+    pub rotate: Option<S<RotateDef>>,
 }
 
 /// An RGB triple written as `[r, g, b]` or as one number for grey.

@@ -66,6 +66,23 @@ fn read_exr(path: &Path) -> Result<RgbImage, String> {
     })
 }
 
+/// An environment map from an image file (Mitsuba's `envmap`): linear RGB texels (8-bit files
+/// sRGB-decoded, as Mitsuba converts them), times `scale`, rotated by `to_world`.
+pub fn read_environment_map(
+    path: &Path,
+    scale: f32,
+    to_world: glam::Mat3,
+) -> Result<lt_core::light::EnvironmentMap, String> {
+    let img = read_rgb(path)?;
+    let texels = if img.srgb_encoded {
+        img.texels.iter().map(|c| c.map(srgb_to_linear)).collect()
+    } else {
+        img.texels
+    };
+    lt_core::light::EnvironmentMap::new(img.width, img.height, texels, scale, to_world)
+        .map_err(|m| format!("{}: {m}", path.display()))
+}
+
 /// The sRGB transfer function inverted (IEC 61966-2-1): display value → linear.
 pub fn srgb_to_linear(v: f32) -> f32 {
     if v <= 0.04045 {

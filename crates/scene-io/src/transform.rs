@@ -50,15 +50,7 @@ pub fn shape_matrix(
         span = s.span();
     }
     if let Some(r) = &def.rotate {
-        let axis = DVec3::from_array(r.get_ref().axis);
-        let angle = r.get_ref().angle;
-        if !axis.is_finite() || !angle.is_finite() {
-            return Err(ctx.at(r.span(), "`rotate` has a NaN or infinite value"));
-        }
-        if axis.length_squared() == 0.0 {
-            return Err(ctx.at(r.span(), "`rotate` axis is the zero vector"));
-        }
-        m = DMat4::from_mat3(rotation(axis.normalize(), angle)) * m;
+        m = DMat4::from_mat3(rotate_def(ctx, r)?) * m;
     }
     if let Some(t) = &def.translate {
         let v = DVec3::from_array(*t.get_ref());
@@ -68,6 +60,19 @@ pub fn shape_matrix(
         m = DMat4::from_translation(v) * m;
     }
     Ok((m, span))
+}
+
+/// The rotation a `rotate` table describes (checked as for shapes).
+pub fn rotate_def(ctx: &Ctx, r: &S<crate::format::RotateDef>) -> Result<DMat3, SceneError> {
+    let axis = DVec3::from_array(r.get_ref().axis);
+    let angle = r.get_ref().angle;
+    if !axis.is_finite() || !angle.is_finite() {
+        return Err(ctx.at(r.span(), "`rotate` has a NaN or infinite value"));
+    }
+    if axis.length_squared() == 0.0 {
+        return Err(ctx.at(r.span(), "`rotate` axis is the zero vector"));
+    }
+    Ok(rotation(axis.normalize(), angle))
 }
 
 /// Rodrigues' rotation about a unit axis, counter-clockwise by `deg` degrees.

@@ -15,12 +15,14 @@
 mod area;
 mod directional;
 mod environment;
+mod envmap;
 mod point;
 mod sun;
 
 pub use area::AreaLight;
 pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
+pub use envmap::{EnvironmentMap, EnvironmentMapLight};
 pub use point::PointLight;
 pub use sun::SunLight;
 
@@ -50,6 +52,10 @@ pub enum LightDesc {
     },
     Environment {
         radiance: Color,
+    },
+    /// An image of radiance at infinity (Mitsuba's `envmap`, `light::EnvironmentMap`).
+    EnvironmentMap {
+        map: std::sync::Arc<EnvironmentMap>,
     },
 }
 
@@ -100,6 +106,7 @@ pub enum Light {
     Sun(SunLight),
     Directional(DirectionalLight),
     Environment(EnvironmentLight),
+    EnvironmentMap(EnvironmentMapLight),
 }
 
 impl Light {
@@ -133,6 +140,9 @@ impl Light {
             LightDesc::Environment { radiance } => {
                 Light::Environment(EnvironmentLight { radiance })
             }
+            LightDesc::EnvironmentMap { ref map } => {
+                Light::EnvironmentMap(EnvironmentMapLight { map: map.clone() })
+            }
         }
     }
 
@@ -142,7 +152,10 @@ impl Light {
     pub fn is_infinite(&self) -> bool {
         matches!(
             self,
-            Light::Sun(_) | Light::Directional(_) | Light::Environment(_)
+            Light::Sun(_)
+                | Light::Directional(_)
+                | Light::Environment(_)
+                | Light::EnvironmentMap(_)
         )
     }
 
@@ -171,6 +184,7 @@ impl Light {
             Light::Sun(l) => l.sample_li(u),
             Light::Directional(l) => Some(l.sample_li()),
             Light::Environment(l) => l.sample_li(u),
+            Light::EnvironmentMap(l) => l.sample_li(u),
         }
     }
 
@@ -182,6 +196,7 @@ impl Light {
             Light::Point(_) | Light::Directional(_) => 0.0,
             Light::Sun(l) => l.pdf_li(wi),
             Light::Environment(_) => environment::pdf_li(),
+            Light::EnvironmentMap(l) => l.pdf_li(wi),
         }
     }
 
@@ -199,6 +214,7 @@ impl Light {
         match self {
             Light::Sun(l) => l.escaped(dir),
             Light::Environment(l) => l.radiance,
+            Light::EnvironmentMap(l) => l.escaped(dir),
             _ => Color::ZERO,
         }
     }
@@ -215,6 +231,7 @@ impl Light {
             Light::Sun(l) => Some(l.sample_le(u_pos, u_dir, bounds)),
             Light::Directional(l) => Some(l.sample_le(u_pos, bounds)),
             Light::Environment(l) => Some(l.sample_le(u_pos, u_dir, bounds)),
+            Light::EnvironmentMap(l) => l.sample_le(u_pos, u_dir, bounds),
         }
     }
 
@@ -229,6 +246,7 @@ impl Light {
             Light::Sun(l) => l.pdf_le(dir, bounds),
             Light::Directional(l) => l.pdf_le(bounds),
             Light::Environment(_) => environment::pdf_le(bounds),
+            Light::EnvironmentMap(l) => l.pdf_le(dir, bounds),
         }
     }
 
@@ -240,6 +258,7 @@ impl Light {
             Light::Sun(l) => l.power(bounds),
             Light::Directional(l) => l.power(bounds),
             Light::Environment(l) => environment::power(l, bounds),
+            Light::EnvironmentMap(l) => l.power(bounds),
         }
     }
 }

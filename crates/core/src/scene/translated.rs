@@ -56,6 +56,9 @@ impl Scene {
                 Light::Environment(e) => b.add_light(LightDesc::Environment {
                     radiance: e.radiance,
                 }),
+                Light::EnvironmentMap(e) => {
+                    b.add_light(LightDesc::EnvironmentMap { map: e.map.clone() })
+                }
             }
         }
         b.build()

@@ -2,11 +2,11 @@
 //! `Scene` through `SceneBuilder`, each value checked on the way (reference: docs/xml.md).
 
 use super::doc::{Doc, Elem};
-use super::props::{textures_refused, ColorUse, Ids, Plugin};
+use super::props::{ColorUse, Ids, Plugin};
 use super::resolve::Resolver;
 use super::values::Xform;
 use crate::error::Ctx;
-use crate::image_file::{filter_type_named, read_bitmap, wrap_mode_named};
+use crate::image_file::{filter_type_named, read_bitmap, read_environment_map, wrap_mode_named};
 use crate::mesh::ply;
 use crate::transform::{check_quad, check_solid};
 use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
@@ -1203,11 +1203,41 @@ impl<'a> Loader<'a> {
                 }
             }
             "area" => return Err(p.err(e, "an area emitter must be nested in a shape")),
-            "envmap" => return Err(textures_refused(self.doc, e)),
+            "envmap" => {
+                let Some((file, fe)) = p.string("filename")? else {
+                    return Err(p.err(e, "an envmap needs a `filename`"));
+                };
+                let path = self.doc.resolver.resolve(file).map_err(|looked| {
+                    p.err(fe, Resolver::not_found("environment map", file, &looked))
+                })?;
+                let scale = p.float("scale")?.unwrap_or(1.0) as f32;
+                let to_world = match p.transform("to_world")? {
+                    None => glam::Mat3::IDENTITY,
+                    Some((x, te)) => {
+                        let m = glam::DMat3::from_mat4(x.m);
+                        let ortho = (m.transpose() * m - glam::DMat3::IDENTITY)
+                            .to_cols_array()
+                            .iter()
+                            .fold(0.0f64, |a, v| a.max(v.abs()));
+                        if !(ortho < 1e-6) || m.determinant() < 0.0 {
+                            return Err(p.err(te, "an envmap's to_world must be a rotation (no scale, shear or mirror)"));
+                        }
+                        m.as_mat3()
+                    }
+                };
+                if p.has("mis_compensation") {
+                    return Err(p.err(e, "`mis_compensation` of an envmap is not supported"));
+                }
+                let map = read_environment_map(&path, scale, to_world).map_err(|m| p.err(fe, m))?;
+                self.meshes.push(path);
+                LightDesc::EnvironmentMap {
+                    map: std::sync::Arc::new(map),
+                }
+            }
             other => {
                 return Err(p.err(
                     e,
-                    format!("emitter `{other}` is not supported (lt reads area, point, constant and directional)"),
+                    format!("emitter `{other}` is not supported (lt reads area, point, constant, directional and envmap)"),
                 ))
             }
         };
@@ -1217,6 +1247,7 @@ impl<'a> Loader<'a> {
             | LightDesc::Directional { irradiance: c, .. }
             | LightDesc::Environment { radiance: c }
             | LightDesc::Sun { radiance: c, .. } => c.max_element(),
+            LightDesc::EnvironmentMap { map } => map.integral(),
         };
         Ok((power > 0.0).then_some((desc, None)))
     }

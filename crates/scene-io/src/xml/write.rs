@@ -290,6 +290,29 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                     v(&e)
                 );
             }
+            "envmap" => {
+                let file = d
+                    .file
+                    .as_ref()
+                    .map(|f| f.get_ref().as_str())
+                    .unwrap_or_default();
+                let rel = relative(&ctx.base_dir.join(file), out_dir);
+                let _ = write!(
+                    x,
+                    "    <emitter type=\"envmap\">\n        <string name=\"filename\" value=\"{}\"/>\n        <float name=\"scale\" value=\"{}\"/>\n",
+                    esc(&rel.to_string_lossy()),
+                    d.scale.as_ref().map_or(1.0, |s| *s.get_ref() as f32)
+                );
+                if let Some(r) = &d.rotate {
+                    let (a, deg) = (r.get_ref().axis, r.get_ref().angle);
+                    let _ = writeln!(
+                        x,
+                        "        <transform name=\"to_world\">\n            <rotate x=\"{}\" y=\"{}\" z=\"{}\" angle=\"{deg}\"/>\n        </transform>",
+                        a[0], a[1], a[2]
+                    );
+                }
+                let _ = writeln!(x, "    </emitter>");
+            }
             "environment" => {
                 let r = col(&d.radiance);
                 if zero(r) {
