@@ -41,7 +41,7 @@ pub fn assemble(ctx: &Ctx, file: &SceneFile) -> Result<Scene, SceneError> {
     }
     for def in &file.lights {
         match light(ctx, def)? {
-            Some(Placed::At(position, intensity)) => b.add_point_light(position, intensity),
+            Some(Placed::At(position, l)) => b.add_light_at(l, position),
             Some(Placed::Anywhere(l)) => b.add_light(l),
             None => continue,
         }
@@ -615,7 +615,7 @@ fn placed(
 
 /// A light with a world position (kept in f64 until the one rounding) or without one.
 enum Placed {
-    At(DVec3, Color),
+    At(DVec3, LightDesc),
     Anywhere(LightDesc),
 }
 
@@ -634,6 +634,12 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
         ("file", d.file.as_ref().map(S::span)),
         ("scale", d.scale.as_ref().map(S::span)),
         ("rotate", d.rotate.as_ref().map(S::span)),
+        ("target", d.target.as_ref().map(S::span)),
+        ("up", d.up.as_ref().map(S::span)),
+        ("cutoff_angle", d.cutoff_angle.as_ref().map(S::span)),
+        ("beam_width", d.beam_width.as_ref().map(S::span)),
+        ("texture", d.texture.as_ref().map(S::span)),
+        ("fov", d.fov.as_ref().map(S::span)),
     ];
     let span = def.span();
     let desc = match kind {
@@ -646,7 +652,11 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
                 "intensity",
                 false,
             )?;
-            return Ok((intensity.max_element() > 0.0).then_some(Placed::At(position, intensity)));
+            let desc = LightDesc::Point {
+                position: glam::Vec3::ZERO,
+                intensity,
+            };
+            return Ok((intensity.max_element() > 0.0).then_some(Placed::At(position, desc)));
         }
         "sun" => {
             ctx.only(
@@ -759,11 +769,102 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
                 map: std::sync::Arc::new(map),
             }
         }
+        "spot" => {
+            ctx.only(
+                &given,
+                &["position", "target", "up", "intensity", "cutoff_angle", "beam_width", "texture"],
+                &what,
+            )?;
+            let (position, to_world) = aimed(ctx, d, &span, &what)?;
+            let intensity = ctx.color(
+                ctx.need(&d.intensity, "intensity", &span, &what)?,
+                "intensity",
+                false,
+            )?;
+            let cutoff = match &d.cutoff_angle {
+                None => 20.0,
+                Some(c) => ctx.positive(c, "cutoff_angle")?,
+            };
+            let texture = match &d.texture {
+                None => None,
+                Some(t) => Some(crate::texture_def::texture(ctx, t)?),
+            };
+            let max = if texture.is_some() { 90.0 } else { 180.0 };
+            if !(cutoff < max) {
+                let at = d.cutoff_angle.as_ref().map_or(span.clone(), S::span);
+                return Err(ctx.at(at, format!("`cutoff_angle` must be below {max}°{}, got {cutoff}", if texture.is_some() { " with a texture (it lies on a plane in front of the light)" } else { "" })));
+            }
+            let beam = match &d.beam_width {
+                None => 0.75 * cutoff,
+                Some(b) => {
+                    let b = ctx.num(b, "beam_width")?;
+                    if !(b >= 0.0) {
+                        return Err(ctx.at(d.beam_width.as_ref().unwrap().span(), format!("`beam_width` must be a non-negative angle in degrees, got {b}")));
+                    }
+                    b
+                }
+            };
+            let dark = intensity.max_element() <= 0.0
+                || texture.as_ref().is_some_and(|t| t.max_value() <= 0.0);
+            let desc = LightDesc::Spot {
+                position: glam::Vec3::ZERO,
+                to_world,
+                intensity,
+                texture,
+                cutoff: cutoff.to_radians(),
+                beam_width: beam.to_radians(),
+            };
+            return Ok((!dark).then_some(Placed::At(position, desc)));
+        }
+        "projector" => {
+            ctx.only(
+                &given,
+                &["position", "target", "up", "irradiance", "texture", "scale", "fov"],
+                &what,
+            )?;
+            let (position, to_world) = aimed(ctx, d, &span, &what)?;
+            let (irradiance, aspect) = match (&d.texture, &d.irradiance) {
+                (Some(_), Some(e)) => {
+                    return Err(ctx.at(e.span(), "give the projector `irradiance` or `texture`, not both"))
+                }
+                (Some(t), None) => {
+                    let tex = crate::texture_def::texture(ctx, t)?;
+                    let aspect = match &tex {
+                        lt_core::texture::Texture::Bitmap(b) => b.width as f32 / b.height as f32,
+                        _ => 1.0,
+                    };
+                    (tex, aspect)
+                }
+                (None, Some(e)) => (lt_core::texture::Texture::Constant(ctx.color(e, "irradiance", false)?), 1.0),
+                (None, None) => {
+                    return Err(ctx.at(span, "missing required key `irradiance` or `texture` for a projector light"))
+                }
+            };
+            let scale = match &d.scale {
+                None => 1.0,
+                Some(s) => ctx.num(s, "scale")?,
+            };
+            let fov_def = ctx.need(&d.fov, "fov", &span, &what)?;
+            let fov = ctx.positive(fov_def, "fov")?;
+            if !(fov < 180.0) || !(scale >= 0.0) {
+                return Err(ctx.at(fov_def.span(), format!("a projector needs 0 < `fov` < 180 (degrees) and `scale` ≥ 0, got {fov} and {scale}")));
+            }
+            let tan_x = (0.5 * fov).to_radians().tan();
+            let dark = scale == 0.0 || irradiance.max_value() <= 0.0;
+            let desc = LightDesc::Projector {
+                position: glam::Vec3::ZERO,
+                to_world,
+                irradiance,
+                scale,
+                tan_half: glam::Vec2::new(tan_x, tan_x / aspect),
+            };
+            return Ok((!dark).then_some(Placed::At(position, desc)));
+        }
         other => {
             return Err(ctx.at(
                 d.kind.span(),
                 format!(
-                    "unknown light type `{other}` (expected point, sun, directional, environment or envmap)"
+                    "unknown light type `{other}` (expected point, spot, projector, sun, directional, environment or envmap)"
                 ),
             ))
         }
@@ -774,6 +875,29 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
         | LightDesc::Directional { irradiance: c, .. }
         | LightDesc::Environment { radiance: c } => c.max_element(),
         LightDesc::EnvironmentMap { map } => map.integral(),
+        LightDesc::Spot { .. } | LightDesc::Projector { .. } => {
+            unreachable!("spot and projector return above")
+        }
     };
     Ok((power > 0.0).then_some(Placed::Anywhere(desc)))
+}
+
+/// The world position and the rotation (Mitsuba's lookat) of a light aimed from `position` at
+/// `target`, with `up` or its default (`transform::default_up`).
+fn aimed(
+    ctx: &Ctx,
+    d: &LightDef,
+    span: &std::ops::Range<usize>,
+    what: &str,
+) -> Result<(DVec3, glam::Mat3), SceneError> {
+    let position = ctx.dvec3(ctx.need(&d.position, "position", span, what)?, "position")?;
+    let target_def = ctx.need(&d.target, "target", span, what)?;
+    let target = ctx.dvec3(target_def, "target")?;
+    let up = match &d.up {
+        Some(u) => ctx.dvec3(u, "up")?,
+        None => crate::transform::default_up(target - position),
+    };
+    let at = d.up.as_ref().map_or(target_def.span(), S::span);
+    let r = crate::transform::look_at_rotation(position, target, up).map_err(|m| ctx.at(at, m))?;
+    Ok((position, r.as_mat3()))
 }

@@ -192,6 +192,18 @@ pub struct LightDef {
     pub file: Option<S<String>>,
     pub scale: Option<S<f64>>,
     pub rotate: Option<S<RotateDef>>,
+    /// `spot` and `projector`: at `position`, aimed at `target`, the image's vertical towards
+    /// `up` (Mitsuba's lookat; default +y, or +z when the axis is vertical).
+    pub target: Option<S<V3>>,
+    pub up: Option<S<V3>>,
+    /// `spot`: angles from the axis in degrees (defaults 20 and ¾ of the cutoff), and an optional
+    /// `texture` over the cone (`intensity` multiplies it).
+    pub cutoff_angle: Option<S<f64>>,
+    pub beam_width: Option<S<f64>>,
+    /// `projector`: the projected image (else the constant `irradiance`), and the full field
+    /// of view across the image's width in degrees.
+    pub texture: Option<S<TextureDef>>,
+    pub fov: Option<S<f64>>,
 }
 
 /// An RGB triple written as `[r, g, b]` or as one number for grey.

@@ -75,6 +75,33 @@ pub fn rotate_def(ctx: &Ctx, r: &S<crate::format::RotateDef>) -> Result<DMat3, S
     Ok(rotation(axis.normalize(), angle))
 }
 
+/// The `up` a spot light or projector takes when the file gives none: +y, or +z when the axis
+/// is within about 0.5° of vertical.
+pub fn default_up(dir: DVec3) -> DVec3 {
+    if dir.normalize().y.abs() < 0.99996 {
+        DVec3::Y
+    } else {
+        DVec3::Z
+    }
+}
+
+/// Mitsuba's lookat rotation: columns (up × d, d × (up × d), d), normalised, with d the unit
+/// direction from `position` to `target` (+z of the local frame).
+pub fn look_at_rotation(position: DVec3, target: DVec3, up: DVec3) -> Result<DMat3, String> {
+    let dir = target - position;
+    if !(dir.length() > 0.0) || !dir.is_finite() {
+        return Err("`position` and `target` coincide".into());
+    }
+    let left = up.cross(dir);
+    if !(left.length() > 1e-9 * up.length() * dir.length()) {
+        return Err(
+            "`up` is parallel to the direction from `position` to `target` (or zero)".into(),
+        );
+    }
+    let (dir, left) = (dir.normalize(), left.normalize());
+    Ok(DMat3::from_cols(left, dir.cross(left), dir))
+}
+
 /// Rodrigues' rotation about a unit axis, counter-clockwise by `deg` degrees.
 fn rotation(a: DVec3, deg: f64) -> DMat3 {
     let (s, c) = sin_cos_deg(deg);

@@ -144,12 +144,9 @@ impl WorldBuilder {
         self.lights.push((light, None));
     }
 
-    /// A point light at a world position given in f64.
-    pub fn add_point_light(&mut self, position: DVec3, intensity: Color) {
-        let light = LightDesc::Point {
-            position: Vec3::ZERO,
-            intensity,
-        };
+    /// A light with a position (point, spot, projector: `LightDesc::position_mut`) placed at a
+    /// world position given in f64; the position in `light` is replaced.
+    pub fn add_light_at(&mut self, light: LightDesc, position: DVec3) {
         self.lights.push((light, Some(position)));
     }
 
@@ -184,7 +181,7 @@ impl WorldBuilder {
             b.add_shape(geometry, s.material, s.emission, s.flip_normals);
         }
         for (mut light, at) in self.lights {
-            if let (LightDesc::Point { position, .. }, Some(p)) = (&mut light, at) {
+            if let (Some(position), Some(p)) = (light.position_mut(), at) {
                 *position = local(p);
             }
             b.add_light(light);

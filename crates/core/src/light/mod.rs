@@ -5,7 +5,7 @@
 //!     distant light emits over) and the directional pdf (solid angle) kept separate;
 //! (c) `pdf_le`: those two pdfs for a given emitted ray.
 //! Delta lights report a pdf of 1 in their delta dimension and say so with `delta_position`
-//! (point: its position is a Dirac, its directions have a density) / `delta_direction`
+//! (point, spot, projector: the position is a Dirac, the directions have a density) / `delta_direction`
 //! (directional: its direction is a Dirac, the positions of its emitted rays have a density on the
 //! bounding disk). Either way `sample_li` returns `delta` with the discrete pdf 1, `pdf_li` is 0
 //! and no walk can hit the light; only a delta in direction also forbids deterministic
@@ -17,6 +17,8 @@ mod directional;
 mod environment;
 mod envmap;
 mod point;
+mod projector;
+mod spot;
 mod sun;
 
 pub use area::AreaLight;
@@ -24,12 +26,16 @@ pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
 pub use envmap::{EnvironmentMap, EnvironmentMapLight};
 pub use point::PointLight;
+pub use projector::ProjectorLight;
+pub use spot::SpotLight;
 pub use sun::SunLight;
 
 use crate::geometry::Ray;
 use crate::math::{luminance, Color, Vec2, Vec3};
 use crate::sampling::Distribution1D;
 use crate::shape::ShapeGeometry;
+use crate::texture::Texture;
+use glam::Mat3;
 
 /// Lights that are not shapes.
 #[derive(Clone, Debug)]
@@ -37,6 +43,25 @@ pub enum LightDesc {
     Point {
         position: Vec3,
         intensity: Color,
+    },
+    /// Mitsuba's `spot` (`light::SpotLight`): angles in radians, `to_world` a rotation taking
+    /// +z to the beam's axis.
+    Spot {
+        position: Vec3,
+        to_world: Mat3,
+        intensity: Color,
+        texture: Option<Texture>,
+        cutoff: f32,
+        beam_width: f32,
+    },
+    /// Mitsuba's `projector` (`light::ProjectorLight`): `to_world` a rotation taking +z to the
+    /// optical axis, `tan_half` the image's half extents on the plane z = 1.
+    Projector {
+        position: Vec3,
+        to_world: Mat3,
+        irradiance: Texture,
+        scale: f32,
+        tan_half: Vec2,
     },
     /// A distant disk light. `direction` points from the scene towards the sun.
     Sun {
@@ -57,6 +82,19 @@ pub enum LightDesc {
     EnvironmentMap {
         map: std::sync::Arc<EnvironmentMap>,
     },
+}
+
+impl LightDesc {
+    /// The position of a light that has one (point, spot, projector): what recentring and
+    /// translation move.
+    pub fn position_mut(&mut self) -> Option<&mut Vec3> {
+        match self {
+            LightDesc::Point { position, .. }
+            | LightDesc::Spot { position, .. }
+            | LightDesc::Projector { position, .. } => Some(position),
+            _ => None,
+        }
+    }
 }
 
 /// A direction towards a light from a shading point.
@@ -103,6 +141,8 @@ pub struct LightLeSample {
 pub enum Light {
     Area(AreaLight),
     Point(PointLight),
+    Spot(SpotLight),
+    Projector(ProjectorLight),
     Sun(SunLight),
     Directional(DirectionalLight),
     Environment(EnvironmentLight),
@@ -128,6 +168,34 @@ impl Light {
                 position,
                 intensity,
             }),
+            LightDesc::Spot {
+                position,
+                to_world,
+                intensity,
+                ref texture,
+                cutoff,
+                beam_width,
+            } => Light::Spot(SpotLight::new(
+                position,
+                to_world,
+                intensity,
+                texture.clone(),
+                cutoff,
+                beam_width,
+            )),
+            LightDesc::Projector {
+                position,
+                to_world,
+                ref irradiance,
+                scale,
+                tan_half,
+            } => Light::Projector(ProjectorLight::new(
+                position,
+                to_world,
+                irradiance.clone(),
+                scale,
+                tan_half,
+            )),
             LightDesc::Sun {
                 direction,
                 solid_angle,
@@ -159,9 +227,20 @@ impl Light {
         )
     }
 
-    /// A point light: a delta in position (uniform in direction).
+    /// A point, spot or projector light: a delta in position (with a density in direction).
     pub fn delta_position(&self) -> bool {
-        matches!(self, Light::Point(_))
+        matches!(self, Light::Point(_) | Light::Spot(_) | Light::Projector(_))
+    }
+
+    /// Intensity (W/sr) a light delta in position emits in direction `w` (leaving it): what
+    /// stands for Le at its path vertex. Zero for every other light.
+    pub fn intensity_towards(&self, w: Vec3) -> Color {
+        match self {
+            Light::Point(l) => l.intensity,
+            Light::Spot(l) => l.intensity_towards(w),
+            Light::Projector(l) => l.intensity_towards(w),
+            _ => Color::ZERO,
+        }
     }
 
     /// A directional light: a delta in direction (its emitted rays have an area density on the
@@ -181,6 +260,8 @@ impl Light {
         match self {
             Light::Area(l) => l.sample_li(p, u),
             Light::Point(l) => l.sample_li(p),
+            Light::Spot(l) => l.sample_li(p),
+            Light::Projector(l) => l.sample_li(p),
             Light::Sun(l) => l.sample_li(u),
             Light::Directional(l) => Some(l.sample_li()),
             Light::Environment(l) => l.sample_li(u),
@@ -193,7 +274,7 @@ impl Light {
     pub fn pdf_li(&self, p: Vec3, wi: Vec3, light_p: Vec3, light_n: Vec3) -> f32 {
         match self {
             Light::Area(l) => l.pdf_li(p, wi, light_p, light_n),
-            Light::Point(_) | Light::Directional(_) => 0.0,
+            Light::Point(_) | Light::Spot(_) | Light::Projector(_) | Light::Directional(_) => 0.0,
             Light::Sun(l) => l.pdf_li(wi),
             Light::Environment(_) => environment::pdf_li(),
             Light::EnvironmentMap(l) => l.pdf_li(wi),
@@ -228,6 +309,8 @@ impl Light {
         match self {
             Light::Area(l) => l.sample_le(u_pos, u_dir),
             Light::Point(l) => Some(l.sample_le(u_dir)),
+            Light::Spot(l) => Some(l.sample_le(u_dir)),
+            Light::Projector(l) => Some(l.sample_le(u_dir)),
             Light::Sun(l) => Some(l.sample_le(u_pos, u_dir, bounds)),
             Light::Directional(l) => Some(l.sample_le(u_pos, bounds)),
             Light::Environment(l) => Some(l.sample_le(u_pos, u_dir, bounds)),
@@ -243,6 +326,8 @@ impl Light {
         match self {
             Light::Area(l) => l.pdf_le(n, dir),
             Light::Point(_) => (1.0, crate::sampling::UNIFORM_SPHERE_PDF),
+            Light::Spot(l) => (1.0, l.pdf_dir(dir)),
+            Light::Projector(l) => (1.0, l.pdf_dir(dir)),
             Light::Sun(l) => l.pdf_le(dir, bounds),
             Light::Directional(l) => l.pdf_le(bounds),
             Light::Environment(_) => environment::pdf_le(bounds),
@@ -255,6 +340,8 @@ impl Light {
         match self {
             Light::Area(l) => l.power(),
             Light::Point(l) => 4.0 * crate::math::PI * luminance(l.intensity),
+            Light::Spot(l) => l.power(),
+            Light::Projector(l) => l.power(),
             Light::Sun(l) => l.power(bounds),
             Light::Directional(l) => l.power(bounds),
             Light::Environment(l) => environment::power(l, bounds),

@@ -177,7 +177,7 @@ impl Path {
         let k = self.k();
         let x0 = &v[0];
         let le = match self.light(scene) {
-            Light::Point(p) => p.intensity,
+            l if l.delta_position() => l.intensity_towards(x0.dir_to(&v[1])),
             Light::Directional(d) => d.irradiance,
             l if x0.is_infinite() => l.escaped(x0.p),
             l => l.emitted(x0.ng, x0.dir_to(&v[1])),

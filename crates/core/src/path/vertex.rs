@@ -4,7 +4,7 @@
 //! conversions of `crate::measure`).
 
 use crate::camera::Camera;
-use crate::light::{Light, LightLeSample, LightLiSample};
+use crate::light::{LightLeSample, LightLiSample};
 use crate::math::{Color, Vec2, Vec3};
 use crate::measure;
 use crate::scene::{ConnectionEnd, Scene, SurfaceHit};
@@ -202,7 +202,7 @@ impl PathVertex {
         let infinite = l.is_infinite();
         let kind = VertexKind::Light { light, infinite };
         let (p, n, le) = match l {
-            Light::Point(pl) => (s.p, Vec3::ZERO, pl.intensity),
+            _ if l.delta_position() => (s.p, Vec3::ZERO, l.intensity_towards(-s.wi)),
             _ if infinite => (s.wi, -s.wi, s.radiance),
             _ => (s.p, s.n, s.radiance),
         };

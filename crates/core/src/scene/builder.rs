@@ -125,7 +125,7 @@ impl SceneBuilder {
         self.lights.push(light);
     }
 
-    /// Indexes the scene, recentred on `scene_origin` of its geometry: every shape, point light
+    /// Indexes the scene, recentred on `scene_origin` of its geometry: every shape, positioned light
     /// and the camera eye are stored as world − origin (see `Scene::origin`); directions (sun,
     /// directional light, environment, shading normals) are unchanged.
     pub fn build(mut self) -> Scene {
@@ -138,7 +138,7 @@ impl SceneBuilder {
                 }
             }
             for light in &mut self.lights {
-                if let LightDesc::Point { position, .. } = light {
+                if let Some(position) = light.position_mut() {
                     *position -= origin;
                 }
             }

@@ -6,7 +6,7 @@ use crate::light::Light;
 use crate::math::Vec3;
 
 impl Scene {
-    /// The scene with eye, every shape and every point light moved by `offset` in world
+    /// The scene with eye, every shape and every positioned light (point, spot, projector) moved by `offset` in world
     /// coordinates (rounded once to f32 per vertex, as a loader `translate` would), then rebuilt,
     /// so recentred on its own `origin`. Distant lights are unchanged.
     pub fn translated(&self, offset: Vec3) -> Scene {
@@ -43,6 +43,21 @@ impl Scene {
                 Light::Point(p) => b.add_light(LightDesc::Point {
                     position: moved(p.position),
                     intensity: p.intensity,
+                }),
+                Light::Spot(l) => b.add_light(LightDesc::Spot {
+                    position: moved(l.position),
+                    to_world: l.to_world,
+                    intensity: l.intensity,
+                    texture: l.texture.clone(),
+                    cutoff: l.cutoff,
+                    beam_width: l.beam_width,
+                }),
+                Light::Projector(l) => b.add_light(LightDesc::Projector {
+                    position: moved(l.position),
+                    to_world: l.to_world,
+                    irradiance: l.irradiance.clone(),
+                    scale: l.scale,
+                    tan_half: l.tan_half,
                 }),
                 Light::Sun(s) => b.add_light(LightDesc::Sun {
                     direction: s.direction,

@@ -313,6 +313,68 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                 }
                 let _ = writeln!(x, "    </emitter>");
             }
+            "spot" | "projector" => {
+                let spot = d.kind.get_ref() == "spot";
+                let get = |p: &Option<toml::Spanned<[f64; 3]>>| {
+                    p.as_ref().map(|p| *p.get_ref()).unwrap_or_default()
+                };
+                let (o, t) = (get(&d.position), get(&d.target));
+                // The loader's default `up`, written out so that Mitsuba builds the same frame.
+                let up = d.up.as_ref().map(|u| *u.get_ref()).unwrap_or_else(|| {
+                    let dir = glam::DVec3::from_array(t) - glam::DVec3::from_array(o);
+                    crate::transform::default_up(dir).to_array()
+                });
+                let _ = writeln!(
+                    x,
+                    "    <emitter type=\"{}\">\n        <transform name=\"to_world\">\n            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>\n        </transform>",
+                    d.kind.get_ref(),
+                    v(&o),
+                    v(&t),
+                    v(&up)
+                );
+                if spot {
+                    let cutoff = d
+                        .cutoff_angle
+                        .as_ref()
+                        .map_or(20.0, |c| *c.get_ref() as f32);
+                    let beam = d
+                        .beam_width
+                        .as_ref()
+                        .map_or(0.75 * cutoff, |b| *b.get_ref() as f32);
+                    let _ = writeln!(
+                        x,
+                        "        <rgb name=\"intensity\" value=\"{}\"/>\n        <float name=\"cutoff_angle\" value=\"{cutoff}\"/>\n        <float name=\"beam_width\" value=\"{beam}\"/>",
+                        v(&col(&d.intensity))
+                    );
+                    if let Some(tex) = &d.texture {
+                        x.push_str(
+                            &texture_xml(&ctx, tex.get_ref(), "texture", out_dir)
+                                .replace("\n    ", "\n"),
+                        );
+                    }
+                } else {
+                    let _ = writeln!(
+                        x,
+                        "        <float name=\"fov\" value=\"{}\"/>\n        <float name=\"scale\" value=\"{}\"/>",
+                        d.fov.as_ref().map_or(0.0, |f| *f.get_ref() as f32),
+                        d.scale.as_ref().map_or(1.0, |s| *s.get_ref() as f32)
+                    );
+                    match &d.texture {
+                        Some(tex) => x.push_str(
+                            &texture_xml(&ctx, tex.get_ref(), "irradiance", out_dir)
+                                .replace("\n    ", "\n"),
+                        ),
+                        None => {
+                            let _ = writeln!(
+                                x,
+                                "        <rgb name=\"irradiance\" value=\"{}\"/>",
+                                v(&col(&d.irradiance))
+                            );
+                        }
+                    }
+                }
+                let _ = writeln!(x, "    </emitter>");
+            }
             "environment" => {
                 let r = col(&d.radiance);
                 if zero(r) {
