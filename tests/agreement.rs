@@ -579,3 +579,12 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_bumped() {
 fn light_and_bdpt_agree_with_pt_per_depth_on_envmap_spheres() {
     per_depth("envmap-spheres", 1..=5);
 }
+
+/// Lights delta in position that aim (a textured spot light and a projector, no area light):
+/// path tracing reaches them only by next-event estimation, light tracing only by their emitted
+/// rays (uniform in the cone / on the image plane), BDPT by both; the intensity towards each
+/// vertex (falloff, texture, 1/cos³) must be the same function in all of them.
+#[test]
+fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_spot() {
+    per_depth("cornell-spot", 1..=5);
+}

@@ -5,12 +5,13 @@
 use lt_core::bsdf::{Diffuse, Material};
 use lt_core::camera::{Camera, FovAxis};
 use lt_core::geometry::Ray;
-use lt_core::light::Light;
+use lt_core::light::{EnvironmentMap, Light};
 use lt_core::math::{gamma, Color, Frame, Vec2, Vec3, PI};
 use lt_core::sampling::Sampler;
 use lt_core::scene::{LightDesc, RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
 use lt_core::testing::chi2::{self, Chi2Outcome, Chi2Test, ParallelogramChart, SphereGrid};
 use lt_core::testing::{binomial_z, sidak, DIRECTION_ROUNDING};
+use lt_core::texture::{Texture, UvTransform};
 
 const ALPHA: f64 = 0.01;
 const Z_MAX: f64 = 4.0;
@@ -138,6 +139,117 @@ fn env_scene() -> Scene {
             radiance: Color::splat(0.7),
         }],
     )
+}
+
+const SPOT_CUTOFF: f32 = 0.5;
+const SPOT_ROTATION: glam::Mat3 = glam::Mat3::from_cols(
+    Vec3::new(0.0, 0.0, 1.0),
+    Vec3::new(1.0, 0.0, 0.0),
+    Vec3::new(0.0, 1.0, 0.0),
+);
+/// A textured spot light at the origin aimed along +y (the rotation cycles the axes).
+fn spot_scene() -> Scene {
+    build(
+        vec![floor()],
+        vec![LightDesc::Spot {
+            position: Vec3::ZERO,
+            to_world: SPOT_ROTATION,
+            intensity: Color::new(3.0, 2.0, 1.0),
+            texture: Some(Texture::Checkerboard {
+                color0: Color::splat(0.2),
+                color1: Color::ONE,
+                to_uv: UvTransform::IDENTITY,
+            }),
+            cutoff: SPOT_CUTOFF,
+            beam_width: 0.3,
+        }],
+    )
+}
+const PROJ_POS: Vec3 = Vec3::new(0.1, -0.2, 0.3);
+const PROJ_TAN: Vec2 = Vec2::new(1.2, 0.7);
+fn projector_scene() -> Scene {
+    build(
+        vec![floor()],
+        vec![LightDesc::Projector {
+            position: PROJ_POS,
+            to_world: SPOT_ROTATION,
+            irradiance: Texture::Constant(Color::ONE),
+            scale: 2.0,
+            tan_half: PROJ_TAN,
+        }],
+    )
+}
+const ENVMAP_SIZE: (usize, usize) = (12, 7);
+const ENVMAP_ROTATION: glam::Mat3 = glam::Mat3::from_cols(
+    Vec3::new(0.0, 1.0, 0.0),
+    Vec3::new(0.0, 0.0, 1.0),
+    Vec3::new(1.0, 0.0, 0.0),
+);
+/// A 12 × 7 map: a dim gradient sky, a black row and one texel 200 times brighter (a sun), turned
+/// so that the map's pole is world +z.
+fn envmap_scene() -> Scene {
+    let (w, h) = ENVMAP_SIZE;
+    let texels = (0..w * h)
+        .map(|k| match (k % w, k / w) {
+            (4, 2) => Color::new(90.0, 80.0, 60.0),
+            (_, 5) => Color::ZERO,
+            (x, y) => Color::new(0.2 + 0.05 * x as f32, 0.3, 0.1 + 0.1 * y as f32),
+        })
+        .collect();
+    let map = EnvironmentMap::new(w, h, texels, 1.5, ENVMAP_ROTATION).unwrap();
+    build(
+        vec![floor()],
+        vec![LightDesc::EnvironmentMap {
+            map: std::sync::Arc::new(map),
+        }],
+    )
+}
+
+/// The sphere charted by an environment map's own coordinates (Mitsuba's latitude–longitude:
+/// local (sin φ sin θ, cos θ, −cos φ sin θ) with (u, v) = (φ / 2π, θ / π)), a = v and b = u, with
+/// dω = 2π² sin θ du dv: the map's cells are bins (each split in two both ways), and the
+/// integrand pdf · Jacobian is the piecewise-constant density in (u, v) itself, with no 1/sin θ
+/// for the cubature to chase at the poles.
+struct LatLongChart {
+    to_world: glam::Mat3,
+    v_edges: Vec<f64>,
+    u_edges: Vec<f64>,
+}
+
+impl LatLongChart {
+    fn new(to_world: glam::Mat3, (w, h): (usize, usize)) -> LatLongChart {
+        let edges = |n: usize| (0..=2 * n).map(|k| k as f64 / (2 * n) as f64).collect();
+        LatLongChart {
+            to_world,
+            v_edges: edges(h),
+            u_edges: edges(w),
+        }
+    }
+}
+
+impl chi2::Chart for LatLongChart {
+    fn a_edges(&self) -> &[f64] {
+        &self.v_edges
+    }
+    fn b_edges(&self) -> &[f64] {
+        &self.u_edges
+    }
+    fn direction(&self, v: f64, u: f64) -> (Vec3, f64) {
+        let (st, ct) = (std::f64::consts::PI * v).sin_cos();
+        let (sp, cp) = (2.0 * std::f64::consts::PI * u).sin_cos();
+        let local = Vec3::new((sp * st) as f32, ct as f32, (-cp * st) as f32);
+        let jac = 2.0 * std::f64::consts::PI * std::f64::consts::PI * st;
+        ((self.to_world * local).normalize(), jac)
+    }
+    fn coords(&self, w: Vec3) -> Option<(f64, f64)> {
+        let d = (self.to_world.transpose() * w).as_dvec3();
+        let theta = (d.x * d.x + d.z * d.z).sqrt().atan2(d.y);
+        let u = d.x.atan2(-d.z) / (2.0 * std::f64::consts::PI);
+        Some((theta / std::f64::consts::PI, u.rem_euclid(1.0)))
+    }
+    fn covers_sphere(&self) -> bool {
+        true
+    }
 }
 
 /// pdf_li for any direction: the light's point and normal come from tracing the ray, as an
@@ -392,6 +504,75 @@ fn light_directions_follow_their_pdfs_chi2() {
             |w| l.pdf_le(n, w, bounds).1,
         ));
     }
+
+    // Spot light: emitted directions uniform in the cutoff cone, the rim on a ring edge.
+    let spot = spot_scene();
+    let l = &spot.lights[0];
+    let bounds = spot.bounding_sphere;
+    let axis = SPOT_ROTATION * Vec3::Z;
+    let h = 1.0 - (SPOT_CUTOFF as f64).cos();
+    let grid = SphereGrid::with_edges(Frame::from_z(axis), cone_edges(h, 12, 4), 24);
+    runs.push(chi2::run(
+        "spot le",
+        next_cfg(),
+        &grid,
+        |s| {
+            l.sample_le(s.next_2d(), s.next_2d(), bounds)
+                .map(|x| x.ray.d)
+        },
+        |w| l.pdf_le(Vec3::ZERO, w, bounds).1,
+    ));
+
+    // Projector: emitted directions through the image plane, charted by the image's own (u, v)
+    // (the frustum's edges are the chart's).
+    let proj = projector_scene();
+    let l = &proj.lights[0];
+    let bounds = proj.bounding_sphere;
+    let (tx, ty) = (PROJ_TAN.x, PROJ_TAN.y);
+    let chart = ParallelogramChart::new(
+        PROJ_POS,
+        PROJ_POS + SPOT_ROTATION * Vec3::new(-tx, -ty, 1.0),
+        SPOT_ROTATION * Vec3::new(2.0 * tx, 0.0, 0.0),
+        SPOT_ROTATION * Vec3::new(0.0, 2.0 * ty, 0.0),
+        24,
+        16,
+    );
+    runs.push(chi2::run(
+        "projector le",
+        next_cfg(),
+        &chart,
+        |s| {
+            l.sample_le(s.next_2d(), s.next_2d(), bounds)
+                .map(|x| x.ray.d)
+        },
+        |w| l.pdf_le(Vec3::ZERO, w, bounds).1,
+    ));
+
+    // Environment map: NEE and emitted directions against the map's piecewise-constant pdf,
+    // charted by the map's own (v, u), each cell split in two both ways.
+    let env = envmap_scene();
+    let l = &env.lights[0];
+    let bounds = env.bounding_sphere;
+    let chart = LatLongChart::new(ENVMAP_ROTATION, ENVMAP_SIZE);
+    runs.push(chi2::run(
+        "envmap li",
+        next_cfg(),
+        &chart,
+        |s| l.sample_li(Vec3::ZERO, s.next_2d()).map(|x| x.wi),
+        |w| pdf_li_traced(&env, 0, Vec3::ZERO, w),
+    ));
+    problems.extend(check_li_samples(&env, 0, Vec3::ZERO, "envmap li").err());
+    runs.push(chi2::run(
+        "envmap le",
+        next_cfg(),
+        &chart,
+        // Light travels along −wi: charted by the direction it comes from.
+        |s| {
+            l.sample_le(s.next_2d(), s.next_2d(), bounds)
+                .map(|x| -x.ray.d)
+        },
+        |w| l.pdf_le(w, -w, bounds).1,
+    ));
 
     let level = sidak(ALPHA, runs.len());
     for r in &runs {

@@ -140,19 +140,23 @@ impl EnvironmentMap {
         if self.rows.is_empty() {
             return None;
         }
-        let (j, p_row, uy) = self.rows.sample(u.y);
-        let (i, p_col, ux) = self.columns[j].sample(u.x);
+        let (j, _, uy) = self.rows.sample(u.y);
+        let (i, _, ux) = self.columns[j].sample(u.x);
         let uv = Vec2::new(
             (i as f32 + ux) / self.width as f32,
             (j as f32 + uy) / self.height as f32,
         );
-        let sin_theta = (PI * uv.y).sin();
-        if !(sin_theta > 0.0) {
+        if !((PI * uv.y).sin() > 0.0) {
             return None;
         }
-        let pdf_uv = p_row * p_col * (self.width * self.height) as f32;
-        let pdf = pdf_uv / (2.0 * PI * PI * sin_theta);
-        (pdf > 0.0 && pdf.is_finite()).then(|| (self.to_world * uv_to_direction(uv), pdf))
+        // The density is `pdf` of the direction (p_row · p_col · W · H / (2π² sin θ) with sin θ
+        // from the direction), not that product with sin(π v): next-event estimation and a BSDF
+        // sample reaching the same direction must weigh it with the same number (the two differed
+        // by 3e-7 relative). Only where rounding moves a sample across a cell edge does it report
+        // the neighbour's density (the unit test below counts those).
+        let w = self.to_world * uv_to_direction(uv);
+        let pdf = self.pdf(w);
+        (pdf > 0.0 && pdf.is_finite()).then_some((w, pdf))
     }
 
     /// Solid-angle pdf of `sample` returning world direction `w`.
