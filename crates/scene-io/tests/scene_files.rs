@@ -437,14 +437,42 @@ fn directional_light_refuses_radiance() {
 
 #[test]
 fn unknown_light_type_lists_the_known_ones() {
-    let text = format!("{BASE}\n[[lights]]\ntype = \"spot\"\n");
+    let text = format!("{BASE}\n[[lights]]\ntype = \"sunsky\"\n");
     assert_err(
         &fail(&text),
-        Some(line_of(&text, "\"spot\"")),
+        Some(line_of(&text, "\"sunsky\"")),
         &[
-            "unknown light type `spot`",
-            "point, sun, directional or environment",
+            "unknown light type `sunsky`",
+            "point, spot, projector, sun, directional, environment or envmap",
         ],
+    );
+}
+
+#[test]
+fn spot_and_projector_errors_name_the_key() {
+    let spot = format!(
+        "{BASE}\n[[lights]]\ntype = \"spot\"\nposition = [0, 0.9, 0]\ntarget = [0, 0.9, 0]\nintensity = 1\n"
+    );
+    assert_err(
+        &fail(&spot),
+        Some(line_of(&spot, "target = [0, 0.9, 0]")),
+        &["`position` and `target` coincide"],
+    );
+    let wide = format!(
+        "{BASE}\n[[lights]]\ntype = \"spot\"\nposition = [0, 0.9, 0]\ntarget = [0, 0, 0]\nintensity = 1\ncutoff_angle = 95\ntexture = {{ type = \"checkerboard\" }}\n"
+    );
+    assert_err(
+        &fail(&wide),
+        Some(line_of(&wide, "cutoff_angle = 95")),
+        &["`cutoff_angle` must be below 90°", "with a texture"],
+    );
+    let both = format!(
+        "{BASE}\n[[lights]]\ntype = \"projector\"\nposition = [0, 0.9, 0]\ntarget = [0, 0, 0]\nfov = 30\nirradiance = 1\ntexture = {{ type = \"checkerboard\" }}\n"
+    );
+    assert_err(
+        &fail(&both),
+        Some(line_of(&both, "irradiance = 1")),
+        &["`irradiance` or `texture`, not both"],
     );
 }
 
