@@ -1159,6 +1159,7 @@ impl<'a> Loader<'a> {
                 if !crate::world::in_range(position) {
                     return Err(p.err(e, out_of_range_message("the point light", position)));
                 }
+                p.finish(&["sampling_weight"], &mut self.report)?;
                 return Ok((intensity.max_element() > 0.0).then_some((
                     LightDesc::Point {
                         position: glam::Vec3::ZERO,
