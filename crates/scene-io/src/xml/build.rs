@@ -1361,7 +1361,7 @@ fn rigid_to_world(p: &Plugin, what: &str) -> Result<(glam::Mat3, DVec3), SceneEr
     if !crate::world::in_range(position) {
         return Err(p.err(te, out_of_range_message(what, position)));
     }
-    Ok((m.as_mat3(), position))
+    Ok((crate::transform::positive_zeros(m).as_mat3(), position))
 }
 
 /// tan(fov_x / 2) of a projector whose image has width / height = `aspect`, read as Mitsuba reads
