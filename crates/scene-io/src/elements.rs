@@ -847,7 +847,7 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
             let fov_def = ctx.need(&d.fov, "fov", &span, &what)?;
             // In f64, as the XML loader computes it, so that a converted scene reads back exactly.
             let fov = *fov_def.get_ref();
-            if !(fov > 0.0 && fov < 180.0) || !(scale >= 0.0) {
+            if !(fov > 0.0 && fov < 180.0 && scale >= 0.0) {
                 return Err(ctx.at(fov_def.span(), format!("a projector needs 0 < `fov` < 180 (degrees) and `scale` ≥ 0, got {fov} and {scale}")));
             }
             let tan_x = (0.5 * fov).to_radians().tan();
