@@ -1118,6 +1118,14 @@ impl<'a> Loader<'a> {
                         ),
                     ));
                 }
+                if let Some(t) = ep.texture("radiance") {
+                    return Err(ep.err(
+                        t,
+                        "a textured area emitter `radiance` is not supported yet (an area \
+                         light's radiance is one colour; textures are read for materials, spot \
+                         lights and projectors)",
+                    ));
+                }
                 let r = ep
                     .color("radiance", ColorUse::Emission, self.opts, &mut self.report)?
                     .unwrap_or(Color::ONE);
