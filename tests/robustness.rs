@@ -50,6 +50,13 @@ const BLACK: &[(&str, &str, Black, &str)] = &[
         "its only light is a point light, which BSDF sampling never hits",
     ),
     (
+        "pt-bsdf",
+        "cornell-spot",
+        Black::Exact,
+        "its only lights, a spot and a projector, are deltas in position, which BSDF sampling \
+         never hits",
+    ),
+    (
         "light",
         "caustic-sds",
         Black::Exact,

@@ -204,6 +204,45 @@ fn xml_bad_files_give_one_clear_error() {
         &["participating media are not supported"],
     );
 
+    // Emitters: a textured area emitter, a spot whose textured cone reaches 90°, a scaled spot
+    // frame, a projector's fov out of range.
+    let text = scene_xml(
+        "    <shape type=\"sphere\">\n        <emitter type=\"area\">\n            <texture type=\"checkerboard\" name=\"radiance\"/>\n        </emitter>\n    </shape>",
+    );
+    fails(
+        &d,
+        &text,
+        line_of(&text, "checkerboard"),
+        &["textured area emitter `radiance` is not supported"],
+    );
+    let text = scene_xml(
+        "    <emitter type=\"spot\">\n        <float name=\"cutoff_angle\" value=\"95\"/>\n        <texture type=\"checkerboard\" name=\"texture\"/>\n    </emitter>",
+    );
+    fails(
+        &d,
+        &text,
+        line_of(&text, "type=\"spot\""),
+        &["`cutoff_angle` must lie in (0°, 90°) with a texture, got 95"],
+    );
+    let text = scene_xml(
+        "    <emitter type=\"spot\">\n        <transform name=\"to_world\"><scale value=\"2\"/></transform>\n    </emitter>",
+    );
+    fails(
+        &d,
+        &text,
+        line_of(&text, "to_world"),
+        &["a spot light's to_world must be a rotation"],
+    );
+    let text = scene_xml(
+        "    <emitter type=\"projector\">\n        <float name=\"fov\" value=\"180\"/>\n    </emitter>",
+    );
+    fails(
+        &d,
+        &text,
+        line_of(&text, "type=\"projector\""),
+        &["a projector's `fov` must lie in (0°, 180°), got 180"],
+    );
+
     // Not a scene at all, or no version.
     let e = error_of(load_in(
         &d,

@@ -830,7 +830,7 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
                 (Some(t), None) => {
                     let tex = crate::texture_def::texture(ctx, t)?;
                     let aspect = match &tex {
-                        lt_core::texture::Texture::Bitmap(b) => b.width as f32 / b.height as f32,
+                        lt_core::texture::Texture::Bitmap(b) => b.width as f64 / b.height as f64,
                         _ => 1.0,
                     };
                     (tex, aspect)
@@ -845,8 +845,9 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
                 Some(s) => ctx.num(s, "scale")?,
             };
             let fov_def = ctx.need(&d.fov, "fov", &span, &what)?;
-            let fov = ctx.positive(fov_def, "fov")?;
-            if !(fov < 180.0) || !(scale >= 0.0) {
+            // In f64, as the XML loader computes it, so that a converted scene reads back exactly.
+            let fov = *fov_def.get_ref();
+            if !(fov > 0.0 && fov < 180.0 && scale >= 0.0) {
                 return Err(ctx.at(fov_def.span(), format!("a projector needs 0 < `fov` < 180 (degrees) and `scale` ≥ 0, got {fov} and {scale}")));
             }
             let tan_x = (0.5 * fov).to_radians().tan();
@@ -856,7 +857,7 @@ fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Option<Placed>, SceneError> {
                 to_world,
                 irradiance,
                 scale,
-                tan_half: glam::Vec2::new(tan_x, tan_x / aspect),
+                tan_half: glam::Vec2::new(tan_x as f32, (tan_x / aspect) as f32),
             };
             return Ok((!dark).then_some(Placed::At(position, desc)));
         }

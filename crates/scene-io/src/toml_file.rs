@@ -47,8 +47,14 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
         .flatten()
         .filter_map(|t| t.get_ref().file.as_ref())
     });
-    // Environment maps last: the XML writer puts emitters after the shapes.
-    let envmaps = file.lights.iter().filter_map(|l| l.get_ref().file.as_ref());
+    // Lights' images last (environment maps, spot and projector textures): the XML writer puts
+    // emitters after the shapes.
+    let envmaps = file.lights.iter().filter_map(|l| {
+        let l = l.get_ref();
+        l.file
+            .as_ref()
+            .or_else(|| l.texture.as_ref().and_then(|t| t.get_ref().file.as_ref()))
+    });
     scene.source_files = std::iter::once(path.to_path_buf())
         .chain(textures.map(|f| ctx.base_dir.join(f.get_ref())))
         .chain(meshes.map(|f| ctx.base_dir.join(f.get_ref())))

@@ -99,7 +99,13 @@ pub fn look_at_rotation(position: DVec3, target: DVec3, up: DVec3) -> Result<DMa
         );
     }
     let (dir, left) = (dir.normalize(), left.normalize());
-    Ok(DMat3::from_cols(left, dir.cross(left), dir))
+    Ok(positive_zeros(DMat3::from_cols(left, dir.cross(left), dir)))
+}
+
+/// The matrix with every −0 made +0: the XML loader's products give +0 where a cross product
+/// gives −0, and a converted scene must read back bit for bit.
+pub fn positive_zeros(m: DMat3) -> DMat3 {
+    DMat3::from_cols_array(&m.to_cols_array().map(|x| x + 0.0))
 }
 
 /// Rodrigues' rotation about a unit axis, counter-clockwise by `deg` degrees.

@@ -1118,6 +1118,14 @@ impl<'a> Loader<'a> {
                         ),
                     ));
                 }
+                if let Some(t) = ep.texture("radiance") {
+                    return Err(ep.err(
+                        t,
+                        "a textured area emitter `radiance` is not supported yet (an area \
+                         light's radiance is one colour; textures are read for materials, spot \
+                         lights and projectors)",
+                    ));
+                }
                 let r = ep
                     .color("radiance", ColorUse::Emission, self.opts, &mut self.report)?
                     .unwrap_or(Color::ONE);
@@ -1362,7 +1370,7 @@ fn rigid_to_world(p: &Plugin, what: &str) -> Result<(glam::Mat3, DVec3), SceneEr
     if !crate::world::in_range(position) {
         return Err(p.err(te, out_of_range_message(what, position)));
     }
-    Ok((m.as_mat3(), position))
+    Ok((crate::transform::positive_zeros(m).as_mat3(), position))
 }
 
 /// tan(fov_x / 2) of a projector whose image has width / height = `aspect`, read as Mitsuba reads

@@ -356,7 +356,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                     let _ = writeln!(
                         x,
                         "        <float name=\"fov\" value=\"{}\"/>\n        <float name=\"scale\" value=\"{}\"/>",
-                        d.fov.as_ref().map_or(0.0, |f| *f.get_ref() as f32),
+                        d.fov.as_ref().map_or(0.0, |f| *f.get_ref()),
                         d.scale.as_ref().map_or(1.0, |s| *s.get_ref() as f32)
                     );
                     match &d.texture {
