@@ -309,7 +309,7 @@ fn render_into(spec: &RunSpec, scene: &Scene, threads: usize, dir: &Path) -> Res
         seconds,
         passes_done: result.runs.iter().map(|r| r.passes).sum(),
         invalid_samples: result.invalid_samples,
-        mean_std_error: se.as_ref().map(crate::render_cmd::mean_of),
+        mean_std_error: se.as_ref().map(crate::image_io::mean_of),
         std_error_source: source.into(),
         radius_scale: log.map(|l| l.radius_scale.clone()).unwrap_or_default(),
         mean_radius: log.map(|l| l.mean_radius.clone()).unwrap_or_default(),
