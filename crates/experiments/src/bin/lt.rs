@@ -33,7 +33,7 @@ enum Command {
     /// Measure BVH and integrator throughput (results/bench.md).
     Bench(x::bench_cmd::BenchArgs),
     /// Check an integrator's MIS weights (pt, bdpt) against the from-scratch path-space oracle.
-    MisCheck(x::mis_check::MisCheckArgs),
+    MisCheck(x::commands::mis_check::MisCheckArgs),
     /// Render (or reuse from the cache) a long reference image of a scene.
     Reference(x::reference_cmd::ReferenceArgs),
     /// Run a study (convergence, unbiased-vs-consistent, radius-shrinkage, equal-time,
@@ -68,7 +68,7 @@ fn main() -> ExitCode {
         Command::Render(a) => x::render_cmd::run(a),
         Command::Compare(a) => x::compare::run(a).map(|report| print!("{report}")),
         Command::Bench(a) => x::bench_cmd::run(a).map(|table| print!("{table}")),
-        Command::MisCheck(a) => x::mis_check::run(a).map(|table| print!("{table}")),
+        Command::MisCheck(a) => x::commands::mis_check::run(a).map(|table| print!("{table}")),
         Command::Reference(a) => x::reference_cmd::run(a),
         Command::Study(a) => x::study::run(a),
         Command::Report(a) => x::report::run(a),
