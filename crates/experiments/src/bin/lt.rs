@@ -38,9 +38,9 @@ enum Command {
     Reference(x::reference_cmd::ReferenceArgs),
     /// Run a study (convergence, unbiased-vs-consistent, radius-shrinkage, equal-time,
     /// per-length, or all) into results/<study>/.
-    Study(x::study::StudyArgs),
+    Study(x::commands::study::StudyArgs),
     /// Write results/index.html from the studies' outputs.
-    Report(x::report::ReportArgs),
+    Report(x::commands::report::ReportArgs),
     /// Write one of our scenes as Mitsuba 3 XML.
     Convert(x::convert_cmd::ConvertArgs),
     /// Merge partial renders (--partial) or independent runs exactly into one image.
@@ -70,8 +70,8 @@ fn main() -> ExitCode {
         Command::Bench(a) => x::bench_cmd::run(a).map(|table| print!("{table}")),
         Command::MisCheck(a) => x::commands::mis_check::run(a).map(|table| print!("{table}")),
         Command::Reference(a) => x::reference_cmd::run(a),
-        Command::Study(a) => x::study::run(a),
-        Command::Report(a) => x::report::run(a),
+        Command::Study(a) => x::commands::study::run(a),
+        Command::Report(a) => x::commands::report::run(a),
         Command::Convert(a) => x::convert_cmd::run(a),
         Command::Merge(a) => x::cluster::merge(a),
         Command::Plan(a) => x::cluster::plan(a),

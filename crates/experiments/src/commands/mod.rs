@@ -2,3 +2,5 @@
 //! module doing the work.
 
 pub mod mis_check;
+pub mod report;
+pub mod study;
