@@ -3,7 +3,7 @@
 
 use crate::cluster::partial::{normalize_params, parse_pass_range, PartialJob, Span};
 use crate::image_io::{mean_of, sibling, write_outputs};
-use crate::strategies::{make_bdpt, write_pyramid, PyramidIntegrator, PyramidMeta};
+use crate::verify::strategies::{make_bdpt, write_pyramid, PyramidIntegrator, PyramidMeta};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use lt_estimators::Image;
@@ -63,7 +63,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "DIR")]
     pub strategies: Option<PathBuf>,
     /// Longest path length k (segments) in the pyramid written by --strategies.
-    #[arg(long, value_name = "L", default_value_t = crate::strategies::DEFAULT_LENGTH)]
+    #[arg(long, value_name = "L", default_value_t = crate::verify::strategies::DEFAULT_LENGTH)]
     pub strategy_length: usize,
 }
 
