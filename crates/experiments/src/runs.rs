@@ -141,6 +141,12 @@ impl RunSpec {
     }
 }
 
+/// Whether the registry lists `integrator` as consistent (error bars from independent runs);
+/// false for a name it does not know.
+pub fn is_consistent(integrator: &str) -> bool {
+    lt_integrators::registry::find(integrator).is_ok_and(|i| i.kind == Kind::Consistent)
+}
+
 /// What a finished run records beside its images.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RunRecord {
@@ -160,6 +166,13 @@ pub struct RunRecord {
     pub mean_radius: Vec<f64>,
     pub code_version: String,
     pub threads: usize,
+}
+
+impl RunRecord {
+    /// Whether its integrator is consistent, as the registry says.
+    pub fn consistent(&self) -> bool {
+        is_consistent(&self.spec.integrator)
+    }
 }
 
 /// A finished run in the cache.

@@ -6,6 +6,7 @@ use crate::verify::mis_check::tolerance::DEFAULT_TOLERANCE;
 use crate::verify::mis_check::vcm_bpm::{self, VcmOptions};
 use clap::Args;
 use lt_core::path::Heuristic;
+use lt_integrators::registry::{self, Weights};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -44,11 +45,20 @@ pub struct MisCheckArgs {
 
 /// `lt mis-check`: the report, or an error carrying it when any check fails.
 pub fn run(args: &MisCheckArgs) -> Result<String, String> {
-    if matches!(args.integrator.as_str(), "vcm" | "bpm") {
-        return run_vcm_bpm(args);
-    }
+    let integrator = match registry::find(&args.integrator)?.weights {
+        Weights::PathTracing => Which::Pt,
+        Weights::Connections => Which::Bdpt,
+        Weights::ConnectMerge { connections } => return run_vcm_bpm(args, connections),
+        Weights::None => {
+            let checked: Vec<&str> = registry::with_weights(|w| w != Weights::None).collect();
+            return Err(format!(
+                "mis-check: {} applies no MIS weights (the integrators that do: {})",
+                args.integrator,
+                checked.join(", ")
+            ));
+        }
+    };
     let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
-    let integrator = Which::parse(&args.integrator)?;
     let mut opts = Options::new(&scene, integrator);
     if let Some(m) = &args.mis {
         opts.heuristic = Heuristic::parse(m)?;
@@ -90,10 +100,10 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
     }
 }
 
-/// `lt mis-check --integrator vcm|bpm`.
-fn run_vcm_bpm(args: &MisCheckArgs) -> Result<String, String> {
+/// `lt mis-check --integrator vcm|bpm`: vcm has connections, bpm has merges only.
+fn run_vcm_bpm(args: &MisCheckArgs, connections: bool) -> Result<String, String> {
     let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
-    let mut opts = VcmOptions::new(&scene, args.integrator == "vcm");
+    let mut opts = VcmOptions::new(&scene, connections);
     if let Some(m) = &args.mis {
         opts.heuristic = Heuristic::parse(m)?;
     }
