@@ -3,9 +3,10 @@
 //! own code gives a path's techniques sum to one. Plus proof that the check can fail.
 
 use lt_core::path::Heuristic;
-use lt_experiments::mis_check::{
-    check_records, check_scene, collect, condition, prepare_scene, Options, Report, Which,
+use lt_experiments::verify::mis_check::pt_bdpt::{
+    check_records, check_scene, collect, prepare_scene, Options, Report, Which,
 };
+use lt_experiments::verify::mis_check::tolerance::condition;
 use lt_tests::{shipped_scene, shipped_scene_names};
 
 /// Paths per (length, technique): small, so the whole file runs in seconds.
@@ -65,7 +66,7 @@ fn cornell_records(
 ) -> (
     lt_core::Scene,
     Options,
-    Vec<lt_experiments::mis_check::Record>,
+    Vec<lt_experiments::verify::mis_check::pt_bdpt::Record>,
 ) {
     let mut scene = shipped_scene("cornell-box", None);
     let mut opts = options(&scene, which, Heuristic::Power);
@@ -79,7 +80,7 @@ fn cornell_records(
 fn check(
     scene: &lt_core::Scene,
     opts: &Options,
-    records: &[lt_experiments::mis_check::Record],
+    records: &[lt_experiments::verify::mis_check::pt_bdpt::Record],
 ) -> Report {
     check_records(scene, records, opts, 0, 0, "cornell-box")
 }

@@ -5,7 +5,7 @@
 //! Plus proof that the check can fail.
 
 use lt_core::path::{Heuristic, Technique};
-use lt_experiments::mis_check_vcm::{
+use lt_experiments::verify::mis_check::vcm_bpm::{
     check_records, check_scene, collect, prepare_scene, VcmOptions, VcmRecord, VcmReport,
 };
 use lt_tests::{shipped_scene, shipped_scene_names};

@@ -4,7 +4,7 @@
 //! keeps passing (`EXPECTED_PASSING`: add a scene when your work makes it pass). Without the
 //! folder the test says it skipped; `LT_REQUIRE_MITSUBA_SUITE=1` (CI) makes that a failure.
 
-use lt_experiments::mitsuba_suite::{run_suite, table, Budget};
+use lt_experiments::verify::mitsuba_suite::{run_suite, table, Budget};
 use std::path::PathBuf;
 use std::time::Duration;
 

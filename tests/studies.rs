@@ -82,7 +82,7 @@ fn interval(text: &str) -> (f64, f64) {
 #[test]
 fn every_study_writes_its_files() {
     let dir = results();
-    for s in study::STUDIES {
+    for s in study::registry::names() {
         let d = dir.join(s);
         let m = lt_experiments::manifest::Manifest::read(&d).unwrap();
         assert!(d.join(&m.summary).is_file(), "{s}: summary");

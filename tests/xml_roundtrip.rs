@@ -71,11 +71,11 @@ fn xml_every_expressible_shipped_scene_round_trips() {
     for name in shipped_scene_names() {
         let toml = scenes_dir().join(format!("{name}.toml"));
         let xml = out.join(format!("{name}.xml"));
-        let args = lt_experiments::convert_cmd::ConvertArgs {
+        let args = lt_experiments::commands::convert::ConvertArgs {
             scene: toml.clone(),
             output: xml.clone(),
         };
-        match lt_experiments::convert_cmd::run(&args) {
+        match lt_experiments::commands::convert::run(&args) {
             Err(e) => {
                 assert!(has_sun(&toml), "{name}: refused without a sun: {e}");
                 assert!(e.contains("no sun of finite solid angle"), "{name}: {e}");

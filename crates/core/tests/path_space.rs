@@ -12,7 +12,7 @@ mod walks;
 
 use checks::*;
 use lt_core::math::Vec3;
-use lt_core::path::mis::{power_weight_by_ratios, relative_pdfs};
+use lt_core::path::densities::{power_weight_by_ratios, relative_pdfs};
 use lt_core::path::{balance_weight, power_weight, Path, PathVertex};
 use scenes::*;
 use techniques::techniques_agree;

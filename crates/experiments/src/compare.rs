@@ -14,24 +14,23 @@ use std::process::Command;
 /// Family-wise false-alarm rate of the z-score test.
 pub const FALSE_ALARM_RATE: f64 = 0.01;
 
-#[derive(clap::Args, Clone, Debug)]
-pub struct CompareArgs {
+/// Two images to compare (what `lt compare` takes).
+#[derive(Clone, Debug)]
+pub struct Comparison {
     /// Image to assess (EXR).
     pub a: PathBuf,
     /// Reference image (EXR); relative MSE divides by it.
     pub b: PathBuf,
     /// Block side in pixels for the per-region z-scores.
-    #[arg(long, default_value_t = 16)]
     pub blocks: usize,
     /// Per-pixel standard-error image of A (e.g. A.stderr.exr from `lt render`).
-    #[arg(long)]
     pub a_stderr: Option<PathBuf>,
     /// Per-pixel standard-error image of B; without it B is taken as exact.
-    #[arg(long)]
     pub b_stderr: Option<PathBuf>,
 }
 
-pub fn run(args: &CompareArgs) -> Result<String, String> {
+/// The text `lt compare` prints.
+pub fn report(args: &Comparison) -> Result<String, String> {
     if args.blocks == 0 {
         return Err("--blocks must be at least 1".into());
     }
@@ -136,12 +135,7 @@ pub fn oiio_peak(a: &Image, b: &Image) -> f64 {
         .fold(1.0f64, |m, &v| m.max(v))
 }
 
-fn write_z_scores(
-    out: &mut String,
-    args: &CompareArgs,
-    a: &Image,
-    b: &Image,
-) -> Result<(), String> {
+fn write_z_scores(out: &mut String, args: &Comparison, a: &Image, b: &Image) -> Result<(), String> {
     let load = |p: &Option<PathBuf>| -> Result<Option<Image>, String> {
         p.as_ref()
             .map(|p| {

@@ -127,6 +127,43 @@ fn check_size(path: &Path, img: &Image) -> Result<(), String> {
     Ok(())
 }
 
+/// Paths of everything written beside the main EXR.
+pub fn sibling(out: &Path, suffix: &str) -> PathBuf {
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    out.with_file_name(format!("{stem}{suffix}"))
+}
+
+/// Writes the image, its preview and, when there is an honest one, its standard error. Where
+/// there is none (one run of a consistent estimator) a stale `.stderr.exr` from an earlier render
+/// is removed, so no file beside the image claims an error bar it does not have.
+pub fn write_outputs(out: &Path, mean: &Image, std_error: Option<&Image>) -> Result<(), String> {
+    write_exr(out, mean)?;
+    write_png_preview(&sibling(out, ".png"), mean)?;
+    let se_path = sibling(out, ".stderr.exr");
+    match std_error {
+        Some(se) => write_exr(&se_path, se),
+        None => match std::fs::remove_file(&se_path) {
+            Ok(()) => Ok(()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+            Err(e) => Err(format!("cannot remove stale {}: {e}", se_path.display())),
+        },
+    }
+}
+
+/// The mean over pixels and channels of a standard-error image (NaN-free pixels only).
+pub fn mean_of(img: &Image) -> f64 {
+    let (sum, n) = img
+        .data
+        .iter()
+        .flatten()
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0u64), |(s, n), v| (s + v, n + 1));
+    sum / n.max(1) as f64
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

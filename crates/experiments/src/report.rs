@@ -15,30 +15,13 @@ mod markdown;
 
 use crate::image_io::write_atomic;
 use crate::manifest::{Manifest, MANIFEST_FILE};
-use clap::Args;
+use crate::study::registry::STUDIES;
 use std::path::{Path, PathBuf};
 
 pub use html::{images_in_page, SELFCHECK_ID};
 
-/// The studies in the order the page shows them (the order `lt study all` runs them); any other
-/// study folder follows, by name.
-pub const ORDER: [&str; 5] = crate::study::STUDIES;
-
 /// The page's file name inside the results folder.
 pub const INDEX_FILE: &str = "index.html";
-
-#[derive(Args, Debug)]
-pub struct ReportArgs {
-    /// The results folder holding one sub-folder per study.
-    #[arg(long, default_value = "results")]
-    pub results: PathBuf,
-}
-
-pub fn run(args: &ReportArgs) -> Result<(), String> {
-    let path = write_report(&args.results)?;
-    println!("{}", path.display());
-    Ok(())
-}
 
 /// One study folder as the page shows it: its manifest, or why it could not be read.
 pub struct StudyDir {
@@ -49,7 +32,8 @@ pub struct StudyDir {
     pub summary: Result<String, String>,
 }
 
-/// Every sub-folder of `results` holding a manifest, in report order (`ORDER`, then by name).
+/// Every sub-folder of `results` holding a manifest, in report order: the studies' table order
+/// (`study::registry::STUDIES`), then any other folder by name.
 pub fn find_studies(results: &Path) -> Result<Vec<StudyDir>, String> {
     let entries = std::fs::read_dir(results)
         .map_err(|e| format!("cannot read results folder {}: {e}", results.display()))?;
@@ -63,7 +47,12 @@ pub fn find_studies(results: &Path) -> Result<Vec<StudyDir>, String> {
             }
         }
     }
-    let rank = |f: &str| ORDER.iter().position(|s| *s == f).unwrap_or(ORDER.len());
+    let rank = |f: &str| {
+        STUDIES
+            .iter()
+            .position(|s| s.name == f)
+            .unwrap_or(STUDIES.len())
+    };
     folders.sort_by(|a, b| rank(a).cmp(&rank(b)).then_with(|| a.cmp(b)));
     Ok(folders
         .into_iter()

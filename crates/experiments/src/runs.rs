@@ -141,6 +141,12 @@ impl RunSpec {
     }
 }
 
+/// Whether the registry lists `integrator` as consistent (error bars from independent runs);
+/// false for a name it does not know.
+pub fn is_consistent(integrator: &str) -> bool {
+    lt_integrators::registry::find(integrator).is_ok_and(|i| i.kind == Kind::Consistent)
+}
+
 /// What a finished run records beside its images.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RunRecord {
@@ -160,6 +166,13 @@ pub struct RunRecord {
     pub mean_radius: Vec<f64>,
     pub code_version: String,
     pub threads: usize,
+}
+
+impl RunRecord {
+    /// Whether its integrator is consistent, as the registry says.
+    pub fn consistent(&self) -> bool {
+        is_consistent(&self.spec.integrator)
+    }
 }
 
 /// A finished run in the cache.
@@ -309,7 +322,7 @@ fn render_into(spec: &RunSpec, scene: &Scene, threads: usize, dir: &Path) -> Res
         seconds,
         passes_done: result.runs.iter().map(|r| r.passes).sum(),
         invalid_samples: result.invalid_samples,
-        mean_std_error: se.as_ref().map(crate::render_cmd::mean_of),
+        mean_std_error: se.as_ref().map(crate::image_io::mean_of),
         std_error_source: source.into(),
         radius_scale: log.map(|l| l.radius_scale.clone()).unwrap_or_default(),
         mean_radius: log.map(|l| l.mean_radius.clone()).unwrap_or_default(),

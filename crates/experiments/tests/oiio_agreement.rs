@@ -4,7 +4,7 @@
 
 use lt_estimators::{image_metrics, Image};
 use lt_experiments::compare::{
-    self, agrees, oiio_diff_using, oiio_peak, CompareArgs, OiioDiff, Printed,
+    self, agrees, oiio_diff_using, oiio_peak, Comparison, OiioDiff, Printed,
 };
 use lt_experiments::image_io::{read_exr, write_exr};
 use std::path::{Path, PathBuf};
@@ -171,7 +171,7 @@ fn identical_images_and_the_report() {
         },
     )
     .unwrap();
-    let report = compare::run(&CompareArgs {
+    let report = compare::report(&Comparison {
         a: pa.clone(),
         b: pb.clone(),
         blocks: 8,

@@ -5,7 +5,7 @@
 use lt_core::Scene;
 use lt_estimators::agreement::agreement_t;
 use lt_estimators::{Image, RunningBlocks};
-use lt_experiments::strategies::{
+use lt_experiments::verify::strategies::{
     make_bdpt, pyramid_pass, render_pyramid, strategies, strategy_index, write_pyramid, PyramidMeta,
 };
 use lt_integrators::{make_integrator, IntegratorParams, RenderOptions};

@@ -25,7 +25,24 @@ pub struct IntegratorInfo {
     pub source: &'static str,
     /// Unbiased or consistent: where the error bars of its images come from.
     pub kind: Kind,
+    /// Which MIS weights it applies, and so which checker of `lt mis-check` holds them to the
+    /// path-space oracle.
+    pub weights: Weights,
     pub make: Constructor,
+}
+
+/// The MIS weights an integrator applies to the paths it completes (through its `Recorder`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Weights {
+    /// None: each path comes from one technique (pt-bsdf, light tracing, the photon family).
+    None,
+    /// pt's: BSDF sampling against next-event estimation.
+    PathTracing,
+    /// bdpt's: every connection technique (s, t).
+    Connections,
+    /// vcm's (`connections` true) or bpm's (false): merging, with or without connections, under
+    /// one recursive MIS (`connect_merge`).
+    ConnectMerge { connections: bool },
 }
 
 pub const INTEGRATORS: &[IntegratorInfo] = &[
@@ -33,6 +50,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "pt",
         about: "path tracing with next-event estimation and MIS (power heuristic)",
         kind: Kind::Unbiased,
+        weights: Weights::PathTracing,
         source: include_str!("pt.rs"),
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(Pt {
@@ -44,6 +62,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "pt-bsdf",
         about: "path tracing by BSDF sampling only (the cross-check of pt)",
         kind: Kind::Unbiased,
+        weights: Weights::None,
         source: include_str!("pt_bsdf.rs"),
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(PtBsdf {
@@ -55,6 +74,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "light",
         about: "light tracing: light subpaths splatted to the camera at every vertex",
         kind: Kind::Unbiased,
+        weights: Weights::None,
         source: include_str!("light.rs"),
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(LightTracer {
@@ -66,6 +86,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "bdpt",
         about: "bidirectional path tracing: every (s,t) strategy under MIS (power heuristic)",
         kind: Kind::Unbiased,
+        weights: Weights::Connections,
         source: include_str!("bdpt.rs"),
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(Bdpt {
@@ -77,6 +98,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "pm",
         about: "photon mapping: one photon map per run, gathered at the first non-delta vertex",
         kind: Kind::Consistent,
+        weights: Weights::None,
         source: include_str!("pm.rs"),
         make: |s, r| {
             Ok(Estimator::Consistent(Box::new(Pm {
@@ -88,6 +110,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "ppm",
         about: "progressive photon mapping: fixed visible points, photon passes pushed into them",
         kind: Kind::Consistent,
+        weights: Weights::None,
         source: include_str!("ppm.rs"),
         make: |s, r| Ok(Estimator::Consistent(Box::new(Ppm::read(s, r)?))),
     },
@@ -95,6 +118,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "sppm",
         about: "stochastic progressive photon mapping: new visible points every pass",
         kind: Kind::Consistent,
+        weights: Weights::None,
         source: include_str!("sppm.rs"),
         make: |s, r| Ok(Estimator::Consistent(Box::new(Sppm::read(s, r)?))),
     },
@@ -102,6 +126,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "bpm",
         about: "bidirectional photon mapping: merging at every camera vertex under MIS",
         kind: Kind::Consistent,
+        weights: Weights::ConnectMerge { connections: false },
         source: include_str!("bpm.rs"),
         make: |s, r| Ok(Estimator::Consistent(Box::new(Bpm::read(s, r)?))),
     },
@@ -109,10 +134,19 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         name: "vcm",
         about: "vertex connection and merging: bdpt's connections and merging under one MIS",
         kind: Kind::Consistent,
+        weights: Weights::ConnectMerge { connections: true },
         source: include_str!("vcm.rs"),
         make: |s, r| Ok(Estimator::Consistent(Box::new(Vcm::read(s, r)?))),
     },
 ];
+
+/// The names of the integrators whose weights `w` describes, in table order.
+pub fn with_weights(w: impl Fn(Weights) -> bool) -> impl Iterator<Item = &'static str> {
+    INTEGRATORS
+        .iter()
+        .filter(move |i| w(i.weights))
+        .map(|i| i.name)
+}
 
 /// The registered names, in table order.
 pub fn names() -> impl Iterator<Item = &'static str> {

@@ -5,12 +5,11 @@
 //! for the kinds it has. Either way the closest hit is the primitive's own distance, unrounded.
 
 use super::flat::{self, Flat};
-use super::quad::Parallelogram;
+use super::primitive::{PrimHit, Primitive};
 use super::ray::Ray;
-use super::sphere::intersect_sphere;
-use super::triangle::{intersect_triangle, ShearedRay};
+use super::triangle::ShearedRay;
 use crate::math::Vec3;
-use glam::{UVec2, Vec3A};
+use glam::UVec2;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::builder::build_cwbvh;
 use obvhs::cwbvh::CwBvh;
@@ -71,79 +70,6 @@ pub fn set_ray_core(core: RayCore) {
 
 fn default_ray_core() -> RayCore {
     RayCore::ALL[RAY_CORE.load(Ordering::Relaxed) as usize]
-}
-
-/// A primitive in the BVH. `shape` indexes the scene's shapes; `index` is the triangle within its mesh.
-#[derive(Clone, Copy, Debug)]
-pub enum Primitive {
-    Triangle {
-        p: [Vec3; 3],
-        shape: u32,
-        index: u32,
-    },
-    /// Triangles `index` and `index + 1` of a mesh that form a parallelogram.
-    Quad {
-        q: Parallelogram,
-        shape: u32,
-        index: u32,
-    },
-    Sphere {
-        center: Vec3,
-        radius: f32,
-        shape: u32,
-    },
-}
-
-impl Primitive {
-    pub fn shape(&self) -> u32 {
-        match *self {
-            Primitive::Triangle { shape, .. }
-            | Primitive::Quad { shape, .. }
-            | Primitive::Sphere { shape, .. } => shape,
-        }
-    }
-
-    /// Hit distance in (0, t_max) from the ray's true origin, or +∞. Always inlined into the
-    /// traversal loops: as a call it costs a few per cent of a path tracer's time.
-    #[inline(always)]
-    pub fn intersect(&self, r: &ShearedRay, o: Vec3, d: Vec3, t_max: f32) -> f32 {
-        match self {
-            Primitive::Triangle { p, .. } => intersect_triangle(r, t_max, p).0,
-            Primitive::Quad { q, .. } => q.intersect(o, d, t_max).0,
-            &Primitive::Sphere { center, radius, .. } => {
-                intersect_sphere(o, d, t_max, center, radius)
-            }
-        }
-    }
-}
-
-impl Boundable for Primitive {
-    fn aabb(&self) -> Aabb {
-        match *self {
-            Primitive::Triangle { p, .. } => {
-                let [a, b, c] = p.map(Vec3A::from);
-                Aabb::new(a.min(b).min(c), a.max(b).max(c))
-            }
-            Primitive::Quad { q, .. } => {
-                let c = [q.p0, q.p0 + q.e1, q.p0 + q.e2, q.p0 + q.e1 + q.e2].map(Vec3A::from);
-                Aabb::new(
-                    c[0].min(c[1]).min(c[2]).min(c[3]),
-                    c[0].max(c[1]).max(c[2]).max(c[3]),
-                )
-            }
-            Primitive::Sphere { center, radius, .. } => {
-                let c = Vec3A::from(center);
-                Aabb::new(c - radius, c + radius)
-            }
-        }
-    }
-}
-
-/// The closest hit of a ray: its distance and the primitive's index in `Accel::primitive`.
-#[derive(Clone, Copy, Debug)]
-pub struct PrimHit {
-    pub t: f32,
-    pub prim: u32,
 }
 
 /// The structure behind an `Accel`.
@@ -435,6 +361,7 @@ const TRAVERSAL_BACKOFF: f32 = 2e-4;
 mod tests {
     use super::*;
     use crate::geometry::flat::Isa;
+    use crate::geometry::quad::Parallelogram;
     use crate::sampling::{sample_uniform_sphere, Sampler};
 
     /// Random triangles, parallelograms and spheres at scale `scale`, `n` of them.

@@ -15,9 +15,10 @@
 //! (distance, primitive index) pair, so a tie (a ray through a shared box edge) goes to the lower
 //! index. `closest_scalar`/`occluded_scalar` are the reference every width is tested against.
 
-use super::accel::{PrimHit, Primitive};
+use super::primitive::{PrimHit, Primitive};
 use super::quad::QuadSoa;
 use super::ray::Ray;
+use super::soa::CHUNK;
 use super::sphere::SphereSoa;
 use super::triangle::ShearedRay;
 
@@ -116,29 +117,6 @@ const NONE: PrimHit = PrimHit {
     t: f32::INFINITY,
     prim: u32::MAX,
 };
-
-/// Primitives per vectorised test: AVX-512's 16 f32 lanes, two AVX2 vectors, four SSE ones.
-pub const CHUNK: usize = 16;
-
-/// Items in structure-of-arrays chunks of `CHUNK`: `[k][i]` is field k of the chunk's item i (as
-/// `fields` lists them). The last chunk is padded with NaN fields, which no primitive test hits.
-pub fn soa_chunks<T, const K: usize>(
-    items: &[T],
-    fields: impl Fn(&T) -> [f32; K],
-) -> Vec<[[f32; CHUNK]; K]> {
-    items
-        .chunks(CHUNK)
-        .map(|chunk| {
-            let mut f = [[f32::NAN; CHUNK]; K];
-            for (i, item) in chunk.iter().enumerate() {
-                for (k, x) in fields(item).into_iter().enumerate() {
-                    f[k][i] = x;
-                }
-            }
-            f
-        })
-        .collect()
-}
 
 /// Indices padded with `u32::MAX` to a multiple of `CHUNK`.
 fn padded_ids(mut ids: Vec<u32>) -> Vec<u32> {

@@ -2,10 +2,13 @@
 
 pub mod accel;
 pub mod flat;
+pub mod primitive;
 pub mod quad;
 pub mod ray;
+pub mod soa;
 pub mod sphere;
 pub mod triangle;
 
-pub use accel::{set_ray_core, Accel, PrimHit, Primitive, RayCore};
+pub use accel::{set_ray_core, Accel, RayCore};
+pub use primitive::{PrimHit, Primitive};
 pub use ray::{offset_ray_origin, Ray, SHADOW_EPSILON};

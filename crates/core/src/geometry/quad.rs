@@ -6,7 +6,7 @@
 //! parallelograms (a box's faces) overlap by rounding-sized slivers instead of leaving cracks,
 //! and hits within the rounding bound of the origin's own plane are rejected (no self-hits).
 
-use super::flat::{soa_chunks, CHUNK};
+use super::soa::{soa_chunks, CHUNK};
 use crate::math::{gamma, Vec3};
 
 /// p0 + u·e1 + v·e2 for (u, v) in [0, 1]².

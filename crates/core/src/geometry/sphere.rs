@@ -2,7 +2,7 @@
 //! when the ray starts far from a small sphere (Haines et al., "Precision Improvements for
 //! Ray/Sphere Intersection", Ray Tracing Gems ch. 7), and the hit is re-projected onto the sphere.
 
-use super::flat::{soa_chunks, CHUNK};
+use super::soa::{soa_chunks, CHUNK};
 use crate::math::{gamma, Vec3};
 
 /// Nearest hit distance in (0, t_max) of a unit-direction ray, or +∞.

@@ -21,8 +21,6 @@
 //! every estimator stays unbiased; they are just not the exact heuristic there (nor are pbrt's,
 //! which make the same choice).
 
-use super::path::Densities;
-
 /// How techniques that can produce the same path share it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Heuristic {
@@ -268,21 +266,4 @@ pub fn oracle_weight(pdfs: &[f64], s: usize, h: Heuristic) -> f64 {
             }
         }
     }
-}
-
-/// `Chain::relative` of a from-scratch `Densities`, as a vector.
-pub fn relative_pdfs(d: &Densities, s: usize) -> Vec<f64> {
-    let mut r = vec![0.0; d.k() + 2];
-    d.chain().relative(s, &mut r);
-    r
-}
-
-/// The power-heuristic weight of technique s computed from `relative_pdfs` (β = 1: balance).
-pub fn power_weight_by_ratios(d: &Densities, s: usize, beta: f64) -> f64 {
-    let c = d.chain();
-    if !c.valid(s) || c.technique(s) == 0.0 {
-        return 0.0;
-    }
-    let sum: f64 = relative_pdfs(d, s).iter().map(|&r| r.powf(beta)).sum();
-    1.0 / sum
 }

@@ -39,9 +39,9 @@
 //! too) gives 0. `tests` hold every weight to [`Chain::weight`](super::Chain::weight) and to
 //! `Densities::vcm_weight` on random chains.
 
+use super::densities::Densities;
 use super::merging::{Technique, TechniqueSet};
 use super::mis::Heuristic;
-use super::path::Densities;
 
 /// The techniques of one pass and how they are weighed.
 #[derive(Clone, Copy, Debug)]

@@ -27,22 +27,23 @@ fn parse_ray_core(s: &str) -> Result<lt_core::geometry::RayCore, String> {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to EXR (+ PNG preview, standard-error EXR, JSON record).
-    Render(x::render_cmd::RenderArgs),
+    Render(x::commands::render::RenderArgs),
     /// Compare two EXR images: metrics, per-block z-scores, and OpenImageIO's view when installed.
-    Compare(x::compare::CompareArgs),
+    Compare(x::commands::compare::CompareArgs),
     /// Measure BVH and integrator throughput (results/bench.md).
-    Bench(x::bench_cmd::BenchArgs),
-    /// Check an integrator's MIS weights (pt, bdpt) against the from-scratch path-space oracle.
-    MisCheck(x::mis_check::MisCheckArgs),
+    Bench(x::commands::bench::BenchArgs),
+    /// Check an integrator's MIS weights (pt, bdpt, vcm, bpm) against the from-scratch path-space
+    /// oracle.
+    MisCheck(x::commands::mis_check::MisCheckArgs),
     /// Render (or reuse from the cache) a long reference image of a scene.
-    Reference(x::reference_cmd::ReferenceArgs),
+    Reference(x::commands::reference::ReferenceArgs),
     /// Run a study (convergence, unbiased-vs-consistent, radius-shrinkage, equal-time,
     /// per-length, or all) into results/<study>/.
-    Study(x::study::StudyArgs),
+    Study(x::commands::study::StudyArgs),
     /// Write results/index.html from the studies' outputs.
-    Report(x::report::ReportArgs),
+    Report(x::commands::report::ReportArgs),
     /// Write one of our scenes as Mitsuba 3 XML.
-    Convert(x::convert_cmd::ConvertArgs),
+    Convert(x::commands::convert::ConvertArgs),
     /// Merge partial renders (--partial) or independent runs exactly into one image.
     Merge(x::cluster::MergeArgs),
     /// Split a render or a study into independent shards for a cluster.
@@ -55,7 +56,7 @@ enum Command {
     Collect(x::cluster::CollectArgs),
     /// Render Mitsuba 3's render-test suite (mitsuba-data's tests/scenes) and judge each scene
     /// against its reference: results/mitsuba-render-tests.md.
-    MitsubaSuite(x::mitsuba_suite::SuiteArgs),
+    MitsubaSuite(x::commands::mitsuba_suite::SuiteArgs),
     /// List the integrators.
     List,
 }
@@ -65,26 +66,21 @@ fn main() -> ExitCode {
     lt_core::geometry::set_ray_core(cli.ray_core);
     lt_scene_io::set_default_load_options(cli.load.options());
     let result = match &cli.command {
-        Command::Render(a) => x::render_cmd::run(a),
-        Command::Compare(a) => x::compare::run(a).map(|report| print!("{report}")),
-        Command::Bench(a) => x::bench_cmd::run(a).map(|table| print!("{table}")),
-        Command::MisCheck(a) => x::mis_check::run(a).map(|table| print!("{table}")),
-        Command::Reference(a) => x::reference_cmd::run(a),
-        Command::Study(a) => x::study::run(a),
-        Command::Report(a) => x::report::run(a),
-        Command::Convert(a) => x::convert_cmd::run(a),
+        Command::Render(a) => x::commands::render::run(a),
+        Command::Compare(a) => x::commands::compare::run(a).map(|report| print!("{report}")),
+        Command::Bench(a) => x::commands::bench::run(a).map(|table| print!("{table}")),
+        Command::MisCheck(a) => x::commands::mis_check::run(a).map(|table| print!("{table}")),
+        Command::Reference(a) => x::commands::reference::run(a),
+        Command::Study(a) => x::commands::study::run(a),
+        Command::Report(a) => x::commands::report::run(a),
+        Command::Convert(a) => x::commands::convert::run(a),
         Command::Merge(a) => x::cluster::merge(a),
         Command::Plan(a) => x::cluster::plan(a),
         Command::RunShard(a) => x::cluster::run_shard(a),
         Command::Submit(a) => x::cluster::submit(a),
         Command::Collect(a) => x::cluster::collect(a),
-        Command::MitsubaSuite(a) => x::mitsuba_suite::run(a),
-        Command::List => {
-            for i in lt_integrators::INTEGRATORS {
-                println!("{:10} {}", i.name, i.about);
-            }
-            Ok(())
-        }
+        Command::MitsubaSuite(a) => x::commands::mitsuba_suite::run(a),
+        Command::List => x::commands::list::run(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -90,7 +90,7 @@ pub fn assemble(plan: &Plan, a: &Assembly) -> Result<bool, String> {
             seconds,
             passes_done: spec.passes,
             invalid_samples: merged.invalid_samples,
-            mean_std_error: se.as_ref().map(crate::render_cmd::mean_of),
+            mean_std_error: se.as_ref().map(crate::image_io::mean_of),
             std_error_source: if se.is_some() {
                 "spread of passes".into()
             } else {

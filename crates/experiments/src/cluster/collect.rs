@@ -191,11 +191,8 @@ pub fn collect(args: &CollectArgs) -> Result<(), String> {
                     missing.len()
                 );
             }
-            let (lines, found, made) =
+            let (found, made) =
                 study_link::collect(name, scale, results, scenes, cache, args.threads)?;
-            for l in &lines {
-                eprintln!("{l}");
-            }
             eprintln!(
                 "study {name} collected from {} ({} renders found in the cache, {} made here) -> {}",
                 dir.display(),

@@ -18,6 +18,7 @@
 //! combine into the accumulator one process would have kept, up to f64 rounding.
 
 use crate::cache::{scene_hash, CODE_VERSION};
+use crate::image_io::{mean_of, sibling, write_atomic, write_outputs};
 use lt_core::Scene;
 use lt_estimators::running::RunningImage;
 use lt_estimators::Image;
@@ -714,16 +715,8 @@ impl Merged {
     ) -> Result<(), String> {
         let mean = self.acc.mean();
         let (se, se_source) = self.std_error();
-        crate::render_cmd::write_outputs(out, &mean, se.as_ref())?;
-        let mean_se = se.as_ref().map(|img| {
-            let (s, n) = img
-                .data
-                .iter()
-                .flatten()
-                .filter(|v| v.is_finite())
-                .fold((0.0, 0u64), |(s, n), v| (s + v, n + 1));
-            s / n.max(1) as f64
-        });
+        write_outputs(out, &mean, se.as_ref())?;
+        let mean_se = se.as_ref().map(mean_of);
         let (spp, runs, seed, seeds) = match self.span {
             Span::Passes { seed, start, end } => (end - start, 1, seed, vec![seed]),
             Span::Runs {
@@ -761,92 +754,11 @@ impl Merged {
             "merge": "Chan et al.'s pairwise update of (count, mean, M2) in f64, parts in order of their first pass or seed",
             "extra": extra,
         });
-        crate::image_io::write_atomic(
-            &crate::render_cmd::sibling(out, ".json"),
+        write_atomic(
+            &sibling(out, ".json"),
             serde_json::to_string_pretty(&record)
                 .map_err(|e| e.to_string())?
                 .as_bytes(),
         )
     }
-}
-
-/// `lt render … --partial OUT [--passes A..B]`: one part, written to OUT.
-pub fn render_partial_cmd(args: &crate::render_cmd::RenderArgs, out: &Path) -> Result<(), String> {
-    if args.runs == 0 {
-        return Err("--runs must be at least 1".into());
-    }
-    if args.time.is_some() {
-        return Err(
-            "--partial takes a fixed number of passes (--passes A..B or --spp N), not \
-                    --time: a part must be reproducible to be merged"
-                .into(),
-        );
-    }
-    if args.output.is_some() || args.strategies.is_some() {
-        return Err(
-            "--partial writes the part only: drop -o/--strategies (lt merge writes the \
-                    images)"
-                .into(),
-        );
-    }
-    let params = normalize_params(args.integrator_args.to_params()?.pairs());
-    let mut job = PartialJob {
-        scene: args.scene.clone(),
-        resolution: None,
-        integrator: args.integrator.clone(),
-        params,
-        span: Span::Runs {
-            first_seed: args.seed,
-            runs: 1,
-            passes: 1,
-        },
-    };
-    let scene = job.load_scene()?;
-    let kind = lt_integrators::registry::find(&args.integrator)?.kind;
-    let passes = args.spp.unwrap_or(scene.settings.spp);
-    if passes == 0 {
-        return Err("--spp must be at least 1".into());
-    }
-    job.span = match (&args.passes, args.runs) {
-        (Some(_), _) if args.spp.is_some() => {
-            return Err("give --passes A..B or --spp N, not both".into())
-        }
-        (Some(_), k) if k > 1 => {
-            return Err(
-                "--passes splits one run into ranges; with --runs K a part holds whole runs \
-                 (split the seeds with --seed S --runs K)"
-                    .into(),
-            )
-        }
-        (Some(r), _) => {
-            let (start, end) = parse_pass_range(r)?;
-            Span::Passes {
-                seed: args.seed,
-                start,
-                end,
-            }
-        }
-        (None, 1) if kind == lt_integrators::Kind::Unbiased => Span::Passes {
-            seed: args.seed,
-            start: 0,
-            end: passes,
-        },
-        (None, k) => Span::Runs {
-            first_seed: args.seed,
-            runs: k,
-            passes,
-        },
-    };
-    let part = job.render(&scene, args.threads, |_, _| {})?;
-    part.write(out)?;
-    if !args.quiet {
-        eprintln!(
-            "{}: {} in {:.2} s -> {}",
-            args.integrator,
-            part.header.span.describe(),
-            part.header.seconds,
-            out.display()
-        );
-    }
-    Ok(())
 }

@@ -174,6 +174,9 @@ pub fn absolute(p: &Path) -> Result<PathBuf, String> {
     std::path::absolute(p).map_err(|e| format!("cannot make {} absolute: {e}", p.display()))
 }
 
+/// GNU parallel's job log, in the plan folder (`lt submit --parallel` writes it).
+pub const JOBLOG: &str = "parallel.joblog";
+
 pub fn state_dir(plan_dir: &Path) -> PathBuf {
     plan_dir.join("state")
 }
@@ -488,7 +491,7 @@ fn write_plan(dir: &Path, plan: &Plan, force: bool) -> Result<(), String> {
         for sub in ["state", "logs", "slurm"] {
             let _ = std::fs::remove_dir_all(dir.join(sub));
         }
-        let _ = std::fs::remove_file(dir.join(super::submit::JOBLOG));
+        let _ = std::fs::remove_file(dir.join(JOBLOG));
     }
     for d in [state_dir(dir), logs_dir(dir)] {
         std::fs::create_dir_all(&d).map_err(|e| format!("cannot create {}: {e}", d.display()))?;

@@ -6,13 +6,10 @@
 //! job log; and every shard that is in the cache returns at once anyway.
 
 use super::collect::{collect, CollectArgs};
-use super::plan::{absolute, logs_dir, shell_quote, Plan};
+use super::plan::{absolute, logs_dir, shell_quote, Plan, JOBLOG};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-/// GNU parallel's job log, in the plan folder.
-pub const JOBLOG: &str = "parallel.joblog";
 
 #[derive(Args, Debug)]
 pub struct SubmitArgs {

@@ -2,12 +2,30 @@
 //! writes, and one progress bar with an ETA over all the renders it asks for.
 
 use super::reference::Reference;
-use super::{Scale, StudyArgs};
+use super::scale::Scale;
 use crate::cache::Cache;
 use crate::runs::{Executor, RunEntry, RunSpec};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+
+/// Where and how a study runs: what `lt study`'s flags, `lt plan study` and `lt collect` give.
+#[derive(Clone, Debug)]
+pub struct StudySetup {
+    /// quick, full or test (`Scale::named`).
+    pub scale: String,
+    /// Where the study folders (and index.html) are written.
+    pub results: PathBuf,
+    /// The cache of finished renders (default RESULTS/cache; references in RESULTS/references).
+    pub cache: Option<PathBuf>,
+    /// The shipped scenes.
+    pub scenes: PathBuf,
+    /// Worker threads (0 = one per core).
+    pub threads: usize,
+    pub quiet: bool,
+    /// Test hook: fail after this many new renders, as an interruption would.
+    pub stop_after: Option<u64>,
+}
 
 pub struct Ctx {
     pub scale: Scale,
@@ -22,8 +40,8 @@ pub struct Ctx {
 }
 
 impl Ctx {
-    pub fn new(args: &StudyArgs) -> Result<Ctx, String> {
-        let scale = args.scale()?;
+    pub fn new(args: &StudySetup) -> Result<Ctx, String> {
+        let scale = Scale::named(&args.scale, &args.scenes)?;
         let cache = args
             .cache
             .clone()

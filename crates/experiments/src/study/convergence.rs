@@ -119,7 +119,7 @@ pub fn curves(ctx: &Ctx, scene: &PathBuf, integrator: &str) -> Result<Curves, St
     Ok(Curves {
         scene: stem(scene),
         integrator: integrator.into(),
-        consistent: entries[0].record.kind == "consistent",
+        consistent: entries[0].record.consistent(),
         passes,
         seconds,
         mse: m,

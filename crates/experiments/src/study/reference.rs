@@ -45,7 +45,7 @@ pub fn spec(scale: &Scale, scene: &Path, max_depth: Option<u32>) -> Result<RunSp
         .unwrap_or_default();
     let (integrator, _) = integrator_for(&stem);
     let res = super::output::film(scale, scene)?;
-    let mut s = if integrator == "vcm" {
+    let mut s = if crate::runs::is_consistent(integrator) {
         RunSpec::new(
             scene,
             integrator,
@@ -103,7 +103,7 @@ impl Reference {
             integrator: e.record.spec.integrator.clone(),
             passes: e.record.spec.passes,
             runs: e.record.spec.runs,
-            consistent: e.record.kind == "consistent",
+            consistent: e.record.consistent(),
             seconds: e.record.seconds.last().copied().unwrap_or(0.0),
         })
     }

@@ -34,7 +34,9 @@
 //! (κ > τ); paths over their tolerance; paths over 1e-4, 1e-5, 1e-6 relative; max |replayed −
 //! oracle| weight (bdpt).
 
-use clap::Args;
+use super::tolerance::{
+    condition, path_tolerance, relative, DEFAULT_TOLERANCE, STRICT_LEVELS, SUM_TOLERANCE,
+};
 use lt_core::bsdf::TransportMode;
 use lt_core::math::{Color, Vec2};
 use lt_core::path::{oracle_weight, Heuristic, Path, PathVertex, VertexKind};
@@ -45,49 +47,7 @@ use lt_integrators::connect::eval_towards;
 use lt_integrators::pt::{Pt, PtParams, Techniques};
 use lt_integrators::record::{Completed, Recorder};
 use std::collections::BTreeSet;
-use std::fmt::{self, Write as _};
-use std::path::PathBuf;
-
-/// Default tolerance of check (a), relative (see the module docs and `lt mis-check --help`).
-pub const DEFAULT_TOLERANCE: f64 = 1e-3;
-/// Tolerance of check (b), absolute on Σ w − 1 (f64 arithmetic on consistent densities for bdpt;
-/// two complementary f32 weights for pt).
-pub const SUM_TOLERANCE: f64 = 1e-6;
-/// Stricter levels of (a) whose exceedances the table counts, for the record.
-pub const STRICT_LEVELS: [f64; 3] = [1e-4, 1e-5, 1e-6];
-
-#[derive(Args, Debug, Clone)]
-pub struct MisCheckArgs {
-    /// Scene file (TOML).
-    pub scene: PathBuf,
-    /// Integrator whose weights are checked: pt, bdpt, vcm or bpm.
-    #[arg(long, default_value = "bdpt")]
-    pub integrator: String,
-    /// MIS heuristic: power (the integrators' default), balance, or none (bdpt only).
-    #[arg(long)]
-    pub mis: Option<String>,
-    /// Paths to check per (path length, technique); each length gets at least this many.
-    #[arg(long, default_value_t = 1000)]
-    pub paths: usize,
-    /// Longest path in segments (default: the scene's max_depth).
-    #[arg(long)]
-    pub max_depth: Option<u32>,
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Film resolution (square) the passes run at.
-    #[arg(long, default_value_t = 16)]
-    pub resolution: u32,
-    /// Give up on lengths still short of `paths` after this many passes.
-    #[arg(long, default_value_t = 2000)]
-    pub max_passes: u32,
-    /// bdpt: light subpaths per pass (default: the pixel count).
-    #[arg(long)]
-    pub light_paths: Option<u64>,
-    /// Relative tolerance τ of the integrator's weight against the oracle's; a path of condition κ
-    /// (segment direction error / |cos|) is held to max(τ, κ).
-    #[arg(long, default_value_t = DEFAULT_TOLERANCE)]
-    pub tolerance: f64,
-}
+use std::fmt;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Which {
@@ -309,29 +269,6 @@ pub struct PathCheck {
     pub replay_error: f64,
     /// Techniques the oracle considers valid with non-zero density.
     pub valid: Vec<usize>,
-}
-
-/// Relative difference |a − b| / max(|a|, |b|) (0 when both are 0; NaN counts as 1).
-fn relative(a: f64, b: f64) -> f64 {
-    if a == b {
-        return 0.0;
-    }
-    let r = (a - b).abs() / a.abs().max(b.abs());
-    if r.is_nan() {
-        1.0
-    } else {
-        r
-    }
-}
-
-/// How far the oracle's densities can stray from the walk's on this path: `Path::condition`.
-pub fn condition(path: &Path) -> f64 {
-    path.condition()
-}
-
-/// The tolerance of (a) for a path of condition `kappa`: `tolerance`, or κ when larger.
-pub fn path_tolerance(tolerance: f64, kappa: f64) -> f64 {
-    tolerance.max(kappa)
 }
 
 fn unit_towards(from: &PathVertex, to: &PathVertex) -> lt_core::Vec3 {
@@ -774,53 +711,5 @@ impl fmt::Display for Report {
             self.checked(),
             self.failures()
         )
-    }
-}
-
-/// `lt mis-check`: the report, or an error carrying it when any check fails.
-pub fn run(args: &MisCheckArgs) -> Result<String, String> {
-    if matches!(args.integrator.as_str(), "vcm" | "bpm") {
-        return crate::mis_check_vcm::run(args);
-    }
-    let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
-    let integrator = Which::parse(&args.integrator)?;
-    let mut opts = Options::new(&scene, integrator);
-    if let Some(m) = &args.mis {
-        opts.heuristic = Heuristic::parse(m)?;
-        if integrator == Which::Pt && opts.heuristic == Heuristic::Uniform {
-            return Err("mis-check: pt takes power or balance".into());
-        }
-    }
-    if let Some(d) = args.max_depth {
-        if d == 0 {
-            return Err("mis-check: max_depth must be at least 1".into());
-        }
-        opts.max_depth = d;
-    }
-    if args.light_paths == Some(0) {
-        return Err("mis-check: light_paths must be at least 1".into());
-    }
-    if args.light_paths.is_some() && integrator == Which::Pt {
-        return Err("mis-check: --light-paths is a bdpt option".into());
-    }
-    opts.paths = args.paths;
-    opts.seed = args.seed;
-    opts.resolution = args.resolution.max(1);
-    opts.max_passes = args.max_passes;
-    opts.light_paths = args.light_paths;
-    opts.tolerance = args.tolerance;
-    let name = args.scene.display().to_string();
-    let report = check_scene(&mut scene, &opts, &name);
-    let mut out = String::new();
-    let _ = write!(out, "{report}");
-    if report.passed() {
-        Ok(out)
-    } else {
-        print!("{out}");
-        Err(format!(
-            "mis-check: {} of {} paths fail",
-            report.failures(),
-            report.checked()
-        ))
     }
 }

@@ -14,7 +14,7 @@
 //! weight reads the light vertex's incoming direction twice (measured: one merge of 2700 on
 //! smallvcm-spheres-point at 1.13 κ, none above 2 κ).
 
-use crate::mis_check::{path_tolerance, MisCheckArgs, DEFAULT_TOLERANCE, SUM_TOLERANCE};
+use super::tolerance::{path_tolerance, relative, DEFAULT_TOLERANCE, SUM_TOLERANCE};
 use lt_core::path::{Densities, Heuristic, Path, PathVertex, SubpathMis, Technique, TechniqueSet};
 use lt_core::Scene;
 use lt_integrators::connect_merge::{initial_radius, Engine, VcmParams};
@@ -22,7 +22,7 @@ use lt_integrators::radius::InitialRadius;
 use lt_integrators::record::{Completed, Merged, Recorder};
 use lt_integrators::splat::Splats;
 use std::collections::BTreeMap;
-use std::fmt::{self, Write as _};
+use std::fmt;
 
 /// What to sample and how to judge it.
 #[derive(Clone, Copy, Debug)]
@@ -249,18 +249,6 @@ pub struct VcmCheck {
     /// Largest |replayed − oracle| weight over the techniques.
     pub replay_error: f64,
     pub techniques: Vec<Technique>,
-}
-
-fn relative(a: f64, b: f64) -> f64 {
-    if a == b {
-        return 0.0;
-    }
-    let r = (a - b).abs() / a.abs().max(b.abs());
-    if r.is_nan() {
-        1.0
-    } else {
-        r
-    }
 }
 
 fn densities(scene: &Scene, path: &Path, ratio: f64) -> Densities {
@@ -528,38 +516,5 @@ impl fmt::Display for VcmReport {
             self.merges(),
             self.failures()
         )
-    }
-}
-
-/// `lt mis-check --integrator vcm|bpm`.
-pub fn run(args: &MisCheckArgs) -> Result<String, String> {
-    let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
-    let mut opts = VcmOptions::new(&scene, args.integrator == "vcm");
-    if let Some(m) = &args.mis {
-        opts.heuristic = Heuristic::parse(m)?;
-    }
-    if let Some(d) = args.max_depth {
-        if d == 0 {
-            return Err("mis-check: max_depth must be at least 1".into());
-        }
-        opts.max_depth = d;
-    }
-    if args.light_paths == Some(0) {
-        return Err("mis-check: light_paths must be at least 1".into());
-    }
-    opts.light_paths = args.light_paths;
-    opts.paths = args.paths;
-    opts.seed = args.seed;
-    opts.resolution = args.resolution;
-    opts.max_passes = args.max_passes;
-    opts.tolerance = args.tolerance;
-    let name = args.scene.display().to_string();
-    let report = check_scene(&mut scene, &opts, &name);
-    let mut out = String::new();
-    write!(out, "{report}").unwrap();
-    if report.passed() {
-        Ok(out)
-    } else {
-        Err(out)
     }
 }

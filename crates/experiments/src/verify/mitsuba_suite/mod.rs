@@ -7,7 +7,7 @@ pub mod cases;
 pub mod judge;
 pub mod table;
 
-use crate::image_io::{read_exr, write_atomic};
+use crate::image_io::read_exr;
 use cases::Case;
 use judge::Judgement;
 use lt_core::Scene;
@@ -17,39 +17,11 @@ use lt_integrators::render::{render, RenderOptions};
 use lt_integrators::{make_integrator, IntegratorParams};
 use lt_scene_io::{load_scene_with, LoadOptions};
 use std::ops::ControlFlow;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
-#[derive(clap::Args, Debug)]
-pub struct SuiteArgs {
-    /// A copy of mitsuba-data (the folder holding tests/scenes), e.g. ../shared/mitsuba-render-tests.
-    pub dir: PathBuf,
-    /// Independent passes per estimator (their spread gives the standard errors).
-    #[arg(long, default_value_t = 32)]
-    pub passes: u32,
-    /// Samples per pixel in each pass.
-    #[arg(long, default_value_t = 8)]
-    pub spp: u32,
-    /// Time budget per scene in seconds, shared by its estimators; an estimator stops at its share
-    /// with the passes it finished (at least 2 are needed).
-    #[arg(long, default_value_t = 12.0)]
-    pub time_per_scene: f64,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// Only the scenes whose name (`folder/file` without `.xml`) contains one of these strings
-    /// (repeatable). A partial run prints its table but writes it only where `--out` says, so the
-    /// committed scoreboard is never overwritten by a part of it.
-    #[arg(long)]
-    pub only: Vec<String>,
-    /// Where the table is written (atomically); default results/mitsuba-render-tests.md for a
-    /// full run, nowhere for a partial one.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-}
-
 /// The scoreboard's home, written by a full run.
-const DEFAULT_OUT: &str = "results/mitsuba-render-tests.md";
+pub const DEFAULT_OUT: &str = "results/mitsuba-render-tests.md";
 
 /// What every render of the suite may spend.
 #[derive(Clone, Debug)]
@@ -205,54 +177,4 @@ fn render_batches(
     }
     let spp = batches.count() * k as u64;
     Ok((batches, spp))
-}
-
-/// The command: runs the suite, prints the table and writes it to `args.out` atomically.
-pub fn run(args: &SuiteArgs) -> Result<(), String> {
-    if args.passes < 2 {
-        return Err("--passes must be at least 2 (standard errors come from their spread)".into());
-    }
-    if !(args.time_per_scene > 0.0) {
-        return Err(format!(
-            "--time-per-scene must be positive, got {}",
-            args.time_per_scene
-        ));
-    }
-    let budget = Budget {
-        passes: args.passes,
-        spp_per_pass: args.spp.max(1),
-        time_per_estimator: Duration::from_secs_f64(args.time_per_scene / 2.0),
-        threads: args.threads,
-        seed: 0,
-    };
-    let rows = run_suite_only(&args.dir, &budget, &args.only)?;
-    if rows.is_empty() {
-        return Err(format!(
-            "no scene of {} matches --only {}",
-            args.dir.display(),
-            args.only.join(", ")
-        ));
-    }
-    let mut command = format!(
-        "lt mitsuba-suite {} --passes {} --spp {} --time-per-scene {}",
-        args.dir.display(),
-        args.passes,
-        args.spp,
-        args.time_per_scene
-    );
-    for o in &args.only {
-        command += &format!(" --only {o}");
-    }
-    let md = table::markdown(&rows, &budget, &command);
-    print!("{md}");
-    let out = match (&args.out, args.only.is_empty()) {
-        (Some(out), _) => out.clone(),
-        (None, true) => PathBuf::from(DEFAULT_OUT),
-        (None, false) => return Ok(()),
-    };
-    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent)
-            .map_err(|e| format!("cannot create {}: {e}", parent.display()))?;
-    }
-    write_atomic(&out, md.as_bytes())
 }

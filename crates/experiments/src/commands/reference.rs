@@ -58,7 +58,7 @@ pub fn run(args: &ReferenceArgs) -> Result<(), String> {
         let s = RunSpec::new(&args.scene, &integrator, REFERENCE_SEED, passes)
             .resolution(resolution)
             .runs(runs);
-        if integrator == "vcm" && args.integrator.is_none() {
+        if consistent && args.integrator.is_none() {
             s.param("radius_px", 1)
         } else {
             s

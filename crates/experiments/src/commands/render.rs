@@ -1,8 +1,9 @@
 //! `lt render`: one scene, one integrator, written as linear EXR plus an sRGB PNG preview, a
 //! standard-error EXR and a JSON record of how the image was made.
 
-use crate::image_io::{write_exr, write_png_preview};
-use crate::strategies::{make_bdpt, write_pyramid, PyramidIntegrator, PyramidMeta};
+use crate::cluster::partial::{normalize_params, parse_pass_range, PartialJob, Span};
+use crate::image_io::{mean_of, sibling, write_outputs};
+use crate::verify::strategies::{make_bdpt, write_pyramid, PyramidIntegrator, PyramidMeta};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use lt_estimators::Image;
@@ -62,45 +63,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "DIR")]
     pub strategies: Option<PathBuf>,
     /// Longest path length k (segments) in the pyramid written by --strategies.
-    #[arg(long, value_name = "L", default_value_t = crate::strategies::DEFAULT_LENGTH)]
+    #[arg(long, value_name = "L", default_value_t = crate::verify::strategies::DEFAULT_LENGTH)]
     pub strategy_length: usize,
-}
-
-/// Paths of everything written beside the main EXR.
-pub fn sibling(out: &Path, suffix: &str) -> PathBuf {
-    let stem = out
-        .file_stem()
-        .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_default();
-    out.with_file_name(format!("{stem}{suffix}"))
-}
-
-/// Writes the image, its preview and, when there is an honest one, its standard error. Where
-/// there is none (one run of a consistent estimator) a stale `.stderr.exr` from an earlier render
-/// is removed, so no file beside the image claims an error bar it does not have.
-pub fn write_outputs(out: &Path, mean: &Image, std_error: Option<&Image>) -> Result<(), String> {
-    write_exr(out, mean)?;
-    write_png_preview(&sibling(out, ".png"), mean)?;
-    let se_path = sibling(out, ".stderr.exr");
-    match std_error {
-        Some(se) => write_exr(&se_path, se),
-        None => match std::fs::remove_file(&se_path) {
-            Ok(()) => Ok(()),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-            Err(e) => Err(format!("cannot remove stale {}: {e}", se_path.display())),
-        },
-    }
-}
-
-/// The mean over pixels and channels of a standard-error image (NaN-free pixels only).
-pub fn mean_of(img: &Image) -> f64 {
-    let (sum, n) = img
-        .data
-        .iter()
-        .flatten()
-        .filter(|v| v.is_finite())
-        .fold((0.0, 0u64), |(s, n), v| (s + v, n + 1));
-    sum / n.max(1) as f64
 }
 
 fn log_json(log: &ProgressLog) -> serde_json::Value {
@@ -114,7 +78,7 @@ fn log_json(log: &ProgressLog) -> serde_json::Value {
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
     if let Some(part) = &args.partial {
-        return crate::cluster::partial::render_partial_cmd(args, part);
+        return run_partial(args, part);
     }
     if let Some(p) = &args.passes {
         return Err(format!(
@@ -357,4 +321,85 @@ fn progress_bar(args: &RenderArgs, passes: u32) -> ProgressBar {
         .unwrap(),
     );
     bar
+}
+
+/// `lt render … --partial OUT [--passes A..B]`: one part, written to OUT.
+fn run_partial(args: &RenderArgs, out: &Path) -> Result<(), String> {
+    if args.runs == 0 {
+        return Err("--runs must be at least 1".into());
+    }
+    if args.time.is_some() {
+        return Err(
+            "--partial takes a fixed number of passes (--passes A..B or --spp N), not \
+                    --time: a part must be reproducible to be merged"
+                .into(),
+        );
+    }
+    if args.output.is_some() || args.strategies.is_some() {
+        return Err(
+            "--partial writes the part only: drop -o/--strategies (lt merge writes the \
+                    images)"
+                .into(),
+        );
+    }
+    let params = normalize_params(args.integrator_args.to_params()?.pairs());
+    let mut job = PartialJob {
+        scene: args.scene.clone(),
+        resolution: None,
+        integrator: args.integrator.clone(),
+        params,
+        span: Span::Runs {
+            first_seed: args.seed,
+            runs: 1,
+            passes: 1,
+        },
+    };
+    let scene = job.load_scene()?;
+    let kind = lt_integrators::registry::find(&args.integrator)?.kind;
+    let passes = args.spp.unwrap_or(scene.settings.spp);
+    if passes == 0 {
+        return Err("--spp must be at least 1".into());
+    }
+    job.span = match (&args.passes, args.runs) {
+        (Some(_), _) if args.spp.is_some() => {
+            return Err("give --passes A..B or --spp N, not both".into())
+        }
+        (Some(_), k) if k > 1 => {
+            return Err(
+                "--passes splits one run into ranges; with --runs K a part holds whole runs \
+                 (split the seeds with --seed S --runs K)"
+                    .into(),
+            )
+        }
+        (Some(r), _) => {
+            let (start, end) = parse_pass_range(r)?;
+            Span::Passes {
+                seed: args.seed,
+                start,
+                end,
+            }
+        }
+        (None, 1) if kind == lt_integrators::Kind::Unbiased => Span::Passes {
+            seed: args.seed,
+            start: 0,
+            end: passes,
+        },
+        (None, k) => Span::Runs {
+            first_seed: args.seed,
+            runs: k,
+            passes,
+        },
+    };
+    let part = job.render(&scene, args.threads, |_, _| {})?;
+    part.write(out)?;
+    if !args.quiet {
+        eprintln!(
+            "{}: {} in {:.2} s -> {}",
+            args.integrator,
+            part.header.span.describe(),
+            part.header.seconds,
+            out.display()
+        );
+    }
+    Ok(())
 }

@@ -1,0 +1,134 @@
+//! `lt mis-check`: an integrator's MIS weights against the path-space oracle
+//! (`crate::verify::mis_check`).
+
+use crate::verify::mis_check::pt_bdpt::{check_scene, Options, Which};
+use crate::verify::mis_check::tolerance::DEFAULT_TOLERANCE;
+use crate::verify::mis_check::vcm_bpm::{self, VcmOptions};
+use clap::Args;
+use lt_core::path::Heuristic;
+use lt_integrators::registry::{self, Weights};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+#[derive(Args, Debug, Clone)]
+pub struct MisCheckArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Integrator whose weights are checked: pt, bdpt, vcm or bpm.
+    #[arg(long, default_value = "bdpt")]
+    pub integrator: String,
+    /// MIS heuristic: power (the integrators' default), balance, or none (bdpt only).
+    #[arg(long)]
+    pub mis: Option<String>,
+    /// Paths to check per (path length, technique); each length gets at least this many.
+    #[arg(long, default_value_t = 1000)]
+    pub paths: usize,
+    /// Longest path in segments (default: the scene's max_depth).
+    #[arg(long)]
+    pub max_depth: Option<u32>,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Film resolution (square) the passes run at.
+    #[arg(long, default_value_t = 16)]
+    pub resolution: u32,
+    /// Give up on lengths still short of `paths` after this many passes.
+    #[arg(long, default_value_t = 2000)]
+    pub max_passes: u32,
+    /// bdpt: light subpaths per pass (default: the pixel count).
+    #[arg(long)]
+    pub light_paths: Option<u64>,
+    /// Relative tolerance τ of the integrator's weight against the oracle's; a path of condition κ
+    /// (segment direction error / |cos|) is held to max(τ, κ).
+    #[arg(long, default_value_t = DEFAULT_TOLERANCE)]
+    pub tolerance: f64,
+}
+
+/// `lt mis-check`: the report, or an error carrying it when any check fails.
+pub fn run(args: &MisCheckArgs) -> Result<String, String> {
+    let integrator = match registry::find(&args.integrator)?.weights {
+        Weights::PathTracing => Which::Pt,
+        Weights::Connections => Which::Bdpt,
+        Weights::ConnectMerge { connections } => return run_vcm_bpm(args, connections),
+        Weights::None => {
+            let checked: Vec<&str> = registry::with_weights(|w| w != Weights::None).collect();
+            return Err(format!(
+                "mis-check: {} applies no MIS weights (the integrators that do: {})",
+                args.integrator,
+                checked.join(", ")
+            ));
+        }
+    };
+    let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let mut opts = Options::new(&scene, integrator);
+    if let Some(m) = &args.mis {
+        opts.heuristic = Heuristic::parse(m)?;
+        if integrator == Which::Pt && opts.heuristic == Heuristic::Uniform {
+            return Err("mis-check: pt takes power or balance".into());
+        }
+    }
+    if let Some(d) = args.max_depth {
+        if d == 0 {
+            return Err("mis-check: max_depth must be at least 1".into());
+        }
+        opts.max_depth = d;
+    }
+    if args.light_paths == Some(0) {
+        return Err("mis-check: light_paths must be at least 1".into());
+    }
+    if args.light_paths.is_some() && integrator == Which::Pt {
+        return Err("mis-check: --light-paths is a bdpt option".into());
+    }
+    opts.paths = args.paths;
+    opts.seed = args.seed;
+    opts.resolution = args.resolution.max(1);
+    opts.max_passes = args.max_passes;
+    opts.light_paths = args.light_paths;
+    opts.tolerance = args.tolerance;
+    let name = args.scene.display().to_string();
+    let report = check_scene(&mut scene, &opts, &name);
+    let mut out = String::new();
+    let _ = write!(out, "{report}");
+    if report.passed() {
+        Ok(out)
+    } else {
+        print!("{out}");
+        Err(format!(
+            "mis-check: {} of {} paths fail",
+            report.failures(),
+            report.checked()
+        ))
+    }
+}
+
+/// `lt mis-check --integrator vcm|bpm`: vcm has connections, bpm has merges only.
+fn run_vcm_bpm(args: &MisCheckArgs, connections: bool) -> Result<String, String> {
+    let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let mut opts = VcmOptions::new(&scene, connections);
+    if let Some(m) = &args.mis {
+        opts.heuristic = Heuristic::parse(m)?;
+    }
+    if let Some(d) = args.max_depth {
+        if d == 0 {
+            return Err("mis-check: max_depth must be at least 1".into());
+        }
+        opts.max_depth = d;
+    }
+    if args.light_paths == Some(0) {
+        return Err("mis-check: light_paths must be at least 1".into());
+    }
+    opts.light_paths = args.light_paths;
+    opts.paths = args.paths;
+    opts.seed = args.seed;
+    opts.resolution = args.resolution;
+    opts.max_passes = args.max_passes;
+    opts.tolerance = args.tolerance;
+    let name = args.scene.display().to_string();
+    let report = vcm_bpm::check_scene(&mut scene, &opts, &name);
+    let mut out = String::new();
+    write!(out, "{report}").unwrap();
+    if report.passed() {
+        Ok(out)
+    } else {
+        Err(out)
+    }
+}

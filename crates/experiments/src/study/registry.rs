@@ -1,0 +1,84 @@
+//! The one table of studies: `lt study NAME`, `lt plan study NAME`, `lt collect` and the report's
+//! order all read it. Adding a study is one entry here (and its module).
+
+use super::context::Ctx;
+use super::scale::Scale;
+use super::{convergence, equal_time, per_length, radius_shrinkage, smoke, unbiased_consistent};
+use crate::runs::RunSpec;
+
+/// What the table knows of one study.
+pub struct StudyInfo {
+    /// The name on the command line and of its folder under the results.
+    pub name: &'static str,
+    /// Whether `lt study all` runs it and `lt study`'s help lists it; a hidden study (`smoke`)
+    /// exists for the tests of plans and is run only by name.
+    pub listed: bool,
+    /// Every render the study asks for at a scale. The context, when given, holds the caches
+    /// (the equal-time study plans its pass counts from the convergence study's timings there;
+    /// without it, it plans the renders that need none).
+    pub specs: fn(&Scale, Option<&Ctx>) -> Result<Vec<RunSpec>, String>,
+    /// Renders what the cache lacks and writes the study's outputs under `RESULTS/<name>/`.
+    pub run: fn(&Ctx) -> Result<(), String>,
+}
+
+/// The studies in the order `lt study all` runs them and the report shows them.
+pub const STUDIES: &[StudyInfo] = &[
+    StudyInfo {
+        name: "convergence",
+        listed: true,
+        specs: |scale, _| Ok(convergence::specs(scale)),
+        run: convergence::run,
+    },
+    StudyInfo {
+        name: "unbiased-vs-consistent",
+        listed: true,
+        specs: |scale, _| Ok(unbiased_consistent::specs(scale)),
+        run: unbiased_consistent::run,
+    },
+    StudyInfo {
+        name: "radius-shrinkage",
+        listed: true,
+        specs: |scale, _| Ok(radius_shrinkage::specs(scale)),
+        run: radius_shrinkage::run,
+    },
+    StudyInfo {
+        name: "equal-time",
+        listed: true,
+        specs: |scale, ctx| match ctx {
+            Some(c) => equal_time::specs(c),
+            None => Ok(equal_time::fixed_specs(scale)),
+        },
+        run: equal_time::run,
+    },
+    StudyInfo {
+        name: "per-length",
+        listed: true,
+        specs: |scale, _| Ok(per_length::specs(scale)),
+        run: per_length::run,
+    },
+    StudyInfo {
+        name: "smoke",
+        listed: false,
+        specs: |scale, _| smoke::specs(scale),
+        run: smoke::run,
+    },
+];
+
+/// The listed studies' names, in table order: what `all` means.
+pub fn names() -> impl Iterator<Item = &'static str> {
+    STUDIES.iter().filter(|s| s.listed).map(|s| s.name)
+}
+
+/// The studies `name` stands for: one, or every listed one for `all`.
+pub fn resolve(name: &str) -> Result<Vec<&'static StudyInfo>, String> {
+    if name == "all" {
+        return Ok(STUDIES.iter().filter(|s| s.listed).collect());
+    }
+    match STUDIES.iter().find(|s| s.name == name) {
+        Some(s) => Ok(vec![s]),
+        None => Err(format!(
+            "unknown study '{name}': the studies are {} and all",
+            names().collect::<Vec<_>>().join(", ")
+        )),
+    }
+}

@@ -1,0 +1,11 @@
+//! `lt mis-check`: samples paths with an integrator's own code (through its `Recorder` hooks) and
+//! holds the MIS weights it applied to the from-scratch oracle of `lt_core::path`.
+//!
+//! - `pt_bdpt`: pt's and bdpt's weights (connection techniques), and bdpt's replayed for every
+//!   technique of the path.
+//! - `vcm_bpm`: vcm's and bpm's (connections and merges), and their recursion replayed.
+//! - `tolerance`: how far a weight may stray from the oracle's.
+
+pub mod pt_bdpt;
+pub mod tolerance;
+pub mod vcm_bpm;
