@@ -186,6 +186,20 @@ impl Material {
         self.local().has_delta_lobe()
     }
 
+    /// The probability that `sample` from `wo` picks a delta lobe (0 for smooth materials): every
+    /// material chooses its delta lobe when `u_lobe` is below its probability, so the sample at
+    /// `u_lobe` = 0 reports it. For walks that treat a material's delta and smooth lobes apart
+    /// (the camera paths of photon mapping).
+    pub fn delta_lobe_probability(&self, sf: &ShadingFrame, wo: Vec3) -> f32 {
+        if !self.has_delta_lobe() {
+            return 0.0;
+        }
+        match self.sample(sf, wo, 0.0, Vec2::splat(0.5), TransportMode::Radiance) {
+            Some(s) if s.delta => s.pdf_w,
+            _ => 0.0,
+        }
+    }
+
     pub fn sample(
         &self,
         sf: &ShadingFrame,
