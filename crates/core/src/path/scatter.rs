@@ -123,7 +123,9 @@ pub fn scatter(
     // Refraction near grazing exit magnifies the positions' angular error by η·cos θt / cos θi,
     // beyond `tol`; the match still stands when it is unambiguous (the other lobe is far further
     // away) and the direction is within MAGNIFIED_TOL of the lobe.
-    if dist < tol || (dist < UNAMBIGUOUS_RATIO * other && dist < MAGNIFIED_TOL) {
+    // Beside smooth lobes the magnified match is off: a smooth direction may fall that close.
+    let unambiguous = m.is_delta() && dist < UNAMBIGUOUS_RATIO * other && dist < MAGNIFIED_TOL;
+    if dist < tol || unambiguous {
         sc
     } else {
         missed()
