@@ -22,9 +22,11 @@ mod glossy;
 pub mod microfacet;
 mod mirror;
 pub mod perturbed;
+pub mod plastic;
 mod quadrature;
 pub mod refraction;
 mod rough_conductor;
+pub mod rough_plastic;
 pub mod textured;
 mod two_sided;
 
@@ -34,7 +36,9 @@ pub use diffuse::Diffuse;
 pub use glossy::Glossy;
 pub use mirror::Mirror;
 pub use perturbed::{NormalSource, Perturbed};
+pub use plastic::Plastic;
 pub use rough_conductor::RoughConductor;
+pub use rough_plastic::RoughPlastic;
 pub use textured::{TextureSlot, Textured};
 pub use two_sided::TwoSided;
 
@@ -118,6 +122,12 @@ pub trait LocalBsdf {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
     /// True when every lobe is a delta: such a vertex can never be connected to.
     fn is_delta(&self) -> bool;
+    /// True when some lobe is a delta (all of them, or a delta beside others, as plastic's
+    /// specular lobe): `sample` may then return `delta` samples, and a vertex that scattered
+    /// through one cannot be joined inside a path (`path::scatter::connectable_inside`).
+    fn has_delta_lobe(&self) -> bool {
+        self.is_delta()
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -128,6 +138,9 @@ pub enum Material {
     Glossy(Glossy),
     Conductor(Conductor),
     RoughConductor(RoughConductor),
+    /// Mitsuba's `plastic`: a delta lobe beside a diffuse one.
+    Plastic(Plastic),
+    RoughPlastic(RoughPlastic),
     /// Mitsuba's `twosided` around a one-sided material (conductors, plastics, …).
     TwoSided(TwoSided),
     /// Parameters read from textures at the shading point's uv.
@@ -146,6 +159,8 @@ impl Material {
             Material::Glossy(m) => m,
             Material::Conductor(m) => m,
             Material::RoughConductor(m) => m,
+            Material::Plastic(m) => m,
+            Material::RoughPlastic(m) => m,
             Material::TwoSided(m) => m,
             Material::Textured(t) => t.base.local(),
             Material::Perturbed(p) => p.inner.local(),
@@ -164,6 +179,25 @@ impl Material {
 
     pub fn is_delta(&self) -> bool {
         self.local().is_delta()
+    }
+
+    /// See `LocalBsdf::has_delta_lobe`.
+    pub fn has_delta_lobe(&self) -> bool {
+        self.local().has_delta_lobe()
+    }
+
+    /// The probability that `sample` from `wo` picks a delta lobe (0 for smooth materials): every
+    /// material chooses its delta lobe when `u_lobe` is below its probability, so the sample at
+    /// `u_lobe` = 0 reports it. For walks that treat a material's delta and smooth lobes apart
+    /// (the camera paths of photon mapping).
+    pub fn delta_lobe_probability(&self, sf: &ShadingFrame, wo: Vec3) -> f32 {
+        if !self.has_delta_lobe() {
+            return 0.0;
+        }
+        match self.sample(sf, wo, 0.0, Vec2::splat(0.5), TransportMode::Radiance) {
+            Some(s) if s.delta => s.pdf_w,
+            _ => 0.0,
+        }
     }
 
     pub fn sample(
@@ -315,6 +349,24 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
         })
     };
     use microfacet::MicrofacetType::{Beckmann, Ggx};
+    let polypropylene = plastic::POLYPROPYLENE_IOR / plastic::AIR_IOR;
+    let plastic = |diffuse, nonlinear| {
+        Material::Plastic(Plastic::new(
+            polypropylene,
+            diffuse,
+            Color::new(1.0, 0.9, 0.8),
+            nonlinear,
+        ))
+    };
+    let rough_plastic = |kind, alpha, sample_visible, nonlinear| {
+        Material::RoughPlastic(RoughPlastic::new(
+            microfacet::Microfacet::new(kind, alpha, alpha, sample_visible),
+            polypropylene,
+            c,
+            Color::ONE,
+            nonlinear,
+        ))
+    };
     vec![
         ("diffuse", Material::Diffuse(Diffuse { albedo: c })),
         ("mirror", Material::Mirror(Mirror { reflectance: c })),
@@ -367,6 +419,54 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
                     crate::texture::Texture::Constant(Color::new(0.2, 0.7, 0.4)),
                 )],
             })),
+        ),
+        ("plastic", plastic(c, false)),
+        ("plastic-nonlinear", plastic(c, true)),
+        (
+            "plastic-ior-2.4-dark",
+            Material::Plastic(Plastic::new(
+                2.4,
+                Color::new(0.05, 0.1, 0.02),
+                Color::ONE,
+                false,
+            )),
+        ),
+        (
+            "roughplastic-beckmann-0.05",
+            rough_plastic(Beckmann, 0.05, true, false),
+        ),
+        (
+            "roughplastic-beckmann-0.3-nonlinear",
+            rough_plastic(Beckmann, 0.3, true, true),
+        ),
+        (
+            "roughplastic-beckmann-0.3-all",
+            rough_plastic(Beckmann, 0.3, false, false),
+        ),
+        (
+            "roughplastic-ggx-0.1-nonlinear",
+            rough_plastic(Ggx, 0.1, true, true),
+        ),
+        ("roughplastic-ggx-0.5", rough_plastic(Ggx, 0.5, true, false)),
+        (
+            "roughplastic-ggx-0.2-all",
+            rough_plastic(Ggx, 0.2, false, false),
+        ),
+        (
+            "textured-plastic",
+            Material::Textured(Box::new(Textured {
+                base: plastic(c, false),
+                slots: vec![(
+                    TextureSlot::Reflectance,
+                    crate::texture::Texture::Constant(Color::new(0.2, 0.7, 0.4)),
+                )],
+            })),
+        ),
+        (
+            "twosided-roughplastic-ggx-0.3",
+            Material::TwoSided(TwoSided {
+                inner: Box::new(rough_plastic(Ggx, 0.3, true, false)),
+            }),
         ),
         (
             "twosided-roughconductor-ggx-0.3",

@@ -19,7 +19,9 @@ use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TwoSided,
 };
+use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight};
 use lt_core::bsdf::{NormalSource, Perturbed, TextureSlot, Textured};
+use lt_core::bsdf::{Plastic, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::math::{Color, Vec2};
 use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
@@ -676,6 +678,16 @@ impl<'a> Loader<'a> {
                     one_sided => one_sided,
                 }
             }
+            "plastic" | "roughplastic" => {
+                let one_sided = self.plastic(&p, &mut slots)?;
+                if in_twosided {
+                    Material::TwoSided(TwoSided {
+                        inner: Box::new(one_sided),
+                    })
+                } else {
+                    one_sided
+                }
+            }
             "normalmap" | "bumpmap" => {
                 let inner = match p.nested(&["bsdf"])[..] {
                     [one] => self.bsdf(one, in_twosided)?,
@@ -713,7 +725,7 @@ impl<'a> Loader<'a> {
             other => {
                 return Err(p.err(
                     e,
-                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, conductor, roughconductor, twosided, normalmap and bumpmap)"),
+                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, conductor, roughconductor, plastic, roughplastic, twosided, normalmap and bumpmap)"),
                 ))
             }
         };
@@ -818,6 +830,61 @@ impl<'a> Loader<'a> {
             }
         };
         Ok(texture)
+    }
+
+    /// Mitsuba's `plastic` and `roughplastic` (one-sided): `int_ior` (polypropylene), `ext_ior`
+    /// (air), `diffuse_reflectance` (0.5) and `specular_reflectance` (1), either a texture,
+    /// `nonlinear` (false); `roughplastic` adds the microfacet parameters (isotropic, α a
+    /// number). The lobe-sampling weight reads a textured reflectance's mean, as Mitsuba does.
+    fn plastic(
+        &mut self,
+        p: &Plugin<'a>,
+        slots: &mut Vec<(TextureSlot, Texture)>,
+    ) -> Result<Material, SceneError> {
+        let e = p.elem;
+        let int = self.ior(p, "int_ior", 1.49)?;
+        let ext = self.ior(p, "ext_ior", 1.000277)?;
+        let eta = (int / ext) as f32;
+        if !(eta.is_finite() && eta > 0.0) {
+            return Err(p.err(e, format!("the relative IOR {int}/{ext} is not a positive number")));
+        }
+        if p.kind == "roughplastic" && int == ext {
+            return Err(p.err(e, "roughplastic needs `int_ior` ≠ `ext_ior` (as Mitsuba)"));
+        }
+        let mut reflectance = |this: &mut Self, name, slot, default| {
+            let c = this.color_or_texture(p, name, slot, slots)?;
+            let mean = match c {
+                Some(c) => c,
+                None => slots
+                    .iter()
+                    .rfind(|(s, _)| *s == slot)
+                    .map_or(default, |(_, t)| t.mean()),
+            };
+            Ok::<_, SceneError>((c.unwrap_or(default), mean))
+        };
+        let (diffuse, diffuse_mean) =
+            reflectance(self, "diffuse_reflectance", TextureSlot::Reflectance, Color::splat(0.5))?;
+        let (specular, specular_mean) = reflectance(
+            self,
+            "specular_reflectance",
+            TextureSlot::SpecularReflectance,
+            Color::ONE,
+        )?;
+        let nonlinear = p.boolean("nonlinear")?.unwrap_or(false);
+        let weight = specular_sampling_weight(channel_mean(diffuse_mean), channel_mean(specular_mean));
+        Ok(if p.kind == "plastic" {
+            let mut m = Plastic::new(eta, diffuse, specular, nonlinear);
+            m.specular_sampling_weight = weight;
+            Material::Plastic(m)
+        } else {
+            let distribution = self.microfacet(p, slots)?;
+            if slots.iter().any(|(s, _)| *s == TextureSlot::Alpha) {
+                return Err(p.err(e, "roughplastic's `alpha` must be a number (Mitsuba takes no texture there)"));
+            }
+            let mut m = RoughPlastic::new(distribution, eta, diffuse, specular, nonlinear);
+            m.specular_sampling_weight = weight;
+            Material::RoughPlastic(m)
+        })
     }
 
     /// An IOR given as a number or by one of Mitsuba's names.
