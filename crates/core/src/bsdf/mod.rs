@@ -25,7 +25,9 @@ pub mod perturbed;
 mod quadrature;
 pub mod refraction;
 mod rough_conductor;
+mod rough_dielectric;
 pub mod textured;
+mod thin_dielectric;
 mod two_sided;
 
 pub use conductor::Conductor;
@@ -35,7 +37,9 @@ pub use glossy::Glossy;
 pub use mirror::Mirror;
 pub use perturbed::{NormalSource, Perturbed};
 pub use rough_conductor::RoughConductor;
+pub use rough_dielectric::RoughDielectric;
 pub use textured::{TextureSlot, Textured};
+pub use thin_dielectric::ThinDielectric;
 pub use two_sided::TwoSided;
 
 use crate::math::{Color, Frame, Vec2, Vec3};
@@ -128,6 +132,10 @@ pub enum Material {
     Glossy(Glossy),
     Conductor(Conductor),
     RoughConductor(RoughConductor),
+    /// Mitsuba's `roughdielectric`: microfacet reflection and refraction (Walter et al. 2007).
+    RoughDielectric(RoughDielectric),
+    /// Mitsuba's `thindielectric`: a pane, delta reflection and straight pass-through.
+    ThinDielectric(ThinDielectric),
     /// Mitsuba's `twosided` around a one-sided material (conductors, plastics, …).
     TwoSided(TwoSided),
     /// Parameters read from textures at the shading point's uv.
@@ -146,6 +154,8 @@ impl Material {
             Material::Glossy(m) => m,
             Material::Conductor(m) => m,
             Material::RoughConductor(m) => m,
+            Material::RoughDielectric(m) => m,
+            Material::ThinDielectric(m) => m,
             Material::TwoSided(m) => m,
             Material::Textured(t) => t.base.local(),
             Material::Perturbed(p) => p.inner.local(),
@@ -164,6 +174,19 @@ impl Material {
 
     pub fn is_delta(&self) -> bool {
         self.local().is_delta()
+    }
+
+    /// η_inside / η_outside of a material that refracts, i.e. whose radiance is scaled by
+    /// `refraction::refracted_throughput_scale` when a path crosses it (the thin dielectric
+    /// passes paths through into the medium they came from, so it is not one of them).
+    pub fn refraction_ior(&self) -> Option<f32> {
+        match self {
+            Material::Dielectric(d) => Some(d.ior),
+            Material::RoughDielectric(d) => Some(d.ior),
+            Material::Textured(t) => t.base.refraction_ior(),
+            Material::Perturbed(p) => p.inner.refraction_ior(),
+            _ => None,
+        }
     }
 
     pub fn sample(
@@ -314,6 +337,26 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
             specular_reflectance: Color::new(1.0, 0.8, 0.9),
         })
     };
+    let rough_glass = |kind, alpha_u, alpha_v, sample_visible, ior, tinted: bool| {
+        let (r, t) = if tinted {
+            (Color::new(0.9, 1.0, 0.7), Color::new(1.0, 0.6, 0.8))
+        } else {
+            (Color::ONE, Color::ONE)
+        };
+        Material::RoughDielectric(RoughDielectric {
+            distribution: microfacet::Microfacet::new(kind, alpha_u, alpha_v, sample_visible),
+            ior,
+            specular_reflectance: r,
+            specular_transmittance: t,
+        })
+    };
+    let pane = |ior, specular_reflectance, specular_transmittance| {
+        Material::ThinDielectric(ThinDielectric {
+            ior,
+            specular_reflectance,
+            specular_transmittance,
+        })
+    };
     use microfacet::MicrofacetType::{Beckmann, Ggx};
     vec![
         ("diffuse", Material::Diffuse(Diffuse { albedo: c })),
@@ -357,6 +400,39 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
         (
             "roughconductor-ggx-0.2x0.5-all",
             rough_gold(Ggx, 0.2, 0.5, false),
+        ),
+        (
+            "roughdielectric-beckmann-0.1-1.5",
+            rough_glass(Beckmann, 0.1, 0.1, true, 1.5, false),
+        ),
+        (
+            "roughdielectric-beckmann-0.3-1/1.5",
+            rough_glass(Beckmann, 0.3, 0.3, true, 1.0 / 1.5, true),
+        ),
+        (
+            "roughdielectric-beckmann-0.4x0.1-all-1.33",
+            rough_glass(Beckmann, 0.4, 0.1, false, 1.33, false),
+        ),
+        (
+            "roughdielectric-ggx-0.05-1.5",
+            rough_glass(Ggx, 0.05, 0.05, true, 1.5, false),
+        ),
+        (
+            "roughdielectric-ggx-0.3-2.4",
+            rough_glass(Ggx, 0.3, 0.3, true, 2.4, true),
+        ),
+        (
+            "roughdielectric-ggx-0.2x0.5-1.5",
+            rough_glass(Ggx, 0.2, 0.5, true, 1.5, false),
+        ),
+        (
+            "roughdielectric-ggx-0.6-all-1/1.33",
+            rough_glass(Ggx, 0.6, 0.6, false, 1.0 / 1.33, false),
+        ),
+        ("thindielectric-1.5", pane(1.5, Color::ONE, Color::ONE)),
+        (
+            "thindielectric-1.33-tinted",
+            pane(1.33, Color::new(0.9, 1.0, 0.7), Color::new(1.0, 0.6, 0.8)),
         ),
         (
             "textured-diffuse",

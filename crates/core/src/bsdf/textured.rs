@@ -64,6 +64,12 @@ pub fn set_parameter(m: &mut Material, slot: TextureSlot, value: Color) -> bool 
             let d = r.distribution;
             r.distribution = Microfacet::new(d.kind, value.x, value.x, d.sample_visible);
         }
+        (Material::RoughDielectric(r), SpecularReflectance) => r.specular_reflectance = value,
+        (Material::RoughDielectric(r), Alpha) => {
+            let d = r.distribution;
+            r.distribution = Microfacet::new(d.kind, value.x, value.x, d.sample_visible);
+        }
+        (Material::ThinDielectric(t), SpecularReflectance) => t.specular_reflectance = value,
         (Material::TwoSided(t), slot) => return set_parameter(&mut t.inner, slot, value),
         _ => return false,
     }
