@@ -293,6 +293,14 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_conductors() {
 
 /// Textures (checkerboard floor, bitmap wall, a rough conductor whose colour and α vary): every
 /// estimator must read the same parameters at the same uv, in both transport modes.
+/// Rough glass (a GGX slab, a Beckmann sphere) and a thin-glass pane the camera sees only
+/// through the slab: rough refraction in both transport modes (radiance scaled by 1/η² crossing
+/// an interface, importance not) and delta pass-through reached by light walks and BSDF samples.
+#[test]
+fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_rough_glass() {
+    per_depth("cornell-rough-glass", 1..=5);
+}
+
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_textured() {
     per_depth("cornell-textured", 1..=5);
