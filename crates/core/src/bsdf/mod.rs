@@ -176,6 +176,20 @@ impl Material {
         self.local().is_delta()
     }
 
+    /// True when light crosses the surface (the dielectrics): light arriving on one side leaves
+    /// on the other, so a photon or light vertex on the far side of such a surface is gathered
+    /// through its BTDF instead of refused as light behind a wall.
+    pub fn transmits(&self) -> bool {
+        match self {
+            Material::Dielectric(_)
+            | Material::RoughDielectric(_)
+            | Material::ThinDielectric(_) => true,
+            Material::Textured(t) => t.base.transmits(),
+            Material::Perturbed(p) => p.inner.transmits(),
+            _ => false,
+        }
+    }
+
     /// η_inside / η_outside of a material that refracts, i.e. whose radiance is scaled by
     /// `refraction::refracted_throughput_scale` when a path crosses it (the thin dielectric
     /// passes paths through into the medium they came from, so it is not one of them).
