@@ -707,6 +707,7 @@ impl<'a> Engine<'a> {
         let sf = lt_core::bsdf::ShadingFrame::new(zv.ng, zv.ns).with_uv(zv.uv);
         let bsdf = scene.material(material);
         let wo_side = zv.ng.dot(zv.wo);
+        let transmits = bsdf.transmits();
         let mut sum = Color::ZERO;
         grid.for_each_within(&lights.merge_positions, zv.p, setup.radius, |e, _| {
             let y = &lights.merge_vertex[e as usize];
@@ -719,8 +720,12 @@ impl<'a> Engine<'a> {
             // looks at z: light stored on the sunlit outside of a wall is never merged at the
             // inner surface meeting that wall at an edge (the leak the SmallVCM sun twin showed),
             // while merges across an inner corner stay.
+            // Through a surface that transmits, the light may arrive on the side facing away
+            // from the camera; it must still arrive on the same side of its own surface as of z's.
             let y_front = y.ng.dot(y.wi) > 0.0;
-            if zv.ng.dot(y.wi) * wo_side <= 0.0 || !(y.cos_g > 0.0) || y_front != (wo_side > 0.0) {
+            let arrives_front = zv.ng.dot(y.wi) > 0.0;
+            let same_side = zv.ng.dot(y.wi) * wo_side > 0.0;
+            if !(same_side || transmits) || !(y.cos_g > 0.0) || y_front != arrives_front {
                 return;
             }
             let ev = bsdf.eval(&sf, zv.wo, y.wi, TransportMode::Radiance);

@@ -12,7 +12,7 @@ use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::textured::set_parameter;
 use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, NormalSource, Perturbed,
-    RoughConductor, TextureSlot, Textured, TwoSided,
+    RoughConductor, RoughDielectric, TextureSlot, Textured, ThinDielectric, TwoSided,
 };
 use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight, AIR_IOR, POLYPROPYLENE_IOR};
 use lt_core::bsdf::{Plastic, RoughPlastic};
@@ -339,6 +339,7 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
         ("k", d.k.as_ref().map(S::span)),
         ("distribution", d.distribution.as_ref().map(S::span)),
         ("alpha", d.alpha.as_ref().map(S::span)),
+        ("transmittance", d.transmittance.as_ref().map(S::span)),
         ("twosided", d.twosided.as_ref().map(S::span)),
         ("albedo_texture", d.albedo_texture.as_ref().map(S::span)),
         (
@@ -394,6 +395,41 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
                 roughness,
             })
         }
+        "roughdielectric" | "thindielectric" => {
+            const THIN: [&str; 4] = ["ior", "reflectance", "transmittance", "reflectance_texture"];
+            const ROUGH: [&str; 7] = [
+                "ior",
+                "reflectance",
+                "transmittance",
+                "distribution",
+                "alpha",
+                "reflectance_texture",
+                "alpha_texture",
+            ];
+            ctx.only(&given, if kind == "thindielectric" { &THIN } else { &ROUGH }, &what)?;
+            let ior = ctx.positive(ctx.need(&d.ior, "ior", &def.span(), &what)?, "ior")?;
+            let specular_reflectance = reflectance(1.0)?;
+            let specular_transmittance = d
+                .transmittance
+                .as_ref()
+                .map(|t| ctx.color(t, "transmittance", true))
+                .transpose()?
+                .unwrap_or(Color::ONE);
+            if kind == "thindielectric" {
+                Material::ThinDielectric(ThinDielectric {
+                    ior,
+                    specular_reflectance,
+                    specular_transmittance,
+                })
+            } else {
+                Material::RoughDielectric(RoughDielectric {
+                    distribution: microfacet(ctx, d)?,
+                    ior,
+                    specular_reflectance,
+                    specular_transmittance,
+                })
+            }
+        }
         "conductor" | "roughconductor" => {
             const SMOOTH: [&str; 6] = [
                 "reflectance",
@@ -442,7 +478,7 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
             return Err(ctx.at(
                 d.kind.span(),
                 format!(
-                "unknown material type `{other}` (expected diffuse, mirror, dielectric, glossy, conductor, roughconductor, plastic or roughplastic)"
+                "unknown material type `{other}` (expected diffuse, mirror, dielectric, roughdielectric, thindielectric, glossy, conductor, roughconductor, plastic or roughplastic)"
             ),
             ))
         }

@@ -27,7 +27,9 @@ mod quadrature;
 pub mod refraction;
 mod rough_conductor;
 pub mod rough_plastic;
+mod rough_dielectric;
 pub mod textured;
+mod thin_dielectric;
 mod two_sided;
 
 pub use conductor::Conductor;
@@ -39,7 +41,9 @@ pub use perturbed::{NormalSource, Perturbed};
 pub use plastic::Plastic;
 pub use rough_conductor::RoughConductor;
 pub use rough_plastic::RoughPlastic;
+pub use rough_dielectric::RoughDielectric;
 pub use textured::{TextureSlot, Textured};
+pub use thin_dielectric::ThinDielectric;
 pub use two_sided::TwoSided;
 
 use crate::math::{Color, Frame, Vec2, Vec3};
@@ -141,6 +145,10 @@ pub enum Material {
     /// Mitsuba's `plastic`: a delta lobe beside a diffuse one.
     Plastic(Plastic),
     RoughPlastic(RoughPlastic),
+    /// Mitsuba's `roughdielectric`: microfacet reflection and refraction (Walter et al. 2007).
+    RoughDielectric(RoughDielectric),
+    /// Mitsuba's `thindielectric`: a pane, delta reflection and straight pass-through.
+    ThinDielectric(ThinDielectric),
     /// Mitsuba's `twosided` around a one-sided material (conductors, plastics, …).
     TwoSided(TwoSided),
     /// Parameters read from textures at the shading point's uv.
@@ -161,6 +169,8 @@ impl Material {
             Material::RoughConductor(m) => m,
             Material::Plastic(m) => m,
             Material::RoughPlastic(m) => m,
+            Material::RoughDielectric(m) => m,
+            Material::ThinDielectric(m) => m,
             Material::TwoSided(m) => m,
             Material::Textured(t) => t.base.local(),
             Material::Perturbed(p) => p.inner.local(),
@@ -197,6 +207,33 @@ impl Material {
         match self.sample(sf, wo, 0.0, Vec2::splat(0.5), TransportMode::Radiance) {
             Some(s) if s.delta => s.pdf_w,
             _ => 0.0,
+        }
+    }
+
+    /// True when light crosses the surface (the dielectrics): light arriving on one side leaves
+    /// on the other, so a photon or light vertex on the far side of such a surface is gathered
+    /// through its BTDF instead of refused as light behind a wall.
+    pub fn transmits(&self) -> bool {
+        match self {
+            Material::Dielectric(_)
+            | Material::RoughDielectric(_)
+            | Material::ThinDielectric(_) => true,
+            Material::Textured(t) => t.base.transmits(),
+            Material::Perturbed(p) => p.inner.transmits(),
+            _ => false,
+        }
+    }
+
+    /// η_inside / η_outside of a material that refracts, i.e. whose radiance is scaled by
+    /// `refraction::refracted_throughput_scale` when a path crosses it (the thin dielectric
+    /// passes paths through into the medium they came from, so it is not one of them).
+    pub fn refraction_ior(&self) -> Option<f32> {
+        match self {
+            Material::Dielectric(d) => Some(d.ior),
+            Material::RoughDielectric(d) => Some(d.ior),
+            Material::Textured(t) => t.base.refraction_ior(),
+            Material::Perturbed(p) => p.inner.refraction_ior(),
+            _ => None,
         }
     }
 
@@ -348,6 +385,26 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
             specular_reflectance: Color::new(1.0, 0.8, 0.9),
         })
     };
+    let rough_glass = |kind, alpha_u, alpha_v, sample_visible, ior, tinted: bool| {
+        let (r, t) = if tinted {
+            (Color::new(0.9, 1.0, 0.7), Color::new(1.0, 0.6, 0.8))
+        } else {
+            (Color::ONE, Color::ONE)
+        };
+        Material::RoughDielectric(RoughDielectric {
+            distribution: microfacet::Microfacet::new(kind, alpha_u, alpha_v, sample_visible),
+            ior,
+            specular_reflectance: r,
+            specular_transmittance: t,
+        })
+    };
+    let pane = |ior, specular_reflectance, specular_transmittance| {
+        Material::ThinDielectric(ThinDielectric {
+            ior,
+            specular_reflectance,
+            specular_transmittance,
+        })
+    };
     use microfacet::MicrofacetType::{Beckmann, Ggx};
     let polypropylene = plastic::POLYPROPYLENE_IOR / plastic::AIR_IOR;
     let plastic = |diffuse, nonlinear| {
@@ -409,6 +466,39 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
         (
             "roughconductor-ggx-0.2x0.5-all",
             rough_gold(Ggx, 0.2, 0.5, false),
+        ),
+        (
+            "roughdielectric-beckmann-0.1-1.5",
+            rough_glass(Beckmann, 0.1, 0.1, true, 1.5, false),
+        ),
+        (
+            "roughdielectric-beckmann-0.3-1/1.5",
+            rough_glass(Beckmann, 0.3, 0.3, true, 1.0 / 1.5, true),
+        ),
+        (
+            "roughdielectric-beckmann-0.4x0.1-all-1.33",
+            rough_glass(Beckmann, 0.4, 0.1, false, 1.33, false),
+        ),
+        (
+            "roughdielectric-ggx-0.05-1.5",
+            rough_glass(Ggx, 0.05, 0.05, true, 1.5, false),
+        ),
+        (
+            "roughdielectric-ggx-0.3-2.4",
+            rough_glass(Ggx, 0.3, 0.3, true, 2.4, true),
+        ),
+        (
+            "roughdielectric-ggx-0.2x0.5-1.5",
+            rough_glass(Ggx, 0.2, 0.5, true, 1.5, false),
+        ),
+        (
+            "roughdielectric-ggx-0.6-all-1/1.33",
+            rough_glass(Ggx, 0.6, 0.6, false, 1.0 / 1.33, false),
+        ),
+        ("thindielectric-1.5", pane(1.5, Color::ONE, Color::ONE)),
+        (
+            "thindielectric-1.33-tinted",
+            pane(1.33, Color::new(0.9, 1.0, 0.7), Color::new(1.0, 0.6, 0.8)),
         ),
         (
             "textured-diffuse",

@@ -68,6 +68,12 @@ pub fn set_parameter(m: &mut Material, slot: TextureSlot, value: Color) -> bool 
         (Material::Plastic(p), SpecularReflectance) => p.specular_reflectance = value,
         (Material::RoughPlastic(p), Reflectance) => p.diffuse_reflectance = value,
         (Material::RoughPlastic(p), SpecularReflectance) => p.specular_reflectance = value,
+        (Material::RoughDielectric(r), SpecularReflectance) => r.specular_reflectance = value,
+        (Material::RoughDielectric(r), Alpha) => {
+            let d = r.distribution;
+            r.distribution = Microfacet::new(d.kind, value.x, value.x, d.sample_visible);
+        }
+        (Material::ThinDielectric(t), SpecularReflectance) => t.specular_reflectance = value,
         (Material::TwoSided(t), slot) => return set_parameter(&mut t.inner, slot, value),
         _ => return false,
     }

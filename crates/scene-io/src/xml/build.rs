@@ -17,7 +17,8 @@ use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor, PERFECT_MIR
 use lt_core::bsdf::fresnel::ComplexIor;
 use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::{
-    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TwoSided,
+    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, RoughDielectric,
+    ThinDielectric, TwoSided,
 };
 use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight};
 use lt_core::bsdf::{NormalSource, Perturbed, TextureSlot, Textured};
@@ -605,7 +606,7 @@ impl<'a> Loader<'a> {
                 match inner[..] {
                     [one] => {
                         let m = self.bsdf(one, true)?;
-                        if matches!(m, Material::Dielectric(_)) {
+                        if matches!(m, Material::Dielectric(_) | Material::RoughDielectric(_) | Material::ThinDielectric(_)) {
                             return Err(p.err(one, "twosided cannot wrap a dielectric (it transmits)"));
                         }
                         m
@@ -627,13 +628,32 @@ impl<'a> Loader<'a> {
                         }
                     }
                 }
-                let int = self.ior(&p, "int_ior", 1.5046)?;
-                let ext = self.ior(&p, "ext_ior", 1.000277)?;
-                let ior = int / ext;
-                if !(ior > 0.0) || !(ior as f32).is_finite() {
-                    return Err(p.err(e, format!("the relative IOR {int}/{ext} is not a positive number")));
+                Material::Dielectric(Dielectric {
+                    ior: self.relative_ior(&p)?,
+                })
+            }
+            "roughdielectric" | "thindielectric" => {
+                let ior = self.relative_ior(&p)?;
+                let specular_reflectance = self
+                    .color_or_texture(&p, "specular_reflectance", TextureSlot::SpecularReflectance, &mut slots)?
+                    .unwrap_or(Color::ONE);
+                let specular_transmittance = p
+                    .color("specular_transmittance", ColorUse::Reflectance, opts, &mut self.report)?
+                    .unwrap_or(Color::ONE);
+                if p.kind == "thindielectric" {
+                    Material::ThinDielectric(ThinDielectric {
+                        ior,
+                        specular_reflectance,
+                        specular_transmittance,
+                    })
+                } else {
+                    Material::RoughDielectric(RoughDielectric {
+                        distribution: self.microfacet(&p, &mut slots)?,
+                        ior,
+                        specular_reflectance,
+                        specular_transmittance,
+                    })
                 }
-                Material::Dielectric(Dielectric { ior: ior as f32 })
             }
             "conductor" | "roughconductor" => {
                 let ior = self.complex_ior(&p)?;
@@ -725,7 +745,7 @@ impl<'a> Loader<'a> {
             other => {
                 return Err(p.err(
                     e,
-                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, conductor, roughconductor, plastic, roughplastic, twosided, normalmap and bumpmap)"),
+                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, plastic, roughplastic, twosided, normalmap and bumpmap)"),
                 ))
             }
         };
@@ -918,6 +938,21 @@ impl<'a> Loader<'a> {
             return Err(p.err(e, format!("`{key}` must be positive, got {x}")));
         }
         Ok(x)
+    }
+
+    /// A dielectric's `int_ior / ext_ior` (Mitsuba's defaults: bk7 = 1.5046 inside, air =
+    /// 1.000277 outside; either a number or a name Mitsuba knows).
+    fn relative_ior(&self, p: &Plugin<'a>) -> Result<f32, SceneError> {
+        let int = self.ior(p, "int_ior", 1.5046)?;
+        let ext = self.ior(p, "ext_ior", 1.000277)?;
+        let ior = int / ext;
+        if !(ior > 0.0) || !(ior as f32).is_finite() {
+            return Err(p.err(
+                p.elem,
+                format!("the relative IOR {int}/{ext} is not a positive number"),
+            ));
+        }
+        Ok(ior as f32)
     }
 
     /// Mitsuba's microfacet parameters: `distribution` (beckmann, the default, or ggx), `alpha` or

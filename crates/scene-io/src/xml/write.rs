@@ -215,6 +215,25 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                     format!("<bsdf type=\"{kind}\" id=\"{id}\">{}\n    </bsdf>", inner.replace("\n            ", "\n        "))
                 }
             }
+            "roughdielectric" | "thindielectric" => {
+                let kind = d.kind.get_ref();
+                let mut inner = format!(
+                    "\n        <float name=\"int_ior\" value=\"{}\"/>\n        <float name=\"ext_ior\" value=\"1\"/>",
+                    d.ior.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(1.0)
+                );
+                if kind == "roughdielectric" {
+                    let dist = d.distribution.as_ref().map_or("beckmann", |s| s.get_ref().as_str());
+                    let alpha = d.alpha.as_ref().map_or(0.1, |a| *a.get_ref() as f32);
+                    let _ = write!(inner, "\n        <string name=\"distribution\" value=\"{}\"/>\n        <float name=\"alpha\" value=\"{alpha}\"/>", esc(dist));
+                }
+                let _ = write!(
+                    inner,
+                    "\n        <rgb name=\"specular_reflectance\" value=\"{}\"/>\n        <rgb name=\"specular_transmittance\" value=\"{}\"/>",
+                    rgb(&d.reflectance, 1.0),
+                    rgb(&d.transmittance, 1.0)
+                );
+                format!("<bsdf type=\"{kind}\" id=\"{id}\">{inner}\n    </bsdf>")
+            }
             "dielectric" => format!(
                 "<bsdf type=\"dielectric\" id=\"{id}\">\n        <float name=\"int_ior\" value=\"{}\"/>\n        <float name=\"ext_ior\" value=\"1\"/>\n    </bsdf>",
                 d.ior.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(1.0)
