@@ -112,7 +112,12 @@ fn every_integrator_gives_finite_non_negative_pixels_on_every_shipped_scene() {
 #[test]
 fn same_seed_gives_identical_images_for_one_and_two_threads() {
     for info in INTEGRATORS {
-        for name in ["cornell-box", "veach-mis", "cornell-glass-light"] {
+        for name in [
+            "cornell-box",
+            "veach-mis",
+            "cornell-glass-light",
+            "cornell-rough-glass",
+        ] {
             let who = format!("{} on {name}", info.name);
             let scene = shipped_scene(name, Some((32, 32)));
             let integ = make_integrator(info.name, &scene, &IntegratorParams::default()).unwrap();

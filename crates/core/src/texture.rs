@@ -189,6 +189,15 @@ impl Texture {
         }
     }
 
+    /// The mean value (Mitsuba's `Texture::mean`: a checkerboard's two colours weigh equally).
+    pub fn mean(&self) -> Color {
+        match self {
+            Texture::Constant(c) => *c,
+            Texture::Bitmap(b) => b.mean(),
+            Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
+        }
+    }
+
     /// The largest value the texture takes (for checks such as reflectance ≤ 1).
     pub fn max_value(&self) -> f32 {
         match self {

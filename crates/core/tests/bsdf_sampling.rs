@@ -60,8 +60,60 @@ fn roughness(m: &Material) -> Option<f32> {
     match m {
         Material::Glossy(g) => Some(g.roughness),
         Material::RoughConductor(c) => Some(c.distribution.max_alpha()),
+        Material::RoughPlastic(p) => Some(p.distribution.max_alpha()),
+        Material::RoughDielectric(d) => Some(d.distribution.max_alpha()),
         Material::TwoSided(t) => roughness(&t.inner),
         _ => None,
+    }
+}
+
+/// The smooth refraction of `wo` through the plane of normal `n` (pointing outside), for a
+/// material of relative IOR `ior` (inside/outside); None under total internal reflection.
+fn refracted(wo: Vec3, n: Vec3, ior: f32) -> Option<Vec3> {
+    let cos_i = wo.dot(n);
+    let eta = if cos_i > 0.0 { ior } else { 1.0 / ior };
+    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let n_o = if cos_i > 0.0 { n } else { -n };
+    Some(-wo / eta + (cos_i.abs() / eta - (1.0 - sin2_t).sqrt()) * n_o)
+}
+
+/// cos θ (from the normal) of the rim where rough refraction ends: the microfacet that refracts
+/// wo into wi, m ∝ η_o wo + η_i wi, is vertical when η_o wo.z + η_i wi.z = 0, and the pdf drops
+/// from D(m) of a vertical facet (not 0 for GGX) to zero there. `cos_o` is wo.z; None when the
+/// cone does not exist (from the denser side at steep incidence).
+fn refraction_rim(cos_o: f32, ior: f32) -> Option<f32> {
+    let (eta_o, eta_i) = if cos_o > 0.0 { (1.0, ior) } else { (ior, 1.0) };
+    let c = -cos_o * eta_o / eta_i;
+    (c.abs() < 1.0).then_some(c)
+}
+
+/// The whole-sphere chart: 40 rings uniform in cos θ (the horizon, where a hemispherical pdf
+/// jumps, on a ring edge) and the refraction rim as one more edge (an edge closer to it than a
+/// tenth of a ring moved onto it).
+fn sphere_grid(frame: Frame, rim_cos: Option<f32>) -> SphereGrid {
+    const RINGS: usize = 40;
+    let mut edges: Vec<f64> = (0..=RINGS).map(|i| 2.0 * i as f64 / RINGS as f64).collect();
+    if let Some(c) = rim_cos {
+        let h = 1.0 - c as f64;
+        let ring = 2.0 / RINGS as f64;
+        edges.retain(|&e| e == 0.0 || e == 2.0 || e == 1.0 || (e - h).abs() > 0.1 * ring);
+        if (h - 1.0).abs() > 1e-9 {
+            edges.push(h);
+        }
+        edges.sort_by(f64::total_cmp);
+    }
+    SphereGrid::with_edges(frame, edges, 80)
+}
+
+/// η_o² of radiance reciprocity across a refracting material: f(wo, wi)/η_o² = f(wi, wo)/η_i²
+/// (Veach 1997, eq. 5.14), η_o the IOR of wo's side (outside 1, inside the material's IOR).
+fn side_ior_squared(m: &Material, n: Vec3, w: Vec3) -> f32 {
+    match m.refraction_ior() {
+        Some(ior) if w.dot(n) < 0.0 => ior * ior,
+        _ => 1.0,
     }
 }
 
@@ -109,13 +161,21 @@ fn sampled_directions_follow_the_pdf_chi2() {
                     seed,
                 };
                 let label = format!("{name} cosθo={cos} {}", mode_name(mode));
+                // A delta lobe beside smooth ones (plastic) has no density: its samples count
+                // as lost mass, which `check_mass` holds to 1 − ∫pdf.
                 let sample = |s: &mut Sampler| {
                     let u_lobe = s.next_f32();
-                    m.sample(&sf, wo, u_lobe, s.next_2d(), mode).map(|b| b.wi)
+                    m.sample(&sf, wo, u_lobe, s.next_2d(), mode)
+                        .filter(|b| !b.delta)
+                        .map(|b| b.wi)
                 };
                 let pdf = |w: Vec3| m.pdf(&sf, wo, w);
-                // Whole sphere, rings uniform in cos θ around the normal, horizon on a ring edge.
-                let grid = SphereGrid::sphere(Frame::from_z(n), 40, 80);
+                // Whole sphere, rings uniform in cos θ around the normal, horizon on a ring edge
+                // (and the rim of rough refraction, for a material that refracts).
+                let rim = m
+                    .refraction_ior()
+                    .and_then(|ior| refraction_rim(wo.dot(n), ior));
+                let grid = sphere_grid(Frame::from_z(n), rim);
                 outcomes.push(chi2::run(
                     &format!("{label} sphere"),
                     cfg,
@@ -136,6 +196,27 @@ fn sampled_directions_follow_the_pdf_chi2() {
                         seed: seed + 1_000,
                     };
                     outcomes.push(chi2::run(&format!("{label} lobe"), cfg, &grid, sample, pdf));
+                    // And around the refracted direction, for a material that refracts.
+                    // It stays above the horizon and inside the rim, where the pdf is smooth.
+                    if let Some(t) = m.refraction_ior().and_then(|ior| refracted(wo, n, ior)) {
+                        let elevation = t.dot(n).abs().asin();
+                        let to_rim =
+                            rim.map_or(f32::INFINITY, |c| (c.acos() - t.dot(n).acos()).abs());
+                        let half_angle = (0.9 * elevation.min(to_rim)).min(10.0 * alpha) as f64;
+                        let grid =
+                            SphereGrid::cap(Frame::from_z(t), 1.0 - half_angle.cos(), 30, 40, 2.0);
+                        let cfg = Chi2Test {
+                            samples: 1_000_000,
+                            seed: seed + 2_000,
+                        };
+                        outcomes.push(chi2::run(
+                            &format!("{label} refraction lobe"),
+                            cfg,
+                            &grid,
+                            sample,
+                            pdf,
+                        ));
+                    }
                 }
             }
         }
@@ -210,17 +291,18 @@ fn check_sample(m: &Material, sf: &ShadingFrame, wo: Vec3, b: &BsdfSample) -> Re
         return Err(format!("bad sample {b:?}"));
     }
     let e = m.eval(sf, wo, wi, mode);
-    if b.delta != m.is_delta() {
+    if (b.delta && !m.has_delta_lobe()) || (!b.delta && m.is_delta()) {
         return Err(format!(
-            "delta flag {} on a material with is_delta {}",
+            "delta flag {} on a material with is_delta {}, has_delta_lobe {}",
             b.delta,
-            m.is_delta()
+            m.is_delta(),
+            m.has_delta_lobe()
         ));
     }
     if b.delta {
-        // Delta lobes: eval and pdf are zero, the pdfs are lobe probabilities.
-        let ok = e.f_cos == Vec3::ZERO
-            && m.pdf(sf, wo, wi) == 0.0
+        // Delta lobes: the pdfs are lobe probabilities; eval and pdf are zero unless smooth
+        // lobes lie beside the delta (plastic), which eval and pdf report alone.
+        let ok = (!m.is_delta() || (e.f_cos == Vec3::ZERO && m.pdf(sf, wo, wi) == 0.0))
             && b.pdf_w > 0.0
             && b.pdf_w <= 1.0
             && b.pdf_rev_w > 0.0
@@ -293,10 +375,10 @@ fn check_adjoint(
     let factor = |w_o: Vec3, w_i: Vec3| {
         (w_o.dot(ns).abs() * w_i.dot(ng).abs() / (w_i.dot(ns).abs() * w_o.dot(ng).abs())) as f64
     };
-    // Glass scales radiance (not importance) by 1/η² on refraction; undo it before comparing.
-    let glass_scale = match m {
-        Material::Dielectric(d) if wi.dot(ng) * wo.dot(ng) < 0.0 => {
-            let eta = if wo.dot(ng) > 0.0 { d.ior } else { 1.0 / d.ior } as f64;
+    // Refraction scales radiance (not importance) by 1/η², η = η_i/η_o; undo it before comparing.
+    let glass_scale = match m.refraction_ior() {
+        Some(ior) if wi.dot(ng) * wo.dot(ng) < 0.0 => {
+            let eta = if wo.dot(ng) > 0.0 { ior } else { 1.0 / ior } as f64;
             eta * eta
         }
         _ => 1.0,
@@ -315,10 +397,9 @@ fn check_adjoint(
             m.eval(sf, wo, wi, TransportMode::Radiance),
         );
         let got = ei.f_cos.x as f64 / er.f_cos.x as f64;
-        if er.f_cos.x > 0.0 && (got / factor(wo, wi) - 1.0).abs() > tol {
+        if er.f_cos.x > 0.0 && (got / expect - 1.0).abs() > tol {
             return Err(format!(
-                "importance/radiance f_cos {got} vs {} (tol {tol:.1e})",
-                factor(wo, wi)
+                "importance/radiance f_cos {got} vs {expect} (tol {tol:.1e})"
             ));
         }
     }
@@ -327,26 +408,35 @@ fn check_adjoint(
 
 #[test]
 fn non_delta_materials_are_reciprocal() {
-    // Radiance mode with ns = ng: f(wo, wi) = f_cos / |cos θi| must equal f(wi, wo). Each side
-    // carries two roundings (× cos in eval, ÷ cos here), hence a relative γ(4).
+    // Radiance mode with ns = ng: f(wo, wi) = f_cos / |cos θi| must equal f(wi, wo); across a
+    // refracting interface f(wo, wi)/η_o² must equal f(wi, wo)/η_i² (Veach 1997, eq. 5.14). Each
+    // side carries two roundings (× cos in eval, ÷ cos here), hence a relative γ(4); a refracted
+    // pair up to ten more per side (η_i², 1/η² in the transport scale, η_o² and ÷ here).
     let sf = flat_frame();
+    let n = sf.ns();
     let mut s = Sampler::new(11, 0, 0);
     for (name, m) in test_registry() {
         if m.is_delta() {
             continue;
         }
         let f = |o: Vec3, i: Vec3| {
-            m.eval(&sf, o, i, TransportMode::Radiance).f_cos / sf.frame.to_local(i).z.abs()
+            m.eval(&sf, o, i, TransportMode::Radiance).f_cos
+                / sf.frame.to_local(i).z.abs()
+                / side_ior_squared(&m, n, o)
         };
         for k in 0..20_000 {
             let wo = sample_uniform_sphere(s.next_2d());
             let mut wi = sample_uniform_sphere(s.next_2d());
-            // Bias towards the mirror direction so narrow lobes are non-zero too.
-            if k % 2 == 0 {
-                wi = (2.0 * wo.dot(sf.ns()) * sf.ns() - wo + 0.1 * wi).normalize();
+            // Bias towards the mirror (and refracted) direction so narrow lobes are non-zero too.
+            let refracted = m.refraction_ior().and_then(|ior| refracted(wo, n, ior));
+            match (k % 3, refracted) {
+                (1, Some(t)) => wi = (t + 0.1 * wi).normalize(),
+                (0 | 1, _) => wi = (2.0 * wo.dot(n) * n - wo + 0.1 * wi).normalize(),
+                _ => {}
             }
             let (a, b) = (f(wo, wi), f(wi, wo));
-            let tol = gamma(4) * a.max(b);
+            let across = wo.dot(n) * wi.dot(n) < 0.0 && m.refraction_ior().is_some();
+            let tol = gamma(if across { 24 } else { 4 }) * a.max(b);
             assert!(
                 a.is_finite() && (a - b).abs().max_element() <= tol.max_element(),
                 "{name}: f(wo,wi) = {a} but f(wi,wo) = {b} for wo {wo} wi {wi}"
@@ -367,19 +457,23 @@ fn energy_is_conserved_and_diffuse_returns_its_albedo() {
                 // Radiance is not conserved across refraction (it scales by 1/η²); only the
                 // adjoint (importance) direction of glass integrates to ≤ 1.
                 let refracts_radiance =
-                    matches!(m, Material::Dielectric(_)) && mode == TransportMode::Radiance;
+                    m.refraction_ior().is_some() && mode == TransportMode::Radiance;
                 let mut s = Sampler::new(13, cos.to_bits() as u64, mode as u64);
                 let mut by_sampling = [MeanEstimate::default(); 3];
+                // The smooth lobes' share of the samples: what eval integrates to.
+                let mut smooth_by_sampling = [MeanEstimate::default(); 3];
                 let mut by_uniform = [MeanEstimate::default(); 3];
                 for _ in 0..n {
                     let u_lobe = s.next_f32();
-                    let w = m
-                        .sample(&sf, wo, u_lobe, s.next_2d(), mode)
-                        .map_or(Vec3::ZERO, |b| b.weight);
+                    let b = m.sample(&sf, wo, u_lobe, s.next_2d(), mode);
+                    let w = b.map_or(Vec3::ZERO, |b| b.weight);
+                    let smooth =
+                        b.map_or(Vec3::ZERO, |b| if b.delta { Vec3::ZERO } else { b.weight });
                     let wi = sample_uniform_sphere(s.next_2d());
                     let f = m.eval(&sf, wo, wi, mode).f_cos / UNIFORM_SPHERE_PDF;
                     for c in 0..3 {
                         by_sampling[c].add(w[c] as f64);
+                        smooth_by_sampling[c].add(smooth[c] as f64);
                         by_uniform[c].add(f[c] as f64);
                     }
                 }
@@ -395,7 +489,8 @@ fn energy_is_conserved_and_diffuse_returns_its_albedo() {
                     }
                     if !m.is_delta() {
                         // Two independent unbiased estimates of the same albedo (both exactly 0
-                        // for a one-sided material seen from behind).
+                        // for a one-sided material seen from behind), of its smooth lobes.
+                        let a = smooth_by_sampling[c];
                         let se = (a.std_error().powi(2) + b.std_error().powi(2)).sqrt();
                         let z = if se == 0.0 && a.mean() == b.mean() {
                             0.0

@@ -31,7 +31,7 @@ use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkL
 use crate::Integrator;
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
-use lt_core::path::scatter::connectable;
+use lt_core::path::scatter::{connectable, connectable_inside};
 use lt_core::path::{Chain, Heuristic, PathVertex, VertexKind};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
@@ -126,7 +126,14 @@ pub fn mis_weight(scene: &Scene, split: Split, evals: EndEvals, h: Heuristic, ra
     };
     for i in 0..=k {
         let v = at(i);
-        conn[i] = connectable(scene, v);
+        // The connection's two ends (x_{s−1}, x_s; x0 alone for s = 0) scatter by evaluation;
+        // inner vertices as their walk sampled (`connectable_inside`).
+        let end = i == s || i + 1 == s;
+        conn[i] = if end {
+            connectable(scene, v)
+        } else {
+            connectable_inside(scene, v)
+        };
         if i < s {
             light[i] = v.pdf_fwd as f64;
             camera[i] = v.pdf_rev as f64;

@@ -27,7 +27,7 @@ use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkL
 use crate::{ProgressLog, ProgressiveRun};
 use lt_core::bsdf::TransportMode;
 use lt_core::math::{Color, Vec2, Vec3, PI};
-use lt_core::path::scatter::connectable;
+use lt_core::path::scatter::{connectable, connectable_inside};
 use lt_core::path::{
     CameraMis, Heuristic, LightMis, PathVertex, SubpathMis, TechniqueSet, VertexKind,
 };
@@ -545,8 +545,8 @@ impl<'a> Engine<'a> {
             let (l0, _) = emission_densities(scene, x0, None);
             return mis.emitter_seen(c0 as f64, l0, joinable(scene, x0, x1));
         }
-        // VC(1) is next-event estimation from x1 (`Chain::valid`).
-        let vc1 = connectable(scene, x1);
+        // VC(1) is next-event estimation from x1 (`Chain::valid`); x1 is inside this path.
+        let vc1 = connectable_inside(scene, x1);
         let (l0, l1) = emission_densities(scene, x0, Some(x1));
         let nee = nee_density(scene, x0, x1);
         mis.emitter_hit(&records[camera.len() - 1], c0 as f64, l0, l1, nee, vc1)
@@ -707,6 +707,7 @@ impl<'a> Engine<'a> {
         let sf = lt_core::bsdf::ShadingFrame::new(zv.ng, zv.ns).with_uv(zv.uv);
         let bsdf = scene.material(material);
         let wo_side = zv.ng.dot(zv.wo);
+        let transmits = bsdf.transmits();
         let mut sum = Color::ZERO;
         grid.for_each_within(&lights.merge_positions, zv.p, setup.radius, |e, _| {
             let y = &lights.merge_vertex[e as usize];
@@ -719,8 +720,12 @@ impl<'a> Engine<'a> {
             // looks at z: light stored on the sunlit outside of a wall is never merged at the
             // inner surface meeting that wall at an edge (the leak the SmallVCM sun twin showed),
             // while merges across an inner corner stay.
+            // Through a surface that transmits, the light may arrive on the side facing away
+            // from the camera; it must still arrive on the same side of its own surface as of z's.
             let y_front = y.ng.dot(y.wi) > 0.0;
-            if zv.ng.dot(y.wi) * wo_side <= 0.0 || !(y.cos_g > 0.0) || y_front != (wo_side > 0.0) {
+            let arrives_front = zv.ng.dot(y.wi) > 0.0;
+            let same_side = zv.ng.dot(y.wi) * wo_side > 0.0;
+            if !(same_side || transmits) || !(y.cos_g > 0.0) || y_front != arrives_front {
                 return;
             }
             let ev = bsdf.eval(&sf, zv.wo, y.wi, TransportMode::Radiance);
@@ -777,13 +782,15 @@ fn light_records(scene: &Scene, mis: &SubpathMis, y: &[PathVertex], out: &mut Ve
             &prev,
             c_pp,
             // VC(1) is next-event estimation: the light samples x0 itself (`Chain::valid`).
+            // VC(j) joins y_j, the end, to y_{j−1}, inside the path.
             if j == 1 {
                 connectable(scene, &y[1])
             } else {
-                joinable(scene, &y[j - 1], &y[j])
+                connectable_inside(scene, &y[j - 1]) && connectable(scene, &y[j])
             },
             nee_over_l0,
             surface && connectable(scene, &y[j]) && mis.merging(),
+            y[j].delta,
         );
         out.push(r);
     }
@@ -800,8 +807,10 @@ fn camera_records(scene: &Scene, mis: &SubpathMis, z: &[PathVertex], out: &mut V
             z[m].pdf_fwd as f64,
             &out[m - 1],
             z[m - 1].pdf_rev as f64,
-            joinable(scene, &z[m], &z[m - 1]),
+            // VC(i+1) joins z_m, the end, to z_{m−1}, inside the path.
+            connectable(scene, &z[m]) && connectable_inside(scene, &z[m - 1]),
             surface && connectable(scene, &z[m]) && mis.merging(),
+            z[m].delta,
         );
         out.push(r);
     }

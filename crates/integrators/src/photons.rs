@@ -170,25 +170,24 @@ pub struct GatherPoint {
 impl GatherPoint {
     /// f(ω_o, ω_p) (|n_s·ω_p| / |n_g,p·ω_p|) β_p of one photon, before the kernel and the 1/N.
     /// `None` (the photon is not gathered) when the path would be longer than `max_depth` or the
-    /// photon arrived at the other side of the surface (a thin wall lit from behind stays dark in
-    /// front).
+    /// photon arrived at the other side of a surface that does not transmit (a thin wall lit from
+    /// behind stays dark in front; rough glass lit from behind does not).
     #[inline]
     pub fn photon_value(&self, scene: &Scene, ph: &Photon, max_depth: u32) -> Option<Color> {
         if self.segments + ph.segments > max_depth {
             return None;
         }
         let ng = self.sf.ng;
-        if ng.dot(ph.wi) * ng.dot(self.wo) <= 0.0 {
+        let material = scene.material(self.material);
+        // Light from the far side reaches the camera only through a surface that transmits.
+        if ng.dot(ph.wi) * ng.dot(self.wo) <= 0.0 && !material.transmits() {
             return None;
         }
         let cos_g = ph.ng.dot(ph.wi).abs();
         if !(cos_g > 0.0) {
             return None;
         }
-        let ev =
-            scene
-                .material(self.material)
-                .eval(&self.sf, self.wo, ph.wi, TransportMode::Radiance);
+        let ev = material.eval(&self.sf, self.wo, ph.wi, TransportMode::Radiance);
         Some(ev.f_cos * ph.beta / cos_g)
     }
 }

@@ -103,7 +103,21 @@ pub fn trace_visible_point(
         }
         let material = scene.material(hit.material);
         let sf = hit.shading_frame();
-        if !material.is_delta() {
+        // A delta lobe beside smooth ones (plastic's coating): the path follows it with the
+        // probability P the material gives it, else stops here with the visible point weighted
+        // by 1/(1 − P), so each part of the BSDF is estimated by one branch. Other materials
+        // draw nothing here (their images keep their bits).
+        let mut follow_delta = None;
+        if !material.is_delta() && material.has_delta_lobe() {
+            let p = material.delta_lobe_probability(&sf, wo);
+            let u_lobe = sampler.next_f32();
+            if u_lobe < p {
+                follow_delta = Some(u_lobe);
+            } else {
+                beta /= 1.0 - p;
+            }
+        }
+        if !material.is_delta() && follow_delta.is_none() {
             if direct == Direct::Nee && depth < max_depth {
                 out.nee = beta * next_event(scene, &hit, &sf, wo, sampler);
             }
@@ -125,6 +139,16 @@ pub fn trace_visible_point(
             return out;
         }
         let mode = TransportMode::Radiance;
+        if let Some(u_lobe) = follow_delta {
+            // u_lobe < P picks the delta lobe; its weight already divides by P.
+            let Some(bs) = material.sample(&sf, wo, u_lobe, sampler.next_2d(), mode) else {
+                return out;
+            };
+            debug_assert!(bs.delta);
+            beta *= bs.weight;
+            ray = hit.spawn_ray(bs.wi);
+            continue;
+        }
         let no_rr = u32::MAX;
         let Some(bs) = continue_path(
             scene,

@@ -514,3 +514,46 @@ fn a_thin_wall_lit_from_behind_stays_black_in_front() {
     }
     assert!(failures.is_empty(), "thin wall:\n{}", failures.join("\n"));
 }
+
+/// The side test keeps light behind an opaque surface out, but not light behind rough glass: a
+/// photon that reached a rough dielectric from inside is gathered by a camera outside through its
+/// BTDF (refusing it would drop everything rough glass transmits from photon mapping and VCM's
+/// merges). The same photon at a diffuse point is refused.
+#[test]
+fn photons_behind_rough_glass_are_gathered_through_it() {
+    use lt_core::bsdf::{microfacet, Diffuse, Material, RoughDielectric, ShadingFrame};
+    use lt_integrators::photons::{GatherPoint, Photon};
+    let mut b = SceneBuilder::new(camera(), RenderSettings::default());
+    let glass = b.add_material(Material::RoughDielectric(RoughDielectric {
+        distribution: microfacet::Microfacet::isotropic(microfacet::MicrofacetType::Ggx, 0.3),
+        ior: 1.5,
+        specular_reflectance: Color::ONE,
+        specular_transmittance: Color::ONE,
+    }));
+    let wall = b.add_material(Material::Diffuse(Diffuse {
+        albedo: Color::splat(0.5),
+    }));
+    let _ = black(&mut b);
+    let scene = b.build();
+    let n = Vec3::Z;
+    let photon = Photon {
+        wi: Vec3::new(0.2, 0.1, -0.97).normalize(), // came from below the surface
+        ng: n,
+        beta: Color::ONE,
+        segments: 1,
+    };
+    let at = |material| GatherPoint {
+        p: Vec3::ZERO,
+        sf: ShadingFrame::new(n, n),
+        wo: Vec3::new(-0.1, 0.3, 0.95).normalize(), // the camera is above
+        material,
+        beta: Color::ONE,
+        segments: 1,
+    };
+    let through = at(glass).photon_value(&scene, &photon, 8);
+    assert!(
+        through.is_some_and(|v| v.x > 0.0),
+        "rough glass refused light from behind: {through:?}"
+    );
+    assert!(at(wall).photon_value(&scene, &photon, 8).is_none());
+}

@@ -12,8 +12,10 @@ use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::textured::set_parameter;
 use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, NormalSource, Perturbed,
-    RoughConductor, TextureSlot, Textured, TwoSided,
+    RoughConductor, RoughDielectric, TextureSlot, Textured, ThinDielectric, TwoSided,
 };
+use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight, AIR_IOR, POLYPROPYLENE_IOR};
+use lt_core::bsdf::{Plastic, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::light::SunLight;
 use lt_core::math::{Color, Vec2, PI};
@@ -316,6 +318,8 @@ fn textured_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Mate
     Ok(if slots.is_empty() {
         base
     } else {
+        let mut base = base;
+        plastic_weight_from_textures(&mut base, &slots);
         Material::Textured(Box::new(Textured { base, slots }))
     })
 }
@@ -335,6 +339,7 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
         ("k", d.k.as_ref().map(S::span)),
         ("distribution", d.distribution.as_ref().map(S::span)),
         ("alpha", d.alpha.as_ref().map(S::span)),
+        ("transmittance", d.transmittance.as_ref().map(S::span)),
         ("twosided", d.twosided.as_ref().map(S::span)),
         ("albedo_texture", d.albedo_texture.as_ref().map(S::span)),
         (
@@ -342,6 +347,7 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
             d.reflectance_texture.as_ref().map(S::span),
         ),
         ("alpha_texture", d.alpha_texture.as_ref().map(S::span)),
+        ("nonlinear", d.nonlinear.as_ref().map(S::span)),
     ];
     let reflectance = |default: f32| {
         d.reflectance
@@ -389,6 +395,41 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
                 roughness,
             })
         }
+        "roughdielectric" | "thindielectric" => {
+            const THIN: [&str; 4] = ["ior", "reflectance", "transmittance", "reflectance_texture"];
+            const ROUGH: [&str; 7] = [
+                "ior",
+                "reflectance",
+                "transmittance",
+                "distribution",
+                "alpha",
+                "reflectance_texture",
+                "alpha_texture",
+            ];
+            ctx.only(&given, if kind == "thindielectric" { &THIN } else { &ROUGH }, &what)?;
+            let ior = ctx.positive(ctx.need(&d.ior, "ior", &def.span(), &what)?, "ior")?;
+            let specular_reflectance = reflectance(1.0)?;
+            let specular_transmittance = d
+                .transmittance
+                .as_ref()
+                .map(|t| ctx.color(t, "transmittance", true))
+                .transpose()?
+                .unwrap_or(Color::ONE);
+            if kind == "thindielectric" {
+                Material::ThinDielectric(ThinDielectric {
+                    ior,
+                    specular_reflectance,
+                    specular_transmittance,
+                })
+            } else {
+                Material::RoughDielectric(RoughDielectric {
+                    distribution: microfacet(ctx, d)?,
+                    ior,
+                    specular_reflectance,
+                    specular_transmittance,
+                })
+            }
+        }
         "conductor" | "roughconductor" => {
             const SMOOTH: [&str; 6] = [
                 "reflectance",
@@ -432,15 +473,113 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
                 one_sided
             }
         }
+        "plastic" | "roughplastic" => plastic(ctx, d, kind, &given, &what)?,
         other => {
             return Err(ctx.at(
                 d.kind.span(),
                 format!(
-                "unknown material type `{other}` (expected diffuse, mirror, dielectric, glossy, conductor or roughconductor)"
+                "unknown material type `{other}` (expected diffuse, mirror, dielectric, roughdielectric, thindielectric, glossy, conductor, roughconductor, plastic or roughplastic)"
             ),
             ))
         }
     })
+}
+
+/// Mitsuba's `plastic` / `roughplastic`: `albedo` (its `diffuse_reflectance`, default 0.5, or
+/// `albedo_texture`), `reflectance` (`specular_reflectance`, default 1, or `reflectance_texture`),
+/// `ior` (int_ior / ext_ior, default polypropylene in air), `nonlinear`, `twosided`; the rough one
+/// adds `distribution` and `alpha`. A textured reflectance's mean sets the lobe-sampling weight
+/// (`textured_material`).
+fn plastic(
+    ctx: &Ctx,
+    d: &MaterialDef,
+    kind: &str,
+    given: &[(&str, Option<std::ops::Range<usize>>)],
+    what: &str,
+) -> Result<Material, SceneError> {
+    const SMOOTH: [&str; 7] = [
+        "albedo",
+        "albedo_texture",
+        "reflectance",
+        "reflectance_texture",
+        "ior",
+        "nonlinear",
+        "twosided",
+    ];
+    const ROUGH: [&str; 9] = [
+        "albedo",
+        "albedo_texture",
+        "reflectance",
+        "reflectance_texture",
+        "ior",
+        "nonlinear",
+        "twosided",
+        "distribution",
+        "alpha",
+    ];
+    ctx.only(given, if kind == "plastic" { &SMOOTH } else { &ROUGH }, what)?;
+    for (plain, texture, key) in [
+        (d.albedo.as_ref().map(S::span), &d.albedo_texture, "albedo"),
+        (d.reflectance.as_ref().map(S::span), &d.reflectance_texture, "reflectance"),
+    ] {
+        if let (Some(_), Some(t)) = (plain, texture) {
+            return Err(ctx.at(t.span(), format!("give `{key}` or `{key}_texture`, not both")));
+        }
+    }
+    let color = |c: &Option<S<crate::format::ColorDef>>, key, default| {
+        c.as_ref()
+            .map(|c| ctx.color(c, key, true))
+            .transpose()
+            .map(|c| c.unwrap_or(Color::splat(default)))
+    };
+    let diffuse = color(&d.albedo, "albedo", 0.5)?;
+    let specular = color(&d.reflectance, "reflectance", 1.0)?;
+    let ior = match &d.ior {
+        None => POLYPROPYLENE_IOR / AIR_IOR,
+        Some(i) => ctx.positive(i, "ior")?,
+    };
+    if kind == "roughplastic" && ior == 1.0 {
+        return Err(ctx.at(d.ior.as_ref().unwrap().span(), "a roughplastic needs `ior` ≠ 1 (as Mitsuba)"));
+    }
+    let nonlinear = d.nonlinear.as_ref().is_some_and(|n| *n.get_ref());
+    let one_sided = if kind == "plastic" {
+        Material::Plastic(Plastic::new(ior, diffuse, specular, nonlinear))
+    } else {
+        Material::RoughPlastic(RoughPlastic::new(microfacet(ctx, d)?, ior, diffuse, specular, nonlinear))
+    };
+    Ok(if d.twosided.as_ref().is_some_and(|t| *t.get_ref()) {
+        Material::TwoSided(TwoSided {
+            inner: Box::new(one_sided),
+        })
+    } else {
+        one_sided
+    })
+}
+
+/// Mitsuba's lobe-sampling weight of a plastic from the means of its textured reflectances.
+fn plastic_weight_from_textures(m: &mut Material, slots: &[(TextureSlot, lt_core::texture::Texture)]) {
+    let mean = |slot, plain: Color| {
+        slots
+            .iter()
+            .rfind(|(s, _)| *s == slot)
+            .map_or(plain, |(_, t)| t.mean())
+    };
+    let weight = |d: Color, s: Color| {
+        specular_sampling_weight(
+            channel_mean(mean(TextureSlot::Reflectance, d)),
+            channel_mean(mean(TextureSlot::SpecularReflectance, s)),
+        )
+    };
+    match m {
+        Material::Plastic(p) => {
+            p.specular_sampling_weight = weight(p.diffuse_reflectance, p.specular_reflectance)
+        }
+        Material::RoughPlastic(p) => {
+            p.specular_sampling_weight = weight(p.diffuse_reflectance, p.specular_reflectance)
+        }
+        Material::TwoSided(t) => plastic_weight_from_textures(&mut t.inner, slots),
+        _ => {}
+    }
 }
 
 /// A conductor's complex IOR: a `material` name Mitsuba knows (default "none": a perfect mirror)

@@ -112,8 +112,13 @@ pub struct MaterialDef {
     /// Rough conductors: "beckmann" (default) or "ggx", and α.
     pub distribution: Option<S<String>>,
     pub alpha: Option<S<f64>>,
-    /// One-sided materials (conductors) reflect on both sides when true.
+    /// Rough and thin dielectrics: the colour factor of transmission (Mitsuba's
+    /// `specular_transmittance`; `reflectance` is their `specular_reflectance`).
+    pub transmittance: Option<S<ColorDef>>,
+    /// One-sided materials (conductors, plastics) reflect on both sides when true.
     pub twosided: Option<S<bool>>,
+    /// Plastics: Mitsuba's `nonlinear` (the base's albedo takes part in the internal reflections).
+    pub nonlinear: Option<S<bool>>,
     /// Textures in place of `albedo`, `reflectance` (the colour factor) and `alpha`.
     pub albedo_texture: Option<S<TextureDef>>,
     pub reflectance_texture: Option<S<TextureDef>>,

@@ -686,3 +686,40 @@ fn cornell_env_is_lit_only_through_the_open_front() {
         }
     }
 }
+
+/// `cornell-rough-glass` hides its thin-glass pane (a delta BSDF) behind the rough slab, so that
+/// no camera ray's first hit is a delta surface and light tracing sees every path the camera
+/// does (the premise of its per-depth agreement test). Checked on a 4×4 grid per pixel at the
+/// full 256² resolution.
+#[test]
+fn cornell_rough_glass_shows_no_delta_surface_to_the_camera() {
+    let s = load("cornell-rough-glass");
+    let (mut rough, mut pane) = (0usize, 0usize);
+    for py in 0..s.camera.height {
+        for px in 0..s.camera.width {
+            for k in 0..16 {
+                let raster = lt_core::math::Vec2::new(
+                    px as f32 + (k % 4) as f32 / 4.0 + 0.125,
+                    py as f32 + (k / 4) as f32 / 4.0 + 0.125,
+                );
+                let Some(hit) = s.intersect(&s.camera.generate_ray(raster)) else {
+                    continue;
+                };
+                let m = s.material(hit.material);
+                assert!(
+                    !m.is_delta(),
+                    "pixel ({px}, {py}) sees a delta surface first: {m:?}"
+                );
+                rough += matches!(m, Material::RoughDielectric(_)) as usize;
+            }
+        }
+    }
+    // The pane is there, and the camera sees it through the slab.
+    for sh in &s.shapes {
+        pane += matches!(s.material(sh.material), Material::ThinDielectric(_)) as usize;
+    }
+    assert!(
+        rough > 0 && pane == 1,
+        "rough glass hits {rough}, panes {pane}"
+    );
+}

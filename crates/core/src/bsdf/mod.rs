@@ -22,10 +22,14 @@ mod glossy;
 pub mod microfacet;
 mod mirror;
 pub mod perturbed;
+pub mod plastic;
 mod quadrature;
 pub mod refraction;
 mod rough_conductor;
+pub mod rough_plastic;
+mod rough_dielectric;
 pub mod textured;
+mod thin_dielectric;
 mod two_sided;
 
 pub use conductor::Conductor;
@@ -34,8 +38,12 @@ pub use diffuse::Diffuse;
 pub use glossy::Glossy;
 pub use mirror::Mirror;
 pub use perturbed::{NormalSource, Perturbed};
+pub use plastic::Plastic;
 pub use rough_conductor::RoughConductor;
+pub use rough_plastic::RoughPlastic;
+pub use rough_dielectric::RoughDielectric;
 pub use textured::{TextureSlot, Textured};
+pub use thin_dielectric::ThinDielectric;
 pub use two_sided::TwoSided;
 
 use crate::math::{Color, Frame, Vec2, Vec3};
@@ -118,6 +126,12 @@ pub trait LocalBsdf {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
     /// True when every lobe is a delta: such a vertex can never be connected to.
     fn is_delta(&self) -> bool;
+    /// True when some lobe is a delta (all of them, or a delta beside others, as plastic's
+    /// specular lobe): `sample` may then return `delta` samples, and a vertex that scattered
+    /// through one cannot be joined inside a path (`path::scatter::connectable_inside`).
+    fn has_delta_lobe(&self) -> bool {
+        self.is_delta()
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -128,6 +142,13 @@ pub enum Material {
     Glossy(Glossy),
     Conductor(Conductor),
     RoughConductor(RoughConductor),
+    /// Mitsuba's `plastic`: a delta lobe beside a diffuse one.
+    Plastic(Plastic),
+    RoughPlastic(RoughPlastic),
+    /// Mitsuba's `roughdielectric`: microfacet reflection and refraction (Walter et al. 2007).
+    RoughDielectric(RoughDielectric),
+    /// Mitsuba's `thindielectric`: a pane, delta reflection and straight pass-through.
+    ThinDielectric(ThinDielectric),
     /// Mitsuba's `twosided` around a one-sided material (conductors, plastics, …).
     TwoSided(TwoSided),
     /// Parameters read from textures at the shading point's uv.
@@ -146,6 +167,10 @@ impl Material {
             Material::Glossy(m) => m,
             Material::Conductor(m) => m,
             Material::RoughConductor(m) => m,
+            Material::Plastic(m) => m,
+            Material::RoughPlastic(m) => m,
+            Material::RoughDielectric(m) => m,
+            Material::ThinDielectric(m) => m,
             Material::TwoSided(m) => m,
             Material::Textured(t) => t.base.local(),
             Material::Perturbed(p) => p.inner.local(),
@@ -164,6 +189,52 @@ impl Material {
 
     pub fn is_delta(&self) -> bool {
         self.local().is_delta()
+    }
+
+    /// See `LocalBsdf::has_delta_lobe`.
+    pub fn has_delta_lobe(&self) -> bool {
+        self.local().has_delta_lobe()
+    }
+
+    /// The probability that `sample` from `wo` picks a delta lobe (0 for smooth materials): every
+    /// material chooses its delta lobe when `u_lobe` is below its probability, so the sample at
+    /// `u_lobe` = 0 reports it. For walks that treat a material's delta and smooth lobes apart
+    /// (the camera paths of photon mapping).
+    pub fn delta_lobe_probability(&self, sf: &ShadingFrame, wo: Vec3) -> f32 {
+        if !self.has_delta_lobe() {
+            return 0.0;
+        }
+        match self.sample(sf, wo, 0.0, Vec2::splat(0.5), TransportMode::Radiance) {
+            Some(s) if s.delta => s.pdf_w,
+            _ => 0.0,
+        }
+    }
+
+    /// True when light crosses the surface (the dielectrics): light arriving on one side leaves
+    /// on the other, so a photon or light vertex on the far side of such a surface is gathered
+    /// through its BTDF instead of refused as light behind a wall.
+    pub fn transmits(&self) -> bool {
+        match self {
+            Material::Dielectric(_)
+            | Material::RoughDielectric(_)
+            | Material::ThinDielectric(_) => true,
+            Material::Textured(t) => t.base.transmits(),
+            Material::Perturbed(p) => p.inner.transmits(),
+            _ => false,
+        }
+    }
+
+    /// η_inside / η_outside of a material that refracts, i.e. whose radiance is scaled by
+    /// `refraction::refracted_throughput_scale` when a path crosses it (the thin dielectric
+    /// passes paths through into the medium they came from, so it is not one of them).
+    pub fn refraction_ior(&self) -> Option<f32> {
+        match self {
+            Material::Dielectric(d) => Some(d.ior),
+            Material::RoughDielectric(d) => Some(d.ior),
+            Material::Textured(t) => t.base.refraction_ior(),
+            Material::Perturbed(p) => p.inner.refraction_ior(),
+            _ => None,
+        }
     }
 
     pub fn sample(
@@ -314,7 +385,45 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
             specular_reflectance: Color::new(1.0, 0.8, 0.9),
         })
     };
+    let rough_glass = |kind, alpha_u, alpha_v, sample_visible, ior, tinted: bool| {
+        let (r, t) = if tinted {
+            (Color::new(0.9, 1.0, 0.7), Color::new(1.0, 0.6, 0.8))
+        } else {
+            (Color::ONE, Color::ONE)
+        };
+        Material::RoughDielectric(RoughDielectric {
+            distribution: microfacet::Microfacet::new(kind, alpha_u, alpha_v, sample_visible),
+            ior,
+            specular_reflectance: r,
+            specular_transmittance: t,
+        })
+    };
+    let pane = |ior, specular_reflectance, specular_transmittance| {
+        Material::ThinDielectric(ThinDielectric {
+            ior,
+            specular_reflectance,
+            specular_transmittance,
+        })
+    };
     use microfacet::MicrofacetType::{Beckmann, Ggx};
+    let polypropylene = plastic::POLYPROPYLENE_IOR / plastic::AIR_IOR;
+    let plastic = |diffuse, nonlinear| {
+        Material::Plastic(Plastic::new(
+            polypropylene,
+            diffuse,
+            Color::new(1.0, 0.9, 0.8),
+            nonlinear,
+        ))
+    };
+    let rough_plastic = |kind, alpha, sample_visible, nonlinear| {
+        Material::RoughPlastic(RoughPlastic::new(
+            microfacet::Microfacet::new(kind, alpha, alpha, sample_visible),
+            polypropylene,
+            c,
+            Color::ONE,
+            nonlinear,
+        ))
+    };
     vec![
         ("diffuse", Material::Diffuse(Diffuse { albedo: c })),
         ("mirror", Material::Mirror(Mirror { reflectance: c })),
@@ -359,6 +468,39 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
             rough_gold(Ggx, 0.2, 0.5, false),
         ),
         (
+            "roughdielectric-beckmann-0.1-1.5",
+            rough_glass(Beckmann, 0.1, 0.1, true, 1.5, false),
+        ),
+        (
+            "roughdielectric-beckmann-0.3-1/1.5",
+            rough_glass(Beckmann, 0.3, 0.3, true, 1.0 / 1.5, true),
+        ),
+        (
+            "roughdielectric-beckmann-0.4x0.1-all-1.33",
+            rough_glass(Beckmann, 0.4, 0.1, false, 1.33, false),
+        ),
+        (
+            "roughdielectric-ggx-0.05-1.5",
+            rough_glass(Ggx, 0.05, 0.05, true, 1.5, false),
+        ),
+        (
+            "roughdielectric-ggx-0.3-2.4",
+            rough_glass(Ggx, 0.3, 0.3, true, 2.4, true),
+        ),
+        (
+            "roughdielectric-ggx-0.2x0.5-1.5",
+            rough_glass(Ggx, 0.2, 0.5, true, 1.5, false),
+        ),
+        (
+            "roughdielectric-ggx-0.6-all-1/1.33",
+            rough_glass(Ggx, 0.6, 0.6, false, 1.0 / 1.33, false),
+        ),
+        ("thindielectric-1.5", pane(1.5, Color::ONE, Color::ONE)),
+        (
+            "thindielectric-1.33-tinted",
+            pane(1.33, Color::new(0.9, 1.0, 0.7), Color::new(1.0, 0.6, 0.8)),
+        ),
+        (
             "textured-diffuse",
             Material::Textured(Box::new(Textured {
                 base: Material::Diffuse(Diffuse { albedo: c }),
@@ -367,6 +509,54 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
                     crate::texture::Texture::Constant(Color::new(0.2, 0.7, 0.4)),
                 )],
             })),
+        ),
+        ("plastic", plastic(c, false)),
+        ("plastic-nonlinear", plastic(c, true)),
+        (
+            "plastic-ior-2.4-dark",
+            Material::Plastic(Plastic::new(
+                2.4,
+                Color::new(0.05, 0.1, 0.02),
+                Color::ONE,
+                false,
+            )),
+        ),
+        (
+            "roughplastic-beckmann-0.05",
+            rough_plastic(Beckmann, 0.05, true, false),
+        ),
+        (
+            "roughplastic-beckmann-0.3-nonlinear",
+            rough_plastic(Beckmann, 0.3, true, true),
+        ),
+        (
+            "roughplastic-beckmann-0.3-all",
+            rough_plastic(Beckmann, 0.3, false, false),
+        ),
+        (
+            "roughplastic-ggx-0.1-nonlinear",
+            rough_plastic(Ggx, 0.1, true, true),
+        ),
+        ("roughplastic-ggx-0.5", rough_plastic(Ggx, 0.5, true, false)),
+        (
+            "roughplastic-ggx-0.2-all",
+            rough_plastic(Ggx, 0.2, false, false),
+        ),
+        (
+            "textured-plastic",
+            Material::Textured(Box::new(Textured {
+                base: plastic(c, false),
+                slots: vec![(
+                    TextureSlot::Reflectance,
+                    crate::texture::Texture::Constant(Color::new(0.2, 0.7, 0.4)),
+                )],
+            })),
+        ),
+        (
+            "twosided-roughplastic-ggx-0.3",
+            Material::TwoSided(TwoSided {
+                inner: Box::new(rough_plastic(Ggx, 0.3, true, false)),
+            }),
         ),
         (
             "twosided-roughconductor-ggx-0.3",

@@ -11,9 +11,9 @@ use crate::texture::Texture;
 /// Which parameter a texture drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TextureSlot {
-    /// Diffuse albedo (Mitsuba's `reflectance` of `diffuse`).
+    /// Diffuse albedo (Mitsuba's `reflectance` of `diffuse`, `diffuse_reflectance` of plastics).
     Reflectance,
-    /// The colour factor of mirrors and conductors (`specular_reflectance`).
+    /// The colour factor of mirrors, conductors and plastics' coatings (`specular_reflectance`).
     SpecularReflectance,
     /// Microfacet roughness α (`alpha`), read from the texture's first channel.
     Alpha,
@@ -64,6 +64,16 @@ pub fn set_parameter(m: &mut Material, slot: TextureSlot, value: Color) -> bool 
             let d = r.distribution;
             r.distribution = Microfacet::new(d.kind, value.x, value.x, d.sample_visible);
         }
+        (Material::Plastic(p), Reflectance) => p.diffuse_reflectance = value,
+        (Material::Plastic(p), SpecularReflectance) => p.specular_reflectance = value,
+        (Material::RoughPlastic(p), Reflectance) => p.diffuse_reflectance = value,
+        (Material::RoughPlastic(p), SpecularReflectance) => p.specular_reflectance = value,
+        (Material::RoughDielectric(r), SpecularReflectance) => r.specular_reflectance = value,
+        (Material::RoughDielectric(r), Alpha) => {
+            let d = r.distribution;
+            r.distribution = Microfacet::new(d.kind, value.x, value.x, d.sample_visible);
+        }
+        (Material::ThinDielectric(t), SpecularReflectance) => t.specular_reflectance = value,
         (Material::TwoSided(t), slot) => return set_parameter(&mut t.inner, slot, value),
         _ => return false,
     }

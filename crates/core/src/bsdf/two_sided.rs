@@ -49,6 +49,10 @@ impl LocalBsdf for FrontFacing<'_> {
     fn is_delta(&self) -> bool {
         self.0.is_delta()
     }
+
+    fn has_delta_lobe(&self) -> bool {
+        self.0.has_delta_lobe()
+    }
 }
 
 impl LocalBsdf for TwoSided {
@@ -66,5 +70,9 @@ impl LocalBsdf for TwoSided {
 
     fn is_delta(&self) -> bool {
         self.inner.local().is_delta()
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        self.inner.local().has_delta_lobe()
     }
 }

@@ -181,7 +181,18 @@ impl Path {
             pc[0] = 0.0;
         }
 
-        let conn = v.iter().map(|x| connectable(scene, x)).collect();
+        // An inner vertex where the path follows a delta lobe beside smooth ones (plastic) is
+        // joined by no technique (`scatter::connectable_inside`).
+        let conn = (0..=k)
+            .map(|i| {
+                connectable(scene, &v[i])
+                    && (i == 0
+                        || i == k
+                        || !self
+                            .scatter_at(scene, i, i + 1, i - 1, TransportMode::Radiance)
+                            .delta)
+            })
+            .collect();
         Densities {
             light: pl,
             camera: pc,

@@ -48,6 +48,9 @@ pub struct Scatter {
     pub f: Color,
     /// Solid-angle density of sampling `wi` given `wo`; for a delta lobe its selection probability.
     pub pdf_w: f32,
+    /// The path scatters through a delta lobe here: no technique joins the path at this vertex
+    /// (for a material with smooth lobes beside the delta, `connectable` alone does not say so).
+    pub delta: bool,
 }
 
 /// Evaluates the vertex's material. `v` must be a `Surface` vertex; anything else scatters nothing.
@@ -69,12 +72,16 @@ pub fn scatter(
     if cos_g == 0.0 {
         return Scatter::default();
     }
-    if !m.is_delta() {
+    let smooth = || {
         let e = m.eval(&sf, wo, wi, mode);
-        return Scatter {
+        Scatter {
             f: e.f_cos / cos_g,
             pdf_w: e.pdf_w,
-        };
+            delta: false,
+        }
+    };
+    if !m.has_delta_lobe() {
+        return smooth();
     }
     // The lobe whose direction is closest to `wi`, and how far the nearest other lobe is.
     let mut best: Option<(f32, Scatter, Vec3)> = None;
@@ -87,6 +94,7 @@ pub fn scatter(
                 let sc = Scatter {
                     f: s.weight * s.pdf_w / cos_g,
                     pdf_w: s.pdf_w,
+                    delta: true,
                 };
                 *slot = Some(s.wi);
                 if best.is_none_or(|b| dist < b.0) {
@@ -95,8 +103,16 @@ pub fn scatter(
             }
         }
     }
+    // Beside smooth lobes (plastic), a direction off every delta lobe scatters smoothly.
+    let missed = || {
+        if m.is_delta() {
+            Scatter::default()
+        } else {
+            smooth()
+        }
+    };
     let Some((dist, sc, dir)) = best else {
-        return Scatter::default();
+        return missed();
     };
     let other = candidates
         .iter()
@@ -107,10 +123,12 @@ pub fn scatter(
     // Refraction near grazing exit magnifies the positions' angular error by η·cos θt / cos θi,
     // beyond `tol`; the match still stands when it is unambiguous (the other lobe is far further
     // away) and the direction is within MAGNIFIED_TOL of the lobe.
-    if dist < tol || (dist < UNAMBIGUOUS_RATIO * other && dist < MAGNIFIED_TOL) {
+    // Beside smooth lobes the magnified match is off: a smooth direction may fall that close.
+    let unambiguous = m.is_delta() && dist < UNAMBIGUOUS_RATIO * other && dist < MAGNIFIED_TOL;
+    if dist < tol || unambiguous {
         sc
     } else {
-        Scatter::default()
+        missed()
     }
 }
 
@@ -119,6 +137,17 @@ const MAGNIFIED_TOL: f32 = 1e-2;
 
 /// A lobe closer to `wi` than this fraction of the distance to any other lobe is the one taken.
 const UNAMBIGUOUS_RATIO: f32 = 0.05;
+
+/// True when `v`, an inner vertex of a path (not the end of a subpath that a connection or a
+/// merge joins), lets a technique join the path there: `connectable`, and the walk did not
+/// scatter through a delta lobe at `v` (`PathVertex::delta`). The two differ only for a material
+/// with a delta lobe beside smooth ones (plastic): a path through its delta lobe is sampled by
+/// walking alone, while a connection at `v` evaluates the smooth lobes (pbrt-v3 and SmallVCM
+/// decide per sampled lobe too). The end vertices of a connection scatter by evaluation, hence
+/// smoothly, whatever their own walk did next: they take `connectable`.
+pub fn connectable_inside(scene: &Scene, v: &PathVertex) -> bool {
+    connectable(scene, v) && !v.delta
+}
 
 /// True when a connection (a deterministic edge between two subpaths) may end at `v`: never at a
 /// delta surface, nor at a light delta in direction (a directional light: the edge would have to

@@ -70,6 +70,9 @@ pub struct LightMis {
     pub own_vc: f64,
     /// VM(j) is possible: y_j is a non-delta surface (j ≥ 1).
     pub mergeable: bool,
+    /// The walk left y_j through a delta lobe beside smooth ones (plastic): inside a longer
+    /// path no technique joins or merges at y_j, so Q_j keeps only the terms below it.
+    pub through_delta: bool,
 }
 
 /// What a camera-subpath vertex z_m carries into its connections and merges.
@@ -83,6 +86,9 @@ pub struct CameraMis {
     pub next_vc: f64,
     /// VM(i) is possible: z_m is a non-delta surface (m ≥ 1).
     pub mergeable: bool,
+    /// The walk left z_m through a delta lobe beside smooth ones: R(z_m), read only while z_m is
+    /// inside a longer path, keeps only the terms above it (as `LightMis::through_delta`).
+    pub through_delta: bool,
 }
 
 impl SubpathMis {
@@ -159,12 +165,18 @@ impl SubpathMis {
 
     /// Q_j of vertex `y` (j ≥ 1) once the walk has left it, `c_prev` = c_{j−1} as stored.
     pub fn light_q(&self, y: &LightMis, c_prev: f64) -> f64 {
-        y.own_vc + self.vm_light(y) + self.u(c_prev / y.l_prev) * y.q_prev
+        let own = if y.through_delta {
+            0.0
+        } else {
+            y.own_vc + self.vm_light(y)
+        };
+        own + self.u(c_prev / y.l_prev) * y.q_prev
     }
 
     /// The record of light vertex y_j (j ≥ 1) with density `l`, after `prev` = y_{j−1}'s record
     /// and its stored `c_prev_prev` = c_{j−2} (Q_{j−1} = 1 for j = 1). `vc_valid`: VC(j) can join
-    /// y_{j−1} and y_j; `nee_over_l0`: nee / l_0 of the subpath (read for j = 1).
+    /// y_{j−1} and y_j; `nee_over_l0`: nee / l_0 of the subpath (read for j = 1);
+    /// `through_delta`: see `LightMis`.
     #[allow(clippy::too_many_arguments)]
     pub fn light_vertex(
         &self,
@@ -175,6 +187,7 @@ impl SubpathMis {
         vc_valid: bool,
         nee_over_l0: f64,
         mergeable: bool,
+        through_delta: bool,
     ) -> LightMis {
         let q_prev = if j == 1 {
             1.0
@@ -192,6 +205,7 @@ impl SubpathMis {
             q_prev,
             own_vc,
             mergeable: mergeable && j >= 1,
+            through_delta,
         }
     }
 
@@ -205,7 +219,8 @@ impl SubpathMis {
 
     /// The record of camera vertex z_m (m ≥ 1) with density `c`, after `prev` = z_{m−1}'s record,
     /// whose stored pdf_rev (l of z_{m−1}) is `l_prev`. `vc_valid`: a connection can join z_m and
-    /// z_{m−1}.
+    /// z_{m−1}; `through_delta`: see `CameraMis`.
+    #[allow(clippy::too_many_arguments)]
     pub fn camera_vertex(
         &self,
         m: usize,
@@ -214,6 +229,7 @@ impl SubpathMis {
         l_prev: f64,
         vc_valid: bool,
         mergeable: bool,
+        through_delta: bool,
     ) -> CameraMis {
         let n = if m == 1 {
             self.light_tracing_ratio
@@ -225,8 +241,14 @@ impl SubpathMis {
             r: 0.0,
             next_vc: if vc_valid { self.vc * self.u(n) } else { 0.0 },
             mergeable: mergeable && m >= 1,
+            through_delta,
         };
-        z.r = z.next_vc + self.vm_camera(&z) + self.u(l_prev / prev.c) * prev.r;
+        let own = if through_delta {
+            0.0
+        } else {
+            z.next_vc + self.vm_camera(&z)
+        };
+        z.r = own + self.u(l_prev / prev.c) * prev.r;
         z
     }
 
@@ -359,6 +381,8 @@ impl SubpathMis {
                 },
                 d.nee / l[0],
                 conn[j],
+                // The oracle's `connectable` already says where the path follows a delta lobe.
+                false,
             );
             light.push(y);
         }
@@ -372,6 +396,7 @@ impl SubpathMis {
                 l[i + 1],
                 conn[i] && conn[i + 1],
                 conn[i] && i >= 1,
+                false,
             );
             camera.push(z);
         }

@@ -17,9 +17,12 @@ use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor, PERFECT_MIR
 use lt_core::bsdf::fresnel::ComplexIor;
 use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::{
-    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, TwoSided,
+    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, RoughDielectric,
+    ThinDielectric, TwoSided,
 };
+use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight};
 use lt_core::bsdf::{NormalSource, Perturbed, TextureSlot, Textured};
+use lt_core::bsdf::{Plastic, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::math::{Color, Vec2};
 use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
@@ -603,7 +606,7 @@ impl<'a> Loader<'a> {
                 match inner[..] {
                     [one] => {
                         let m = self.bsdf(one, true)?;
-                        if matches!(m, Material::Dielectric(_)) {
+                        if matches!(m, Material::Dielectric(_) | Material::RoughDielectric(_) | Material::ThinDielectric(_)) {
                             return Err(p.err(one, "twosided cannot wrap a dielectric (it transmits)"));
                         }
                         m
@@ -625,13 +628,32 @@ impl<'a> Loader<'a> {
                         }
                     }
                 }
-                let int = self.ior(&p, "int_ior", 1.5046)?;
-                let ext = self.ior(&p, "ext_ior", 1.000277)?;
-                let ior = int / ext;
-                if !(ior > 0.0) || !(ior as f32).is_finite() {
-                    return Err(p.err(e, format!("the relative IOR {int}/{ext} is not a positive number")));
+                Material::Dielectric(Dielectric {
+                    ior: self.relative_ior(&p)?,
+                })
+            }
+            "roughdielectric" | "thindielectric" => {
+                let ior = self.relative_ior(&p)?;
+                let specular_reflectance = self
+                    .color_or_texture(&p, "specular_reflectance", TextureSlot::SpecularReflectance, &mut slots)?
+                    .unwrap_or(Color::ONE);
+                let specular_transmittance = p
+                    .color("specular_transmittance", ColorUse::Reflectance, opts, &mut self.report)?
+                    .unwrap_or(Color::ONE);
+                if p.kind == "thindielectric" {
+                    Material::ThinDielectric(ThinDielectric {
+                        ior,
+                        specular_reflectance,
+                        specular_transmittance,
+                    })
+                } else {
+                    Material::RoughDielectric(RoughDielectric {
+                        distribution: self.microfacet(&p, &mut slots)?,
+                        ior,
+                        specular_reflectance,
+                        specular_transmittance,
+                    })
                 }
-                Material::Dielectric(Dielectric { ior: ior as f32 })
             }
             "conductor" | "roughconductor" => {
                 let ior = self.complex_ior(&p)?;
@@ -676,6 +698,16 @@ impl<'a> Loader<'a> {
                     one_sided => one_sided,
                 }
             }
+            "plastic" | "roughplastic" => {
+                let one_sided = self.plastic(&p, &mut slots)?;
+                if in_twosided {
+                    Material::TwoSided(TwoSided {
+                        inner: Box::new(one_sided),
+                    })
+                } else {
+                    one_sided
+                }
+            }
             "normalmap" | "bumpmap" => {
                 let inner = match p.nested(&["bsdf"])[..] {
                     [one] => self.bsdf(one, in_twosided)?,
@@ -713,7 +745,7 @@ impl<'a> Loader<'a> {
             other => {
                 return Err(p.err(
                     e,
-                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, conductor, roughconductor, twosided, normalmap and bumpmap)"),
+                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, plastic, roughplastic, twosided, normalmap and bumpmap)"),
                 ))
             }
         };
@@ -820,6 +852,61 @@ impl<'a> Loader<'a> {
         Ok(texture)
     }
 
+    /// Mitsuba's `plastic` and `roughplastic` (one-sided): `int_ior` (polypropylene), `ext_ior`
+    /// (air), `diffuse_reflectance` (0.5) and `specular_reflectance` (1), either a texture,
+    /// `nonlinear` (false); `roughplastic` adds the microfacet parameters (isotropic, α a
+    /// number). The lobe-sampling weight reads a textured reflectance's mean, as Mitsuba does.
+    fn plastic(
+        &mut self,
+        p: &Plugin<'a>,
+        slots: &mut Vec<(TextureSlot, Texture)>,
+    ) -> Result<Material, SceneError> {
+        let e = p.elem;
+        let int = self.ior(p, "int_ior", 1.49)?;
+        let ext = self.ior(p, "ext_ior", 1.000277)?;
+        let eta = (int / ext) as f32;
+        if !(eta.is_finite() && eta > 0.0) {
+            return Err(p.err(e, format!("the relative IOR {int}/{ext} is not a positive number")));
+        }
+        if p.kind == "roughplastic" && int == ext {
+            return Err(p.err(e, "roughplastic needs `int_ior` ≠ `ext_ior` (as Mitsuba)"));
+        }
+        let mut reflectance = |this: &mut Self, name, slot, default| {
+            let c = this.color_or_texture(p, name, slot, slots)?;
+            let mean = match c {
+                Some(c) => c,
+                None => slots
+                    .iter()
+                    .rfind(|(s, _)| *s == slot)
+                    .map_or(default, |(_, t)| t.mean()),
+            };
+            Ok::<_, SceneError>((c.unwrap_or(default), mean))
+        };
+        let (diffuse, diffuse_mean) =
+            reflectance(self, "diffuse_reflectance", TextureSlot::Reflectance, Color::splat(0.5))?;
+        let (specular, specular_mean) = reflectance(
+            self,
+            "specular_reflectance",
+            TextureSlot::SpecularReflectance,
+            Color::ONE,
+        )?;
+        let nonlinear = p.boolean("nonlinear")?.unwrap_or(false);
+        let weight = specular_sampling_weight(channel_mean(diffuse_mean), channel_mean(specular_mean));
+        Ok(if p.kind == "plastic" {
+            let mut m = Plastic::new(eta, diffuse, specular, nonlinear);
+            m.specular_sampling_weight = weight;
+            Material::Plastic(m)
+        } else {
+            let distribution = self.microfacet(p, slots)?;
+            if slots.iter().any(|(s, _)| *s == TextureSlot::Alpha) {
+                return Err(p.err(e, "roughplastic's `alpha` must be a number (Mitsuba takes no texture there)"));
+            }
+            let mut m = RoughPlastic::new(distribution, eta, diffuse, specular, nonlinear);
+            m.specular_sampling_weight = weight;
+            Material::RoughPlastic(m)
+        })
+    }
+
     /// An IOR given as a number or by one of Mitsuba's names.
     fn ior(&self, p: &Plugin<'a>, key: &str, default: f64) -> Result<f64, SceneError> {
         let Some(e) = p.take_elem(key) else {
@@ -851,6 +938,21 @@ impl<'a> Loader<'a> {
             return Err(p.err(e, format!("`{key}` must be positive, got {x}")));
         }
         Ok(x)
+    }
+
+    /// A dielectric's `int_ior / ext_ior` (Mitsuba's defaults: bk7 = 1.5046 inside, air =
+    /// 1.000277 outside; either a number or a name Mitsuba knows).
+    fn relative_ior(&self, p: &Plugin<'a>) -> Result<f32, SceneError> {
+        let int = self.ior(p, "int_ior", 1.5046)?;
+        let ext = self.ior(p, "ext_ior", 1.000277)?;
+        let ior = int / ext;
+        if !(ior > 0.0) || !(ior as f32).is_finite() {
+            return Err(p.err(
+                p.elem,
+                format!("the relative IOR {int}/{ext} is not a positive number"),
+            ));
+        }
+        Ok(ior as f32)
     }
 
     /// Mitsuba's microfacet parameters: `distribution` (beckmann, the default, or ggx), `alpha` or

@@ -13,6 +13,7 @@ use crate::error::Ctx;
 use crate::format::{ColorDef, SceneFile, ShapeDef};
 use crate::transform::shape_matrix;
 use crate::SceneError;
+use lt_core::bsdf::plastic::{AIR_IOR, POLYPROPYLENE_IOR};
 use lt_core::camera::{FilterShape, Lens};
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
@@ -196,6 +197,43 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                     format!("<bsdf type=\"{kind}\" id=\"{id}\">{}\n    </bsdf>", inner.replace("\n            ", "\n        "))
                 }
             }
+            "plastic" | "roughplastic" => {
+                let kind = d.kind.get_ref();
+                let ior = d.ior.as_ref().map_or(POLYPROPYLENE_IOR / AIR_IOR, |r| *r.get_ref() as f32);
+                let mut inner = format!("\n            <float name=\"int_ior\" value=\"{ior}\"/>\n            <float name=\"ext_ior\" value=\"1\"/>\n            <rgb name=\"diffuse_reflectance\" value=\"{}\"/>\n            <rgb name=\"specular_reflectance\" value=\"{}\"/>", rgb(&d.albedo, 0.5), rgb(&d.reflectance, 1.0));
+                if d.nonlinear.as_ref().is_some_and(|n| *n.get_ref()) {
+                    inner.push_str("\n            <boolean name=\"nonlinear\" value=\"true\"/>");
+                }
+                if kind == "roughplastic" {
+                    let dist = d.distribution.as_ref().map_or("beckmann", |s| s.get_ref().as_str());
+                    let alpha = d.alpha.as_ref().map_or(0.1, |a| *a.get_ref() as f32);
+                    let _ = write!(inner, "\n            <string name=\"distribution\" value=\"{}\"/>\n            <float name=\"alpha\" value=\"{alpha}\"/>", esc(dist));
+                }
+                if d.twosided.as_ref().is_some_and(|t| *t.get_ref()) {
+                    format!("<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"{kind}\">{inner}\n        </bsdf>\n    </bsdf>")
+                } else {
+                    format!("<bsdf type=\"{kind}\" id=\"{id}\">{}\n    </bsdf>", inner.replace("\n            ", "\n        "))
+                }
+            }
+            "roughdielectric" | "thindielectric" => {
+                let kind = d.kind.get_ref();
+                let mut inner = format!(
+                    "\n        <float name=\"int_ior\" value=\"{}\"/>\n        <float name=\"ext_ior\" value=\"1\"/>",
+                    d.ior.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(1.0)
+                );
+                if kind == "roughdielectric" {
+                    let dist = d.distribution.as_ref().map_or("beckmann", |s| s.get_ref().as_str());
+                    let alpha = d.alpha.as_ref().map_or(0.1, |a| *a.get_ref() as f32);
+                    let _ = write!(inner, "\n        <string name=\"distribution\" value=\"{}\"/>\n        <float name=\"alpha\" value=\"{alpha}\"/>", esc(dist));
+                }
+                let _ = write!(
+                    inner,
+                    "\n        <rgb name=\"specular_reflectance\" value=\"{}\"/>\n        <rgb name=\"specular_transmittance\" value=\"{}\"/>",
+                    rgb(&d.reflectance, 1.0),
+                    rgb(&d.transmittance, 1.0)
+                );
+                format!("<bsdf type=\"{kind}\" id=\"{id}\">{inner}\n    </bsdf>")
+            }
             "dielectric" => format!(
                 "<bsdf type=\"dielectric\" id=\"{id}\">\n        <float name=\"int_ior\" value=\"{}\"/>\n        <float name=\"ext_ior\" value=\"1\"/>\n    </bsdf>",
                 d.ior.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(1.0)
@@ -205,9 +243,11 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
             }
         };
         // Textured parameters become nested <texture>s of the innermost BSDF.
+        let plastic = matches!(d.kind.get_ref().as_str(), "plastic" | "roughplastic");
+        let albedo = if plastic { "diffuse_reflectance" } else { "reflectance" };
         let mut textures = String::new();
         for (t, name) in [
-            (&d.albedo_texture, "reflectance"),
+            (&d.albedo_texture, albedo),
             (&d.reflectance_texture, "specular_reflectance"),
             (&d.alpha_texture, "alpha"),
         ] {
@@ -220,7 +260,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
             .split_inclusive('\n')
             .filter(|line| {
                 ![
-                    (&d.albedo_texture, "name=\"reflectance\""),
+                    (&d.albedo_texture, if plastic { "name=\"diffuse_reflectance\"" } else { "name=\"reflectance\"" }),
                     (&d.reflectance_texture, "name=\"specular_reflectance\""),
                     (&d.alpha_texture, "name=\"alpha\""),
                 ]

@@ -275,10 +275,14 @@ fn unit_towards(from: &PathVertex, to: &PathVertex) -> lt_core::Vec3 {
     from.dir_to(to)
 }
 
-/// The `delta` flag a walk stores: a delta surface, or a light delta in direction.
-fn is_delta(scene: &Scene, v: &PathVertex) -> bool {
+/// The `delta` flag a walk stores: a delta surface, or a surface the path leaves through a delta
+/// lobe beside smooth ones (plastic: the oracle's `connectable` is false there), or a light delta
+/// in direction.
+fn is_delta(scene: &Scene, v: &PathVertex, d: &lt_core::path::Densities, i: usize) -> bool {
     match v.kind {
-        VertexKind::Surface { material } => scene.material(material).is_delta(),
+        VertexKind::Surface { material } => {
+            scene.material(material).is_delta() || !d.connectable[i]
+        }
         VertexKind::Light { light, .. } => scene.lights[light as usize].delta_direction(),
         VertexKind::Camera => false,
     }
@@ -307,7 +311,7 @@ fn replay_bdpt(
             } else {
                 unit_towards(&v[i], &v[i - 1])
             };
-            x.delta = is_delta(scene, &v[i]);
+            x.delta = is_delta(scene, &v[i], d, i);
             x
         })
         .collect();
@@ -326,7 +330,7 @@ fn replay_bdpt(
             } else {
                 unit_towards(&v[i], &v[i + 1])
             };
-            x.delta = is_delta(scene, &v[i]);
+            x.delta = is_delta(scene, &v[i], d, i);
             x
         })
         .collect();
