@@ -230,7 +230,7 @@ fn xml_bad_files_give_one_clear_error() {
     fails(
         &d,
         &text,
-        line_of(&text, "to_world"),
+        line_of(&text, "<scale value=\"2\"/>"),
         &["a spot light's to_world must be a rotation"],
     );
     let text = scene_xml(
