@@ -103,6 +103,7 @@ fn walk_densities_match_the_oracle_on_shipped_scenes() {
         "cornell-env",
         "veach-mis",
         "cornell-directional",
+        "cornell-plastic",
     ] {
         let sc = scene(name);
         let (count, worst, over) = check(&sc, 4000, 1e-3);

@@ -9,12 +9,12 @@ use glam::DVec3;
 use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor, PERFECT_MIRROR};
 use lt_core::bsdf::fresnel::ComplexIor;
 use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
+use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight, AIR_IOR, POLYPROPYLENE_IOR};
 use lt_core::bsdf::textured::set_parameter;
 use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, NormalSource, Perturbed,
     RoughConductor, RoughDielectric, TextureSlot, Textured, ThinDielectric, TwoSided,
 };
-use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight, AIR_IOR, POLYPROPYLENE_IOR};
 use lt_core::bsdf::{Plastic, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::light::SunLight;
@@ -517,13 +517,24 @@ fn plastic(
         "distribution",
         "alpha",
     ];
-    ctx.only(given, if kind == "plastic" { &SMOOTH } else { &ROUGH }, what)?;
+    ctx.only(
+        given,
+        if kind == "plastic" { &SMOOTH } else { &ROUGH },
+        what,
+    )?;
     for (plain, texture, key) in [
         (d.albedo.as_ref().map(S::span), &d.albedo_texture, "albedo"),
-        (d.reflectance.as_ref().map(S::span), &d.reflectance_texture, "reflectance"),
+        (
+            d.reflectance.as_ref().map(S::span),
+            &d.reflectance_texture,
+            "reflectance",
+        ),
     ] {
         if let (Some(_), Some(t)) = (plain, texture) {
-            return Err(ctx.at(t.span(), format!("give `{key}` or `{key}_texture`, not both")));
+            return Err(ctx.at(
+                t.span(),
+                format!("give `{key}` or `{key}_texture`, not both"),
+            ));
         }
     }
     let color = |c: &Option<S<crate::format::ColorDef>>, key, default| {
@@ -539,13 +550,22 @@ fn plastic(
         Some(i) => ctx.positive(i, "ior")?,
     };
     if kind == "roughplastic" && ior == 1.0 {
-        return Err(ctx.at(d.ior.as_ref().unwrap().span(), "a roughplastic needs `ior` ≠ 1 (as Mitsuba)"));
+        return Err(ctx.at(
+            d.ior.as_ref().unwrap().span(),
+            "a roughplastic needs `ior` ≠ 1 (as Mitsuba)",
+        ));
     }
     let nonlinear = d.nonlinear.as_ref().is_some_and(|n| *n.get_ref());
     let one_sided = if kind == "plastic" {
         Material::Plastic(Plastic::new(ior, diffuse, specular, nonlinear))
     } else {
-        Material::RoughPlastic(RoughPlastic::new(microfacet(ctx, d)?, ior, diffuse, specular, nonlinear))
+        Material::RoughPlastic(RoughPlastic::new(
+            microfacet(ctx, d)?,
+            ior,
+            diffuse,
+            specular,
+            nonlinear,
+        ))
     };
     Ok(if d.twosided.as_ref().is_some_and(|t| *t.get_ref()) {
         Material::TwoSided(TwoSided {
@@ -557,7 +577,10 @@ fn plastic(
 }
 
 /// Mitsuba's lobe-sampling weight of a plastic from the means of its textured reflectances.
-fn plastic_weight_from_textures(m: &mut Material, slots: &[(TextureSlot, lt_core::texture::Texture)]) {
+fn plastic_weight_from_textures(
+    m: &mut Material,
+    slots: &[(TextureSlot, lt_core::texture::Texture)],
+) {
     let mean = |slot, plain: Color| {
         slots
             .iter()

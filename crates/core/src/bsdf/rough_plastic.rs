@@ -13,9 +13,12 @@
 //! mean over visible normals of G1(reflected)·F(·, 1/η). Each mean is an n×n Gauss–Legendre rule
 //! over the visible-normal sampler's unit square (n = 32 for relative IOR > 1, else 128); T is
 //! interpolated linearly between the tabulated cosines. Visible normals are always sampled here,
-//! whatever `sample_visible` says. Differences from Mitsuba, so its values are matched up to
-//! them: our Beckmann G1 is exact (erf) and our Beckmann visible-normal sampler exact, where
-//! Mitsuba uses a rational G1 fit and three Newton steps (both < 0.4 %; see `microfacet`).
+//! whatever `sample_visible` says. GGX normals are drawn through Mitsuba's map from the unit
+//! square (a concentric disk; the quadrature depends on the map: our polar map moves T by 10 % at
+//! grazing incidence), Beckmann's by our exact sampler (Mitsuba's three Newton steps would move T
+//! by 2e-7). What is not matched: Mitsuba's Beckmann G1 is a rational fit (see `microfacet`), in
+//! the specular lobe and inside T's integrand, where it moves T by ~5e-5; against Mitsuba 3.9.1
+//! the diffuse lobe agrees to 2e-5 (GGX) and 6e-5 (Beckmann), the Beckmann specular lobe to 0.6 %.
 //!
 //! f is symmetric in (wo, wi), the same in both transport modes (see `plastic`). Lobe choice:
 //! the specular lobe with probability P = (1 − T(cos θo)) w / ((1 − T) w + T (1 − w)), w as in
@@ -291,7 +294,7 @@ impl LocalBsdf for RoughPlastic {
 
 #[cfg(test)]
 mod tests {
-    use super::super::plastic::tests::check_pins;
+    use super::super::plastic::tests::{check_pins, check_pins_within};
     use super::*;
 
     #[test]
@@ -322,14 +325,37 @@ mod tests {
         check_pins(
             &ggx,
             &[
-                (a.0, a.1, [0.155_828_49, 0.085_585_6, 0.032_903_43], 0.271_613_72),
-                (b.0, b.1, [0.096_664_08, 0.049_222_87, 0.013_641_957], 0.153_173_12),
-                (c.0, c.1, [0.023_531_77, 0.012_358_081, 0.003_977_814], 0.049_924_27),
-                (a.0, near, [0.200_516_64, 0.118_674_755, 0.057_293_35], 0.365_700_78),
+                (
+                    a.0,
+                    a.1,
+                    [0.155_828_49, 0.085_585_6, 0.032_903_43],
+                    0.271_613_72,
+                ),
+                (
+                    b.0,
+                    b.1,
+                    [0.096_664_08, 0.049_222_87, 0.013_641_957],
+                    0.153_173_12,
+                ),
+                (
+                    c.0,
+                    c.1,
+                    [0.023_531_77, 0.012_358_081, 0.003_977_814],
+                    0.049_924_27,
+                ),
+                (
+                    a.0,
+                    near,
+                    [0.200_516_64, 0.118_674_755, 0.057_293_35],
+                    0.365_700_78,
+                ),
             ],
         );
-        // Beckmann away from its lobe (Mitsuba's G1 is a fit, see `microfacet`): the diffuse lobe
-        // alone pins the transmittance table and the internal reflectance; bk7, nonlinear.
+        // Beckmann far from its lobe: the diffuse lobe alone pins the transmittance table and
+        // the internal reflectance; bk7, nonlinear. Mitsuba's Beckmann G1 is a rational fit
+        // (see `microfacet`), also inside the table's integrand, which moves T by ~5e-5
+        // (measured: 5.4e-5 here; Mitsuba's own three-Newton-step sampler instead of ours moves
+        // it by 2e-7), so these pins allow 1e-4.
         let beckmann = RoughPlastic::new(
             Microfacet::isotropic(MicrofacetType::Beckmann, 0.1),
             1.5046 / AIR_IOR,
@@ -337,12 +363,28 @@ mod tests {
             Color::ONE,
             true,
         );
-        check_pins(
+        check_pins_within(
             &beckmann,
+            1e-4,
             &[
-                (a.0, a.1, [0.157_515_48, 0.055_556_05, 0.012_254_124], 0.236_735_14),
-                (b.0, b.1, [0.104_867_78, 0.036_470_864, 0.007_422_850_5], 0.138_133_17),
-                (c.0, c.1, [0.020_187_203, 0.007_020_695, 0.001_428_909_7], 0.046_573_557),
+                (
+                    a.0,
+                    a.1,
+                    [0.157_515_48, 0.055_556_05, 0.012_254_124],
+                    0.236_735_14,
+                ),
+                (
+                    b.0,
+                    b.1,
+                    [0.104_867_78, 0.036_470_864, 0.007_422_850_5],
+                    0.138_133_17,
+                ),
+                (
+                    c.0,
+                    c.1,
+                    [0.020_187_203, 0.007_020_695, 0.001_428_909_7],
+                    0.046_573_557,
+                ),
             ],
         );
     }

@@ -16,11 +16,11 @@ use glam::{DMat4, DVec3, DVec4};
 use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor, PERFECT_MIRROR};
 use lt_core::bsdf::fresnel::ComplexIor;
 use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
+use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight};
 use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, RoughDielectric,
     ThinDielectric, TwoSided,
 };
-use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight};
 use lt_core::bsdf::{NormalSource, Perturbed, TextureSlot, Textured};
 use lt_core::bsdf::{Plastic, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
@@ -866,7 +866,10 @@ impl<'a> Loader<'a> {
         let ext = self.ior(p, "ext_ior", 1.000277)?;
         let eta = (int / ext) as f32;
         if !(eta.is_finite() && eta > 0.0) {
-            return Err(p.err(e, format!("the relative IOR {int}/{ext} is not a positive number")));
+            return Err(p.err(
+                e,
+                format!("the relative IOR {int}/{ext} is not a positive number"),
+            ));
         }
         if p.kind == "roughplastic" && int == ext {
             return Err(p.err(e, "roughplastic needs `int_ior` ≠ `ext_ior` (as Mitsuba)"));
@@ -882,8 +885,12 @@ impl<'a> Loader<'a> {
             };
             Ok::<_, SceneError>((c.unwrap_or(default), mean))
         };
-        let (diffuse, diffuse_mean) =
-            reflectance(self, "diffuse_reflectance", TextureSlot::Reflectance, Color::splat(0.5))?;
+        let (diffuse, diffuse_mean) = reflectance(
+            self,
+            "diffuse_reflectance",
+            TextureSlot::Reflectance,
+            Color::splat(0.5),
+        )?;
         let (specular, specular_mean) = reflectance(
             self,
             "specular_reflectance",
@@ -891,7 +898,8 @@ impl<'a> Loader<'a> {
             Color::ONE,
         )?;
         let nonlinear = p.boolean("nonlinear")?.unwrap_or(false);
-        let weight = specular_sampling_weight(channel_mean(diffuse_mean), channel_mean(specular_mean));
+        let weight =
+            specular_sampling_weight(channel_mean(diffuse_mean), channel_mean(specular_mean));
         Ok(if p.kind == "plastic" {
             let mut m = Plastic::new(eta, diffuse, specular, nonlinear);
             m.specular_sampling_weight = weight;
@@ -899,7 +907,10 @@ impl<'a> Loader<'a> {
         } else {
             let distribution = self.microfacet(p, slots)?;
             if slots.iter().any(|(s, _)| *s == TextureSlot::Alpha) {
-                return Err(p.err(e, "roughplastic's `alpha` must be a number (Mitsuba takes no texture there)"));
+                return Err(p.err(
+                    e,
+                    "roughplastic's `alpha` must be a number (Mitsuba takes no texture there)",
+                ));
             }
             let mut m = RoughPlastic::new(distribution, eta, diffuse, specular, nonlinear);
             m.specular_sampling_weight = weight;

@@ -244,7 +244,11 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
         };
         // Textured parameters become nested <texture>s of the innermost BSDF.
         let plastic = matches!(d.kind.get_ref().as_str(), "plastic" | "roughplastic");
-        let albedo = if plastic { "diffuse_reflectance" } else { "reflectance" };
+        let albedo = if plastic {
+            "diffuse_reflectance"
+        } else {
+            "reflectance"
+        };
         let mut textures = String::new();
         for (t, name) in [
             (&d.albedo_texture, albedo),
@@ -260,7 +264,14 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
             .split_inclusive('\n')
             .filter(|line| {
                 ![
-                    (&d.albedo_texture, if plastic { "name=\"diffuse_reflectance\"" } else { "name=\"reflectance\"" }),
+                    (
+                        &d.albedo_texture,
+                        if plastic {
+                            "name=\"diffuse_reflectance\""
+                        } else {
+                            "name=\"reflectance\""
+                        },
+                    ),
                     (&d.reflectance_texture, "name=\"specular_reflectance\""),
                     (&d.alpha_texture, "name=\"alpha\""),
                 ]
