@@ -302,8 +302,8 @@ fn walks_under_a_sun_and_a_point_light_match_p_and_f() {
     }
 }
 
-/// Two directional lights (deltas in direction) above the plane, with unequal powers, so that
-/// light selection pmfs are 2/3 and 1/3.
+/// Two directional lights (deltas in direction) above the plane, with unequal powers 2:1, so that
+/// light selection pmfs are ½·⅔ + ½·½ = 7/12 and 5/12 (half by power, half uniform).
 fn directional_pair() -> PlaneLight {
     PlaneLight::Directional {
         dir: Vec3::new(0.3, 1.0, 0.2),
@@ -325,7 +325,7 @@ fn directional_light_paths_match_p_and_f_and_only_nee_and_light_walks_reach_them
     // it (p_0 = 0) and the pinhole cannot be joined to it (no k = 1 path, p = 0 if built).
     let scene = plane(directional_pair());
     let pmfs = [0, 1].map(|i| scene.light_sampler.pmf(i));
-    assert!((pmfs[0] - 2.0 / 3.0).abs() < 1e-6, "pmfs {pmfs:?}");
+    assert!((pmfs[0] - 7.0 / 12.0).abs() < 1e-6, "pmfs {pmfs:?}");
     for camera in [true, false] {
         let made = collect(&scene, 13, 20_000, camera, 2);
         let by_s = |s: usize| made.iter().filter(|m| m.s == s).count();
