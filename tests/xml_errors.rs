@@ -88,12 +88,12 @@ fn xml_bad_files_give_one_clear_error() {
 
     // An unknown plugin.
     let text =
-        scene_xml("    <shape type=\"sphere\">\n        <bsdf type=\"plastic\"/>\n    </shape>");
+        scene_xml("    <shape type=\"sphere\">\n        <bsdf type=\"measured\"/>\n    </shape>");
     fails(
         &d,
         &text,
-        line_of(&text, "plastic"),
-        &["BSDF `plastic` is not supported"],
+        line_of(&text, "measured"),
+        &["BSDF `measured` is not supported"],
     );
     let text = scene_xml("    <shape type=\"cylinder\"/>");
     fails(
