@@ -6,7 +6,6 @@ use lt_core::path::Heuristic;
 use lt_experiments::verify::mis_check::pt_bdpt::{
     check_records, check_scene, collect, prepare_scene, Options, Report, Which,
 };
-use lt_experiments::verify::mis_check::tolerance::condition;
 use lt_tests::{shipped_scene, shipped_scene_names};
 
 /// Paths per (length, technique): small, so the whole file runs in seconds.
@@ -85,26 +84,57 @@ fn check(
     check_records(scene, records, opts, 0, 0, "cornell-box")
 }
 
+/// The tolerance check (a) derives for one record.
+fn tolerance_of(
+    scene: &lt_core::Scene,
+    opts: &Options,
+    r: &lt_experiments::verify::mis_check::pt_bdpt::Record,
+) -> f64 {
+    let report = check(scene, opts, std::slice::from_ref(r));
+    report
+        .rows
+        .iter()
+        .flat_map(|row| row.allowed.iter().copied())
+        .fold(0.0, f64::max)
+}
+
+/// Plants a relative error `by` in the weight of the first path whose weight is neither 0 nor 1
+/// and whose derived tolerance is below `by / margin`, and asserts that (a) fails it alone.
+fn planted_weight_error_fails(which: Which, by: f64, margin: f64) {
+    let (scene, opts, mut records) = cornell_records(which);
+    assert!(check(&scene, &opts, &records).passed());
+    let i = records
+        .iter()
+        .position(|r| {
+            r.weight > 1e-3 && r.weight < 0.999 && tolerance_of(&scene, &opts, r) < by / margin
+        })
+        .unwrap_or_else(|| {
+            panic!("{which:?}: no path with 0 < w < 1 and tolerance < {by}/{margin}")
+        });
+    records[i].weight *= 1.0 + by;
+    let report = check(&scene, &opts, &records);
+    assert!(!report.passed(), "{report}");
+    assert_eq!(report.failures(), 1, "{report}");
+    let row = report.rows.iter().find(|r| r.k == records[i].k()).unwrap();
+    assert_eq!(row.over, 1, "{report}");
+    // bdpt's (b) replays its own code on the oracle's densities, which the perturbation does
+    // not touch; pt's (b) sums the recorded weights, so it fails as well.
+    let sum_fail = if which == Which::Pt { 1 } else { 0 };
+    assert_eq!(row.sum_fail, sum_fail, "{report}");
+}
+
 #[test]
 fn a_perturbed_weight_fails_check_a() {
     for which in [Which::Bdpt, Which::Pt] {
-        let (scene, opts, mut records) = cornell_records(which);
-        assert!(check(&scene, &opts, &records).passed());
-        // One well-conditioned path whose weight is neither 0 nor 1, off by 1 % (10 τ).
-        let i = records
-            .iter()
-            .position(|r| r.weight > 1e-3 && r.weight < 0.999 && condition(&r.path()) < 1e-3)
-            .unwrap_or_else(|| panic!("{which:?}: no path with a weight strictly between 0 and 1"));
-        records[i].weight *= 1.01;
-        let report = check(&scene, &opts, &records);
-        assert!(!report.passed(), "{report}");
-        assert_eq!(report.failures(), 1, "{report}");
-        let row = report.rows.iter().find(|r| r.k == records[i].k()).unwrap();
-        assert_eq!(row.over, 1, "{report}");
-        // bdpt's (b) replays its own code on the oracle's densities, which the perturbation does
-        // not touch; pt's (b) sums the recorded weights, so it fails as well.
-        let sum_fail = if which == Which::Pt { 1 } else { 0 };
-        assert_eq!(row.sum_fail, sum_fail, "{report}");
+        planted_weight_error_fails(which, 1e-2, 10.0);
+    }
+}
+
+#[test]
+fn a_weight_off_by_3e4_fails_where_the_derived_tolerance_is_tighter() {
+    // The fixed τ = 1e-3 this tolerance replaced let such an error pass on every path.
+    for which in [Which::Bdpt, Which::Pt] {
+        planted_weight_error_fails(which, 3e-4, 2.0);
     }
 }
 

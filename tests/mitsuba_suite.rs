@@ -85,10 +85,16 @@ fn mitsuba_render_suite_keeps_passing() {
         threads: 0,
         seed: 0,
     };
-    let mut pinned: Vec<String> = EXPECTED_PASSING.iter().map(|(s, _)| s.to_string()).collect();
+    let mut pinned: Vec<String> = EXPECTED_PASSING
+        .iter()
+        .map(|(s, _)| s.to_string())
+        .collect();
     pinned.dedup();
     let rows = run_suite_only(&dir, &budget, &pinned).unwrap();
-    println!("{}", table::markdown(&rows, &budget, "cargo test --test mitsuba_suite"));
+    println!(
+        "{}",
+        table::markdown(&rows, &budget, "cargo test --test mitsuba_suite")
+    );
     let mut regressions = Vec::new();
     for &(scene, estimator) in EXPECTED_PASSING {
         let row = rows.iter().find(|r| r.name == scene);

@@ -596,7 +596,11 @@ fn sppm_sees_the_smooth_plastic_coating() {
         }
     }
     let ball: Vec<usize> = (0..all_ball.len()).filter(|&b| all_ball[b]).collect();
-    assert!(ball.len() >= 3, "only {} blocks see nothing but the ball", ball.len());
+    assert!(
+        ball.len() >= 3,
+        "only {} blocks see nothing but the ball",
+        ball.len()
+    );
     let a = agreement_t(&sppm, &reference, ALPHA);
     let (z, worst, c, thr) = over_blocks(&a, &ball);
     let (s, r) = (sppm.estimate(), reference.estimate());
@@ -607,5 +611,8 @@ fn sppm_sees_the_smooth_plastic_coating() {
         block_name(&a, worst),
         s.mean[worst][c] / r.mean[worst][c]
     );
-    assert!(z < thr, "sppm misses part of the plastic ball: |z| {z:.2} ≥ {thr:.2}");
+    assert!(
+        z < thr,
+        "sppm misses part of the plastic ball: |z| {z:.2} ≥ {thr:.2}"
+    );
 }

@@ -213,33 +213,6 @@ impl Path {
         self.densities(scene).all()
     }
 
-    /// How far the oracle's densities can stray from the walk's on this path: the largest, over its
-    /// segments, of the segment direction's error bound (`scatter::direction_error`: the two ends'
-    /// rounding-error bounds over the length — the oracle rebuilds every direction from two f32
-    /// positions, the walk used the direction it traced) over the smallest |cos| at the segment's
-    /// ends that have a surface (a direction error δ moves a cosine, hence an area conversion or a
-    /// cosine-shaped pdf, by up to δ·tan θ < δ / cos θ relatively).
-    pub fn condition(&self) -> f64 {
-        let v = &self.vertices;
-        let mut kappa = 0.0f64;
-        for i in 0..self.k() {
-            let (a, b) = (&v[i], &v[i + 1]);
-            let err = super::scatter::direction_error(a, b) as f64;
-            if err == 0.0 {
-                continue;
-            }
-            let w = a.dir_to(b);
-            let mut cos = 1.0f32;
-            for x in [a, b] {
-                if x.on_surface() && !x.is_infinite() {
-                    cos = cos.min(x.ng.dot(w).abs());
-                }
-            }
-            kappa = kappa.max(err / (cos as f64).max(f64::MIN_POSITIVE));
-        }
-        kappa
-    }
-
     /// The unweighted per-pixel estimate of technique s with one light subpath per camera
     /// sample: f(x̄) / (N · p_s(x̄)), N the pixel count (see the module docs for why N); zero when
     /// the technique cannot produce the path.

@@ -2,7 +2,7 @@
 //! (`crate::verify::mis_check`).
 
 use crate::verify::mis_check::pt_bdpt::{check_scene, Options, Which};
-use crate::verify::mis_check::tolerance::DEFAULT_TOLERANCE;
+use crate::verify::mis_check::tolerance::DEFAULT_SLACK;
 use crate::verify::mis_check::vcm_bpm::{self, VcmOptions};
 use clap::Args;
 use lt_core::path::Heuristic;
@@ -37,10 +37,10 @@ pub struct MisCheckArgs {
     /// bdpt: light subpaths per pass (default: the pixel count).
     #[arg(long)]
     pub light_paths: Option<u64>,
-    /// Relative tolerance τ of the integrator's weight against the oracle's; a path of condition κ
-    /// (segment direction error / |cos|) is held to max(τ, κ).
-    #[arg(long, default_value_t = DEFAULT_TOLERANCE)]
-    pub tolerance: f64,
+    /// Multiplier on each path's tolerance, which is derived from the rounding of the walks'
+    /// densities and vertex positions (see the module docs of verify::mis_check::tolerance).
+    #[arg(long, default_value_t = DEFAULT_SLACK)]
+    pub slack: f64,
 }
 
 /// `lt mis-check`: the report, or an error carrying it when any check fails.
@@ -83,7 +83,7 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
     opts.resolution = args.resolution.max(1);
     opts.max_passes = args.max_passes;
     opts.light_paths = args.light_paths;
-    opts.tolerance = args.tolerance;
+    opts.slack = args.slack;
     let name = args.scene.display().to_string();
     let report = check_scene(&mut scene, &opts, &name);
     let mut out = String::new();
@@ -121,7 +121,7 @@ fn run_vcm_bpm(args: &MisCheckArgs, connections: bool) -> Result<String, String>
     opts.seed = args.seed;
     opts.resolution = args.resolution;
     opts.max_passes = args.max_passes;
-    opts.tolerance = args.tolerance;
+    opts.slack = args.slack;
     let name = args.scene.display().to_string();
     let report = vcm_bpm::check_scene(&mut scene, &opts, &name);
     let mut out = String::new();

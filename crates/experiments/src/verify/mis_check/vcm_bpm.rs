@@ -10,11 +10,14 @@
 //! x_{i−1} aims the light walk at y_i, not z), the camera side from the path through z, and the
 //! two densities joining them from z's BSDF with the light vertex's incoming direction, as
 //! Georgiev et al. define a merge. It rebuilds every direction from positions, so the tolerance
-//! is that of connections, max(τ, κ), with κ taken over both paths and doubled for merges: their
-//! weight reads the light vertex's incoming direction twice (measured: one merge of 2700 on
-//! smallvcm-spheres-point at 1.13 κ, none above 2 κ).
+//! is derived as for connections (`tolerance::derived_tolerance`), with the vertices of both
+//! subpaths moved within their rounding boxes: y_i and z separately, since a merge's weight reads
+//! the light vertex's incoming direction through z's BSDF.
 
-use super::tolerance::{path_tolerance, relative, DEFAULT_TOLERANCE, SUM_TOLERANCE};
+use super::pt_bdpt::{median_and_max, slack_note};
+use super::tolerance::{
+    derived_tolerance, relative, weight_error_bound, DEFAULT_SLACK, SUM_TOLERANCE,
+};
 use lt_core::path::{Densities, Heuristic, Path, PathVertex, SubpathMis, Technique, TechniqueSet};
 use lt_core::Scene;
 use lt_integrators::connect_merge::{initial_radius, Engine, VcmParams};
@@ -38,7 +41,8 @@ pub struct VcmOptions {
     pub resolution: u32,
     pub max_passes: u32,
     pub light_paths: Option<u64>,
-    pub tolerance: f64,
+    /// Multiplier on the derived tolerance of (a) (`tolerance::derived_tolerance`).
+    pub slack: f64,
     pub radius: InitialRadius,
 }
 
@@ -54,7 +58,7 @@ impl VcmOptions {
             resolution: 16,
             max_passes: 2000,
             light_paths: None,
-            tolerance: DEFAULT_TOLERANCE,
+            slack: DEFAULT_SLACK,
             // Large radii (relative to the 16² film's footprint) so merging techniques carry
             // weights far from 0 and 1, where a wrong density shows.
             radius: InitialRadius::Pixels(2.0),
@@ -240,10 +244,8 @@ pub struct VcmCheck {
     pub technique: Technique,
     pub oracle: f64,
     pub mismatch: f64,
-    /// The tolerance the mismatch is held to.
+    /// The tolerance the mismatch is held to, derived for this path.
     pub allowed: f64,
-    /// The path's condition κ (for merges, the larger of its two paths').
-    pub condition: f64,
     /// Σ of the replayed weights over the techniques, minus 1.
     pub sum_error: f64,
     /// Largest |replayed − oracle| weight over the techniques.
@@ -265,28 +267,43 @@ pub fn check_record(scene: &Scene, r: &VcmRecord, opts: &VcmOptions, ratio: f64)
     };
     let h = opts.heuristic;
     let path = r.path();
-    let mut kappa = path.condition();
     let d = match r.technique {
         Technique::Merge(_) => {
             let mut d = Densities::merged(scene, &r.light, &r.camera);
             d.light_tracing_ratio = ratio;
-            if let Some(other) = r.light_side_path() {
-                kappa = kappa.max(other.condition());
-            }
             d
         }
         Technique::Connect(_) => densities(scene, &path, ratio),
     };
     let oracle = d.vcm_weight(set, r.technique, h);
     let mismatch = relative(r.weight, oracle);
-    // A merge's weight reads the light vertex's incoming direction twice (c_{i−1} and l_{i+1},
-    // both through z's BSDF), which the integrator has as traced and the oracle rebuilds from
-    // positions: its condition counts twice.
-    let kappa = match r.technique {
-        Technique::Merge(_) => 2.0 * kappa,
-        Technique::Connect(_) => kappa,
+    let weight = |d: &Densities| d.vcm_weight(set, r.technique, h);
+    let bound = match r.technique {
+        Technique::Merge(_) => {
+            let both: Vec<PathVertex> = r.light.iter().chain(&r.camera).copied().collect();
+            let n = r.light.len();
+            let merged = |v: &[PathVertex]| {
+                let mut d = Densities::merged(scene, &v[..n], &v[n..]);
+                d.light_tracing_ratio = ratio;
+                d
+            };
+            weight_error_bound(&both, merged, weight)
+        }
+        Technique::Connect(_) => weight_error_bound(
+            &path.vertices,
+            |v| {
+                densities(
+                    scene,
+                    &Path {
+                        vertices: v.to_vec(),
+                    },
+                    ratio,
+                )
+            },
+            weight,
+        ),
     };
-    let allowed = path_tolerance(opts.tolerance, kappa);
+    let allowed = derived_tolerance(bound, opts.slack);
     let mis = SubpathMis::new(h, set, ratio);
     let techniques = d.vcm_techniques(set);
     let mut sum = 0.0;
@@ -302,7 +319,6 @@ pub fn check_record(scene: &Scene, r: &VcmRecord, opts: &VcmOptions, ratio: f64)
         oracle,
         mismatch,
         allowed,
-        condition: kappa,
         sum_error: if sum.is_nan() {
             f64::INFINITY
         } else {
@@ -322,10 +338,17 @@ pub struct VcmRow {
     pub max_sum_error: f64,
     pub max_mismatch_connect: f64,
     pub max_mismatch_merge: f64,
-    /// Largest mismatch over well-conditioned paths (κ ≤ τ), connections and merges.
-    pub max_mismatch_well: f64,
-    /// Ill-conditioned paths (κ > τ), held to κ.
-    pub ill: usize,
+    /// Largest mismatch / its path's tolerance.
+    pub max_ratio: f64,
+    /// Paths over their tolerance that merged at the first light vertex, Merge(1), counted apart:
+    /// under the balance heuristic they differ from the oracle by up to 7.7e-4 on scenes lit by
+    /// an area light (cornell-box, cornell-mesh-light; never under the power heuristic, never on
+    /// veach-mis or sun-room). Found when the derived tolerance replaced τ = 1e-3; not explained
+    /// yet — a technique of small weight whose density differs, which only the balance heuristic
+    /// shows (its weights are linear in the densities, the power heuristic's quadratic).
+    pub over_first_merge: usize,
+    /// Every path's tolerance, for the median and the largest.
+    pub allowed: Vec<f64>,
     pub max_replay_error: f64,
     /// Techniques seen valid on the recorded paths: connections (s) and merges (i).
     pub valid_connect: std::collections::BTreeSet<usize>,
@@ -344,6 +367,11 @@ pub struct VcmReport {
 }
 
 impl VcmReport {
+    /// Paths over their tolerance that merged at the first light vertex (see `VcmRow`).
+    pub fn first_merge_failures(&self) -> usize {
+        self.rows.iter().map(|r| r.over_first_merge).sum()
+    }
+
     pub fn failures(&self) -> usize {
         self.too_long
             + self
@@ -410,14 +438,12 @@ pub fn check_records(
                 Technique::Merge(i) => row.valid_merge.insert(i),
             };
         }
-        if v.condition <= opts.tolerance {
-            row.max_mismatch_well = row.max_mismatch_well.max(v.mismatch);
-        } else {
-            row.ill += 1;
-        }
+        row.max_ratio = row.max_ratio.max(v.mismatch / v.allowed);
+        row.allowed.push(v.allowed);
         row.max_sum_error = row.max_sum_error.max(v.sum_error.abs());
         row.max_replay_error = row.max_replay_error.max(v.replay_error);
         let over = !(v.mismatch <= v.allowed);
+        row.over_first_merge += (over && v.technique == Technique::Merge(1)) as usize;
         let sum_fail = !(v.sum_error.abs() <= SUM_TOLERANCE);
         row.over += over as usize;
         row.sum_fail += sum_fail as usize;
@@ -427,8 +453,8 @@ pub fn check_records(
             .count();
         if (over || sum_fail) && shown < 3 {
             examples.push(format!(
-                "k={} {:?} weight={:.9e} oracle={:.9e} rel={:.3e} allowed={:.3e} κ={:.3e} Σw−1={:.3e}{} techniques={:?}",
-                v.k, v.technique, r.weight, v.oracle, v.mismatch, v.allowed, v.condition,
+                "k={} {:?} weight={:.9e} oracle={:.9e} rel={:.3e} allowed={:.3e} Σw−1={:.3e}{} techniques={:?}",
+                v.k, v.technique, r.weight, v.oracle, v.mismatch, v.allowed,
                 v.sum_error, if sum_fail { " Σw−1 FAIL" } else { "" }, v.techniques
             ));
         }
@@ -458,17 +484,17 @@ impl fmt::Display for VcmReport {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         writeln!(
             f,
-            "mis-check {} {} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ max(τ={:e}, κ); (b) |Σw−1| ≤ {:e} over connections and merges",
+            "mis-check {} {} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ the path's derived tolerance{}; (b) |Σw−1| ≤ {:e} over connections and merges",
             self.scene,
             self.options.name(),
             self.options.heuristic.name(),
             self.passes,
-            self.options.tolerance,
+            slack_note(self.options.slack),
             SUM_TOLERANCE
         )?;
         writeln!(
             f,
-            "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9} {:>9} {:>9} {:>9} {:>5} {:>8} {:>5} {:>5}",
+            "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9} {:>9} {:>9} {:>8} {:>8} {:>7} {:>8} {:>5} {:>5}",
             "k",
             "conn",
             "merges",
@@ -477,16 +503,18 @@ impl fmt::Display for VcmReport {
             "max|Σw−1|",
             "rel conn",
             "rel merge",
-            "rel κ≤τ",
-            "ill",
+            "tol med",
+            "tol max",
+            "rel/tol",
             "replay",
             "over",
             "Σfail"
         )?;
         for r in &self.rows {
+            let (med, max) = median_and_max(&r.allowed);
             writeln!(
                 f,
-                "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9.2e} {:>9.2e} {:>9.2e} {:>9.2e} {:>5} {:>8.1e} {:>5} {:>5}",
+                "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9.2e} {:>9.2e} {:>9.2e} {:>8.2e} {:>8.2e} {:>7.3} {:>8.1e} {:>5} {:>5}",
                 r.k,
                 r.connections,
                 r.merges,
@@ -495,8 +523,9 @@ impl fmt::Display for VcmReport {
                 r.max_sum_error,
                 r.max_mismatch_connect,
                 r.max_mismatch_merge,
-                r.max_mismatch_well,
-                r.ill,
+                med,
+                max,
+                r.max_ratio,
                 r.max_replay_error,
                 r.over,
                 r.sum_fail
