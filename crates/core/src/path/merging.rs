@@ -72,8 +72,10 @@ impl Densities {
         let w_z = z.dir_to(zp);
         let tol = delta_tolerance(z, y, zp);
         let towards_light = scatter(scene, z, w_z, w_y, TransportMode::Radiance, tol).pdf_w;
-        // No walk lands on a delta light: the oracle's own c_0 says so.
-        let landable = i > 1 || at_camera.camera[0] > 0.0;
+        // No walk lands on a delta light. Ask the light itself, not the path through z: z's BSDF
+        // towards y_0 from z may vanish (y_0 behind z's surface) while c_0 here is z's BSDF along
+        // ω_y, which is what the walk would have sampled.
+        let landable = i > 1 || !light_is_delta(scene, &light[0]);
         d.camera[i - 1] = if landable {
             y.convert_density(towards_light, yp) as f64
         } else {
@@ -138,5 +140,13 @@ impl Densities {
             .filter(|(_, &p)| p > 0.0)
             .map(|(i, _)| Technique::Merge(i));
         connect.chain(merge).collect()
+    }
+}
+
+/// Whether the light that emitted `x0` is a point or directional light, on which no walk lands.
+fn light_is_delta(scene: &Scene, x0: &PathVertex) -> bool {
+    match x0.kind {
+        crate::path::VertexKind::Light { light, .. } => scene.lights[light as usize].is_delta(),
+        _ => unreachable!("a light subpath starts on a light"),
     }
 }

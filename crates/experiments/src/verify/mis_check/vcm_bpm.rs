@@ -340,13 +340,6 @@ pub struct VcmRow {
     pub max_mismatch_merge: f64,
     /// Largest mismatch / its path's tolerance.
     pub max_ratio: f64,
-    /// Paths over their tolerance that merged at the first light vertex, Merge(1), counted apart:
-    /// under the balance heuristic they differ from the oracle by up to 7.7e-4 on scenes lit by
-    /// an area light (cornell-box, cornell-mesh-light; never under the power heuristic, never on
-    /// veach-mis or sun-room). Found when the derived tolerance replaced τ = 1e-3; not explained
-    /// yet — a technique of small weight whose density differs, which only the balance heuristic
-    /// shows (its weights are linear in the densities, the power heuristic's quadratic).
-    pub over_first_merge: usize,
     /// Every path's tolerance, for the median and the largest.
     pub allowed: Vec<f64>,
     pub max_replay_error: f64,
@@ -367,11 +360,6 @@ pub struct VcmReport {
 }
 
 impl VcmReport {
-    /// Paths over their tolerance that merged at the first light vertex (see `VcmRow`).
-    pub fn first_merge_failures(&self) -> usize {
-        self.rows.iter().map(|r| r.over_first_merge).sum()
-    }
-
     pub fn failures(&self) -> usize {
         self.too_long
             + self
@@ -443,7 +431,6 @@ pub fn check_records(
         row.max_sum_error = row.max_sum_error.max(v.sum_error.abs());
         row.max_replay_error = row.max_replay_error.max(v.replay_error);
         let over = !(v.mismatch <= v.allowed);
-        row.over_first_merge += (over && v.technique == Technique::Merge(1)) as usize;
         let sum_fail = !(v.sum_error.abs() <= SUM_TOLERANCE);
         row.over += over as usize;
         row.sum_fail += sum_fail as usize;
