@@ -36,6 +36,14 @@ const EXPECTED_PASSING: &[(&str, &str)] = &[
     ("instancing/test_instancing_path", "bdpt"),
     ("texture_interp/test_texture_interp_direct", "pt"),
     ("texture_interp/test_texture_interp_direct", "bdpt"),
+    ("bsdf_spheres/test_arealight_path", "pt"),
+    ("bsdf_spheres/test_arealight_path", "bdpt"),
+    ("bsdf_spheres/test_constant_path", "pt"),
+    ("bsdf_spheres/test_constant_path", "bdpt"),
+    ("bsdf_spheres/test_envmap_path", "pt"),
+    ("bsdf_spheres/test_envmap_path", "bdpt"),
+    ("bsdf_spheres/test_pointlight_path", "pt"),
+    ("bsdf_spheres/test_pointlight_path", "bdpt"),
 ];
 
 #[test]

@@ -19,6 +19,7 @@ mod dielectric;
 mod diffuse;
 pub mod fresnel;
 mod glossy;
+pub mod mask;
 pub mod microfacet;
 mod mirror;
 pub mod perturbed;
@@ -36,6 +37,7 @@ pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use glossy::Glossy;
+pub use mask::Mask;
 pub use mirror::Mirror;
 pub use perturbed::{NormalSource, Perturbed};
 pub use plastic::Plastic;
@@ -155,6 +157,8 @@ pub enum Material {
     Textured(Box<Textured>),
     /// A material under a normal or bump map (Mitsuba's `normalmap`, `bumpmap`).
     Perturbed(Box<Perturbed>),
+    /// A material that is partly absent (Mitsuba's `mask`): a pass-through delta lobe beside it.
+    Mask(Box<Mask>),
 }
 
 impl Material {
@@ -174,6 +178,9 @@ impl Material {
             Material::TwoSided(m) => m,
             Material::Textured(t) => t.base.local(),
             Material::Perturbed(p) => p.inner.local(),
+            // Only `is_delta` asks a mask's local BSDF: its pass-through is a delta lobe, so it
+            // is all-delta exactly when the nested material is.
+            Material::Mask(m) => m.inner.local(),
         }
     }
 
@@ -183,6 +190,7 @@ impl Material {
     pub fn perturbation(&self) -> Option<&Perturbed> {
         match self {
             Material::Perturbed(p) => Some(p),
+            Material::Mask(m) => m.inner.perturbation(),
             _ => None,
         }
     }
@@ -193,7 +201,7 @@ impl Material {
 
     /// See `LocalBsdf::has_delta_lobe`.
     pub fn has_delta_lobe(&self) -> bool {
-        self.local().has_delta_lobe()
+        matches!(self, Material::Mask(_)) || self.local().has_delta_lobe()
     }
 
     /// The probability that `sample` from `wo` picks a delta lobe (0 for smooth materials): every
@@ -203,6 +211,9 @@ impl Material {
     pub fn delta_lobe_probability(&self, sf: &ShadingFrame, wo: Vec3) -> f32 {
         if !self.has_delta_lobe() {
             return 0.0;
+        }
+        if let Material::Mask(m) = self {
+            return m.delta_lobe_probability(sf, wo);
         }
         match self.sample(sf, wo, 0.0, Vec2::splat(0.5), TransportMode::Radiance) {
             Some(s) if s.delta => s.pdf_w,
@@ -220,6 +231,8 @@ impl Material {
             | Material::ThinDielectric(_) => true,
             Material::Textured(t) => t.base.transmits(),
             Material::Perturbed(p) => p.inner.transmits(),
+            // The pass-through is a delta lobe: nothing is gathered through it.
+            Material::Mask(m) => m.inner.transmits(),
             _ => false,
         }
     }
@@ -233,6 +246,8 @@ impl Material {
             Material::RoughDielectric(d) => Some(d.ior),
             Material::Textured(t) => t.base.refraction_ior(),
             Material::Perturbed(p) => p.inner.refraction_ior(),
+            // The pass-through does not refract; the nested material may.
+            Material::Mask(m) => m.inner.refraction_ior(),
             _ => None,
         }
     }
@@ -250,6 +265,7 @@ impl Material {
                 t.with_local(sf.uv, |m| sample_local(m, sf, wo, u_lobe, u, mode))
             }
             Material::Perturbed(p) => p.sample(sf, wo, u_lobe, u, mode),
+            Material::Mask(m) => m.sample(sf, wo, u_lobe, u, mode),
             _ => sample_local(self.local(), sf, wo, u_lobe, u, mode),
         }
     }
@@ -258,6 +274,7 @@ impl Material {
         match self {
             Material::Textured(t) => t.with_local(sf.uv, |m| eval_local(m, sf, wo, wi, mode)),
             Material::Perturbed(p) => p.eval(sf, wo, wi, mode),
+            Material::Mask(m) => m.eval(sf, wo, wi, mode),
             _ => eval_local(self.local(), sf, wo, wi, mode),
         }
     }
@@ -267,6 +284,7 @@ impl Material {
         match self {
             Material::Textured(t) => t.with_local(sf.uv, |m| pdf_local(m, sf, wo, wi)),
             Material::Perturbed(p) => p.pdf(sf, wo, wi),
+            Material::Mask(m) => m.pdf(sf, wo, wi),
             _ => pdf_local(self.local(), sf, wo, wi),
         }
     }
@@ -557,6 +575,22 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
             Material::TwoSided(TwoSided {
                 inner: Box::new(rough_plastic(Ggx, 0.3, true, false)),
             }),
+        ),
+        (
+            "mask-0.4-diffuse",
+            Material::Mask(Box::new(Mask {
+                opacity: crate::texture::Texture::Constant(Color::splat(0.4)),
+                inner: Material::Diffuse(Diffuse { albedo: c }),
+            })),
+        ),
+        (
+            "mask-0.7-twosided-plastic",
+            Material::Mask(Box::new(Mask {
+                opacity: crate::texture::Texture::Constant(Color::splat(0.7)),
+                inner: Material::TwoSided(TwoSided {
+                    inner: Box::new(plastic(c, false)),
+                }),
+            })),
         ),
         (
             "twosided-roughconductor-ggx-0.3",

@@ -21,7 +21,7 @@ use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, RoughDielectric,
     ThinDielectric, TwoSided,
 };
-use lt_core::bsdf::{NormalSource, Perturbed, TextureSlot, Textured};
+use lt_core::bsdf::{Mask, NormalSource, Perturbed, TextureSlot, Textured};
 use lt_core::bsdf::{Plastic, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::math::{Color, Vec2};
@@ -742,10 +742,27 @@ impl<'a> Loader<'a> {
                     shadowing: p.boolean("use_shadowing_function")?.unwrap_or(true),
                 }))
             }
+            "mask" => {
+                let inner = match p.nested(&["bsdf"])[..] {
+                    [one] => self.bsdf(one, in_twosided)?,
+                    [] => return Err(p.err(e, "mask needs a nested BSDF")),
+                    [_, second, ..] => {
+                        return Err(p.err(second, "mask takes one nested BSDF, this is a second one"))
+                    }
+                };
+                let opacity = match p.texture("opacity") {
+                    Some(t) => self.texture(t)?,
+                    None => Texture::Constant(
+                        p.color("opacity", ColorUse::Reflectance, opts, &mut self.report)?
+                            .unwrap_or(Color::splat(0.5)),
+                    ),
+                };
+                Material::Mask(Box::new(Mask { opacity, inner }))
+            }
             other => {
                 return Err(p.err(
                     e,
-                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, plastic, roughplastic, twosided, normalmap and bumpmap)"),
+                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, plastic, roughplastic, twosided, normalmap, bumpmap and mask)"),
                 ))
             }
         };
