@@ -15,11 +15,12 @@ use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, NormalSource, Perturbed,
     RoughConductor, RoughDielectric, TextureSlot, Textured, ThinDielectric, TwoSided,
 };
-use lt_core::bsdf::{Plastic, RoughPlastic};
+use lt_core::bsdf::{Mask, Plastic, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::light::SunLight;
 use lt_core::math::{Color, Vec2, PI};
 use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
+use lt_core::texture::Texture;
 use std::collections::HashMap;
 
 /// GGX α below this is numerically a mirror; use `mirror` instead.
@@ -231,7 +232,28 @@ fn render(ctx: &Ctx, file: &SceneFile) -> Result<RenderSettings, SceneError> {
 
 fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Material, SceneError> {
     let m = textured_material(ctx, name, def)?;
-    perturbed(ctx, def, m)
+    let m = perturbed(ctx, def, m)?;
+    masked(ctx, def, m)
+}
+
+/// `m` under the material's `opacity` or `opacity_texture` (Mitsuba's `mask`), if it has one.
+fn masked(ctx: &Ctx, def: &S<MaterialDef>, m: Material) -> Result<Material, SceneError> {
+    let d = def.get_ref();
+    let opacity = match (&d.opacity, &d.opacity_texture) {
+        (None, None) => return Ok(m),
+        (Some(_), Some(t)) => {
+            return Err(ctx.at(t.span(), "give `opacity` or `opacity_texture`, not both"));
+        }
+        (Some(a), None) => {
+            let v: f32 = ctx.num(a, "opacity")?;
+            if !(0.0..=1.0).contains(&v) {
+                return Err(ctx.at(a.span(), format!("`opacity` must lie in [0, 1], got {v}")));
+            }
+            Texture::Constant(Color::splat(v))
+        }
+        (None, Some(t)) => crate::texture_def::texture(ctx, t)?,
+    };
+    Ok(Material::Mask(Box::new(Mask { opacity, inner: m })))
 }
 
 /// `m` under the material's `normal_map` or `bump_map`, if it has one.

@@ -132,6 +132,10 @@ pub struct MaterialDef {
     pub bump_scale: Option<S<f64>>,
     pub flip_invalid_normals: Option<S<bool>>,
     pub bump_shadowing: Option<S<bool>>,
+    /// Mitsuba's `mask` around the material: its opacity α (1 opaque; light passes straight
+    /// through with probability 1 − α), a number in [0, 1] or a texture (its luminance).
+    pub opacity: Option<S<f64>>,
+    pub opacity_texture: Option<S<TextureDef>>,
 }
 
 /// A texture: `type = "bitmap"` with `file` (PNG, JPEG, BMP, HDR or EXR, relative to the scene

@@ -289,6 +289,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
             _ => body,
         };
         let body = perturbation_xml(&ctx, d, &id, body, out_dir);
+        let body = mask_xml(&ctx, d, &id, body, out_dir);
         let _ = writeln!(x, "    {body}");
     }
     for def in &file.shapes {
@@ -599,6 +600,29 @@ fn perturbation_xml(
         "<bsdf type=\"{kind}\" id=\"{id}\">\n{}{params}    {inner}\n    </bsdf>",
         texture.trim_start_matches("    ")
     )
+}
+
+/// `body` inside Mitsuba's `mask` when the material has an `opacity` or `opacity_texture`.
+fn mask_xml(
+    ctx: &Ctx,
+    d: &crate::format::MaterialDef,
+    id: &str,
+    body: String,
+    out_dir: &Path,
+) -> String {
+    let opacity = match (&d.opacity, &d.opacity_texture) {
+        (_, Some(t)) => texture_xml(ctx, t.get_ref(), "opacity", out_dir)
+            .replace("\n            ", "\n        ")
+            .trim_start_matches("    ")
+            .to_string(),
+        (Some(a), None) => format!(
+            "        <float name=\"opacity\" value=\"{}\"/>\n",
+            *a.get_ref() as f32
+        ),
+        (None, None) => return body,
+    };
+    let inner = body.replacen(&format!(" id=\"{id}\""), "", 1);
+    format!("<bsdf type=\"mask\" id=\"{id}\">\n{opacity}    {inner}\n    </bsdf>")
 }
 
 fn texture_xml(ctx: &Ctx, t: &crate::format::TextureDef, name: &str, out_dir: &Path) -> String {
