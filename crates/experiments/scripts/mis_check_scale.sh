@@ -11,7 +11,8 @@ LT=${1:-target/release/lt}
 # MIS_CHECK_RUNS="vcm power 10000;bpm power 10000" replaces the list (integrator, heuristic, paths).
 RUNS=("bdpt power 60000" "bdpt balance 20000" "pt power 20000" "vcm power 10000" "vcm balance 10000" "bpm power 10000")
 if [ -n "${MIS_CHECK_RUNS:-}" ]; then IFS=';' read -r -a RUNS <<< "$MIS_CHECK_RUNS"; fi
-for scene in scenes/*.toml; do
+# MIS_CHECK_SCENES="scenes/a.toml scenes/b.toml" limits the scenes.
+for scene in ${MIS_CHECK_SCENES:-scenes/*.toml}; do
   for run in "${RUNS[@]}"; do
     set -- $run
     start=$(date +%s.%N)

@@ -13,6 +13,7 @@
 //!   given `wi`. For a delta lobe both are the discrete probability of choosing that lobe and
 //!   `delta` is set; `eval` and `pdf` return zero for delta lobes.
 
+pub mod blend;
 mod conductor;
 pub mod conductor_ior;
 mod dielectric;
@@ -33,6 +34,7 @@ pub mod textured;
 mod thin_dielectric;
 mod two_sided;
 
+pub use blend::Blend;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
@@ -159,6 +161,8 @@ pub enum Material {
     Perturbed(Box<Perturbed>),
     /// A material that is partly absent (Mitsuba's `mask`): a pass-through delta lobe beside it.
     Mask(Box<Mask>),
+    /// A weighted sum of two materials (Mitsuba's `blendbsdf`).
+    Blend(Box<Blend>),
 }
 
 impl Material {
@@ -181,6 +185,9 @@ impl Material {
             // Only `is_delta` asks a mask's local BSDF: its pass-through is a delta lobe, so it
             // is all-delta exactly when the nested material is.
             Material::Mask(m) => m.inner.local(),
+            // Never reached: every query a blend answers (`is_delta`, `has_delta_lobe`, `sample`,
+            // `eval`, `pdf`) is answered before `local` is asked.
+            Material::Blend(b) => b.first.local(),
         }
     }
 
@@ -196,12 +203,19 @@ impl Material {
     }
 
     pub fn is_delta(&self) -> bool {
+        if let Material::Blend(b) = self {
+            return b.first.is_delta() && b.second.is_delta();
+        }
         self.local().is_delta()
     }
 
     /// See `LocalBsdf::has_delta_lobe`.
     pub fn has_delta_lobe(&self) -> bool {
-        matches!(self, Material::Mask(_)) || self.local().has_delta_lobe()
+        match self {
+            Material::Mask(_) => true,
+            Material::Blend(b) => b.first.has_delta_lobe() || b.second.has_delta_lobe(),
+            _ => self.local().has_delta_lobe(),
+        }
     }
 
     /// The probability that `sample` from `wo` picks a delta lobe (0 for smooth materials): every
@@ -212,8 +226,10 @@ impl Material {
         if !self.has_delta_lobe() {
             return 0.0;
         }
-        if let Material::Mask(m) = self {
-            return m.delta_lobe_probability(sf, wo);
+        match self {
+            Material::Mask(m) => return m.delta_lobe_probability(sf, wo),
+            Material::Blend(b) => return b.delta_lobe_probability(sf, wo),
+            _ => {}
         }
         match self.sample(sf, wo, 0.0, Vec2::splat(0.5), TransportMode::Radiance) {
             Some(s) if s.delta => s.pdf_w,
@@ -233,6 +249,7 @@ impl Material {
             Material::Perturbed(p) => p.inner.transmits(),
             // The pass-through is a delta lobe: nothing is gathered through it.
             Material::Mask(m) => m.inner.transmits(),
+            Material::Blend(b) => b.first.transmits() || b.second.transmits(),
             _ => false,
         }
     }
@@ -248,6 +265,8 @@ impl Material {
             Material::Perturbed(p) => p.inner.refraction_ior(),
             // The pass-through does not refract; the nested material may.
             Material::Mask(m) => m.inner.refraction_ior(),
+            // The loader refuses blends of refracting materials: none scales radiance by η².
+            Material::Blend(_) => None,
             _ => None,
         }
     }
@@ -266,6 +285,7 @@ impl Material {
             }
             Material::Perturbed(p) => p.sample(sf, wo, u_lobe, u, mode),
             Material::Mask(m) => m.sample(sf, wo, u_lobe, u, mode),
+            Material::Blend(b) => b.sample(sf, wo, u_lobe, u, mode),
             _ => sample_local(self.local(), sf, wo, u_lobe, u, mode),
         }
     }
@@ -275,6 +295,7 @@ impl Material {
             Material::Textured(t) => t.with_local(sf.uv, |m| eval_local(m, sf, wo, wi, mode)),
             Material::Perturbed(p) => p.eval(sf, wo, wi, mode),
             Material::Mask(m) => m.eval(sf, wo, wi, mode),
+            Material::Blend(b) => b.eval(sf, wo, wi, mode),
             _ => eval_local(self.local(), sf, wo, wi, mode),
         }
     }
@@ -285,6 +306,7 @@ impl Material {
             Material::Textured(t) => t.with_local(sf.uv, |m| pdf_local(m, sf, wo, wi)),
             Material::Perturbed(p) => p.pdf(sf, wo, wi),
             Material::Mask(m) => m.pdf(sf, wo, wi),
+            Material::Blend(b) => b.pdf(sf, wo, wi),
             _ => pdf_local(self.local(), sf, wo, wi),
         }
     }
@@ -590,6 +612,22 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
                 inner: Material::TwoSided(TwoSided {
                     inner: Box::new(plastic(c, false)),
                 }),
+            })),
+        ),
+        (
+            "blend-0.3-diffuse-roughconductor",
+            Material::Blend(Box::new(Blend {
+                weight: crate::texture::Texture::Constant(Color::splat(0.3)),
+                first: Material::Diffuse(Diffuse { albedo: c }),
+                second: rough_gold(Ggx, 0.2, 0.2, true),
+            })),
+        ),
+        (
+            "blend-0.6-plastic-glossy",
+            Material::Blend(Box::new(Blend {
+                weight: crate::texture::Texture::Constant(Color::splat(0.6)),
+                first: plastic(c, false),
+                second: glossy(0.3),
             })),
         ),
         (

@@ -17,11 +17,11 @@ use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor, PERFECT_MIR
 use lt_core::bsdf::fresnel::ComplexIor;
 use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight};
+use lt_core::bsdf::{Blend, Mask, NormalSource, Perturbed, TextureSlot, Textured};
 use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, RoughDielectric,
     ThinDielectric, TwoSided,
 };
-use lt_core::bsdf::{Mask, NormalSource, Perturbed, TextureSlot, Textured};
 use lt_core::bsdf::{Plastic, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::math::{Color, Vec2};
@@ -759,10 +759,35 @@ impl<'a> Loader<'a> {
                 };
                 Material::Mask(Box::new(Mask { opacity, inner }))
             }
+            "blendbsdf" => {
+                let (first, second) = match p.nested(&["bsdf"])[..] {
+                    [a, b] => (self.bsdf(a, in_twosided)?, self.bsdf(b, in_twosided)?),
+                    [_, _, third, ..] => {
+                        return Err(p.err(third, "blendbsdf takes two nested BSDFs, this is a third one"))
+                    }
+                    _ => return Err(p.err(e, "blendbsdf needs two nested BSDFs")),
+                };
+                for m in [&first, &second] {
+                    if m.refraction_ior().is_some() || m.perturbation().is_some() {
+                        return Err(p.err(
+                            e,
+                            "blendbsdf of a refracting or normal/bump-mapped BSDF is not supported (its η² scaling and shading normal belong to one material)",
+                        ));
+                    }
+                }
+                let weight = match p.texture("weight") {
+                    Some(t) => self.texture(t)?,
+                    None => Texture::Constant(
+                        p.color("weight", ColorUse::Reflectance, opts, &mut self.report)?
+                            .unwrap_or(Color::splat(0.5)),
+                    ),
+                };
+                Material::Blend(Box::new(Blend { weight, first, second }))
+            }
             other => {
                 return Err(p.err(
                     e,
-                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, plastic, roughplastic, twosided, normalmap, bumpmap and mask)"),
+                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, plastic, roughplastic, twosided, normalmap, bumpmap, mask and blendbsdf)"),
                 ))
             }
         };
