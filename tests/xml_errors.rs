@@ -204,16 +204,16 @@ fn xml_bad_files_give_one_clear_error() {
         &["participating media are not supported"],
     );
 
-    // Emitters: a textured area emitter, a spot whose textured cone reaches 90°, a scaled spot
-    // frame, a projector's fov out of range.
+    // Emitters: a textured area emitter whose bitmap names no file, a spot whose textured cone
+    // reaches 90°, a scaled spot frame, a projector's fov out of range.
     let text = scene_xml(
-        "    <shape type=\"sphere\">\n        <emitter type=\"area\">\n            <texture type=\"checkerboard\" name=\"radiance\"/>\n        </emitter>\n    </shape>",
+        "    <shape type=\"sphere\">\n        <emitter type=\"area\">\n            <texture type=\"bitmap\" name=\"radiance\"/>\n        </emitter>\n    </shape>",
     );
     fails(
         &d,
         &text,
-        line_of(&text, "checkerboard"),
-        &["textured area emitter `radiance` is not supported"],
+        line_of(&text, "bitmap"),
+        &["a bitmap texture needs a `filename`"],
     );
     let text = scene_xml(
         "    <emitter type=\"spot\">\n        <float name=\"cutoff_angle\" value=\"95\"/>\n        <texture type=\"checkerboard\" name=\"texture\"/>\n    </emitter>",

@@ -2,7 +2,7 @@
 //! and cube as meshes) and exact spheres. The scene indexes them for ray queries; area lights
 //! sample them.
 
-use crate::math::{Vec2, Vec3};
+use crate::math::{Vec2, Vec3, PI};
 
 /// A triangle mesh in world space.
 #[derive(Clone, Debug, Default)]
@@ -133,4 +133,12 @@ impl TriangleMesh {
 pub enum ShapeGeometry {
     Mesh(TriangleMesh),
     Sphere { center: Vec3, radius: f32 },
+}
+
+/// Mitsuba's sphere parameterisation from the unit outward normal (object frame = world axes:
+/// a sphere's rotation is not kept): u = φ / 2π with φ = atan2(y, x) in [0, 2π), v = θ / π.
+pub fn sphere_uv(n: Vec3) -> Vec2 {
+    let phi = n.y.atan2(n.x);
+    let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+    Vec2::new(phi / (2.0 * PI), n.z.clamp(-1.0, 1.0).acos() / PI)
 }

@@ -303,11 +303,11 @@ fn check_li_samples(scene: &Scene, light: usize, p: Vec3, label: &str) -> Result
                 ls.p, ls.wi, ls.distance
             ));
         }
-        if l.emitted(ls.n, -ls.wi) != ls.radiance {
+        if l.emitted(ls.n, -ls.wi, ls.uv) != ls.radiance {
             return Err(format!(
                 "{label}: radiance {} vs emitted {}",
                 ls.radiance,
-                l.emitted(ls.n, -ls.wi)
+                l.emitted(ls.n, -ls.wi, ls.uv)
             ));
         }
     }
@@ -753,7 +753,7 @@ fn directional_light_is_a_delta_in_direction() {
         assert_eq!(l.escaped(ls.wi), Color::ZERO);
         let w = Vec3::new(s.next_f32() - 0.5, s.next_f32(), s.next_f32() - 0.5).normalize();
         assert_eq!(l.pdf_li(p, w, w, -w), 0.0);
-        assert_eq!(l.emitted(-w, w), Color::ZERO);
+        assert_eq!(l.emitted(-w, w, Vec2::ZERO), Color::ZERO);
         let le = l.sample_le(s.next_2d(), s.next_2d(), b).unwrap();
         assert_eq!(le.ray.d, -d.direction);
         assert!(le.pdf_dir == 1.0 && le.radiance == e);

@@ -66,7 +66,7 @@ pub fn connect_to_camera(
             } else {
                 let lens = cam.connect(y.p, sampler)?;
                 let dir = lens.dir;
-                let le = l.emitted(y.ng, -dir) * y.ng.dot(dir).abs();
+                let le = l.emitted(y.ng, -dir, y.uv) * y.ng.dot(dir).abs();
                 (lens, le / y.pdf_fwd, None)
             }
         }

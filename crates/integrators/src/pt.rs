@@ -230,7 +230,7 @@ impl Pt {
             }
             if let Some(li) = hit.light {
                 let light = &scene.lights[li as usize];
-                let le = light.emitted(hit.ng, wo);
+                let le = light.emitted(hit.ng, wo, hit.uv);
                 if le != Color::ZERO {
                     let light_pdf = scene.light_sampler.pmf(li as usize)
                         * light.pdf_li(prev_p, ray.d, hit.p, hit.ng);

@@ -50,7 +50,7 @@ impl PtBsdf {
             };
             let wo = -ray.d;
             if let Some(li) = hit.light {
-                l += beta * scene.lights[li as usize].emitted(hit.ng, wo);
+                l += beta * scene.lights[li as usize].emitted(hit.ng, wo, hit.uv);
             }
             if depth == self.params.max_depth {
                 break;

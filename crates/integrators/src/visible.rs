@@ -99,7 +99,7 @@ pub fn trace_visible_point(
         length += hit.t;
         let wo = -ray.d;
         if let Some(li) = hit.light {
-            out.emitted += beta * scene.lights[li as usize].emitted(hit.ng, wo);
+            out.emitted += beta * scene.lights[li as usize].emitted(hit.ng, wo, hit.uv);
         }
         let material = scene.material(hit.material);
         let sf = hit.shading_frame();

@@ -774,14 +774,20 @@ fn shape(
             format!("material `{name}` is not defined ({list})"),
         ));
     };
-    let emission = d
-        .emission
-        .as_ref()
-        .map(|e| ctx.color(e, "emission", false))
-        .transpose()?
-        .filter(|e| e.max_element() > 0.0);
-    let emits = emission.is_some();
-    b.add_shape(geometry, material, emission, d.flip_normals);
+    let radiance = match (&d.emission, &d.emission_texture) {
+        (Some(_), Some(t)) => {
+            return Err(ctx.at(t.span(), "give `emission` or `emission_texture`, not both"))
+        }
+        (Some(e), None) => Some(ctx.color(e, "emission", false)?)
+            .filter(|e| e.max_element() > 0.0)
+            .map(Texture::Constant),
+        (None, Some(t)) => {
+            Some(crate::texture_def::texture(ctx, t)?).filter(|t| t.max_value() > 0.0)
+        }
+        (None, None) => None,
+    };
+    let emits = radiance.is_some();
+    b.add_shape(geometry, material, radiance, d.flip_normals);
     Ok(emits)
 }
 

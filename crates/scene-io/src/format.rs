@@ -163,6 +163,8 @@ pub struct ShapeDef {
     pub kind: S<String>,
     pub material: S<String>,
     pub emission: Option<S<ColorDef>>,
+    /// The emitted radiance as a texture over the shape's uv (instead of `emission`).
+    pub emission_texture: Option<S<TextureDef>>,
     #[serde(default)]
     pub flip_normals: bool,
     // mesh

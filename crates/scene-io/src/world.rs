@@ -10,8 +10,9 @@ use glam::{DMat3, DMat4, DVec3};
 use lt_core::bsdf::Material;
 use lt_core::camera::{Camera, FovAxis};
 use lt_core::light::LightDesc;
-use lt_core::math::{Color, Vec3};
+use lt_core::math::Vec3;
 use lt_core::scene::{RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
+use lt_core::texture::Texture;
 
 /// Largest world coordinate a scene may hold. f32 products of two coordinates (squared distances,
 /// cross products for areas and normals) overflow beyond ~1.8e19; keep a margin of ten.
@@ -95,7 +96,8 @@ pub enum WorldGeometry {
 struct WorldShape {
     geometry: WorldGeometry,
     material: u32,
-    emission: Option<Color>,
+    /// The emitted radiance (a constant or a texture over the shape's uv) when it is a light.
+    radiance: Option<Texture>,
     flip_normals: bool,
 }
 
@@ -124,17 +126,18 @@ impl WorldBuilder {
         (self.materials.len() - 1) as u32
     }
 
+    /// A shape, emitting `radiance` (a constant or a texture over its uv) when given.
     pub fn add_shape(
         &mut self,
         geometry: WorldGeometry,
         material: u32,
-        emission: Option<Color>,
+        radiance: Option<Texture>,
         flip_normals: bool,
     ) {
         self.shapes.push(WorldShape {
             geometry,
             material,
-            emission,
+            radiance,
             flip_normals,
         });
     }
@@ -178,7 +181,7 @@ impl WorldBuilder {
                     radius: radius as f32,
                 },
             };
-            b.add_shape(geometry, s.material, s.emission, s.flip_normals);
+            b.add_emitting_shape(geometry, s.material, s.radiance, s.flip_normals);
         }
         for (mut light, at) in self.lights {
             if let (Some(position), Some(p)) = (light.position_mut(), at) {

@@ -1,7 +1,9 @@
 //! Area lights: any triangle mesh or sphere with `emission`, one-sided on its normal side.
 //! Meshes are sampled uniformly by area (triangle chosen by area). Spheres are sampled by the cone
 //! they subtend when the shading point is outside (much less variance for small, far spheres) and
-//! uniformly by area from inside.
+//! uniformly by area from inside. A textured radiance (Mitsuba's area emitter with a `radiance`
+//! texture) is read at the point's uv, in the shape's own parameterisation (the one hits report);
+//! sampling stays uniform by area, as Mitsuba's, so only the value changes, not any density.
 
 use super::{LightLeSample, LightLiSample};
 use crate::geometry::quad::Parallelogram;
@@ -12,6 +14,7 @@ use crate::sampling::{
     sample_uniform_triangle, uniform_cone_pdf, Distribution1D,
 };
 use crate::shape::{ShapeGeometry, TriangleMesh};
+use crate::texture::Texture;
 
 /// A piece of an emitting mesh: a triangle, or a pair of triangles forming a parallelogram
 /// (sampled with two uniform variates, no square root; same uniform area density).
@@ -26,6 +29,9 @@ enum Emitter {
     Triangles {
         pieces: Vec<Piece>,
         pick: Distribution1D,
+        /// Each piece's vertex uvs, kept only for a textured light (whose pieces are all
+        /// triangles: a merged parallelogram would lose the triangles' own uvs).
+        uvs: Option<Vec<[Vec2; 3]>>,
     },
     Sphere {
         center: Vec3,
@@ -36,19 +42,22 @@ enum Emitter {
 #[derive(Clone, Debug)]
 pub struct AreaLight {
     pub shape: u32,
+    /// The radiance, or for a textured light its mean (what the light's power is judged by).
     pub emission: Color,
+    /// The radiance over the shape's uv when it is not constant.
+    texture: Option<Texture>,
     pub area: f32,
     flip: bool,
     emitter: Emitter,
 }
 
-/// The mesh's triangles as sampling pieces (parallelogram pairs merged, as the BVH does) with
-/// their areas.
-fn mesh_pieces(m: &TriangleMesh) -> (Vec<Piece>, Vec<f32>) {
+/// The mesh's triangles as sampling pieces (parallelogram pairs merged, as the BVH does, unless
+/// `keep_triangles`) with their areas.
+fn mesh_pieces(m: &TriangleMesh, keep_triangles: bool) -> (Vec<Piece>, Vec<f32>) {
     let (mut pieces, mut areas) = (Vec::new(), Vec::new());
     let mut i = 0;
     while i < m.indices.len() {
-        if i + 1 < m.indices.len() {
+        if i + 1 < m.indices.len() && !keep_triangles {
             if let Some(q) = Parallelogram::from_triangle_pair(m.triangle(i), m.triangle(i + 1)) {
                 areas.push(m.triangle_area(i) + m.triangle_area(i + 1));
                 pieces.push(Piece::Parallelogram(q));
@@ -67,17 +76,30 @@ impl AreaLight {
     pub fn new(
         shape: u32,
         geometry: &ShapeGeometry,
-        emission: Color,
+        radiance: &Texture,
         flip_normals: bool,
     ) -> AreaLight {
+        let texture = match radiance {
+            Texture::Constant(_) => None,
+            t => Some(t.clone()),
+        };
         let (emitter, area) = match geometry {
             ShapeGeometry::Mesh(m) => {
-                let (pieces, areas) = mesh_pieces(m);
+                let (pieces, areas) = mesh_pieces(m, texture.is_some());
                 let total: f64 = areas.iter().map(|&a| a as f64).sum();
+                let uvs = texture.as_ref().map(|_| {
+                    (0..m.indices.len())
+                        .map(|i| {
+                            [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
+                                .map(|(b0, b1, b2)| m.uv(i, b0, b1, b2))
+                        })
+                        .collect()
+                });
                 (
                     Emitter::Triangles {
                         pieces,
                         pick: Distribution1D::new(&areas),
+                        uvs,
                     },
                     total as f32,
                 )
@@ -89,17 +111,19 @@ impl AreaLight {
         };
         AreaLight {
             shape,
-            emission,
+            emission: radiance.mean(),
+            texture,
             area,
             flip: flip_normals,
             emitter,
         }
     }
 
-    /// A uniformly distributed point on the surface with its outward (emitting-side) normal.
-    fn sample_area(&self, u: Vec2) -> (Vec3, Vec3, Vec3) {
-        let (p, n, err) = match &self.emitter {
-            Emitter::Triangles { pieces, pick } => {
+    /// A uniformly distributed point on the surface with its outward (emitting-side) normal, its
+    /// rounding bound and its uv (zero unless the light is textured).
+    fn sample_area(&self, u: Vec2) -> (Vec3, Vec3, Vec3, Vec2) {
+        let (p, n, err, uv) = match &self.emitter {
+            Emitter::Triangles { pieces, pick, uvs } => {
                 let (i, _, ux) = pick.sample(u.x);
                 match &pieces[i] {
                     &Piece::Triangle([a, b, c]) => {
@@ -107,31 +131,61 @@ impl AreaLight {
                         let b0 = 1.0 - b1 - b2;
                         let p = b0 * a + b1 * b + b2 * c;
                         let err = crate::geometry::ray::barycentric_error([b0, b1, b2], [a, b, c]);
-                        (p, (b - a).cross(c - a).normalize(), err)
+                        // The hit's interpolation (`TriangleMesh::uv`), so both agree on a point.
+                        let uv = uvs.as_ref().map_or(Vec2::ZERO, |uvs| {
+                            let [t0, t1, t2] = uvs[i];
+                            b0 * t0 + b1 * t1 + b2 * t2
+                        });
+                        (p, (b - a).cross(c - a).normalize(), err, uv)
                     }
                     Piece::Parallelogram(q) => {
                         let (e1, e2) = (ux * q.e1, u.y * q.e2);
                         let err = (q.p0.abs() + e1.abs() + e2.abs()) * gamma(3);
-                        (q.p0 + e1 + e2, q.e1.cross(q.e2).normalize(), err)
+                        (
+                            q.p0 + e1 + e2,
+                            q.e1.cross(q.e2).normalize(),
+                            err,
+                            Vec2::ZERO,
+                        )
                     }
                 }
             }
             &Emitter::Sphere { center, radius } => {
                 let n = sample_uniform_sphere(u);
                 let p = center + radius * n;
-                (p, n, (p.abs() + center.abs()) * gamma(6))
+                let uv = self.sphere_uv(n);
+                (p, n, (p.abs() + center.abs()) * gamma(6), uv)
             }
         };
-        (p, if self.flip { -n } else { n }, err)
+        (p, if self.flip { -n } else { n }, err, uv)
+    }
+
+    /// The sphere's uv at outward normal `n` when the light is textured (zero otherwise).
+    #[inline]
+    fn sphere_uv(&self, n: Vec3) -> Vec2 {
+        match self.texture {
+            Some(_) => crate::shape::sphere_uv(n),
+            None => Vec2::ZERO,
+        }
     }
 
     #[inline]
-    pub fn emitted(&self, n: Vec3, w: Vec3) -> Color {
+    pub fn emitted(&self, n: Vec3, w: Vec3, uv: Vec2) -> Color {
         if n.dot(w) > 0.0 {
-            self.emission
+            match &self.texture {
+                None => self.emission,
+                Some(t) => t.eval(uv),
+            }
         } else {
             Color::ZERO
         }
+    }
+
+    /// The radiance as the builder was given it (a constant or a texture).
+    pub fn radiance(&self) -> Texture {
+        self.texture
+            .clone()
+            .unwrap_or(Texture::Constant(self.emission))
     }
 
     /// 1 − cos θmax of the cone a sphere subtends from `p`, or None when `p` is inside it or on
@@ -155,7 +209,7 @@ impl AreaLight {
                 return self.sample_sphere_cone(p, center, radius, h, u);
             }
         }
-        let (lp, n, lp_err) = self.sample_area(u);
+        let (lp, n, lp_err, uv) = self.sample_area(u);
         let to = lp - p;
         let d2 = to.length_squared();
         if !(d2 > 0.0) {
@@ -174,7 +228,8 @@ impl AreaLight {
             n,
             p_err: lp_err,
             distance,
-            radiance: self.emitted(n, -wi),
+            uv,
+            radiance: self.emitted(n, -wi, uv),
             pdf_w,
             delta: false,
         })
@@ -200,6 +255,7 @@ impl AreaLight {
         let lp_raw = p + wi * ds;
         let mut n = (lp_raw - center).normalize();
         let lp = center + n * radius;
+        let uv = self.sphere_uv(n);
         if self.flip {
             n = -n;
         }
@@ -211,7 +267,8 @@ impl AreaLight {
             // center + radius·n: the rounding of a sum of two terms (`sample_area`'s bound).
             p_err: (lp.abs() + center.abs()) * gamma(6),
             distance,
-            radiance: self.emitted(n, -wi),
+            uv,
+            radiance: self.emitted(n, -wi, uv),
             pdf_w: uniform_cone_pdf(h),
             delta: false,
         })
@@ -232,7 +289,7 @@ impl AreaLight {
     }
 
     pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<LightLeSample> {
-        let (p, n, err) = self.sample_area(u_pos);
+        let (p, n, err, uv) = self.sample_area(u_pos);
         let local = sample_cosine_hemisphere(u_dir);
         let pdf_dir = cosine_hemisphere_pdf(local.z);
         if pdf_dir == 0.0 {
@@ -245,7 +302,8 @@ impl AreaLight {
             p,
             p_err: err,
             n,
-            radiance: self.emission,
+            uv,
+            radiance: self.emitted(n, n, uv),
             pdf_pos: 1.0 / self.area,
             pdf_dir,
         })

@@ -40,6 +40,7 @@ impl DirectionalLight {
     pub fn sample_li(&self) -> LightLiSample {
         let wi = self.direction;
         LightLiSample {
+            uv: Vec2::ZERO,
             p_err: Vec3::ZERO,
             wi,
             p: wi,

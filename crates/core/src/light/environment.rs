@@ -14,6 +14,7 @@ impl EnvironmentLight {
     pub fn sample_li(&self, u: Vec2) -> Option<LightLiSample> {
         let wi = sample_uniform_sphere(u);
         Some(LightLiSample {
+            uv: Vec2::ZERO,
             p_err: Vec3::ZERO,
             wi,
             p: wi,
@@ -65,6 +66,7 @@ pub fn distant_le(
 ) -> LightLeSample {
     let ray = ray_from_bounding_disk(d, u_pos, bounds);
     LightLeSample {
+        uv: Vec2::ZERO,
         ray,
         p: ray.o,
         p_err: Vec3::ZERO,

@@ -228,6 +228,7 @@ impl EnvironmentMapLight {
         let (wi, pdf_w) = self.map.sample(u)?;
         let radiance = self.map.eval(wi);
         Some(LightLiSample {
+            uv: Vec2::ZERO,
             p_err: Vec3::ZERO,
             wi,
             p: wi,

@@ -110,6 +110,8 @@ pub struct LightLiSample {
     /// short of the light's surface by its real error instead of a guessed one.
     pub p_err: Vec3,
     pub distance: f32,
+    /// Texture coordinates of `p` on an area light (zero for other lights).
+    pub uv: Vec2,
     /// Radiance arriving along −wi, delta-stripped for delta lights: intensity / distance² for a
     /// point light, irradiance for a directional light (what f_s·cos multiplies in both cases).
     pub radiance: Color,
@@ -129,6 +131,8 @@ pub struct LightLeSample {
     pub p_err: Vec3,
     /// Normal at the ray origin (for distant lights: the ray direction).
     pub n: Vec3,
+    /// Texture coordinates of `p` on an area light (zero for other lights).
+    pub uv: Vec2,
     /// Emitted radiance along the ray (point lights: intensity; directional lights: irradiance).
     pub radiance: Color,
     /// Area pdf of the origin (1 for a point light).
@@ -153,10 +157,10 @@ impl Light {
     pub fn area(
         shape: u32,
         geometry: &ShapeGeometry,
-        emission: Color,
+        radiance: &Texture,
         flip_normals: bool,
     ) -> Light {
-        Light::Area(AreaLight::new(shape, geometry, emission, flip_normals))
+        Light::Area(AreaLight::new(shape, geometry, radiance, flip_normals))
     }
 
     pub fn from_desc(desc: &LightDesc) -> Light {
@@ -281,10 +285,11 @@ impl Light {
         }
     }
 
-    /// Radiance an area light emits from a point with normal `n` in direction `w` (one-sided).
-    pub fn emitted(&self, n: Vec3, w: Vec3) -> Color {
+    /// Radiance an area light emits from a point with normal `n` and texture coordinates `uv`
+    /// in direction `w` (one-sided).
+    pub fn emitted(&self, n: Vec3, w: Vec3, uv: Vec2) -> Color {
         match self {
-            Light::Area(l) => l.emitted(n, w),
+            Light::Area(l) => l.emitted(n, w, uv),
             _ => Color::ZERO,
         }
     }

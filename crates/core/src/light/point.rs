@@ -21,6 +21,7 @@ impl PointLight {
         let distance = d2.sqrt();
         let wi = to / distance;
         Some(LightLiSample {
+            uv: Vec2::ZERO,
             p_err: Vec3::ZERO,
             wi,
             p: self.position,
@@ -35,6 +36,7 @@ impl PointLight {
     pub fn sample_le(&self, u_dir: Vec2) -> LightLeSample {
         let d = sample_uniform_sphere(u_dir);
         LightLeSample {
+            uv: Vec2::ZERO,
             ray: Ray::new(self.position, d),
             p: self.position,
             p_err: Vec3::ZERO,

@@ -81,6 +81,7 @@ impl ProjectorLight {
         let distance = d2.sqrt();
         let wi = to / distance;
         Some(LightLiSample {
+            uv: Vec2::ZERO,
             p_err: Vec3::ZERO,
             wi,
             p: self.position,
@@ -96,6 +97,7 @@ impl ProjectorLight {
         let q = (2.0 * u_dir - Vec2::ONE) * self.tan_half;
         let d = (self.to_world * Vec3::new(q.x, q.y, 1.0)).normalize();
         LightLeSample {
+            uv: Vec2::ZERO,
             ray: Ray::new(self.position, d),
             p: self.position,
             p_err: Vec3::ZERO,

@@ -98,6 +98,7 @@ impl SpotLight {
         let distance = d2.sqrt();
         let wi = to / distance;
         Some(LightLiSample {
+            uv: Vec2::ZERO,
             p_err: Vec3::ZERO,
             wi,
             p: self.position,
@@ -112,6 +113,7 @@ impl SpotLight {
     pub fn sample_le(&self, u_dir: Vec2) -> LightLeSample {
         let d = self.to_world * sample_uniform_cone(u_dir, self.one_minus_cos_cutoff);
         LightLeSample {
+            uv: Vec2::ZERO,
             ray: Ray::new(self.position, d),
             p: self.position,
             p_err: Vec3::ZERO,

@@ -71,6 +71,7 @@ impl SunLight {
     pub fn sample_li(&self, u: Vec2) -> Option<LightLiSample> {
         let wi = self.sample_dir(u);
         Some(LightLiSample {
+            uv: Vec2::ZERO,
             p_err: Vec3::ZERO,
             wi,
             p: wi,

@@ -113,7 +113,7 @@ impl Path {
             l if l.delta_position() => l.intensity_towards(x0.dir_to(&v[1])),
             Light::Directional(d) => d.irradiance,
             l if x0.is_infinite() => l.escaped(x0.p),
-            l => l.emitted(x0.ng, x0.dir_to(&v[1])),
+            l => l.emitted(x0.ng, x0.dir_to(&v[1]), x0.uv),
         };
         let mut f = le.as_dvec3() * geometry(x0, &v[1]) as f64;
         for i in 1..k {

@@ -184,6 +184,7 @@ impl PathVertex {
             pdf,
         );
         v.p_err = s.p_err;
+        v.uv = s.uv;
         v
     }
 
@@ -208,6 +209,7 @@ impl PathVertex {
         };
         let mut v = PathVertex::endpoint(kind, p, n, Color::ZERO, 0.0);
         v.p_err = s.p_err;
+        v.uv = s.uv;
         v.delta = l.delta_direction();
         v.pdf_fwd = if s.delta {
             pmf

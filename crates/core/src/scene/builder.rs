@@ -9,6 +9,7 @@ use crate::geometry::{Accel, Primitive};
 use crate::light::{Light, LightDesc, LightSampler};
 use crate::math::{Color, Vec3};
 use crate::shape::{ShapeGeometry, TriangleMesh};
+use crate::texture::Texture;
 
 /// Triangles of a mesh as BVH primitives; consecutive pairs that split a parallelogram (quads,
 /// cube faces, quads triangulated from OBJ) become one analytic parallelogram.
@@ -48,7 +49,7 @@ fn push_mesh_primitives(m: &TriangleMesh, shape: u32, prims: &mut Vec<Primitive>
 /// p − c is exact (Sterbenz): the recentred geometry is the input geometry, merely moved. (The
 /// eye and point lights, outside the box, may round once, by at most half an ulp of their
 /// distance to c.)
-fn scene_origin(shapes: &[(ShapeGeometry, u32, Option<Color>, bool)]) -> Vec3 {
+fn scene_origin(shapes: &[(ShapeGeometry, u32, Option<Texture>, bool)]) -> Vec3 {
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for (geometry, ..) in shapes {
         match geometry {
@@ -78,7 +79,7 @@ pub struct SceneBuilder {
     camera: Camera,
     settings: RenderSettings,
     materials: Vec<Material>,
-    shapes: Vec<(ShapeGeometry, u32, Option<Color>, bool)>,
+    shapes: Vec<(ShapeGeometry, u32, Option<Texture>, bool)>,
     lights: Vec<LightDesc>,
     /// Set by a loader that recentred in f64 itself (`set_origin`).
     origin: Option<Vec3>,
@@ -117,8 +118,21 @@ impl SceneBuilder {
         emission: Option<Color>,
         flip_normals: bool,
     ) {
+        let radiance = emission.map(Texture::Constant);
+        self.add_emitting_shape(geometry, material, radiance, flip_normals);
+    }
+
+    /// `add_shape` with the emitted radiance a texture over the shape's uv (Mitsuba's area
+    /// emitter with a textured `radiance`); a constant texture is the plain area light.
+    pub fn add_emitting_shape(
+        &mut self,
+        geometry: ShapeGeometry,
+        material: u32,
+        radiance: Option<Texture>,
+        flip_normals: bool,
+    ) {
         self.shapes
-            .push((geometry, material, emission, flip_normals));
+            .push((geometry, material, radiance, flip_normals));
     }
 
     pub fn add_light(&mut self, light: LightDesc) {
@@ -158,7 +172,7 @@ impl SceneBuilder {
                 }),
             }
             let light = emission.map(|e| {
-                lights.push(Light::area(shape_id, &geometry, e, flip_normals));
+                lights.push(Light::area(shape_id, &geometry, &e, flip_normals));
                 (lights.len() - 1) as u32
             });
             shapes.push(Shape {

@@ -73,7 +73,7 @@ impl SurfaceHit {
             Primitive::Sphere { center, radius, .. } => {
                 let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
                 let n = (p - center).normalize();
-                (p, err, n, n, sphere_uv(n), 0)
+                (p, err, n, n, crate::shape::sphere_uv(n), 0)
             }
         };
         if shape.flip_normals {
@@ -175,12 +175,4 @@ fn tangents(
         }
         _ => fallback(),
     }
-}
-
-/// Mitsuba's sphere parameterisation from the unit outward normal (object frame = world axes:
-/// a sphere's rotation is not kept): u = φ / 2π with φ = atan2(y, x) in [0, 2π), v = θ / π.
-fn sphere_uv(n: Vec3) -> Vec2 {
-    let phi = n.y.atan2(n.x);
-    let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
-    Vec2::new(phi / (2.0 * PI), n.z.clamp(-1.0, 1.0).acos() / PI)
 }

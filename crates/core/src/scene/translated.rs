@@ -29,11 +29,11 @@ impl Scene {
                     radius,
                 },
             };
-            let emission = s.light.and_then(|l| match &self.lights[l as usize] {
-                Light::Area(a) => Some(a.emission),
+            let radiance = s.light.and_then(|l| match &self.lights[l as usize] {
+                Light::Area(a) => Some(a.radiance()),
                 _ => None,
             });
-            b.add_shape(geometry, s.material, emission, s.flip_normals);
+            b.add_emitting_shape(geometry, s.material, radiance, s.flip_normals);
         }
         // Area lights come first (one per emitting shape, as the builder makes them); the rest
         // are re-described so the builder orders them the same way.

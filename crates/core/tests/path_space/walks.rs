@@ -78,7 +78,7 @@ pub fn camera_walk(
         f *= solid_angle_to_area(1.0, prev.p, hit.p, hit.ng) as f64;
         if let Some(x0) = v.as_light_endpoint() {
             let le = scene.lights[hit.light.unwrap() as usize]
-                .emitted(hit.ng, -ray.d)
+                .emitted(hit.ng, -ray.d, hit.uv)
                 .as_dvec3();
             out(Made {
                 path: Path::from_subpaths(&[x0], &verts),
@@ -210,7 +210,7 @@ pub fn light_walk(scene: &Scene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
             let le_cam = if infinite {
                 light.escaped(dir_from_cam)
             } else {
-                light.emitted(le.n, d)
+                light.emitted(le.n, d, le.uv)
             };
             if imp > 0.0 && le_cam != Color::ZERO {
                 let cos_l = if infinite { 1.0 } else { le.n.dot(d).abs() };

@@ -1273,28 +1273,40 @@ impl<'a> Loader<'a> {
                         ),
                     ));
                 }
+                // A textured radiance is read at the shape's uv, as materials' textures are.
                 if let Some(t) = ep.texture("radiance") {
-                    return Err(ep.err(
-                        t,
-                        "a textured area emitter `radiance` is not supported yet (an area \
-                         light's radiance is one colour; textures are read for materials, spot \
-                         lights and projectors)",
-                    ));
+                    let texture = self.texture(t)?;
+                    ep.finish(&["sampling_weight"], &mut self.report)?;
+                    return self.finish_shape(&p, b, geometry, material, Some(texture), flip);
                 }
                 let r = ep
                     .color("radiance", ColorUse::Emission, self.opts, &mut self.report)?
                     .unwrap_or(Color::ONE);
                 ep.finish(&["sampling_weight"], &mut self.report)?;
-                (r.max_element() > 0.0).then_some(r)
+                (r.max_element() > 0.0).then_some(Texture::Constant(r))
             }
         };
+        self.finish_shape(&p, b, geometry, material, emission, flip)
+    }
+
+    /// The shape's last step: its remaining parameters checked, then added (emitting when
+    /// `radiance` is given); whether it emits.
+    fn finish_shape(
+        &mut self,
+        p: &Plugin<'a>,
+        b: &mut WorldBuilder,
+        geometry: WorldGeometry,
+        material: u32,
+        radiance: Option<Texture>,
+        flip: bool,
+    ) -> Result<bool, SceneError> {
         let ignored: &[&str] = match p.kind {
             "obj" | "ply" => &["flip_tex_coords"],
             _ => &[],
         };
         p.finish(ignored, &mut self.report)?;
-        let emits = emission.is_some();
-        b.add_shape(geometry, material, emission, flip);
+        let emits = radiance.is_some();
+        b.add_shape(geometry, material, radiance, flip);
         Ok(emits)
     }
 

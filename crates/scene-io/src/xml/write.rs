@@ -533,6 +533,13 @@ fn shape(
             );
         }
     }
+    if let Some(t) = &d.emission_texture {
+        let _ = write!(
+            x,
+            "        <emitter type=\"area\">\n{}        </emitter>\n",
+            texture_xml(ctx, t.get_ref(), "radiance", out_dir)
+        );
+    }
     x.push_str("    </shape>\n");
     Ok(x)
 }
