@@ -152,84 +152,94 @@ fn absorbs_from(m: &Material, sf: &ShadingFrame, wo: Vec3) -> bool {
 fn sampled_directions_follow_the_pdf_chi2() {
     let sf = flat_frame();
     let n = sf.ns();
-    let mut outcomes = Vec::new();
+    let registry = test_registry();
+    // The cases in a fixed order with their seeds, then run on every core: the outcomes, gathered
+    // back in case order, do not depend on the thread count.
+    let mut cases = Vec::new();
     let mut seed = 1u64;
-    for (name, m) in test_registry() {
+    for (index, (_, m)) in registry.iter().enumerate() {
         if m.is_delta() {
             continue;
         }
         for (cos, wo_l) in wo_cases() {
             let wo = sf.frame.to_world(wo_l);
-            if absorbs_from(&m, &sf, wo) {
+            if absorbs_from(m, &sf, wo) {
                 continue; // a one-sided material seen from behind: nothing to fit
             }
             for mode in MODES {
                 seed += 1;
+                cases.push((index, cos, wo, mode, seed));
+            }
+        }
+    }
+    let run_case = |&(index, cos, wo, mode, seed): &(usize, f32, Vec3, TransportMode, u64)| {
+        let (name, m) = &registry[index];
+        let mut outcomes = Vec::new();
+        let cfg = Chi2Test {
+            samples: 1_000_000,
+            seed,
+        };
+        let label = format!("{name} cosθo={cos} {}", mode_name(mode));
+        // A delta lobe beside smooth ones (plastic) has no density: its samples count
+        // as lost mass, which `check_mass` holds to 1 − ∫pdf.
+        let sample = |s: &mut Sampler| {
+            let u_lobe = s.next_f32();
+            m.sample(&sf, wo, u_lobe, s.next_2d(), mode)
+                .filter(|b| !b.delta)
+                .map(|b| b.wi)
+        };
+        let pdf = |w: Vec3| m.pdf(&sf, wo, w);
+        // Whole sphere, rings uniform in cos θ around the normal, horizon on a ring edge
+        // (and the rim of rough refraction, for a material that refracts).
+        let rim = m
+            .refraction_ior()
+            .and_then(|ior| refraction_rim(wo.dot(n), ior));
+        let grid = sphere_grid(Frame::from_z(n), rim);
+        outcomes.push(chi2::run(
+            &format!("{label} sphere"),
+            cfg,
+            &grid,
+            sample,
+            pdf,
+        ));
+        // Cap around the mirror direction with rings of equal angle, to resolve peaks;
+        // it stays above the horizon, where the pdf is smooth.
+        if let Some(alpha) = roughness(m) {
+            let r = 2.0 * wo.dot(n) * n - wo;
+            let elevation = wo.dot(n).abs().asin();
+            let half_angle = (0.9 * elevation).min(10.0 * alpha) as f64;
+            let grid = SphereGrid::cap(Frame::from_z(r), 1.0 - half_angle.cos(), 30, 40, 2.0);
+            let cfg = Chi2Test {
+                samples: 1_000_000,
+                seed: seed + 1_000,
+            };
+            outcomes.push(chi2::run(&format!("{label} lobe"), cfg, &grid, sample, pdf));
+            // And around the refracted direction, for a material that refracts.
+            // It stays above the horizon and inside the rim, where the pdf is smooth.
+            if let Some(t) = m.refraction_ior().and_then(|ior| refracted(wo, n, ior)) {
+                let elevation = t.dot(n).abs().asin();
+                let to_rim = rim.map_or(f32::INFINITY, |c| (c.acos() - t.dot(n).acos()).abs());
+                let half_angle = (0.9 * elevation.min(to_rim)).min(10.0 * alpha) as f64;
+                let grid = SphereGrid::cap(Frame::from_z(t), 1.0 - half_angle.cos(), 30, 40, 2.0);
                 let cfg = Chi2Test {
                     samples: 1_000_000,
-                    seed,
+                    seed: seed + 2_000,
                 };
-                let label = format!("{name} cosθo={cos} {}", mode_name(mode));
-                // A delta lobe beside smooth ones (plastic) has no density: its samples count
-                // as lost mass, which `check_mass` holds to 1 − ∫pdf.
-                let sample = |s: &mut Sampler| {
-                    let u_lobe = s.next_f32();
-                    m.sample(&sf, wo, u_lobe, s.next_2d(), mode)
-                        .filter(|b| !b.delta)
-                        .map(|b| b.wi)
-                };
-                let pdf = |w: Vec3| m.pdf(&sf, wo, w);
-                // Whole sphere, rings uniform in cos θ around the normal, horizon on a ring edge
-                // (and the rim of rough refraction, for a material that refracts).
-                let rim = m
-                    .refraction_ior()
-                    .and_then(|ior| refraction_rim(wo.dot(n), ior));
-                let grid = sphere_grid(Frame::from_z(n), rim);
                 outcomes.push(chi2::run(
-                    &format!("{label} sphere"),
+                    &format!("{label} refraction lobe"),
                     cfg,
                     &grid,
                     sample,
                     pdf,
                 ));
-                // Cap around the mirror direction with rings of equal angle, to resolve peaks;
-                // it stays above the horizon, where the pdf is smooth.
-                if let Some(alpha) = roughness(&m) {
-                    let r = 2.0 * wo.dot(n) * n - wo;
-                    let elevation = wo.dot(n).abs().asin();
-                    let half_angle = (0.9 * elevation).min(10.0 * alpha) as f64;
-                    let grid =
-                        SphereGrid::cap(Frame::from_z(r), 1.0 - half_angle.cos(), 30, 40, 2.0);
-                    let cfg = Chi2Test {
-                        samples: 1_000_000,
-                        seed: seed + 1_000,
-                    };
-                    outcomes.push(chi2::run(&format!("{label} lobe"), cfg, &grid, sample, pdf));
-                    // And around the refracted direction, for a material that refracts.
-                    // It stays above the horizon and inside the rim, where the pdf is smooth.
-                    if let Some(t) = m.refraction_ior().and_then(|ior| refracted(wo, n, ior)) {
-                        let elevation = t.dot(n).abs().asin();
-                        let to_rim =
-                            rim.map_or(f32::INFINITY, |c| (c.acos() - t.dot(n).acos()).abs());
-                        let half_angle = (0.9 * elevation.min(to_rim)).min(10.0 * alpha) as f64;
-                        let grid =
-                            SphereGrid::cap(Frame::from_z(t), 1.0 - half_angle.cos(), 30, 40, 2.0);
-                        let cfg = Chi2Test {
-                            samples: 1_000_000,
-                            seed: seed + 2_000,
-                        };
-                        outcomes.push(chi2::run(
-                            &format!("{label} refraction lobe"),
-                            cfg,
-                            &grid,
-                            sample,
-                            pdf,
-                        ));
-                    }
-                }
             }
         }
-    }
+        outcomes
+    };
+    let outcomes: Vec<_> = on_every_core(&cases, run_case)
+        .into_iter()
+        .flatten()
+        .collect();
     let level = sidak(ALPHA, outcomes.len());
     let mut failures = Vec::new();
     for o in &outcomes {
@@ -254,6 +264,32 @@ fn sampled_directions_follow_the_pdf_chi2() {
         failures.len(),
         failures.join("\n")
     );
+}
+
+/// `f` of every item, computed on every core (items taken in turn from a shared counter), returned
+/// in the items' order.
+fn on_every_core<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Mutex;
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<R>>> = Mutex::new((0..items.len()).map(|_| None).collect());
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(item) = items.get(i) else { break };
+                let r = f(item);
+                results.lock().unwrap()[i] = Some(r);
+            });
+        }
+    });
+    results
+        .into_inner()
+        .unwrap()
+        .into_iter()
+        .map(|r| r.expect("every item ran"))
+        .collect()
 }
 
 /// Sum of how much `f(wo, wi)` may move when either direction is perturbed by rounding.
