@@ -57,6 +57,7 @@ fn quad_scene() -> Scene {
         normals: None,
         uvs: None,
         indices: vec![[0, 2, 1], [0, 3, 2]],
+        attributes: Vec::new(),
     };
     build(
         vec![(ShapeGeometry::Mesh(mesh), Some(Color::ONE), false)],
@@ -80,6 +81,7 @@ fn parallelogram_scene() -> Scene {
         normals: None,
         uvs: None,
         indices: vec![[0, 1, 2], [0, 2, 3]],
+        attributes: Vec::new(),
     };
     build(
         vec![(ShapeGeometry::Mesh(mesh), Some(Color::ONE), false)],

@@ -26,6 +26,8 @@ pub struct WorldMesh {
     /// Texture coordinates: no transform touches them.
     pub uvs: Option<Vec<lt_core::math::Vec2>>,
     pub indices: Vec<[u32; 3]>,
+    /// Mesh attributes: no transform touches them.
+    pub attributes: Vec<lt_core::scene::MeshAttribute>,
 }
 
 impl WorldMesh {
@@ -53,6 +55,7 @@ impl WorldMesh {
             normals,
             uvs: local.uvs.clone(),
             indices,
+            attributes: local.attributes.clone(),
         }
     }
 
@@ -119,6 +122,10 @@ impl WorldBuilder {
     }
 
     /// Returns the material's id for `add_shape`.
+    pub fn material(&self, id: u32) -> &Material {
+        &self.materials[id as usize]
+    }
+
     pub fn add_material(&mut self, m: Material) -> u32 {
         self.materials.push(m);
         (self.materials.len() - 1) as u32
@@ -172,6 +179,7 @@ impl WorldBuilder {
                     normals: m.normals,
                     uvs: m.uvs,
                     indices: m.indices,
+                    attributes: m.attributes,
                 }),
                 WorldGeometry::Sphere { center, radius } => ShapeGeometry::Sphere {
                     center: local(center),

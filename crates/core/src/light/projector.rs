@@ -69,7 +69,7 @@ impl ProjectorLight {
         }
         let uv = Vec2::splat(0.5) - 0.5 * q / self.tan_half;
         let cos3 = d.z * d.z * d.z;
-        self.irradiance.eval(uv) * (PI * self.scale / cos3)
+        self.irradiance.eval(crate::texture::TexPoint::at(uv)) * (PI * self.scale / cos3)
     }
 
     pub fn sample_li(&self, p: Vec3) -> Option<LightLiSample> {

@@ -83,7 +83,10 @@ impl SpotLight {
             None => Color::ONE,
             Some(t) => {
                 let s = 0.5 / (self.tan_cutoff * cos_theta);
-                t.eval(Vec2::new(0.5 + d.x * s, 0.5 + d.y * s))
+                t.eval(crate::texture::TexPoint::at(Vec2::new(
+                    0.5 + d.x * s,
+                    0.5 + d.y * s,
+                )))
             }
         };
         self.intensity * tex * falloff.max(0.0)

@@ -857,11 +857,24 @@ impl<'a> Loader<'a> {
                     to_uv,
                 }
             }
+            "mesh_attribute" => {
+                let Some((name, ne)) = p.string("name")? else {
+                    return Err(p.err(e, "a mesh_attribute texture needs a `name`"));
+                };
+                if !(name.starts_with("vertex_") || name.starts_with("face_")) {
+                    return Err(p.err(
+                        ne,
+                        format!("mesh attribute `{name}`: its name must start with `vertex_` or `face_`"),
+                    ));
+                }
+                p.finish(&[], &mut self.report)?;
+                Texture::MeshAttribute { name: name.into() }
+            }
             other => {
                 return Err(p.err(
                     e,
                     format!(
-                        "texture `{other}` is not supported (lt reads bitmap and checkerboard)"
+                        "texture `{other}` is not supported (lt reads bitmap, checkerboard and mesh_attribute)"
                     ),
                 ))
             }
@@ -1263,6 +1276,27 @@ impl<'a> Loader<'a> {
                 (r.max_element() > 0.0).then_some(r)
             }
         };
+        if let Some(name) = b.material(material).mesh_attribute() {
+            let has = match &geometry {
+                WorldGeometry::Mesh(m) => m.attributes.iter().any(|a| a.name == name),
+                _ => false,
+            };
+            if !has {
+                let known: Vec<&str> = match &geometry {
+                    WorldGeometry::Mesh(m) => {
+                        m.attributes.iter().map(|a| a.name.as_str()).collect()
+                    }
+                    _ => Vec::new(),
+                };
+                return Err(p.err(
+                    e,
+                    format!(
+                        "the shape's material reads mesh attribute `{name}`, which the shape does not have (it has: {})",
+                        if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                    ),
+                ));
+            }
+        }
         let ignored: &[&str] = match p.kind {
             "obj" | "ply" => &["flip_tex_coords"],
             _ => &[],
@@ -1578,6 +1612,7 @@ fn unit_disk_fan() -> TriangleMesh {
         normals: None,
         uvs: None,
         indices,
+        attributes: Vec::new(),
     }
 }
 
@@ -1702,6 +1737,7 @@ mod tests {
             normals: None,
             uvs: None,
             indices: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            attributes: Vec::new(),
         };
         let n = vertex_normals(&m);
         let theirs = glam::Vec3::new(-0.275_421_47, 0.921_024_4, -0.275_421_47);
