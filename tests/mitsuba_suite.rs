@@ -46,6 +46,15 @@ const EXPECTED_PASSING: &[(&str, &str)] = &[
     ("bsdf_spheres/test_envmap_path", "bdpt"),
     ("bsdf_spheres/test_pointlight_path", "pt"),
     ("bsdf_spheres/test_pointlight_path", "bdpt"),
+    ("mesh_attributes/test_mesh_attributes_3_face_direct", "pt"),
+    ("mesh_attributes/test_mesh_attributes_3_face_direct", "bdpt"),
+    ("mesh_attributes/test_mesh_attributes_3_vertex_direct", "pt"),
+    (
+        "mesh_attributes/test_mesh_attributes_3_vertex_direct",
+        "bdpt",
+    ),
+    ("mesh_attributes/test_mesh_attributes_1_face_direct", "pt"),
+    ("mesh_attributes/test_mesh_attributes_1_face_direct", "bdpt"),
 ];
 
 #[test]

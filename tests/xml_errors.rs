@@ -659,3 +659,38 @@ fn xml_overflowing_geometry_is_one_clear_error() {
         &["the sphere", "world coordinates"],
     );
 }
+
+/// A `mesh_attribute` texture names an attribute the PLY has (`vertex_<p>` from `<p>_0.._2`,
+/// `face_<p>` from a lone `<p>_0`): a misspelt one is refused at the shape with the names it has,
+/// a name without `vertex_`/`face_` at the texture; the right ones load.
+#[test]
+fn mesh_attribute_names_are_checked_against_the_mesh() {
+    let d = dir("mesh-attribute");
+    std::fs::write(
+        d.join("tri.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float color_0\nproperty float color_1\nproperty float color_2\nelement face 1\nproperty list uchar int vertex_indices\nproperty float weight_0\nend_header\n-1 -1 0 1 0 0\n1 -1 0 0 1 0\n0 1 0 0 0 1\n3 0 1 2 0.25\n",
+    )
+    .unwrap();
+    let with = |name: &str| {
+        scene_xml(&format!(
+            "    <texture type=\"mesh_attribute\" id=\"t\"><string name=\"name\" value=\"{name}\"/></texture>\n    <bsdf type=\"diffuse\" id=\"m\"><ref name=\"reflectance\" id=\"t\"/></bsdf>\n    <shape type=\"ply\">\n        <string name=\"filename\" value=\"tri.ply\"/><ref id=\"m\"/>\n    </shape>"
+        ))
+    };
+    let text = with("vertex_colour");
+    fails(
+        &d,
+        &text,
+        line_of(&text, "<shape type=\"ply\">"),
+        &["`vertex_colour`", "vertex_color, face_weight"],
+    );
+    let text = with("colour");
+    fails(
+        &d,
+        &text,
+        line_of(&text, "value=\"colour\""),
+        &["must start with `vertex_` or `face_`"],
+    );
+    for ok in ["vertex_color", "face_weight"] {
+        load_in(&d, "scene.xml", &with(ok), LoadOptions::default()).unwrap();
+    }
+}

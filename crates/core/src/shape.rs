@@ -2,7 +2,7 @@
 //! and cube as meshes) and exact spheres. The scene indexes them for ray queries; area lights
 //! sample them.
 
-use crate::math::{Vec2, Vec3, PI};
+use crate::math::{Color, Vec2, Vec3, PI};
 
 /// A triangle mesh in world space.
 #[derive(Clone, Debug, Default)]
@@ -14,9 +14,48 @@ pub struct TriangleMesh {
     /// flipped for OBJ files, so that v = 0 is the image's top row).
     pub uvs: Option<Vec<Vec2>>,
     pub indices: Vec<[u32; 3]>,
+    /// Named quantities the mesh file carries (Mitsuba's mesh attributes), read by
+    /// `mesh_attribute` textures.
+    pub attributes: Vec<MeshAttribute>,
+}
+
+/// A per-vertex or per-face quantity of a mesh, under Mitsuba's name: `vertex_<p>` or `face_<p>`
+/// for the file's properties `<p>_0`, `<p>_1`, … (or a lone `<p>`).
+#[derive(Clone, Debug)]
+pub struct MeshAttribute {
+    pub name: String,
+    /// One value per triangle (a face's value copied to each triangle it was split into) when
+    /// true; one per vertex otherwise.
+    pub per_face: bool,
+    /// A one-channel attribute is stored as grey (Mitsuba broadcasts it to every channel).
+    pub values: Vec<Color>,
 }
 
 impl TriangleMesh {
+    /// Index into `attributes` of the one called `name`.
+    pub fn attribute_index(&self, name: &str) -> Option<u32> {
+        self.attributes
+            .iter()
+            .position(|a| a.name == name)
+            .map(|k| k as u32)
+    }
+
+    /// Attribute `k` at barycentrics `b` of triangle `i`: a face attribute is the triangle's
+    /// value, a vertex attribute the barycentric blend of its corners' (Mitsuba's
+    /// `eval_attribute`).
+    #[inline]
+    pub fn attribute(&self, k: u32, i: usize, b: [f32; 3]) -> Color {
+        let a = &self.attributes[k as usize];
+        if a.per_face {
+            a.values[i]
+        } else {
+            let [v0, v1, v2] = self.indices[i];
+            b[0] * a.values[v0 as usize]
+                + b[1] * a.values[v1 as usize]
+                + b[2] * a.values[v2 as usize]
+        }
+    }
+
     pub fn triangle(&self, i: usize) -> [Vec3; 3] {
         let [a, b, c] = self.indices[i];
         [
@@ -69,6 +108,7 @@ impl TriangleMesh {
                 Vec2::new(0.0, 1.0),
             ]),
             indices: vec![[0, 1, 2], [0, 2, 3]],
+            attributes: Vec::new(),
         }
     }
 
@@ -105,6 +145,7 @@ impl TriangleMesh {
             normals: None,
             uvs: Some(uvs),
             indices,
+            attributes: Vec::new(),
         }
     }
 

@@ -146,6 +146,26 @@ fn wrap_index(i: i64, n: usize, wrap: WrapMode) -> usize {
     j as usize
 }
 
+/// Where a texture is read: the point's texture coordinates and, when its material reads a mesh
+/// attribute, that attribute's value there (zero otherwise). The hit fills `attr` only for
+/// materials that ask (`Material::mesh_attribute`), so other scenes pay nothing for it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TexPoint {
+    pub uv: Vec2,
+    pub attr: Color,
+}
+
+impl TexPoint {
+    /// A point known by its texture coordinates only.
+    #[inline]
+    pub fn at(uv: Vec2) -> TexPoint {
+        TexPoint {
+            uv,
+            attr: Color::ZERO,
+        }
+    }
+}
+
 #[derive(Clone, Debug)]
 pub enum Texture {
     Constant(Color),
@@ -156,13 +176,21 @@ pub enum Texture {
         color1: Color,
         to_uv: UvTransform,
     },
+    /// Mitsuba's `mesh_attribute`: a per-vertex (`vertex_<name>`, interpolated barycentrically)
+    /// or per-face (`face_<name>`, constant over the face) quantity the mesh file carries. The
+    /// value arrives in `TexPoint::attr`; a material reads at most one attribute.
+    MeshAttribute {
+        name: Arc<str>,
+    },
 }
 
 impl Texture {
     #[inline]
-    pub fn eval(&self, uv: Vec2) -> Color {
+    pub fn eval(&self, at: TexPoint) -> Color {
+        let uv = at.uv;
         match self {
             Texture::Constant(c) => *c,
+            Texture::MeshAttribute { .. } => at.attr,
             Texture::Bitmap(b) => b.eval(uv),
             Texture::Checkerboard {
                 color0,
@@ -185,7 +213,9 @@ impl Texture {
     pub fn grad(&self, uv: Vec2) -> Vec2 {
         match self {
             Texture::Bitmap(b) => b.grad(uv),
-            Texture::Constant(_) | Texture::Checkerboard { .. } => Vec2::ZERO,
+            Texture::Constant(_) | Texture::Checkerboard { .. } | Texture::MeshAttribute { .. } => {
+                Vec2::ZERO
+            }
         }
     }
 
@@ -195,6 +225,16 @@ impl Texture {
             Texture::Constant(c) => *c,
             Texture::Bitmap(b) => b.mean(),
             Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
+            // Unknown before a mesh is at hand: the middle of [0, 1].
+            Texture::MeshAttribute { .. } => Color::splat(0.5),
+        }
+    }
+
+    /// The mesh attribute the texture reads, if it is one.
+    pub fn mesh_attribute(&self) -> Option<&str> {
+        match self {
+            Texture::MeshAttribute { name } => Some(name),
+            _ => None,
         }
     }
 
@@ -206,6 +246,8 @@ impl Texture {
             Texture::Checkerboard { color0, color1, .. } => {
                 color0.max_element().max(color1.max_element())
             }
+            // Checked against the mesh's values where the shape is read.
+            Texture::MeshAttribute { .. } => 0.0,
         }
     }
 }
@@ -289,8 +331,8 @@ mod tests {
             color1: Color::ONE,
             to_uv: UvTransform::IDENTITY,
         };
-        assert_eq!(t.eval(Vec2::new(0.1, 0.1)), Color::ZERO);
-        assert_eq!(t.eval(Vec2::new(0.6, 0.1)), Color::ONE);
-        assert_eq!(t.eval(Vec2::new(0.6, 0.6)), Color::ZERO);
+        assert_eq!(t.eval(TexPoint::at(Vec2::new(0.1, 0.1))), Color::ZERO);
+        assert_eq!(t.eval(TexPoint::at(Vec2::new(0.6, 0.1))), Color::ONE);
+        assert_eq!(t.eval(TexPoint::at(Vec2::new(0.6, 0.6))), Color::ZERO);
     }
 }

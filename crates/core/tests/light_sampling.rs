@@ -57,6 +57,7 @@ fn quad_scene() -> Scene {
         normals: None,
         uvs: None,
         indices: vec![[0, 2, 1], [0, 3, 2]],
+        attributes: Vec::new(),
     };
     build(
         vec![(ShapeGeometry::Mesh(mesh), Some(Color::ONE), false)],
@@ -80,6 +81,7 @@ fn parallelogram_scene() -> Scene {
         normals: None,
         uvs: None,
         indices: vec![[0, 1, 2], [0, 2, 3]],
+        attributes: Vec::new(),
     };
     build(
         vec![(ShapeGeometry::Mesh(mesh), Some(Color::ONE), false)],
@@ -753,7 +755,7 @@ fn directional_light_is_a_delta_in_direction() {
         assert_eq!(l.escaped(ls.wi), Color::ZERO);
         let w = Vec3::new(s.next_f32() - 0.5, s.next_f32(), s.next_f32() - 0.5).normalize();
         assert_eq!(l.pdf_li(p, w, w, -w), 0.0);
-        assert_eq!(l.emitted(-w, w, Vec2::ZERO), Color::ZERO);
+        assert_eq!(l.emitted(-w, w, Default::default()), Color::ZERO);
         let le = l.sample_le(s.next_2d(), s.next_2d(), b).unwrap();
         assert_eq!(le.ray.d, -d.direction);
         assert!(le.pdf_dir == 1.0 && le.radiance == e);

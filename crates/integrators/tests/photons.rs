@@ -205,6 +205,7 @@ fn flux_cases() -> Vec<Case> {
         normals: None,
         uvs: None,
         indices: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        attributes: Vec::new(),
     };
     let (a, b, c) = (ta as f64, tb as f64, tc as f64);
     let area = (a * b + a * c + b * c) / 2.0

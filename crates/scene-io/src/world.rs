@@ -27,6 +27,8 @@ pub struct WorldMesh {
     /// Texture coordinates: no transform touches them.
     pub uvs: Option<Vec<lt_core::math::Vec2>>,
     pub indices: Vec<[u32; 3]>,
+    /// Mesh attributes: no transform touches them.
+    pub attributes: Vec<lt_core::scene::MeshAttribute>,
 }
 
 impl WorldMesh {
@@ -54,6 +56,7 @@ impl WorldMesh {
             normals,
             uvs: local.uvs.clone(),
             indices,
+            attributes: local.attributes.clone(),
         }
     }
 
@@ -121,6 +124,10 @@ impl WorldBuilder {
     }
 
     /// Returns the material's id for `add_shape`.
+    pub fn material(&self, id: u32) -> &Material {
+        &self.materials[id as usize]
+    }
+
     pub fn add_material(&mut self, m: Material) -> u32 {
         self.materials.push(m);
         (self.materials.len() - 1) as u32
@@ -175,6 +182,7 @@ impl WorldBuilder {
                     normals: m.normals,
                     uvs: m.uvs,
                     indices: m.indices,
+                    attributes: m.attributes,
                 }),
                 WorldGeometry::Sphere { center, radius } => ShapeGeometry::Sphere {
                     center: local(center),

@@ -13,7 +13,7 @@
 
 use super::{BsdfEval, BsdfSample, Material, ShadingFrame, TransportMode};
 use crate::math::{luminance, Vec2, Vec3};
-use crate::texture::Texture;
+use crate::texture::{TexPoint, Texture};
 
 #[derive(Clone, Debug)]
 pub struct Blend {
@@ -25,8 +25,8 @@ pub struct Blend {
 
 impl Blend {
     #[inline]
-    fn weight_at(&self, uv: Vec2) -> f32 {
-        luminance(self.weight.eval(uv)).clamp(0.0, 1.0)
+    fn weight_at(&self, at: TexPoint) -> f32 {
+        luminance(self.weight.eval(at)).clamp(0.0, 1.0)
     }
 
     pub fn sample(

@@ -17,6 +17,7 @@
 
 use super::{BsdfEval, BsdfSample, Material, ShadingFrame, TransportMode};
 use crate::math::{luminance, Vec2, Vec3};
+use crate::texture::TexPoint;
 use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
@@ -30,7 +31,7 @@ pub struct Mask {
 impl Mask {
     /// α at texture coordinates `uv`.
     #[inline]
-    pub fn opacity_at(&self, uv: Vec2) -> f32 {
+    pub fn opacity_at(&self, uv: TexPoint) -> f32 {
         luminance(self.opacity.eval(uv)).clamp(0.0, 1.0)
     }
 

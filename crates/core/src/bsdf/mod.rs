@@ -51,6 +51,7 @@ pub use thin_dielectric::ThinDielectric;
 pub use two_sided::TwoSided;
 
 use crate::math::{Color, Frame, Vec2, Vec3};
+use crate::texture::TexPoint;
 
 /// Which quantity a path carries: radiance (paths from the camera) or importance (from lights).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,8 +67,9 @@ pub struct ShadingFrame {
     pub ng: Vec3,
     /// Orthonormal frame around the shading normal.
     pub frame: Frame,
-    /// Texture coordinates of the point (textured materials read their parameters there).
-    pub uv: Vec2,
+    /// Texture coordinates of the point, with the mesh attribute its material reads (textured
+    /// materials read their parameters there).
+    pub uv: TexPoint,
 }
 
 impl ShadingFrame {
@@ -75,13 +77,13 @@ impl ShadingFrame {
         ShadingFrame {
             ng,
             frame: Frame::from_z(ns),
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
         }
     }
 
-    /// The same frame at texture coordinates `uv`.
+    /// The same frame at texture point `uv`.
     #[inline]
-    pub fn with_uv(self, uv: Vec2) -> ShadingFrame {
+    pub fn with_uv(self, uv: TexPoint) -> ShadingFrame {
         ShadingFrame { uv, ..self }
     }
     #[inline]
@@ -198,6 +200,26 @@ impl Material {
         match self {
             Material::Perturbed(p) => Some(p),
             Material::Mask(m) => m.inner.perturbation(),
+            _ => None,
+        }
+    }
+
+    /// The mesh attribute the material reads through a `mesh_attribute` texture, if any (the
+    /// hit computes it only then).
+    pub fn mesh_attribute(&self) -> Option<&str> {
+        match self {
+            Material::Textured(t) => t.slots.iter().find_map(|(_, x)| x.mesh_attribute()),
+            Material::Mask(m) => m
+                .opacity
+                .mesh_attribute()
+                .or_else(|| m.inner.mesh_attribute()),
+            Material::Perturbed(p) => p.inner.mesh_attribute(),
+            Material::TwoSided(t) => t.inner.mesh_attribute(),
+            Material::Blend(b) => b
+                .weight
+                .mesh_attribute()
+                .or_else(|| b.first.mesh_attribute())
+                .or_else(|| b.second.mesh_attribute()),
             _ => None,
         }
     }

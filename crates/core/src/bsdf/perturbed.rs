@@ -27,7 +27,7 @@
 
 use super::{BsdfEval, BsdfSample, Material, ShadingFrame, TransportMode};
 use crate::math::{Frame, Vec2, Vec3};
-use crate::texture::Texture;
+use crate::texture::{TexPoint, Texture};
 
 /// Where the perturbed normal comes from.
 #[derive(Clone, Debug)]
@@ -54,7 +54,7 @@ impl Perturbed {
     /// The perturbed shading normal at a point with unperturbed shading normal `ns`, geometric
     /// normal `ng` (both unit, same side), surface tangents ∂p/∂u, ∂p/∂v and texture coordinates
     /// `uv`. The shading frame's first axis is ∂p/∂u made orthogonal to `ns`, as Mitsuba's.
-    pub fn normal(&self, ng: Vec3, ns: Vec3, dpdu: Vec3, dpdv: Vec3, uv: Vec2) -> Vec3 {
+    pub fn normal(&self, ng: Vec3, ns: Vec3, dpdu: Vec3, dpdv: Vec3, uv: TexPoint) -> Vec3 {
         let n = match &self.source {
             NormalSource::NormalMap(t) => {
                 let c = t.eval(uv) * 2.0 - 1.0;
@@ -70,7 +70,7 @@ impl Perturbed {
                 frame.to_world(c)
             }
             NormalSource::BumpMap { height, scale } => {
-                let g = height.grad(uv) * *scale;
+                let g = height.grad(uv.uv) * *scale;
                 // Tangents of the displaced surface p + h n, with n's own variation neglected
                 // (Mitsuba's choice): the in-plane parts of ∂p/∂u, ∂p/∂v plus ∂h along n.
                 let du = dpdu + ns * (g.x - ns.dot(dpdu));
@@ -205,9 +205,9 @@ mod tests {
     fn normal_map_is_read_in_the_frame_of_dpdu() {
         let (ng, dpdu, dpdv) = (Vec3::Z, Vec3::new(2.0, 0.0, 0.3), Vec3::Y);
         let id = flat_normal_map(Color::new(0.5, 0.5, 1.0));
-        assert!((id.normal(ng, ng, dpdu, dpdv, Vec2::ZERO) - ng).length() < 1e-6);
+        assert!((id.normal(ng, ng, dpdu, dpdv, Default::default()) - ng).length() < 1e-6);
         let tilted = flat_normal_map(Color::new(0.5 + 0.5 * 0.6, 0.5, 0.5 + 0.5 * 0.8));
-        let n = tilted.normal(ng, ng, dpdu, dpdv, Vec2::ZERO);
+        let n = tilted.normal(ng, ng, dpdu, dpdv, Default::default());
         assert!((n - Vec3::new(0.6, 0.0, 0.8)).length() < 1e-6, "{n}");
     }
 

@@ -5,8 +5,8 @@
 use super::microfacet::Microfacet;
 use super::two_sided::FrontFacing;
 use super::{LocalBsdf, Material};
-use crate::math::{Color, Vec2};
-use crate::texture::Texture;
+use crate::math::Color;
+use crate::texture::{TexPoint, Texture};
 
 /// Which parameter a texture drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,7 +31,7 @@ impl Textured {
     /// lives on the stack: a two-sided base is resolved as its inner material (no `Box` cloned
     /// per shading query) and seen from both sides through `FrontFacing`.
     #[inline]
-    pub(super) fn with_local<R>(&self, uv: Vec2, f: impl FnOnce(&dyn LocalBsdf) -> R) -> R {
+    pub(super) fn with_local<R>(&self, uv: TexPoint, f: impl FnOnce(&dyn LocalBsdf) -> R) -> R {
         match &self.base {
             Material::TwoSided(t) => {
                 let inner = self.resolved((*t.inner).clone(), uv);
@@ -42,7 +42,7 @@ impl Textured {
     }
 
     /// `m` with every textured parameter set from its texture at `uv`.
-    fn resolved(&self, mut m: Material, uv: Vec2) -> Material {
+    fn resolved(&self, mut m: Material, uv: TexPoint) -> Material {
         for (slot, texture) in &self.slots {
             set_parameter(&mut m, *slot, texture.eval(uv));
         }

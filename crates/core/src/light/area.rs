@@ -14,7 +14,7 @@ use crate::sampling::{
     sample_uniform_triangle, uniform_cone_pdf, Distribution1D,
 };
 use crate::shape::{ShapeGeometry, TriangleMesh};
-use crate::texture::Texture;
+use crate::texture::{TexPoint, Texture};
 
 /// A piece of an emitting mesh: a triangle, or a pair of triangles forming a parallelogram
 /// (sampled with two uniform variates, no square root; same uniform area density).
@@ -121,7 +121,7 @@ impl AreaLight {
 
     /// A uniformly distributed point on the surface with its outward (emitting-side) normal, its
     /// rounding bound and its uv (zero unless the light is textured).
-    fn sample_area(&self, u: Vec2) -> (Vec3, Vec3, Vec3, Vec2) {
+    fn sample_area(&self, u: Vec2) -> (Vec3, Vec3, Vec3, TexPoint) {
         let (p, n, err, uv) = match &self.emitter {
             Emitter::Triangles { pieces, pick, uvs } => {
                 let (i, _, ux) = pick.sample(u.x);
@@ -157,7 +157,7 @@ impl AreaLight {
                 (p, n, (p.abs() + center.abs()) * gamma(6), uv)
             }
         };
-        (p, if self.flip { -n } else { n }, err, uv)
+        (p, if self.flip { -n } else { n }, err, TexPoint::at(uv))
     }
 
     /// The sphere's uv at outward normal `n` when the light is textured (zero otherwise).
@@ -170,7 +170,7 @@ impl AreaLight {
     }
 
     #[inline]
-    pub fn emitted(&self, n: Vec3, w: Vec3, uv: Vec2) -> Color {
+    pub fn emitted(&self, n: Vec3, w: Vec3, uv: TexPoint) -> Color {
         if n.dot(w) > 0.0 {
             match &self.texture {
                 None => self.emission,
@@ -255,7 +255,7 @@ impl AreaLight {
         let lp_raw = p + wi * ds;
         let mut n = (lp_raw - center).normalize();
         let lp = center + n * radius;
-        let uv = self.sphere_uv(n);
+        let uv = TexPoint::at(self.sphere_uv(n));
         if self.flip {
             n = -n;
         }

@@ -18,6 +18,7 @@
 use super::environment::{disk_pdf, distant_le};
 use super::{LightLeSample, LightLiSample};
 use crate::math::{luminance, Color, Vec2, Vec3, PI};
+use crate::texture::TexPoint;
 
 #[derive(Clone, Debug)]
 pub struct DirectionalLight {
@@ -40,7 +41,7 @@ impl DirectionalLight {
     pub fn sample_li(&self) -> LightLiSample {
         let wi = self.direction;
         LightLiSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             p_err: Vec3::ZERO,
             wi,
             p: wi,

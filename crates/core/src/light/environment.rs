@@ -4,6 +4,7 @@ use super::{LightLeSample, LightLiSample};
 use crate::geometry::Ray;
 use crate::math::{luminance, Color, Frame, Vec2, Vec3, PI};
 use crate::sampling::{sample_concentric_disk, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
+use crate::texture::TexPoint;
 
 #[derive(Clone, Debug)]
 pub struct EnvironmentLight {
@@ -14,7 +15,7 @@ impl EnvironmentLight {
     pub fn sample_li(&self, u: Vec2) -> Option<LightLiSample> {
         let wi = sample_uniform_sphere(u);
         Some(LightLiSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             p_err: Vec3::ZERO,
             wi,
             p: wi,
@@ -66,7 +67,7 @@ pub fn distant_le(
 ) -> LightLeSample {
     let ray = ray_from_bounding_disk(d, u_pos, bounds);
     LightLeSample {
-        uv: Vec2::ZERO,
+        uv: TexPoint::default(),
         ray,
         p: ray.o,
         p_err: Vec3::ZERO,

@@ -19,6 +19,7 @@ use super::environment::{disk_pdf, distant_le};
 use super::{LightLeSample, LightLiSample};
 use crate::math::{luminance, Color, Vec2, Vec3, PI};
 use crate::sampling::Distribution1D;
+use crate::texture::TexPoint;
 use glam::Mat3;
 use std::sync::Arc;
 
@@ -228,7 +229,7 @@ impl EnvironmentMapLight {
         let (wi, pdf_w) = self.map.sample(u)?;
         let radiance = self.map.eval(wi);
         Some(LightLiSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             p_err: Vec3::ZERO,
             wi,
             p: wi,

@@ -34,7 +34,7 @@ use crate::geometry::Ray;
 use crate::math::{luminance, Color, Vec2, Vec3};
 use crate::sampling::Distribution1D;
 use crate::shape::ShapeGeometry;
-use crate::texture::Texture;
+use crate::texture::{TexPoint, Texture};
 use glam::Mat3;
 
 /// Lights that are not shapes.
@@ -111,7 +111,7 @@ pub struct LightLiSample {
     pub p_err: Vec3,
     pub distance: f32,
     /// Texture coordinates of `p` on an area light (zero for other lights).
-    pub uv: Vec2,
+    pub uv: TexPoint,
     /// Radiance arriving along −wi, delta-stripped for delta lights: intensity / distance² for a
     /// point light, irradiance for a directional light (what f_s·cos multiplies in both cases).
     pub radiance: Color,
@@ -132,7 +132,7 @@ pub struct LightLeSample {
     /// Normal at the ray origin (for distant lights: the ray direction).
     pub n: Vec3,
     /// Texture coordinates of `p` on an area light (zero for other lights).
-    pub uv: Vec2,
+    pub uv: TexPoint,
     /// Emitted radiance along the ray (point lights: intensity; directional lights: irradiance).
     pub radiance: Color,
     /// Area pdf of the origin (1 for a point light).
@@ -287,7 +287,7 @@ impl Light {
 
     /// Radiance an area light emits from a point with normal `n` and texture coordinates `uv`
     /// in direction `w` (one-sided).
-    pub fn emitted(&self, n: Vec3, w: Vec3, uv: Vec2) -> Color {
+    pub fn emitted(&self, n: Vec3, w: Vec3, uv: TexPoint) -> Color {
         match self {
             Light::Area(l) => l.emitted(n, w, uv),
             _ => Color::ZERO,

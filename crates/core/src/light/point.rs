@@ -4,6 +4,7 @@ use super::{LightLeSample, LightLiSample};
 use crate::geometry::Ray;
 use crate::math::{Color, Vec2, Vec3};
 use crate::sampling::{sample_uniform_sphere, UNIFORM_SPHERE_PDF};
+use crate::texture::TexPoint;
 
 #[derive(Clone, Debug)]
 pub struct PointLight {
@@ -21,7 +22,7 @@ impl PointLight {
         let distance = d2.sqrt();
         let wi = to / distance;
         Some(LightLiSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             p_err: Vec3::ZERO,
             wi,
             p: self.position,
@@ -36,7 +37,7 @@ impl PointLight {
     pub fn sample_le(&self, u_dir: Vec2) -> LightLeSample {
         let d = sample_uniform_sphere(u_dir);
         LightLeSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             ray: Ray::new(self.position, d),
             p: self.position,
             p_err: Vec3::ZERO,

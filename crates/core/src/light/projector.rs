@@ -17,6 +17,7 @@
 use super::{LightLeSample, LightLiSample};
 use crate::geometry::Ray;
 use crate::math::{luminance, Color, Vec2, Vec3, PI};
+use crate::texture::TexPoint;
 use crate::texture::Texture;
 use glam::Mat3;
 
@@ -69,7 +70,7 @@ impl ProjectorLight {
         }
         let uv = Vec2::splat(0.5) - 0.5 * q / self.tan_half;
         let cos3 = d.z * d.z * d.z;
-        self.irradiance.eval(uv) * (PI * self.scale / cos3)
+        self.irradiance.eval(crate::texture::TexPoint::at(uv)) * (PI * self.scale / cos3)
     }
 
     pub fn sample_li(&self, p: Vec3) -> Option<LightLiSample> {
@@ -81,7 +82,7 @@ impl ProjectorLight {
         let distance = d2.sqrt();
         let wi = to / distance;
         Some(LightLiSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             p_err: Vec3::ZERO,
             wi,
             p: self.position,
@@ -97,7 +98,7 @@ impl ProjectorLight {
         let q = (2.0 * u_dir - Vec2::ONE) * self.tan_half;
         let d = (self.to_world * Vec3::new(q.x, q.y, 1.0)).normalize();
         LightLeSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             ray: Ray::new(self.position, d),
             p: self.position,
             p_err: Vec3::ZERO,

@@ -17,6 +17,7 @@ use super::{LightLeSample, LightLiSample};
 use crate::geometry::Ray;
 use crate::math::{luminance, Color, Vec2, Vec3, PI};
 use crate::sampling::{sample_uniform_cone, uniform_cone_pdf};
+use crate::texture::TexPoint;
 use crate::texture::Texture;
 use glam::Mat3;
 
@@ -83,7 +84,10 @@ impl SpotLight {
             None => Color::ONE,
             Some(t) => {
                 let s = 0.5 / (self.tan_cutoff * cos_theta);
-                t.eval(Vec2::new(0.5 + d.x * s, 0.5 + d.y * s))
+                t.eval(crate::texture::TexPoint::at(Vec2::new(
+                    0.5 + d.x * s,
+                    0.5 + d.y * s,
+                )))
             }
         };
         self.intensity * tex * falloff.max(0.0)
@@ -98,7 +102,7 @@ impl SpotLight {
         let distance = d2.sqrt();
         let wi = to / distance;
         Some(LightLiSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             p_err: Vec3::ZERO,
             wi,
             p: self.position,
@@ -113,7 +117,7 @@ impl SpotLight {
     pub fn sample_le(&self, u_dir: Vec2) -> LightLeSample {
         let d = self.to_world * sample_uniform_cone(u_dir, self.one_minus_cos_cutoff);
         LightLeSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             ray: Ray::new(self.position, d),
             p: self.position,
             p_err: Vec3::ZERO,

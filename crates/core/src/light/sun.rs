@@ -6,6 +6,7 @@ use super::environment::{disk_pdf, distant_le};
 use super::{LightLeSample, LightLiSample};
 use crate::math::{luminance, Color, Frame, Vec2, Vec3, PI};
 use crate::sampling::{sample_uniform_cone, uniform_cone_pdf};
+use crate::texture::TexPoint;
 
 #[derive(Clone, Debug)]
 pub struct SunLight {
@@ -71,7 +72,7 @@ impl SunLight {
     pub fn sample_li(&self, u: Vec2) -> Option<LightLiSample> {
         let wi = self.sample_dir(u);
         Some(LightLiSample {
-            uv: Vec2::ZERO,
+            uv: TexPoint::default(),
             p_err: Vec3::ZERO,
             wi,
             p: wi,

@@ -5,7 +5,7 @@
 
 use crate::camera::Camera;
 use crate::light::{LightLeSample, LightLiSample};
-use crate::math::{Color, Vec2, Vec3};
+use crate::math::{Color, Vec3};
 use crate::measure;
 use crate::scene::{ConnectionEnd, Scene, SurfaceHit};
 
@@ -59,8 +59,8 @@ pub struct PathVertex {
     pub wo: Vec3,
     /// The light a surface vertex emits as, when it lies on an emitter (technique s = 0).
     pub emitter: Option<u32>,
-    /// Texture coordinates of a surface vertex (zero elsewhere).
-    pub uv: Vec2,
+    /// Texture point of a surface vertex (zero elsewhere).
+    pub uv: crate::texture::TexPoint,
 }
 
 impl PathVertex {
@@ -77,7 +77,7 @@ impl PathVertex {
             delta: false,
             wo: Vec3::ZERO,
             emitter: None,
-            uv: Vec2::ZERO,
+            uv: Default::default(),
         }
     }
 

@@ -175,11 +175,20 @@ impl SceneBuilder {
                 lights.push(Light::area(shape_id, &geometry, &e, flip_normals));
                 (lights.len() - 1) as u32
             });
+            // A missing attribute reads as zero (the loaders report it first).
+            let attribute = match (
+                &geometry,
+                self.materials[material as usize].mesh_attribute(),
+            ) {
+                (ShapeGeometry::Mesh(m), Some(name)) => m.attribute_index(name),
+                _ => None,
+            };
             shapes.push(Shape {
                 geometry,
                 material,
                 light,
                 flip_normals,
+                attribute,
             });
         }
         let accel = Accel::build(prims);

@@ -6,7 +6,8 @@ use crate::geometry::ray::barycentric_error;
 use crate::geometry::sphere::refine_sphere_hit;
 use crate::geometry::triangle::{intersect_triangle, ShearedRay};
 use crate::geometry::{offset_ray_origin, PrimHit, Primitive, Ray, SHADOW_EPSILON};
-use crate::math::{Vec2, Vec3, PI};
+use crate::math::{Color, Vec2, Vec3, PI};
+use crate::texture::TexPoint;
 
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceHit {
@@ -18,8 +19,9 @@ pub struct SurfaceHit {
     /// Shading normal, unit, on the same side as `ng`.
     pub ns: Vec3,
     pub t: f32,
-    /// Texture coordinates (Mitsuba's parameterisation of each shape).
-    pub uv: Vec2,
+    /// Texture coordinates (Mitsuba's parameterisation of each shape), with the mesh attribute
+    /// the material reads.
+    pub uv: TexPoint,
     pub shape: u32,
     pub material: u32,
     /// Index into `Scene::lights` when the surface emits.
@@ -31,7 +33,7 @@ impl SurfaceHit {
         let prim = *scene.accel.primitive(h.prim);
         let shape = &scene.shapes[prim.shape() as usize];
         // `tri`: the mesh triangle holding the point (a parallelogram's source triangle).
-        let (p, p_err, mut ng, mut ns, uv, tri) = match prim {
+        let (p, p_err, mut ng, mut ns, uv, tri, bary) = match prim {
             Primitive::Triangle {
                 p: [p0, p1, p2],
                 index,
@@ -49,7 +51,7 @@ impl SurfaceHit {
                     ),
                     ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
                 };
-                (p, err, ng, ns, uv, index)
+                (p, err, ng, ns, uv, index, [b0, b1, b2])
             }
             Primitive::Quad { q, index, .. } => {
                 let (p, err, u, v) = q.hit_point(ray.o, ray.d, h.t);
@@ -68,13 +70,20 @@ impl SurfaceHit {
                     ),
                     ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
                 };
-                (p, err, ng, ns, uv, tri)
+                (p, err, ng, ns, uv, tri, b)
             }
             Primitive::Sphere { center, radius, .. } => {
                 let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
                 let n = (p - center).normalize();
-                (p, err, n, n, crate::shape::sphere_uv(n), 0)
+                (p, err, n, n, crate::shape::sphere_uv(n), 0, [1.0, 0.0, 0.0])
             }
+        };
+        let uv = TexPoint {
+            uv,
+            attr: match (shape.attribute, &shape.geometry) {
+                (Some(k), ShapeGeometry::Mesh(m)) => m.attribute(k, tri as usize, bary),
+                _ => Color::ZERO,
+            },
         };
         if shape.flip_normals {
             ng = -ng;

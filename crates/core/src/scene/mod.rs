@@ -9,7 +9,7 @@ mod translated;
 mod visibility;
 
 pub use crate::light::LightDesc;
-pub use crate::shape::{ShapeGeometry, TriangleMesh};
+pub use crate::shape::{MeshAttribute, ShapeGeometry, TriangleMesh};
 pub use builder::SceneBuilder;
 pub use hit::SurfaceHit;
 pub use visibility::ConnectionEnd;
@@ -52,6 +52,9 @@ pub struct Shape {
     pub light: Option<u32>,
     /// Flips the geometric (and shading) normal: emission and inside/outside follow it.
     pub flip_normals: bool,
+    /// The mesh attribute (index into the mesh's `attributes`) the shape's material reads, if
+    /// any: only then does a hit compute one.
+    pub attribute: Option<u32>,
 }
 
 pub struct Scene {

@@ -201,6 +201,7 @@ mod tests {
                 normals: None,
                 uvs: None,
                 indices: vec![[0, 1, 2], [0, 2, 3]],
+                attributes: Vec::new(),
             };
             b.add_shape(ShapeGeometry::Mesh(mesh), m, None, false);
         }

@@ -309,7 +309,7 @@ impl<'a> Loader<'a> {
             (Some((Xform { m, lookat: None }, te)), _) => {
                 let (sx, sy) = (m.x_axis.truncate().length(), m.y_axis.truncate().length());
                 if !((sx - sy).abs() <= 1e-6 * sx.max(sy)) {
-                    return Err(p.err(*te, format!("an orthographic sensor scaled unequally in x ({sx}) and y ({sy}) is not supported")));
+                    return Err(p.err(te, format!("an orthographic sensor scaled unequally in x ({sx}) and y ({sy}) is not supported")));
                 }
                 Some(sx as f32)
             }
@@ -882,11 +882,24 @@ impl<'a> Loader<'a> {
                     to_uv,
                 }
             }
+            "mesh_attribute" => {
+                let Some((name, ne)) = p.string("name")? else {
+                    return Err(p.err(e, "a mesh_attribute texture needs a `name`"));
+                };
+                if !(name.starts_with("vertex_") || name.starts_with("face_")) {
+                    return Err(p.err(
+                        ne,
+                        format!("mesh attribute `{name}`: its name must start with `vertex_` or `face_`"),
+                    ));
+                }
+                p.finish(&[], &mut self.report)?;
+                Texture::MeshAttribute { name: name.into() }
+            }
             other => {
                 return Err(p.err(
                     e,
                     format!(
-                        "texture `{other}` is not supported (lt reads bitmap and checkerboard)"
+                        "texture `{other}` is not supported (lt reads bitmap, checkerboard and mesh_attribute)"
                     ),
                 ))
             }
@@ -1276,6 +1289,13 @@ impl<'a> Loader<'a> {
                 // A textured radiance is read at the shape's uv, as materials' textures are.
                 if let Some(t) = ep.texture("radiance") {
                     let texture = self.texture(t)?;
+                    if texture.mesh_attribute().is_some() {
+                        return Err(ep.err(
+                            t,
+                            "a mesh attribute as an area emitter's `radiance` is not supported \
+                             (light samples know a point's uv, not its attributes)",
+                        ));
+                    }
                     ep.finish(&["sampling_weight"], &mut self.report)?;
                     return self.finish_shape(&p, b, geometry, material, Some(texture), flip);
                 }
@@ -1300,6 +1320,27 @@ impl<'a> Loader<'a> {
         radiance: Option<Texture>,
         flip: bool,
     ) -> Result<bool, SceneError> {
+        if let Some(name) = b.material(material).mesh_attribute() {
+            let has = match &geometry {
+                WorldGeometry::Mesh(m) => m.attributes.iter().any(|a| a.name == name),
+                _ => false,
+            };
+            if !has {
+                let known: Vec<&str> = match &geometry {
+                    WorldGeometry::Mesh(m) => {
+                        m.attributes.iter().map(|a| a.name.as_str()).collect()
+                    }
+                    _ => Vec::new(),
+                };
+                return Err(p.err(
+                    p.elem,
+                    format!(
+                        "the shape's material reads mesh attribute `{name}`, which the shape does not have (it has: {})",
+                        if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                    ),
+                ));
+            }
+        }
         let ignored: &[&str] = match p.kind {
             "obj" | "ply" => &["flip_tex_coords"],
             _ => &[],
@@ -1615,6 +1656,7 @@ fn unit_disk_fan() -> TriangleMesh {
         normals: None,
         uvs: None,
         indices,
+        attributes: Vec::new(),
     }
 }
 
@@ -1739,6 +1781,7 @@ mod tests {
             normals: None,
             uvs: None,
             indices: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            attributes: Vec::new(),
         };
         let n = vertex_normals(&m);
         let theirs = glam::Vec3::new(-0.275_421_47, 0.921_024_4, -0.275_421_47);
