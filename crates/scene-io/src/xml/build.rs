@@ -860,11 +860,29 @@ impl<'a> Loader<'a> {
                     to_uv,
                 }
             }
+            "rawconstant" => {
+                // Mitsuba's `rawconstant`: `value`, a float or a 3-vector used as is (no colour
+                // conversion: normal maps store directions in it).
+                let is_float = e.children.iter().any(|c| {
+                    c.attr("name") == Some("value") && matches!(c.tag.as_str(), "float" | "integer")
+                });
+                let value = if is_float {
+                    p.float("value")?.map(|x| Color::splat(x as f32))
+                } else {
+                    p.vec3("value")?
+                        .map(|v| Color::new(v[0] as f32, v[1] as f32, v[2] as f32))
+                };
+                let Some(value) = value else {
+                    return Err(p.err(e, "a rawconstant texture needs a `value`"));
+                };
+                p.finish(&[], &mut self.report)?;
+                Texture::Constant(value)
+            }
             other => {
                 return Err(p.err(
                     e,
                     format!(
-                        "texture `{other}` is not supported (lt reads bitmap and checkerboard)"
+                        "texture `{other}` is not supported (lt reads bitmap, checkerboard and rawconstant)"
                     ),
                 ))
             }
