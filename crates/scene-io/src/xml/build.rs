@@ -309,7 +309,7 @@ impl<'a> Loader<'a> {
             (Some((Xform { m, lookat: None }, te)), _) => {
                 let (sx, sy) = (m.x_axis.truncate().length(), m.y_axis.truncate().length());
                 if !((sx - sy).abs() <= 1e-6 * sx.max(sy)) {
-                    return Err(p.err(*te, format!("an orthographic sensor scaled unequally in x ({sx}) and y ({sy}) is not supported")));
+                    return Err(p.err(te, format!("an orthographic sensor scaled unequally in x ({sx}) and y ({sy}) is not supported")));
                 }
                 Some(sx as f32)
             }
