@@ -28,6 +28,14 @@ const EXPECTED_PASSING: &[(&str, &str)] = &[
     ("bsdf_spheres/test_bumpmap_path", "bdpt"),
     ("bsdf_spheres/test_normalmap_path", "pt"),
     ("bsdf_spheres/test_normalmap_path", "bdpt"),
+    (
+        "bsdf_spheres/test_normalmap_identity_roughconductor_path",
+        "pt",
+    ),
+    (
+        "bsdf_spheres/test_normalmap_identity_roughconductor_path",
+        "bdpt",
+    ),
     ("bsdf_spheres/test_textured_diffuse_path", "pt"),
     ("bsdf_spheres/test_textured_diffuse_path", "bdpt"),
     ("bsdf_spheres/test_roughplastic_linear_path", "pt"),

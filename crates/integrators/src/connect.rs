@@ -3,7 +3,7 @@
 //! towards another vertex. Visibility is always `Scene::connection_visible`, which offsets both
 //! ends by their error bounds.
 
-use lt_core::bsdf::{BsdfEval, ShadingFrame, TransportMode};
+use lt_core::bsdf::{BsdfEval, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::path::{PathVertex, VertexKind};
 use lt_core::sampling::Sampler;
@@ -35,7 +35,7 @@ pub fn eval_towards(
     let VertexKind::Surface { material } = v.kind else {
         return None;
     };
-    let sf = ShadingFrame::new(v.ng, v.ns).with_uv(v.uv);
+    let sf = v.shading_frame();
     Some(scene.material(material).eval(&sf, v.wo, wi, mode))
 }
 

@@ -704,7 +704,7 @@ impl<'a> Engine<'a> {
         };
         let max_k = self.params.max_depth;
         let camera_segments = (t - 1) as u32;
-        let sf = lt_core::bsdf::ShadingFrame::new(zv.ng, zv.ns).with_uv(zv.uv);
+        let sf = zv.shading_frame();
         let bsdf = scene.material(material);
         let wo_side = zv.ng.dot(zv.wo);
         let transmits = bsdf.transmits();

@@ -1,7 +1,9 @@
 //! Turns the parsed file into a `Scene` through `SceneBuilder`, checking each value on the way.
 
 use crate::error::Ctx;
-use crate::format::{CameraDef, FilterDef, LightDef, MaterialDef, SceneFile, ShapeDef, S};
+use crate::format::{
+    CameraDef, FilterDef, LightDef, MaterialDef, SceneFile, ShapeDef, TextureDef, S,
+};
 use crate::transform::{check_quad, check_solid, shape_matrix};
 use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
 use crate::SceneError;
@@ -317,10 +319,12 @@ fn textured_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Mate
             "reflectance_texture",
         ),
         (&d.alpha_texture, TextureSlot::Alpha, "alpha_texture"),
+        (&d.alpha_u_texture, TextureSlot::AlphaU, "alpha_u_texture"),
+        (&d.alpha_v_texture, TextureSlot::AlphaV, "alpha_v_texture"),
     ] {
         let Some(t) = tex else { continue };
         let texture = crate::texture_def::texture(ctx, t)?;
-        if slot != TextureSlot::Alpha && texture.max_value() > 1.0 {
+        if !slot.is_roughness() && texture.max_value() > 1.0 {
             return Err(ctx.at(
                 t.span(),
                 format!(
@@ -361,6 +365,8 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
         ("k", d.k.as_ref().map(S::span)),
         ("distribution", d.distribution.as_ref().map(S::span)),
         ("alpha", d.alpha.as_ref().map(S::span)),
+        ("alpha_u", d.alpha_u.as_ref().map(S::span)),
+        ("alpha_v", d.alpha_v.as_ref().map(S::span)),
         ("transmittance", d.transmittance.as_ref().map(S::span)),
         ("twosided", d.twosided.as_ref().map(S::span)),
         ("albedo_texture", d.albedo_texture.as_ref().map(S::span)),
@@ -369,6 +375,8 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
             d.reflectance_texture.as_ref().map(S::span),
         ),
         ("alpha_texture", d.alpha_texture.as_ref().map(S::span)),
+        ("alpha_u_texture", d.alpha_u_texture.as_ref().map(S::span)),
+        ("alpha_v_texture", d.alpha_v_texture.as_ref().map(S::span)),
         ("nonlinear", d.nonlinear.as_ref().map(S::span)),
     ];
     let reflectance = |default: f32| {
@@ -419,7 +427,7 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
         }
         "roughdielectric" | "thindielectric" => {
             const THIN: [&str; 4] = ["ior", "reflectance", "transmittance", "reflectance_texture"];
-            const ROUGH: [&str; 7] = [
+            const ROUGH: [&str; 11] = [
                 "ior",
                 "reflectance",
                 "transmittance",
@@ -427,6 +435,10 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
                 "alpha",
                 "reflectance_texture",
                 "alpha_texture",
+                "alpha_u",
+                "alpha_v",
+                "alpha_u_texture",
+                "alpha_v_texture",
             ];
             ctx.only(&given, if kind == "thindielectric" { &THIN } else { &ROUGH }, &what)?;
             let ior = ctx.positive(ctx.need(&d.ior, "ior", &def.span(), &what)?, "ior")?;
@@ -445,7 +457,7 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
                 })
             } else {
                 Material::RoughDielectric(RoughDielectric {
-                    distribution: microfacet(ctx, d)?,
+                    distribution: microfacet(ctx, d, def.span())?,
                     ior,
                     specular_reflectance,
                     specular_transmittance,
@@ -461,7 +473,7 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
                 "twosided",
                 "reflectance_texture",
             ];
-            const ROUGH: [&str; 9] = [
+            const ROUGH: [&str; 13] = [
                 "reflectance",
                 "material",
                 "eta",
@@ -471,6 +483,10 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
                 "alpha",
                 "reflectance_texture",
                 "alpha_texture",
+                "alpha_u",
+                "alpha_v",
+                "alpha_u_texture",
+                "alpha_v_texture",
             ];
             ctx.only(&given, if kind == "conductor" { &SMOOTH } else { &ROUGH }, &what)?;
             let ior = complex_ior(ctx, d, def)?;
@@ -482,7 +498,7 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
                 })
             } else {
                 Material::RoughConductor(RoughConductor {
-                    distribution: microfacet(ctx, d)?,
+                    distribution: microfacet(ctx, d, def.span())?,
                     ior,
                     specular_reflectance,
                 })
@@ -582,7 +598,7 @@ fn plastic(
         Material::Plastic(Plastic::new(ior, diffuse, specular, nonlinear))
     } else {
         Material::RoughPlastic(RoughPlastic::new(
-            microfacet(ctx, d)?,
+            microfacet(ctx, d, d.kind.span())?,
             ior,
             diffuse,
             specular,
@@ -659,9 +675,13 @@ fn complex_ior(ctx: &Ctx, d: &MaterialDef, def: &S<MaterialDef>) -> Result<Compl
 }
 
 /// A rough conductor's microfacet distribution: `distribution` (beckmann, the default, or ggx)
-/// and `alpha` (default 0.1, at least 1e-4), isotropic, sampling visible normals (Mitsuba's
-/// defaults).
-fn microfacet(ctx: &Ctx, d: &MaterialDef) -> Result<Microfacet, SceneError> {
+/// and `alpha` (default 0.1, at least 1e-4) or `alpha_u` and `alpha_v`, sampling visible normals
+/// (Mitsuba's defaults).
+fn microfacet(
+    ctx: &Ctx,
+    d: &MaterialDef,
+    at: std::ops::Range<usize>,
+) -> Result<Microfacet, SceneError> {
     let kind = match &d.distribution {
         None => MicrofacetType::Beckmann,
         Some(s) => match s.get_ref().as_str() {
@@ -675,17 +695,44 @@ fn microfacet(ctx: &Ctx, d: &MaterialDef) -> Result<Microfacet, SceneError> {
             }
         },
     };
-    let alpha = match &d.alpha {
-        None => 0.1,
-        Some(a) => {
-            let x = ctx.num(a, "alpha")?;
-            if !(x >= MIN_ROUGHNESS) {
-                return Err(ctx.at(a.span(), format!("`alpha` must be at least {MIN_ROUGHNESS}, got {x} (use a conductor for a perfectly smooth surface)")));
-            }
-            x
+    let num = |a: &Option<S<f64>>, key: &str| -> Result<Option<f32>, SceneError> {
+        let Some(a) = a else { return Ok(None) };
+        let x = ctx.num(a, key)?;
+        if !(x >= MIN_ROUGHNESS) {
+            return Err(ctx.at(a.span(), format!("`{key}` must be at least {MIN_ROUGHNESS}, got {x} (use a conductor for a perfectly smooth surface)")));
         }
+        Ok(Some(x))
     };
-    Ok(Microfacet::isotropic(kind, alpha))
+    // An axis given by a texture counts as given (its value here is a placeholder).
+    let given = |a: &Option<S<f64>>, t: &Option<S<TextureDef>>| a.is_some() || t.is_some();
+    let (u_given, v_given) = (
+        given(&d.alpha_u, &d.alpha_u_texture),
+        given(&d.alpha_v, &d.alpha_v_texture),
+    );
+    let iso_given = given(&d.alpha, &d.alpha_texture);
+    if u_given != v_given || (u_given && iso_given) {
+        return Err(ctx.at(
+            at,
+            "give `alpha` (or `alpha_texture`), or both `alpha_u` and `alpha_v` (or their textures)",
+        ));
+    }
+    for (a, t, key) in [
+        (&d.alpha, &d.alpha_texture, "alpha"),
+        (&d.alpha_u, &d.alpha_u_texture, "alpha_u"),
+        (&d.alpha_v, &d.alpha_v_texture, "alpha_v"),
+    ] {
+        if let (Some(_), Some(t)) = (a, t) {
+            return Err(ctx.at(
+                t.span(),
+                format!("give `{key}` or `{key}_texture`, not both"),
+            ));
+        }
+    }
+    let alpha = num(&d.alpha, "alpha")?.unwrap_or(0.1);
+    let au = num(&d.alpha_u, "alpha_u")?.unwrap_or(alpha);
+    let av = num(&d.alpha_v, "alpha_v")?.unwrap_or(alpha);
+    // α_u runs along ∂p/∂u made orthogonal to the normal (`SurfaceHit::tangent`), as in Mitsuba.
+    Ok(Microfacet::new(kind, au, av, true))
 }
 
 /// Adds the shape; returns whether it emits.

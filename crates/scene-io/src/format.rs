@@ -112,6 +112,10 @@ pub struct MaterialDef {
     /// Rough conductors: "beckmann" (default) or "ggx", and α.
     pub distribution: Option<S<String>>,
     pub alpha: Option<S<f64>>,
+    /// Rough conductors and dielectrics: anisotropic α along ∂p/∂u and along ∂p/∂v (Mitsuba's
+    /// `alpha_u`, `alpha_v`; both or neither, in place of `alpha`).
+    pub alpha_u: Option<S<f64>>,
+    pub alpha_v: Option<S<f64>>,
     /// Rough and thin dielectrics: the colour factor of transmission (Mitsuba's
     /// `specular_transmittance`; `reflectance` is their `specular_reflectance`).
     pub transmittance: Option<S<ColorDef>>,
@@ -123,6 +127,8 @@ pub struct MaterialDef {
     pub albedo_texture: Option<S<TextureDef>>,
     pub reflectance_texture: Option<S<TextureDef>>,
     pub alpha_texture: Option<S<TextureDef>>,
+    pub alpha_u_texture: Option<S<TextureDef>>,
+    pub alpha_v_texture: Option<S<TextureDef>>,
     /// Mitsuba's `normalmap` around the material: a texture of tangent-space normals ((x+1)/2;
     /// give `raw = true` for 8-bit files), or `bumpmap`: a height texture times `bump_scale`
     /// (default 1). `flip_invalid_normals` and `bump_shadowing` (Mitsuba's

@@ -62,7 +62,13 @@ impl Microfacet {
         )
     }
 
+    /// α_u ≠ α_v: the lobe depends on the frame's tangent.
+    pub fn is_anisotropic(&self) -> bool {
+        self.alpha_u != self.alpha_v
+    }
+
     /// The larger roughness (what a test places its bins by).
+    #[inline]
     pub fn max_alpha(&self) -> f32 {
         self.alpha_u.max(self.alpha_v)
     }

@@ -70,14 +70,42 @@ pub struct ShadingFrame {
     /// Texture coordinates of the point, with the mesh attribute its material reads (textured
     /// materials read their parameters there).
     pub uv: TexPoint,
+    /// The direction the frame's x axis follows (zero: any, `Frame::from_z`); kept so a frame
+    /// rebuilt around another normal (a flipped normal map) stays oriented the same way.
+    pub tangent: Vec3,
 }
 
 impl ShadingFrame {
+    /// A frame around `ns` with an arbitrary tangent: all an isotropic material needs.
     pub fn new(ng: Vec3, ns: Vec3) -> ShadingFrame {
         ShadingFrame {
             ng,
             frame: Frame::from_z(ns),
             uv: TexPoint::default(),
+            tangent: Vec3::ZERO,
+        }
+    }
+
+    /// A frame around `ns` whose x axis is `tangent` made orthogonal to `ns` (Gram–Schmidt), as
+    /// anisotropic materials need (α_u along x, Mitsuba's `sh_frame.s`); a zero or degenerate
+    /// tangent gives `new`'s frame, bit for bit.
+    #[inline]
+    pub fn oriented(ng: Vec3, ns: Vec3, tangent: Vec3) -> ShadingFrame {
+        if tangent == Vec3::ZERO {
+            return ShadingFrame::new(ng, ns);
+        }
+        match (tangent - ns * ns.dot(tangent)).try_normalize() {
+            Some(x) => ShadingFrame {
+                ng,
+                frame: Frame {
+                    x,
+                    y: ns.cross(x),
+                    z: ns,
+                },
+                uv: TexPoint::default(),
+                tangent,
+            },
+            None => ShadingFrame::new(ng, ns),
         }
     }
 
@@ -221,6 +249,23 @@ impl Material {
                 .or_else(|| b.first.mesh_attribute())
                 .or_else(|| b.second.mesh_attribute()),
             _ => None,
+        }
+    }
+
+    /// True when the material is anisotropic (α_u ≠ α_v, or either textured): its shading frame
+    /// must then follow the surface's ∂p/∂u (`ShadingFrame::oriented`). Every other material
+    /// keeps the arbitrary tangent of `Frame::from_z`, and so its bits and speed.
+    pub fn needs_tangent(&self) -> bool {
+        match self {
+            Material::RoughConductor(r) => r.distribution.is_anisotropic(),
+            Material::RoughDielectric(r) => r.distribution.is_anisotropic(),
+            Material::RoughPlastic(r) => r.distribution.is_anisotropic(),
+            Material::TwoSided(t) => t.inner.needs_tangent(),
+            Material::Textured(t) => t.is_anisotropic() || t.base.needs_tangent(),
+            Material::Perturbed(p) => p.inner.needs_tangent(),
+            Material::Mask(m) => m.inner.needs_tangent(),
+            Material::Blend(b) => b.first.needs_tangent() || b.second.needs_tangent(),
+            _ => false,
         }
     }
 

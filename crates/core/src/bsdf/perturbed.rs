@@ -92,7 +92,10 @@ impl Perturbed {
         let (n0, n) = (sf.ng, sf.ns());
         if self.flip_invalid_normals && n0.dot(cam) * n.dot(cam) <= 0.0 {
             let mirrored = (n0 * (2.0 * n0.dot(n)) - n).normalize();
-            (ShadingFrame::new(sf.ng, mirrored).with_uv(sf.uv), true)
+            (
+                ShadingFrame::oriented(sf.ng, mirrored, sf.tangent).with_uv(sf.uv),
+                true,
+            )
         } else {
             (*sf, false)
         }

@@ -17,6 +17,20 @@ pub enum TextureSlot {
     SpecularReflectance,
     /// Microfacet roughness α (`alpha`), read from the texture's first channel.
     Alpha,
+    /// Roughness along the shading frame's x axis alone (`alpha_u`; x follows ∂p/∂u).
+    AlphaU,
+    /// Roughness along y alone (`alpha_v`).
+    AlphaV,
+}
+
+impl TextureSlot {
+    /// A roughness, not a reflectance (no upper bound of 1).
+    pub fn is_roughness(self) -> bool {
+        matches!(
+            self,
+            TextureSlot::Alpha | TextureSlot::AlphaU | TextureSlot::AlphaV
+        )
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -27,6 +41,13 @@ pub struct Textured {
 }
 
 impl Textured {
+    /// True when a texture drives one roughness axis alone: the frame must then follow ∂p/∂u.
+    pub fn is_anisotropic(&self) -> bool {
+        self.slots
+            .iter()
+            .any(|(s, _)| matches!(s, TextureSlot::AlphaU | TextureSlot::AlphaV))
+    }
+
     /// Calls `f` with the plain local BSDF at texture coordinates `uv`. The resolved material
     /// lives on the stack: a two-sided base is resolved as its inner material (no `Box` cloned
     /// per shading query) and seen from both sides through `FrontFacing`.
@@ -60,22 +81,30 @@ pub fn set_parameter(m: &mut Material, slot: TextureSlot, value: Color) -> bool 
         (Material::Glossy(g), Alpha) => g.roughness = value.x.max(super::microfacet::MIN_ALPHA),
         (Material::Conductor(c), SpecularReflectance) => c.specular_reflectance = value,
         (Material::RoughConductor(r), SpecularReflectance) => r.specular_reflectance = value,
-        (Material::RoughConductor(r), Alpha) => {
-            let d = r.distribution;
-            r.distribution = Microfacet::new(d.kind, value.x, value.x, d.sample_visible);
+        (Material::RoughConductor(r), Alpha | AlphaU | AlphaV) => {
+            r.distribution = with_alpha(r.distribution, slot, value.x)
         }
         (Material::Plastic(p), Reflectance) => p.diffuse_reflectance = value,
         (Material::Plastic(p), SpecularReflectance) => p.specular_reflectance = value,
         (Material::RoughPlastic(p), Reflectance) => p.diffuse_reflectance = value,
         (Material::RoughPlastic(p), SpecularReflectance) => p.specular_reflectance = value,
         (Material::RoughDielectric(r), SpecularReflectance) => r.specular_reflectance = value,
-        (Material::RoughDielectric(r), Alpha) => {
-            let d = r.distribution;
-            r.distribution = Microfacet::new(d.kind, value.x, value.x, d.sample_visible);
+        (Material::RoughDielectric(r), Alpha | AlphaU | AlphaV) => {
+            r.distribution = with_alpha(r.distribution, slot, value.x)
         }
         (Material::ThinDielectric(t), SpecularReflectance) => t.specular_reflectance = value,
         (Material::TwoSided(t), slot) => return set_parameter(&mut t.inner, slot, value),
         _ => return false,
     }
     true
+}
+
+/// `d` with the roughness of `slot` (both axes, x or y) set to `a`.
+fn with_alpha(d: Microfacet, slot: TextureSlot, a: f32) -> Microfacet {
+    let (au, av) = match slot {
+        TextureSlot::AlphaU => (a, d.alpha_v),
+        TextureSlot::AlphaV => (d.alpha_u, a),
+        _ => (a, a),
+    };
+    Microfacet::new(d.kind, au, av, d.sample_visible)
 }

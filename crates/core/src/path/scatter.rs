@@ -67,7 +67,7 @@ pub fn scatter(
         return Scatter::default();
     };
     let m = scene.material(material);
-    let sf = crate::bsdf::ShadingFrame::new(v.ng, v.ns).with_uv(v.uv);
+    let sf = v.shading_frame();
     let cos_g = v.ng.dot(wi).abs();
     if cos_g == 0.0 {
         return Scatter::default();

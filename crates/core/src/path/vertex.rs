@@ -61,6 +61,9 @@ pub struct PathVertex {
     pub emitter: Option<u32>,
     /// Texture point of a surface vertex (zero elsewhere).
     pub uv: crate::texture::TexPoint,
+    /// The hit's `SurfaceHit::tangent` (zero unless the material is anisotropic), so frames
+    /// rebuilt at this vertex agree with the one the walk sampled with.
+    pub tangent: Vec3,
 }
 
 impl PathVertex {
@@ -78,6 +81,7 @@ impl PathVertex {
             wo: Vec3::ZERO,
             emitter: None,
             uv: Default::default(),
+            tangent: Vec3::ZERO,
         }
     }
 
@@ -121,9 +125,16 @@ impl PathVertex {
             wo,
             emitter: hit.light,
             uv: hit.uv,
+            tangent: hit.tangent,
         };
         v.pdf_fwd = prev.convert_density(pdf, &v);
         v
+    }
+
+    /// The BSDF's frame at a surface vertex: the same as `SurfaceHit::shading_frame` of its hit.
+    #[inline]
+    pub fn shading_frame(&self) -> crate::bsdf::ShadingFrame {
+        crate::bsdf::ShadingFrame::oriented(self.ng, self.ns, self.tangent).with_uv(self.uv)
     }
 
     /// The same surface as a light endpoint x0 (a camera walk hit an emitter: technique s = 0).

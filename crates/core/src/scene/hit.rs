@@ -22,6 +22,11 @@ pub struct SurfaceHit {
     /// Texture coordinates (Mitsuba's parameterisation of each shape), with the mesh attribute
     /// the material reads.
     pub uv: TexPoint,
+    /// Where the shading frame's x axis points: ∂p/∂u made orthogonal to the unperturbed shading
+    /// normal (Mitsuba's `sh_frame.s`), for anisotropic materials only (`needs_tangent`); zero
+    /// for every other material, whose frame keeps `Frame::from_z`'s arbitrary tangent. Born
+    /// here, carried by `PathVertex::tangent`: every frame is rebuilt from (ng, ns, tangent).
+    pub tangent: Vec3,
     pub shape: u32,
     pub material: u32,
     /// Index into `Scene::lights` when the surface emits.
@@ -93,10 +98,24 @@ impl SurfaceHit {
         if ns.dot(ng) < 0.0 {
             ns = -ns;
         }
-        // A normal or bump map replaces the shading normal (only such materials need tangents).
-        if let Some(perturbed) = scene.material(shape.material).perturbation() {
+        // A normal or bump map replaces the shading normal, and an anisotropic material orients
+        // its frame along ∂p/∂u (only such materials need tangents). Under a normal map the
+        // frame's x axis is the unperturbed one made orthogonal to the new normal
+        // (`ShadingFrame::oriented`), as Mitsuba 3's `normalmap` rotates its frame (PR #905).
+        let material = scene.material(shape.material);
+        let perturbation = material.perturbation();
+        let mut tangent = Vec3::ZERO;
+        let oriented = material.needs_tangent();
+        if perturbation.is_some() || oriented {
             let (dpdu, dpdv) = tangents(&shape.geometry, &prim, tri as usize, p, ng);
-            ns = perturbed.normal(ng, ns, dpdu, dpdv, uv);
+            if oriented {
+                tangent = (dpdu - ns * ns.dot(dpdu))
+                    .try_normalize()
+                    .unwrap_or_else(|| crate::math::Frame::from_z(ns).x);
+            }
+            if let Some(perturbed) = perturbation {
+                ns = perturbed.normal(ng, ns, dpdu, dpdv, uv);
+            }
         }
         SurfaceHit {
             p,
@@ -105,6 +124,7 @@ impl SurfaceHit {
             ns,
             t: h.t,
             uv,
+            tangent,
             shape: prim.shape(),
             material: shape.material,
             light: shape.light,
@@ -113,7 +133,7 @@ impl SurfaceHit {
 
     #[inline]
     pub fn shading_frame(&self) -> ShadingFrame {
-        ShadingFrame::new(self.ng, self.ns).with_uv(self.uv)
+        ShadingFrame::oriented(self.ng, self.ns, self.tangent).with_uv(self.uv)
     }
 
     /// A ray leaving the surface in direction `dir`, started safely off the surface.

@@ -684,7 +684,10 @@ impl<'a> Loader<'a> {
                     Material::RoughConductor(r)
                         if ideal
                             && r.distribution.kind == MicrofacetType::Ggx
-                            && r.distribution.alpha_u == r.distribution.alpha_v
+                            && !r.distribution.is_anisotropic()
+                            && !slots.iter().any(|(s, _)| {
+                                matches!(s, TextureSlot::AlphaU | TextureSlot::AlphaV)
+                            })
                             && r.distribution.sample_visible =>
                     {
                         Material::Glossy(Glossy {
@@ -810,7 +813,7 @@ impl<'a> Loader<'a> {
     ) -> Result<Option<Color>, SceneError> {
         if let Some(t) = p.texture(name) {
             let texture = self.texture(t)?;
-            if slot != TextureSlot::Alpha && texture.max_value() > 1.0 {
+            if !slot.is_roughness() && texture.max_value() > 1.0 {
                 return Err(p.err(
                     t,
                     format!(
@@ -822,7 +825,7 @@ impl<'a> Loader<'a> {
             slots.push((slot, texture));
             return Ok(None);
         }
-        let usage = if slot == TextureSlot::Alpha {
+        let usage = if slot.is_roughness() {
             ColorUse::Emission
         } else {
             ColorUse::Reflectance
@@ -895,11 +898,29 @@ impl<'a> Loader<'a> {
                 p.finish(&[], &mut self.report)?;
                 Texture::MeshAttribute { name: name.into() }
             }
+            "rawconstant" => {
+                // Mitsuba's `rawconstant`: `value`, a float or a 3-vector used as is (no colour
+                // conversion: normal maps store directions in it).
+                let is_float = e.children.iter().any(|c| {
+                    c.attr("name") == Some("value") && matches!(c.tag.as_str(), "float" | "integer")
+                });
+                let value = if is_float {
+                    p.float("value")?.map(|x| Color::splat(x as f32))
+                } else {
+                    p.vec3("value")?
+                        .map(|v| Color::new(v[0] as f32, v[1] as f32, v[2] as f32))
+                };
+                let Some(value) = value else {
+                    return Err(p.err(e, "a rawconstant texture needs a `value`"));
+                };
+                p.finish(&[], &mut self.report)?;
+                Texture::Constant(value)
+            }
             other => {
                 return Err(p.err(
                     e,
                     format!(
-                        "texture `{other}` is not supported (lt reads bitmap, checkerboard and mesh_attribute)"
+                        "texture `{other}` is not supported (lt reads bitmap, checkerboard, mesh_attribute and rawconstant)"
                     ),
                 ))
             }
@@ -961,10 +982,16 @@ impl<'a> Loader<'a> {
             Material::Plastic(m)
         } else {
             let distribution = self.microfacet(p, slots)?;
-            if slots.iter().any(|(s, _)| *s == TextureSlot::Alpha) {
+            if slots.iter().any(|(s, _)| s.is_roughness()) {
                 return Err(p.err(
                     e,
                     "roughplastic's `alpha` must be a number (Mitsuba takes no texture there)",
+                ));
+            }
+            if distribution.is_anisotropic() {
+                return Err(p.err(
+                    e,
+                    "roughplastic is isotropic in Mitsuba: give `alpha`, not `alpha_u` ≠ `alpha_v`",
                 ));
             }
             let mut m = RoughPlastic::new(distribution, eta, diffuse, specular, nonlinear);
@@ -1039,33 +1066,37 @@ impl<'a> Loader<'a> {
                 ))
             }
         };
-        // A texture of α: the distribution keeps the default 0.1 until a point sets it.
-        let alpha = match p.texture("alpha") {
-            Some(t) => {
-                let texture = self.texture(t)?;
-                slots.push((TextureSlot::Alpha, texture));
-                None
+        // A texture of α (or of α_u, α_v): the distribution keeps the default 0.1 there until a
+        // point sets it (`TextureSlot::Alpha`, `AlphaU`, `AlphaV`).
+        let mut roughness = |name: &str, slot| -> Result<Option<Option<f64>>, SceneError> {
+            match p.texture(name) {
+                Some(t) => {
+                    let texture = self.texture(t)?;
+                    slots.push((slot, texture));
+                    Ok(Some(None))
+                }
+                None => Ok(p.float(name)?.map(Some)),
             }
-            None => p.float("alpha")?,
         };
-        let (au, av) = (p.float("alpha_u")?, p.float("alpha_v")?);
-        let a = match (alpha, au, av) {
-            (Some(a), None, None) => a,
-            (None, None, None) => 0.1,
-            (None, Some(u), Some(v)) if u == v => u,
-            (None, Some(_), Some(_)) => {
-                return Err(p.err(
-                    e,
-                    "an anisotropic roughness (alpha_u ≠ alpha_v) is not supported yet: it needs the surface's texture-space tangents, which lt's shapes do not carry",
-                ))
-            }
+        let alpha = roughness("alpha", TextureSlot::Alpha)?;
+        let au = roughness("alpha_u", TextureSlot::AlphaU)?;
+        let av = roughness("alpha_v", TextureSlot::AlphaV)?;
+        // α_u runs along the shading frame's x axis, ∂p/∂u made orthogonal to the normal
+        // (`SurfaceHit::tangent`), as in Mitsuba.
+        let (u, v) = match (alpha, au, av) {
+            (Some(a), None, None) => (a, a),
+            (None, None, None) => (Some(0.1), Some(0.1)),
+            (None, Some(u), Some(v)) => (u, v),
             _ => return Err(p.err(e, "give `alpha`, or both `alpha_u` and `alpha_v`")),
         };
-        if !(a >= MIN_ROUGHNESS) || !(a.is_finite()) {
-            return Err(p.err(e, format!("`alpha` must be at least {MIN_ROUGHNESS}, got {a} (use a conductor for a mirror)")));
+        for a in [u, v].into_iter().flatten() {
+            if !(a >= MIN_ROUGHNESS) || !(a.is_finite()) {
+                return Err(p.err(e, format!("`alpha` must be at least {MIN_ROUGHNESS}, got {a} (use a conductor for a mirror)")));
+            }
         }
         let sample_visible = p.boolean("sample_visible")?.unwrap_or(true);
-        Ok(Microfacet::new(kind, a as f32, a as f32, sample_visible))
+        let (u, v) = (u.unwrap_or(0.1) as f32, v.unwrap_or(0.1) as f32);
+        Ok(Microfacet::new(kind, u, v, sample_visible))
     }
 
     /// A conductor's complex IOR: Mitsuba's `material` name (default "none", a perfect mirror), or

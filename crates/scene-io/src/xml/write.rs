@@ -10,7 +10,7 @@
 //! directional light or an environment map would change the image, so nothing is approximated).
 
 use crate::error::Ctx;
-use crate::format::{ColorDef, SceneFile, ShapeDef};
+use crate::format::{ColorDef, MaterialDef, SceneFile, ShapeDef, S};
 use crate::transform::shape_matrix;
 use crate::SceneError;
 use lt_core::bsdf::plastic::{AIR_IOR, POLYPROPYLENE_IOR};
@@ -187,8 +187,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                 }
                 if kind == "roughconductor" {
                     let dist = d.distribution.as_ref().map_or("beckmann", |s| s.get_ref().as_str());
-                    let alpha = d.alpha.as_ref().map_or(0.1, |a| *a.get_ref() as f32);
-                    let _ = write!(inner, "\n            <string name=\"distribution\" value=\"{}\"/>\n            <float name=\"alpha\" value=\"{alpha}\"/>", esc(dist));
+                    let _ = write!(inner, "\n            <string name=\"distribution\" value=\"{}\"/>{}", esc(dist), roughness_xml(d, "\n            "));
                 }
                 let _ = write!(inner, "\n            <rgb name=\"specular_reflectance\" value=\"{}\"/>", rgb(&d.reflectance, 1.0));
                 if d.twosided.as_ref().is_some_and(|t| *t.get_ref()) {
@@ -223,8 +222,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                 );
                 if kind == "roughdielectric" {
                     let dist = d.distribution.as_ref().map_or("beckmann", |s| s.get_ref().as_str());
-                    let alpha = d.alpha.as_ref().map_or(0.1, |a| *a.get_ref() as f32);
-                    let _ = write!(inner, "\n        <string name=\"distribution\" value=\"{}\"/>\n        <float name=\"alpha\" value=\"{alpha}\"/>", esc(dist));
+                    let _ = write!(inner, "\n        <string name=\"distribution\" value=\"{}\"/>{}", esc(dist), roughness_xml(d, "\n        "));
                 }
                 let _ = write!(
                     inner,
@@ -254,6 +252,8 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
             (&d.albedo_texture, albedo),
             (&d.reflectance_texture, "specular_reflectance"),
             (&d.alpha_texture, "alpha"),
+            (&d.alpha_u_texture, "alpha_u"),
+            (&d.alpha_v_texture, "alpha_v"),
         ] {
             if let Some(t) = t {
                 textures.push_str(&texture_xml(&ctx, t.get_ref(), name, out_dir));
@@ -274,6 +274,8 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                     ),
                     (&d.reflectance_texture, "name=\"specular_reflectance\""),
                     (&d.alpha_texture, "name=\"alpha\""),
+                    (&d.alpha_u_texture, "name=\"alpha_u\""),
+                    (&d.alpha_v_texture, "name=\"alpha_v\""),
                 ]
                 .iter()
                 .any(|(t, key)| t.is_some() && line.contains(key) && !line.contains("<texture"))
@@ -707,4 +709,25 @@ fn rfilter_xml(shape: FilterShape) -> String {
         return "<rfilter type=\"box\"/>".into();
     }
     format!("<rfilter type=\"{kind}\">{params}\n            </rfilter>")
+}
+
+/// A microfacet material's roughness lines: `alpha`, or `alpha_u` and `alpha_v` when either is
+/// given (as a number or a texture; a textured one's placeholder line is dropped later).
+fn roughness_xml(d: &MaterialDef, indent: &str) -> String {
+    let value =
+        |a: &Option<S<f64>>, default: f32| a.as_ref().map_or(default, |a| *a.get_ref() as f32);
+    let alpha = value(&d.alpha, 0.1);
+    let anisotropic = d.alpha_u.is_some()
+        || d.alpha_v.is_some()
+        || d.alpha_u_texture.is_some()
+        || d.alpha_v_texture.is_some();
+    if anisotropic {
+        format!(
+            "{indent}<float name=\"alpha_u\" value=\"{}\"/>{indent}<float name=\"alpha_v\" value=\"{}\"/>",
+            value(&d.alpha_u, alpha),
+            value(&d.alpha_v, alpha)
+        )
+    } else {
+        format!("{indent}<float name=\"alpha\" value=\"{alpha}\"/>")
+    }
 }
