@@ -215,3 +215,42 @@ fn an_interrupted_run_resumes_without_redoing_finished_renders() {
     assert_eq!(third.counts().0, 0, "a finished run redoes nothing");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The committed report's claims hold against its own numbers: in
+/// `results/radius-shrinkage/rates.csv` every row whose `inside` says "yes" or "no" has the rate it
+/// compares with (K&Z's at these N where given, else the asymptotic one) inside, or outside, its
+/// own interval as claimed. Reads the committed CSV only, so it is fast.
+#[test]
+fn committed_radius_shrinkage_claims_hold_within_their_intervals() {
+    let path = lt_tests::scenes_dir()
+        .parent()
+        .unwrap()
+        .join("results/radius-shrinkage/rates.csv");
+    let rows = csv(&path);
+    let mut checked = 0;
+    for r in &rows {
+        let claim = r["inside"].as_str();
+        if claim != "yes" && claim != "no" {
+            continue;
+        }
+        // r² rows state a schedule match, not an interval: nothing to recompute here.
+        if !r["CI"].starts_with('[') {
+            continue;
+        }
+        let (lo, hi) = interval(&r["CI"]);
+        let at_n = r["predicted at these N"].parse::<f64>();
+        let predicted = at_n.unwrap_or_else(|_| r["predicted"].parse().unwrap());
+        let inside = lo <= predicted && predicted <= hi;
+        assert_eq!(
+            inside,
+            claim == "yes",
+            "{}: {} α = {} {}: claims inside = {claim}, but {predicted} vs [{lo}, {hi}]",
+            path.display(),
+            r["integrator"],
+            r["α"],
+            r["quantity"]
+        );
+        checked += 1;
+    }
+    assert!(checked > 0, "{}: no claims found", path.display());
+}
