@@ -230,6 +230,13 @@ impl Texture {
         }
     }
 
+    /// The value at `at` as a fraction: its luminance clamped to [0, 1] (how Mitsuba reads a
+    /// mask's opacity and a blend's weight).
+    #[inline]
+    pub fn fraction(&self, at: TexPoint) -> f32 {
+        luminance(self.eval(at)).clamp(0.0, 1.0)
+    }
+
     /// The mesh attribute the texture reads, if it is one.
     pub fn mesh_attribute(&self) -> Option<&str> {
         match self {

@@ -12,7 +12,7 @@
 //! part mapped back onto the component's own `u_lobe` range where it picks the same lobe.
 
 use super::{BsdfEval, BsdfSample, Material, ShadingFrame, TransportMode};
-use crate::math::{luminance, Vec2, Vec3};
+use crate::math::{Vec2, Vec3};
 use crate::texture::{TexPoint, Texture};
 
 #[derive(Clone, Debug)]
@@ -26,7 +26,7 @@ pub struct Blend {
 impl Blend {
     #[inline]
     fn weight_at(&self, at: TexPoint) -> f32 {
-        luminance(self.weight.eval(at)).clamp(0.0, 1.0)
+        self.weight.fraction(at)
     }
 
     pub fn sample(

@@ -16,7 +16,7 @@
 //! (photon mapping's camera paths) sees every delta part.
 
 use super::{BsdfEval, BsdfSample, Material, ShadingFrame, TransportMode};
-use crate::math::{luminance, Vec2, Vec3};
+use crate::math::{Vec2, Vec3};
 use crate::texture::TexPoint;
 use crate::texture::Texture;
 
@@ -32,7 +32,7 @@ impl Mask {
     /// α at texture coordinates `uv`.
     #[inline]
     pub fn opacity_at(&self, uv: TexPoint) -> f32 {
-        luminance(self.opacity.eval(uv)).clamp(0.0, 1.0)
+        self.opacity.fraction(uv)
     }
 
     pub fn sample(
