@@ -15,7 +15,7 @@ pub enum TextureSlot {
     Reflectance,
     /// The colour factor of mirrors, conductors and plastics' coatings (`specular_reflectance`).
     SpecularReflectance,
-    /// Microfacet roughness α (`alpha`), read from the texture's first channel.
+    /// Microfacet roughness α (`alpha`), read as a scalar (`Texture::eval_scalar`).
     Alpha,
     /// Roughness along the shading frame's x axis alone (`alpha_u`; x follows ∂p/∂u).
     AlphaU,
@@ -65,7 +65,13 @@ impl Textured {
     /// `m` with every textured parameter set from its texture at `uv`.
     fn resolved(&self, mut m: Material, uv: TexPoint) -> Material {
         for (slot, texture) in &self.slots {
-            set_parameter(&mut m, *slot, texture.eval(uv));
+            // A roughness is a scalar parameter: Mitsuba reads it with `eval_1`.
+            let value = if slot.is_roughness() {
+                Color::splat(texture.eval_scalar(uv))
+            } else {
+                texture.eval(uv)
+            };
+            set_parameter(&mut m, *slot, value);
         }
         m
     }
