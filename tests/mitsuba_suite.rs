@@ -85,6 +85,7 @@ fn mitsuba_render_suite_keeps_passing() {
         time_per_estimator: Duration::from_secs(1),
         threads: 0,
         seed: 0,
+        diagnostics: None,
     };
     let rows = run_suite(&dir, &token).unwrap();
     let md = table::markdown(&rows, &token, "cargo test --test mitsuba_suite");
@@ -111,6 +112,7 @@ fn mitsuba_render_suite_keeps_passing() {
         time_per_estimator: Duration::from_secs(6),
         threads: 0,
         seed: 0,
+        diagnostics: None,
     };
     let mut pinned: Vec<String> = EXPECTED_PASSING
         .iter()

@@ -34,6 +34,11 @@ pub struct SuiteArgs {
     /// full run, nowhere for a partial one.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// A folder to write, per judged render, its mean (`<scene>_<estimator>_mean.exr`) and its
+    /// signed z map (`…_z.exr`: (mean − reference) / σ per value, σ as the rule forms it), to see
+    /// where a failing image fails.
+    #[arg(long)]
+    pub diagnostics: Option<PathBuf>,
 }
 
 /// The command: runs the suite, prints the table and writes it to `args.out` atomically.
@@ -53,7 +58,12 @@ pub fn run(args: &SuiteArgs) -> Result<(), String> {
         time_per_estimator: Duration::from_secs_f64(args.time_per_scene / 2.0),
         threads: args.threads,
         seed: 0,
+        diagnostics: args.diagnostics.clone(),
     };
+    if let Some(dir) = &args.diagnostics {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
     let rows = run_suite_only(&args.dir, &budget, &args.only)?;
     if rows.is_empty() {
         return Err(format!(

@@ -60,18 +60,16 @@ pub fn judge(
     }
     let pixels = mean.data.len();
     let z_threshold = sidak_threshold(FAMILY_ALPHA, pixels);
+    let signed = signed_z(mean, se, spp, reference, reference_var);
     let (mut passed, mut max_z, mut ours, mut theirs) = (0usize, 0.0f64, 0.0, 0.0);
     for i in 0..pixels {
         for c in 0..3 {
-            let (m, r) = (mean.data[i][c], reference.data[i][c]);
-            let ours_var = (se.data[i][c].powi(2)).max(VARIANCE_FLOOR / spp);
-            let ref_var = reference_var.data[i][c].max(VARIANCE_FLOOR) / REFERENCE_SPP;
-            let z = (m - r).abs() / (ours_var + ref_var).sqrt();
+            let z = signed.data[i][c].abs();
             let z = if z.is_nan() { f64::INFINITY } else { z };
             passed += (z < z_threshold) as usize;
             max_z = max_z.max(z);
-            ours += m;
-            theirs += r;
+            ours += mean.data[i][c];
+            theirs += reference.data[i][c];
         }
     }
     Ok(Judgement {
@@ -80,6 +78,26 @@ pub fn judge(
         max_z,
         mean_ratio: ours / theirs,
     })
+}
+
+/// Per pixel value, (mean − ref) / σ with σ as the rule forms it (the sizes already checked): the
+/// map `--diagnostics` writes, where a bias shows as a region of one sign and noise as speckle.
+pub fn signed_z(
+    mean: &Image,
+    se: &Image,
+    spp: f64,
+    reference: &Image,
+    reference_var: &Image,
+) -> Image {
+    let mut z = Image::new(mean.width, mean.height);
+    for (i, out) in z.data.iter_mut().enumerate() {
+        for (c, z_c) in out.iter_mut().enumerate() {
+            let ours_var = (se.data[i][c].powi(2)).max(VARIANCE_FLOOR / spp);
+            let ref_var = reference_var.data[i][c].max(VARIANCE_FLOOR) / REFERENCE_SPP;
+            *z_c = (mean.data[i][c] - reference.data[i][c]) / (ours_var + ref_var).sqrt();
+        }
+    }
+    z
 }
 
 #[cfg(test)]

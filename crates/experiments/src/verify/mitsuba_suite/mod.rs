@@ -7,7 +7,7 @@ pub mod cases;
 pub mod judge;
 pub mod table;
 
-use crate::image_io::read_exr;
+use crate::image_io::{read_exr, write_exr};
 use cases::Case;
 use judge::Judgement;
 use lt_core::Scene;
@@ -17,7 +17,7 @@ use lt_integrators::render::{render, RenderOptions};
 use lt_integrators::{make_integrator, IntegratorParams};
 use lt_scene_io::{load_scene_with, LoadOptions};
 use std::ops::ControlFlow;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// The scoreboard's home, written by a full run.
@@ -31,6 +31,8 @@ pub struct Budget {
     pub time_per_estimator: Duration,
     pub threads: usize,
     pub seed: u64,
+    /// Where each judged render's mean and signed z map are written as EXR (`--diagnostics`).
+    pub diagnostics: Option<PathBuf>,
 }
 
 /// One estimator's result on one scene.
@@ -113,13 +115,14 @@ fn render_and_judge(scene: &Scene, estimator: &str, case: &Case, budget: &Budget
         let reference = read_exr(&case.reference)?;
         let reference_var = read_exr(&case.reference_var)?;
         let (batches, spp) = render_batches(scene, estimator, budget)?;
-        let judgement = judge::judge(
-            &batches.mean(),
-            &batches.std_error(),
-            spp as f64,
-            &reference,
-            &reference_var,
-        )?;
+        let (mean, se) = (batches.mean(), batches.std_error());
+        let judgement = judge::judge(&mean, &se, spp as f64, &reference, &reference_var)?;
+        if let Some(dir) = &budget.diagnostics {
+            let z = judge::signed_z(&mean, &se, spp as f64, &reference, &reference_var);
+            let stem = format!("{}_{estimator}", case.name.replace('/', "_"));
+            write_exr(&dir.join(format!("{stem}_mean.exr")), &mean)?;
+            write_exr(&dir.join(format!("{stem}_z.exr")), &z)?;
+        }
         Ok(Outcome::Judged { judgement, spp })
     };
     judged().unwrap_or_else(Outcome::Error)

@@ -1,0 +1,25 @@
+//! The workspace's checks that can share one process, one module per file (see Cargo.toml for
+//! why they are one binary and which stay apart). Run one file's checks with, for example,
+//! `cargo test --release --test checks agreement::`.
+
+mod agreement;
+mod consistency;
+mod directional;
+mod furnace;
+mod light_paths;
+mod mis_check;
+mod mis_check_vcm;
+mod partial_merge;
+mod photon_estimates;
+mod pt_agreement;
+mod robustness;
+mod runs;
+mod studies;
+mod translation;
+mod vcm_consistency;
+mod vcm_is_bdpt;
+mod vcm_leak;
+mod xml_cornell;
+mod xml_errors;
+mod xml_file_rules;
+mod xml_roundtrip;
