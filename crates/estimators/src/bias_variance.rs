@@ -186,20 +186,20 @@ impl ImageBiasVariance {
         let mut mse_run = vec![0.0; k];
         let mut xs = vec![0.0; k];
         for (p, r) in reference.data.iter().enumerate() {
-            for c in 0..3 {
+            for (c, &r_c) in r.iter().enumerate() {
                 xs.iter_mut()
                     .zip(runs)
                     .for_each(|(x, run)| *x = run.data[p][c]);
                 let s = RunningStat::from_slice(&xs);
                 let (m, m2) = (s.mean(), s.sample_variance() * (kf - 1.0));
-                b2 += (m - r[c]).powi(2) - m2 / ((kf - 1.0) * kf);
+                b2 += (m - r_c).powi(2) - m2 / ((kf - 1.0) * kf);
                 var += m2 / (kf - 1.0);
                 for (j, &x) in xs.iter().enumerate() {
-                    mse_run[j] += (x - r[c]).powi(2);
+                    mse_run[j] += (x - r_c).powi(2);
                     // Removing one point: mean' = (K m − x)/(K−1), M2' = M2 − (x − m)² K/(K−1).
                     let m_j = (kf * m - x) / (kf - 1.0);
                     let m2_j = (m2 - (x - m).powi(2) * kf / (kf - 1.0)).max(0.0);
-                    b2_loo[j] += (m_j - r[c]).powi(2) - m2_j / ((kf - 2.0) * (kf - 1.0));
+                    b2_loo[j] += (m_j - r_c).powi(2) - m2_j / ((kf - 2.0) * (kf - 1.0));
                     var_loo[j] += m2_j / (kf - 2.0);
                 }
             }

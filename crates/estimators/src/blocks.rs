@@ -16,8 +16,8 @@ pub fn block_means(img: &Image, block: usize) -> Image {
         for x in 0..img.width {
             let i = (y / block) * bx + x / block;
             let p = img.get(x, y);
-            for c in 0..3 {
-                out.data[i][c] += p[c];
+            for (o, v) in out.data[i].iter_mut().zip(p) {
+                *o += v;
             }
             n[i] += 1;
         }

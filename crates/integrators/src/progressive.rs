@@ -241,13 +241,13 @@ impl ProgressiveState {
         let n = self.passes.max(1) as f64;
         let ne = self.photon_paths.max(1) as f64;
         for (out, px) in img.data.iter_mut().zip(&self.pixels) {
-            for c in 0..3 {
+            for (c, out_c) in out.iter_mut().enumerate() {
                 let photons = match params.update {
                     Update::Global => px.photons[c] / n,
                     Update::Local if px.r2 > 0.0 => px.tau[c] / (ne * PI as f64 * px.r2),
                     Update::Local => 0.0,
                 };
-                out[c] = px.direct[c] / n + photons;
+                *out_c = px.direct[c] / n + photons;
             }
         }
         img

@@ -154,7 +154,7 @@ fn render_in(
             elapsed,
             state,
         };
-        on_pass(&report).is_continue() && !opts.time_limit.is_some_and(|t| elapsed >= t)
+        on_pass(&report).is_continue() && opts.time_limit.is_none_or(|t| elapsed < t)
     };
     match estimator {
         EstimatorRef::Unbiased(integrator) => {

@@ -58,18 +58,22 @@ impl RoughInterface {
 
     /// The interface of microfacets `kind`, `alpha` and relative IOR `eta` (η_inside/η_outside),
     /// computed once per distinct triple and kept for the process (a table costs up to ~1M
-    /// visible-normal samples).
-    pub fn get(kind: MicrofacetType, alpha: f32, eta: f32) -> RoughInterface {
+    /// visible-normal samples). Materials hold a shared reference: the 260-byte table inline made
+    /// `Material` six times larger than its next-largest variant.
+    pub fn get(kind: MicrofacetType, alpha: f32, eta: f32) -> &'static RoughInterface {
         type Key = (bool, u32, u32);
-        static CACHE: OnceLock<Mutex<HashMap<Key, RoughInterface>>> = OnceLock::new();
+        static CACHE: OnceLock<Mutex<HashMap<Key, &'static RoughInterface>>> = OnceLock::new();
         let key = (kind == MicrofacetType::Ggx, alpha.to_bits(), eta.to_bits());
         let cache = CACHE.get_or_init(Default::default);
         if let Some(t) = cache.lock().unwrap().get(&key) {
-            return *t;
+            return t;
         }
-        let t = RoughInterface::compute(kind, alpha, eta);
-        cache.lock().unwrap().insert(key, t);
-        t
+        // Leaked on purpose: one table per distinct triple, alive as long as the cache is.
+        let t: &'static RoughInterface =
+            Box::leak(Box::new(RoughInterface::compute(kind, alpha, eta)));
+        let mut map = cache.lock().unwrap();
+        map.entry(key).or_insert(t);
+        map[&key]
     }
 
     fn compute(kind: MicrofacetType, alpha: f32, eta: f32) -> RoughInterface {
@@ -178,7 +182,7 @@ pub struct RoughPlastic {
     pub nonlinear: bool,
     /// As `Plastic::specular_sampling_weight`.
     pub specular_sampling_weight: f32,
-    pub interface: RoughInterface,
+    pub interface: &'static RoughInterface,
 }
 
 impl RoughPlastic {
