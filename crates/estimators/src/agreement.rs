@@ -99,12 +99,25 @@ pub fn agreement_with_reference(
 /// difference is a Welch t statistic (Welch–Satterthwaite dof) and is mapped to the normal z with
 /// the same tail probability, so the stated false-alarm rate holds for any pass count ≥ 2.
 pub fn agreement_t(a: &RunningBlocks, b: &RunningBlocks, false_alarm_rate: f64) -> Agreement {
-    let (ea, eb) = (a.estimate(), b.estimate());
+    let eb = b.estimate();
+    agreement_t_with_estimate(a, &eb, b.count() as f64 - 1.0, false_alarm_rate)
+}
+
+/// [`agreement_t`] against an estimate known only by its block means and standard errors (a
+/// peer's render, from its per-pixel mean and standard-error images), whose variances have
+/// `b_dof` degrees of freedom (seeds − 1 for errors taken across seeds: the conservative choice).
+pub fn agreement_t_with_estimate(
+    a: &RunningBlocks,
+    eb: &BlockEstimate,
+    b_dof: f64,
+    false_alarm_rate: f64,
+) -> Agreement {
+    let ea = a.estimate();
     assert!(
         (ea.blocks_x, ea.blocks_y) == (eb.blocks_x, eb.blocks_y),
         "agreement_t: block grids differ"
     );
-    let (da, db) = (a.count() as f64 - 1.0, b.count() as f64 - 1.0);
+    let (da, db) = (a.count() as f64 - 1.0, b_dof);
     let z = (0..ea.regions())
         .map(|i| {
             [0, 1, 2].map(|c| {

@@ -15,7 +15,7 @@
 //! | `radius` | f32 | — | initial radius in scene units |
 //! | `alpha` | f64 | 0.75 | radius reduction α: rᵢ = r₀ i^((α−1)/2) |
 
-use crate::connect_merge::{Run, VcmParams};
+use crate::connect_merge::{Run, Techniques, VcmParams};
 use crate::params::ParamReader;
 use crate::{Progressive, ProgressiveRun};
 use lt_core::Scene;
@@ -27,7 +27,7 @@ pub struct Bpm {
 impl Bpm {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<Bpm, String> {
         Ok(Bpm {
-            params: VcmParams::read(scene, r, "bpm", false, true)?,
+            params: VcmParams::read(scene, r, "bpm", Techniques::BPM)?,
         })
     }
 }

@@ -55,14 +55,41 @@ pub struct VcmParams {
 /// SmallVCM's radius reduction.
 pub const DEFAULT_ALPHA: f64 = 0.75;
 
+/// Which techniques a VCM-family estimator runs besides light tracing (t = 1) and the camera
+/// walk reaching a light (s = 0), which always run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Techniques {
+    /// Connections s ≥ 1, t ≥ 2 (bdpt's techniques).
+    pub connections: bool,
+    /// Merging at camera vertices (photon mapping's technique).
+    pub merging: bool,
+}
+
+impl Techniques {
+    /// `vcm`: connections and merging under one MIS.
+    pub const VCM: Techniques = Techniques {
+        connections: true,
+        merging: true,
+    };
+    /// `bpm`: merging without connections (Georgiev et al. 2012's bidirectional photon mapping).
+    pub const BPM: Techniques = Techniques {
+        connections: false,
+        merging: true,
+    };
+    /// `vcm merging=false`: bdpt's techniques under VCM's bookkeeping.
+    pub const CONNECTIONS: Techniques = Techniques {
+        connections: true,
+        merging: false,
+    };
+}
+
 impl VcmParams {
     /// Reads the keys common to `vcm` and `bpm`.
     pub fn read(
         scene: &Scene,
         r: &ParamReader,
         who: &str,
-        connections: bool,
-        merging: bool,
+        techniques: Techniques,
     ) -> Result<VcmParams, String> {
         if scene.camera.is_delta_direction() {
             // Its MIS records count light tracing as a technique; with a camera that no
@@ -85,8 +112,8 @@ impl VcmParams {
             light_paths: r.light_paths()?,
             radius: InitialRadius::read(r, who)?,
             alpha,
-            connections,
-            merging,
+            connections: techniques.connections,
+            merging: techniques.merging,
         })
     }
 

@@ -18,7 +18,7 @@
 //! | `alpha` | f64 | 0.75 | radius reduction α: rᵢ = r₀ i^((α−1)/2) |
 //! | `merging` | true/false | true | false: connections only (BDPT) |
 
-use crate::connect_merge::{Run, VcmParams};
+use crate::connect_merge::{Run, Techniques, VcmParams};
 use crate::params::ParamReader;
 use crate::{Progressive, ProgressiveRun};
 use lt_core::Scene;
@@ -29,9 +29,12 @@ pub struct Vcm {
 
 impl Vcm {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<Vcm, String> {
-        let merging = r.get::<bool>("merging")?.unwrap_or(true);
+        let techniques = match r.get::<bool>("merging")?.unwrap_or(true) {
+            true => Techniques::VCM,
+            false => Techniques::CONNECTIONS,
+        };
         Ok(Vcm {
-            params: VcmParams::read(scene, r, "vcm", true, merging)?,
+            params: VcmParams::read(scene, r, "vcm", techniques)?,
         })
     }
 }
