@@ -7,6 +7,7 @@ mod consistency;
 mod directional;
 mod furnace;
 mod light_paths;
+mod material_grid;
 mod mis_check;
 mod mis_check_vcm;
 mod partial_merge;

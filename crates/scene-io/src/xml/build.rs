@@ -82,6 +82,8 @@ pub(super) struct Loader<'a> {
     /// Material ids of BSDF elements already converted (by element address).
     materials: HashMap<*const Elem, u32>,
     default_material: Option<u32>,
+    /// The black diffuse of emitting shapes without a BSDF.
+    default_emitter_material: Option<u32>,
     /// Mesh files read, in order.
     pub meshes: Vec<PathBuf>,
 }
@@ -113,6 +115,7 @@ pub(super) fn load(
         ids,
         materials: HashMap::new(),
         default_material: None,
+        default_emitter_material: None,
         meshes: Vec::new(),
     };
     let root = &doc.root;
@@ -1291,8 +1294,22 @@ impl<'a> Loader<'a> {
             }
         };
         let bsdf = p.one_nested(&["bsdf"], "BSDF")?;
+        // Mitsuba gives a shape without a BSDF a diffuse one of reflectance 0.5, except an
+        // emitting shape, whose default is black: a light does not reflect unless it is told to
+        // (the material grid's floor was 0.35 % too bright by light bounced off the lamp).
+        let emits = p.one_nested(&["emitter"], "emitter")?.is_some();
         let material = match bsdf {
             Some(be) => self.material(be, b)?,
+            None if emits => match self.default_emitter_material {
+                Some(id) => id,
+                None => {
+                    let id = b.add_material(Material::Diffuse(Diffuse {
+                        albedo: Color::ZERO,
+                    }));
+                    self.default_emitter_material = Some(id);
+                    id
+                }
+            },
             None => match self.default_material {
                 Some(id) => id,
                 None => {
