@@ -69,7 +69,7 @@ pub fn run(args: &ReferenceArgs) -> Result<(), String> {
         threads: args.threads,
     };
     let passes = match (args.spp, args.time) {
-        (Some(n), _) if n == 0 => return Err("--spp must be at least 1".into()),
+        (Some(0), _) => return Err("--spp must be at least 1".into()),
         (Some(n), _) => n,
         (None, Some(t)) if !(t > 0.0 && t.is_finite()) => {
             return Err("--time must be a positive number of seconds".into())
