@@ -64,12 +64,15 @@ fn equal_time_passes(ctx: &Ctx, scene: &PathBuf) -> Result<Vec<(&'static str, u3
     passes_from_timings(ctx, scene, true).map(|v| v.unwrap_or_default())
 }
 
+/// (integrator, passes, seconds) of each integrator at equal time.
+type EqualPasses = Vec<(&'static str, u32, f64)>;
+
 /// The same from the cache alone: None when a convergence run is not there yet (`render` false).
 fn passes_from_timings(
     ctx: &Ctx,
     scene: &PathBuf,
     render: bool,
-) -> Result<Option<Vec<(&'static str, u32, f64)>>, String> {
+) -> Result<Option<EqualPasses>, String> {
     let scale = &ctx.scale;
     let mut cost = Vec::new();
     for i in integrators() {

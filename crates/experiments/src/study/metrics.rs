@@ -70,14 +70,14 @@ pub fn subset_bias_variance(images: &[Image], kept: &[usize], r: &Reference) -> 
     let k = kept.len() as f64;
     let (mut b2, mut var) = (0.0, 0.0);
     for (p, rp) in r.image.data.iter().enumerate() {
-        for c in 0..3 {
+        for (c, &rc) in rp.iter().enumerate() {
             let m = kept.iter().map(|&i| images[i].data[p][c]).sum::<f64>() / k;
             let s2 = kept
                 .iter()
                 .map(|&i| (images[i].data[p][c] - m).powi(2))
                 .sum::<f64>()
                 / (k - 1.0);
-            b2 += (m - rp[c]).powi(2) - s2 / k;
+            b2 += (m - rc).powi(2) - s2 / k;
             var += s2;
         }
     }

@@ -151,10 +151,10 @@ impl StudyOutput {
     }
 
     pub fn finish(mut self) -> Result<(), String> {
-        let _ = write!(
+        let _ = writeln!(
             self.summary,
             "_Scale `{}`; code version `{}`. Every number here is recomputed from cached renders by \
-             rerunning the study._\n",
+             rerunning the study._",
             self.manifest.scale,
             crate::cache::CODE_VERSION
         );

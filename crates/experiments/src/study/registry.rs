@@ -3,7 +3,9 @@
 
 use super::context::Ctx;
 use super::scale::Scale;
-use super::{convergence, equal_time, per_length, radius_shrinkage, smoke, unbiased_consistent};
+use super::{
+    convergence, equal_time, per_length, radius_plane, radius_shrinkage, smoke, unbiased_consistent,
+};
 use crate::runs::RunSpec;
 
 /// What the table knows of one study.
@@ -40,6 +42,14 @@ pub const STUDIES: &[StudyInfo] = &[
         listed: true,
         specs: |scale, _| Ok(radius_shrinkage::specs(scale)),
         run: radius_shrinkage::run,
+    },
+    // Not in `all`: its committed results are at the full scale, and the quick main command must
+    // not overwrite them. Run it by name (`lt study radius-shrinkage-plane --scale full`).
+    StudyInfo {
+        name: radius_plane::NAME,
+        listed: false,
+        specs: |scale, _| Ok(radius_plane::specs(scale)),
+        run: radius_plane::run,
     },
     StudyInfo {
         name: "equal-time",

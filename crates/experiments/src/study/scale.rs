@@ -32,6 +32,11 @@ pub struct Scale {
     pub bias_runs: usize,
     /// Passes of the radius-shrinkage and unbiased-vs-consistent studies.
     pub progressive_passes: u32,
+    /// The radius-shrinkage-plane study (ppm at frozen points on `point-plane`): independent
+    /// runs, passes and photon paths per pass.
+    pub plane_runs: usize,
+    pub plane_passes: u32,
+    pub plane_photons: u64,
     /// Repetitions of the lecture's 1-D example per N.
     pub lecture_repetitions: usize,
     pub confidence: f64,
@@ -76,6 +81,9 @@ impl Scale {
             alphas: ALL_ALPHAS.to_vec(),
             bias_runs: 8,
             progressive_passes: 64,
+            plane_runs: 16,
+            plane_passes: 256,
+            plane_photons: 1000,
             lecture_repetitions: 20_000,
             confidence: 0.95,
         };
@@ -90,6 +98,9 @@ impl Scale {
                 max_length: 8,
                 bias_runs: 16,
                 progressive_passes: 1024,
+                plane_runs: 64,
+                plane_passes: 1024,
+                plane_photons: 4000,
                 lecture_repetitions: 200_000,
                 ..base
             }),
@@ -105,6 +116,10 @@ impl Scale {
                 alphas: vec![0.5, 2.0 / 3.0, 1.0],
                 bias_runs: 16,
                 progressive_passes: 64,
+                // bias² at N = 1 must clear 0 at the test's strict level.
+                plane_runs: 16,
+                plane_passes: 64,
+                plane_photons: 4000,
                 lecture_repetitions: 4000,
                 // The tests check dozens of intervals; at 0.999 each, the chance that any of 50
                 // misses by luck is 1 − 0.999⁵⁰ ≈ 5 % (Šidák), which a fixed seed then pins.

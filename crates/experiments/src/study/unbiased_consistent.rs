@@ -19,7 +19,12 @@ use std::path::Path;
 pub const NAME: &str = "unbiased-vs-consistent";
 
 /// (label, integrator, parameters).
-pub const CONFIGS: [(&str, &str, &[(&str, &str)]); 6] = [
+type Config = (
+    &'static str,
+    &'static str,
+    &'static [(&'static str, &'static str)],
+);
+pub const CONFIGS: [Config; 6] = [
     ("pt", "pt", &[]),
     ("bdpt", "bdpt", &[]),
     (
