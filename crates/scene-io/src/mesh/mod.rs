@@ -1,4 +1,6 @@
-//! Mesh files: Wavefront OBJ (the TOML and XML paths share one reader) and PLY.
+//! Mesh files: Wavefront OBJ (the TOML and XML paths share one reader), PLY and Mitsuba's
+//! serialized format.
 
 pub(crate) mod obj;
 pub(crate) mod ply;
+pub(crate) mod serialized;

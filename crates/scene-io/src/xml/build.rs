@@ -7,7 +7,7 @@ use super::resolve::Resolver;
 use super::values::Xform;
 use crate::error::Ctx;
 use crate::image_file::{filter_type_named, read_bitmap, read_environment_map, wrap_mode_named};
-use crate::mesh::ply;
+use crate::mesh::{ply, serialized};
 use crate::transform::{check_quad, check_solid};
 use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
 use crate::SceneError;
@@ -1251,11 +1251,19 @@ impl<'a> Loader<'a> {
                 )?;
                 placed(WorldMesh::place(&unit_disk_fan(), &m), span)?
             }
-            "obj" | "ply" => {
+            "obj" | "ply" | "serialized" => {
                 let Some((file, fe)) = p.string("filename")? else {
                     return Err(p.err(e, format!("shape `{}` needs a `filename`", p.kind)));
                 };
-                let face_normals = p.boolean("face_normals")?.unwrap_or(false);
+                let mut face_normals = p.boolean("face_normals")?.unwrap_or(false);
+                let shape_index = match p.kind {
+                    "serialized" => p.integer("shape_index")?.map_or(Ok(0), |i| {
+                        u32::try_from(i).map_err(|_| {
+                            p.err(e, format!("`shape_index` must be a non-negative integer, got {i}"))
+                        })
+                    })?,
+                    _ => 0,
+                };
                 check_solid(&ctx, &m, span.clone(), "mesh")?;
                 let path = doc.resolver.resolve(file).map_err(|looked| {
                     p.err(fe, Resolver::not_found("mesh file", file, &looked))
@@ -1265,10 +1273,15 @@ impl<'a> Loader<'a> {
                 let resolved = Ctx { base_dir: PathBuf::new(), ..doc.ctx(e.src) };
                 let spanned =
                     toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
-                let mut mesh = if p.kind == "obj" {
-                    crate::mesh::obj::load_obj(&resolved, &spanned)?
-                } else {
-                    ply::load_ply(&resolved, &spanned)?
+                let mut mesh = match p.kind {
+                    "obj" => crate::mesh::obj::load_obj(&resolved, &spanned)?,
+                    "ply" => ply::load_ply(&resolved, &spanned)?,
+                    _ => {
+                        // The file's own "face normals" flag is the same as `face_normals`.
+                        let s = serialized::load_serialized(&resolved, &spanned, shape_index)?;
+                        face_normals |= s.face_normals;
+                        s.mesh
+                    }
                 };
                 self.meshes.push(path);
                 if face_normals {
@@ -1286,7 +1299,7 @@ impl<'a> Loader<'a> {
             other => {
                 return Err(p.err(
                     e,
-                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, obj and ply, and disk with --approximate)"),
+                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, obj, ply and serialized, and disk with --approximate)"),
                 ))
             }
         };
