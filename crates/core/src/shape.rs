@@ -2,6 +2,7 @@
 //! and cube as meshes) and exact spheres. The scene indexes them for ray queries; area lights
 //! sample them.
 
+pub use crate::geometry::quadric::Affine;
 use crate::math::{Color, Vec2, Vec3, PI};
 
 /// A triangle mesh in world space.
@@ -173,7 +174,21 @@ impl TriangleMesh {
 #[derive(Clone, Debug)]
 pub enum ShapeGeometry {
     Mesh(TriangleMesh),
-    Sphere { center: Vec3, radius: f32 },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    /// Mitsuba's disk: the unit disk (z = 0, normal +z) under `to_world`, any invertible affine
+    /// map (a non-uniform scale makes an ellipse).
+    Disk {
+        to_world: Affine,
+    },
+    /// Mitsuba's open cylinder: x² + y² = 1, 0 ≤ z ≤ 1 under `to_world`, a rotation (or
+    /// reflection) times diag(r, r, l) plus a translation (what `quadric::is_round_cylinder_map`
+    /// accepts; area sampling assumes it).
+    Cylinder {
+        to_world: Affine,
+    },
 }
 
 /// Mitsuba's sphere parameterisation from the unit outward normal (object frame = world axes:

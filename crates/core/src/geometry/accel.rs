@@ -449,6 +449,10 @@ mod tests {
                         Primitive::Sphere { center, radius, .. } => {
                             center + Vec3::X * radius * 1.001
                         }
+                        Primitive::Disk { to_object, .. }
+                        | Primitive::Cylinder { to_object, .. } => {
+                            to_object.inverse().point(Vec3::new(0.5, 0.5, 0.5))
+                        }
                     }
                 };
                 let d = if at_edges && k % 4 == 0 {

@@ -4,6 +4,7 @@ pub mod accel;
 pub mod flat;
 pub mod primitive;
 pub mod quad;
+pub mod quadric;
 pub mod ray;
 pub mod soa;
 pub mod sphere;

@@ -5,6 +5,7 @@ use super::{RenderSettings, Scene, Shape};
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::geometry::quad::Parallelogram;
+use crate::geometry::quadric;
 use crate::geometry::{Accel, Primitive};
 use crate::light::{Light, LightDesc, LightSampler};
 use crate::math::{Color, Vec3};
@@ -60,6 +61,14 @@ fn scene_origin(shapes: &[(ShapeGeometry, u32, Option<Texture>, bool)]) -> Vec3 
             }
             &ShapeGeometry::Sphere { center, radius } => {
                 (lo, hi) = (lo.min(center - radius), hi.max(center + radius));
+            }
+            ShapeGeometry::Disk { to_world } => {
+                let (a, b) = quadric::disk_bounds(to_world);
+                (lo, hi) = (lo.min(a), hi.max(b));
+            }
+            ShapeGeometry::Cylinder { to_world } => {
+                let (a, b) = quadric::cylinder_bounds(to_world);
+                (lo, hi) = (lo.min(a), hi.max(b));
             }
         }
     }
@@ -149,6 +158,9 @@ impl SceneBuilder {
                 match geometry {
                     ShapeGeometry::Mesh(m) => m.positions.iter_mut().for_each(|p| *p -= origin),
                     ShapeGeometry::Sphere { center, .. } => *center -= origin,
+                    ShapeGeometry::Disk { to_world } | ShapeGeometry::Cylinder { to_world } => {
+                        to_world.t -= origin
+                    }
                 }
             }
             for light in &mut self.lights {
@@ -168,6 +180,14 @@ impl SceneBuilder {
                 &ShapeGeometry::Sphere { center, radius } => prims.push(Primitive::Sphere {
                     center,
                     radius,
+                    shape: shape_id,
+                }),
+                ShapeGeometry::Disk { to_world } => prims.push(Primitive::Disk {
+                    to_object: to_world.inverse(),
+                    shape: shape_id,
+                }),
+                ShapeGeometry::Cylinder { to_world } => prims.push(Primitive::Cylinder {
+                    to_object: to_world.inverse(),
                     shape: shape_id,
                 }),
             }

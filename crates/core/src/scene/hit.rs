@@ -2,6 +2,7 @@
 
 use super::{Scene, ShapeGeometry};
 use crate::bsdf::ShadingFrame;
+use crate::geometry::quadric::{cylinder_at, disk_at};
 use crate::geometry::ray::barycentric_error;
 use crate::geometry::sphere::refine_sphere_hit;
 use crate::geometry::triangle::{intersect_triangle, ShearedRay};
@@ -38,6 +39,8 @@ impl SurfaceHit {
         let prim = *scene.accel.primitive(h.prim);
         let shape = &scene.shapes[prim.shape() as usize];
         // `tri`: the mesh triangle holding the point (a parallelogram's source triangle).
+        // `analytic`: a disk's or cylinder's own ∂p/∂u, ∂p/∂v.
+        let mut analytic = None;
         let (p, p_err, mut ng, mut ns, uv, tri, bary) = match prim {
             Primitive::Triangle {
                 p: [p0, p1, p2],
@@ -54,7 +57,7 @@ impl SurfaceHit {
                         m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng),
                         m.uv(index as usize, b0, b1, b2),
                     ),
-                    ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
+                    _ => (ng, Vec2::ZERO),
                 };
                 (p, err, ng, ns, uv, index, [b0, b1, b2])
             }
@@ -73,7 +76,7 @@ impl SurfaceHit {
                             .unwrap_or(ng),
                         m.uv(tri as usize, b[0], b[1], b[2]),
                     ),
-                    ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
+                    _ => (ng, Vec2::ZERO),
                 };
                 (p, err, ng, ns, uv, tri, b)
             }
@@ -81,6 +84,16 @@ impl SurfaceHit {
                 let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
                 let n = (p - center).normalize();
                 (p, err, n, n, crate::shape::sphere_uv(n), 0, [1.0, 0.0, 0.0])
+            }
+            Primitive::Disk { to_object, .. } | Primitive::Cylinder { to_object, .. } => {
+                let local = to_object.point(ray.at(h.t));
+                let q = match shape.geometry {
+                    ShapeGeometry::Disk { to_world } => disk_at(local, &to_world, &to_object),
+                    ShapeGeometry::Cylinder { to_world } => cylinder_at(local, &to_world),
+                    _ => unreachable!("a disk or cylinder primitive of another shape"),
+                };
+                analytic = Some((q.dpdu, q.dpdv));
+                (q.p, q.p_err, q.n, q.n, q.uv, 0, [1.0, 0.0, 0.0])
             }
         };
         let uv = TexPoint {
@@ -107,7 +120,8 @@ impl SurfaceHit {
         let mut tangent = Vec3::ZERO;
         let oriented = material.needs_tangent();
         if perturbation.is_some() || oriented {
-            let (dpdu, dpdv) = tangents(&shape.geometry, &prim, tri as usize, p, ng);
+            let (dpdu, dpdv) =
+                analytic.unwrap_or_else(|| tangents(&shape.geometry, &prim, tri as usize, p, ng));
             if oriented {
                 tangent = (dpdu - ns * ns.dot(dpdu))
                     .try_normalize()

@@ -2,6 +2,7 @@
 //! the scene sits in floating-point space (large coordinates leave fewer bits for the geometry).
 
 use super::{LightDesc, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
+use crate::geometry::quadric::Affine;
 use crate::light::Light;
 use crate::math::Vec3;
 
@@ -27,6 +28,12 @@ impl Scene {
                 &ShapeGeometry::Sphere { center, radius } => ShapeGeometry::Sphere {
                     center: moved(center),
                     radius,
+                },
+                &ShapeGeometry::Disk { to_world } => ShapeGeometry::Disk {
+                    to_world: Affine::new(to_world.m, moved(to_world.t)),
+                },
+                &ShapeGeometry::Cylinder { to_world } => ShapeGeometry::Cylinder {
+                    to_world: Affine::new(to_world.m, moved(to_world.t)),
                 },
             };
             let radiance = s.light.and_then(|l| match &self.lights[l as usize] {

@@ -330,7 +330,10 @@ mod tests {
         let whole = parse(&good, 0).unwrap().mesh.positions;
         for len in 0..good.len() - 12 {
             if let Ok(m) = parse(&good[..len], 0) {
-                assert!(m.mesh.positions == whole && m.mesh.indices == vec![[0, 1, 2]], "{len}");
+                assert!(
+                    m.mesh.positions == whole && m.mesh.indices == vec![[0, 1, 2]],
+                    "{len}"
+                );
             }
         }
         assert!(parse(&good[..good.len() - 20], 0).is_err());

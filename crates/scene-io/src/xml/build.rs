@@ -1242,14 +1242,43 @@ impl<'a> Loader<'a> {
                 }
                 WorldGeometry::Sphere { center, radius }
             }
+            // Exact disk: the unit disk under `to_world` (an ellipse under a non-uniform scale).
             "disk" => {
                 check_quad(&ctx, &m, span.clone())?;
-                self.substitute(
-                    e,
-                    "the analytic disk is not supported (lt has no disk primitive)".into(),
-                    format!("use a {DISK_SIDES}-gon inscribed in it (area {:.1e} smaller)", disk_area_deficit()),
-                )?;
-                placed(WorldMesh::place(&unit_disk_fan(), &m), span)?
+                quadric_in_range(&p, e, &m, "disk")?
+            }
+            // Mitsuba's cylinder: to_world · translate(p0) · to_frame(p1 − p0) · scale(r, r, |p1 −
+            // p0|) maps the unit cylinder; Mitsuba then keeps only that map's rotation and its
+            // diagonal stretch (r, l), so a shear or unequal x/y scale is refused here rather
+            // than rendered differently.
+            "cylinder" => {
+                let r = p.float("radius")?.unwrap_or(1.0);
+                let p0 = DVec3::from_array(p.vec3("p0")?.unwrap_or([0.0; 3]));
+                let p1 = DVec3::from_array(p.vec3("p1")?.unwrap_or([0.0, 0.0, 1.0]));
+                let axis = p1 - p0;
+                let len = axis.length();
+                if !(len > 0.0) || !(r != 0.0) || !r.is_finite() {
+                    return Err(p.err(e, format!("a cylinder needs p0 ≠ p1 and a non-zero radius (got radius {r}, |p1 − p0| = {len})")));
+                }
+                // Duff et al.'s orthonormal basis around the axis (Mitsuba's Frame, lt's Frame::from_z).
+                let f = lt_core::math::Frame::from_z(axis.normalize().as_vec3());
+                let frame = DMat4::from_cols(
+                    f.x.as_dvec3().extend(0.0),
+                    f.y.as_dvec3().extend(0.0),
+                    (axis / len).extend(0.0),
+                    glam::DVec4::W,
+                );
+                let full = m
+                    * DMat4::from_translation(p0)
+                    * frame
+                    * DMat4::from_scale(DVec3::new(r, r, len));
+                if !lt_core::geometry::quadric::is_round_cylinder_map(&glam::DMat3::from_mat4(full), 1e-5) {
+                    return Err(p.err(
+                        xform.as_ref().map_or(e, |(_, te)| te),
+                        "a cylinder's to_world must be a rotation, a scale equal along x and y, and a translation (Mitsuba drops shear and unequal x/y scales, with a warning)",
+                    ));
+                }
+                quadric_in_range(&p, e, &full, "cylinder")?
             }
             "obj" | "ply" | "serialized" => {
                 let Some((file, fe)) = p.string("filename")? else {
@@ -1299,7 +1328,7 @@ impl<'a> Loader<'a> {
             other => {
                 return Err(p.err(
                     e,
-                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, obj, ply and serialized, and disk with --approximate)"),
+                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, disk, cylinder, obj, ply and serialized)"),
                 ))
             }
         };
@@ -1676,32 +1705,29 @@ fn projector_tan_half_x(p: &Plugin, aspect: f64) -> Result<f64, SceneError> {
     Ok(tan_half * to_x)
 }
 
-/// Sides of the polygon `--approximate` puts in place of a disk.
-const DISK_SIDES: u32 = 256;
-
-/// The relative area a regular `DISK_SIDES`-gon inscribed in a circle lacks.
-fn disk_area_deficit() -> f64 {
-    let t = std::f64::consts::TAU / DISK_SIDES as f64;
-    1.0 - DISK_SIDES as f64 * t.sin() / std::f64::consts::TAU
-}
-
-/// Mitsuba's disk (radius 1 in the z = 0 plane, normal +z) as a fan of triangles.
-fn unit_disk_fan() -> TriangleMesh {
-    let mut positions = vec![glam::Vec3::ZERO];
-    for k in 0..DISK_SIDES {
-        let (s, c) = (std::f64::consts::TAU * k as f64 / DISK_SIDES as f64).sin_cos();
-        positions.push(glam::Vec3::new(c as f32, s as f32, 0.0));
+/// A disk or cylinder under `m` (the unit shape's object-to-world map), refused when its map
+/// is singular or reaches beyond the coordinates the scene can hold.
+fn quadric_in_range(
+    p: &Plugin,
+    e: &Elem,
+    m: &DMat4,
+    what: &str,
+) -> Result<WorldGeometry, SceneError> {
+    let corner = m.transform_point3(DVec3::ONE);
+    let det = glam::DMat3::from_mat4(*m).determinant();
+    if !crate::world::in_range(corner) || !crate::world::in_range(m.w_axis.truncate()) {
+        return Err(p.err(e, out_of_range_message(&format!("the {what}"), corner)));
     }
-    let indices = (0..DISK_SIDES)
-        .map(|k| [0, 1 + k, 1 + (k + 1) % DISK_SIDES])
-        .collect();
-    TriangleMesh {
-        positions,
-        normals: None,
-        uvs: None,
-        indices,
-        attributes: Vec::new(),
+    if !(det.abs() > 0.0) || !det.is_finite() {
+        return Err(p.err(
+            e,
+            format!("the {what}'s to_world is singular (determinant {det})"),
+        ));
     }
+    Ok(match what {
+        "disk" => WorldGeometry::Disk { to_world: *m },
+        _ => WorldGeometry::Cylinder { to_world: *m },
+    })
 }
 
 /// Angle-weighted vertex normals (each face's unit normal weighted by its angle at the vertex),
