@@ -3,6 +3,7 @@
 //! sample them.
 
 pub use crate::geometry::quadric::Affine;
+pub use crate::geometry::sdf::SdfGrid;
 use crate::math::{Color, Vec2, Vec3, PI};
 
 /// A triangle mesh in world space.
@@ -187,6 +188,12 @@ pub enum ShapeGeometry {
     /// reflection) times diag(r, r, l) plus a translation (what `quadric::is_round_cylinder_map`
     /// accepts; area sampling assumes it).
     Cylinder {
+        to_world: Affine,
+    },
+    /// Mitsuba's `sdfgrid`: the grid's unit cube under `to_world` (any invertible affine map).
+    /// Not an emitter (Mitsuba's cannot be one either).
+    SdfGrid {
+        grid: std::sync::Arc<SdfGrid>,
         to_world: Affine,
     },
 }

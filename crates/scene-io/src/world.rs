@@ -106,6 +106,11 @@ pub enum WorldGeometry {
     Cylinder {
         to_world: DMat4,
     },
+    /// Mitsuba's `sdfgrid`: the grid's unit cube under this map (`ShapeGeometry::SdfGrid`).
+    SdfGrid {
+        grid: std::sync::Arc<lt_core::shape::SdfGrid>,
+        to_world: DMat4,
+    },
 }
 
 /// The world box of the unit disk at height `z` under `m`: per axis, the centre ± √(m_i0² + m_i1²).
@@ -222,6 +227,10 @@ impl WorldBuilder {
                 WorldGeometry::Cylinder { to_world } => ShapeGeometry::Cylinder {
                     to_world: local_affine(&to_world, origin),
                 },
+                WorldGeometry::SdfGrid { grid, to_world } => ShapeGeometry::SdfGrid {
+                    grid,
+                    to_world: local_affine(&to_world, origin),
+                },
             };
             b.add_emitting_shape(geometry, s.material, s.radiance, s.flip_normals);
         }
@@ -258,6 +267,14 @@ impl WorldBuilder {
                     for z in [0.0, 1.0] {
                         let (a, b) = disk_box(to_world, z);
                         (lo, hi) = (lo.min(a), hi.max(b));
+                    }
+                }
+                WorldGeometry::SdfGrid { to_world, .. } => {
+                    for i in 0..8 {
+                        let c =
+                            DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2 & 1) as f64);
+                        let p = to_world.transform_point3(c);
+                        (lo, hi) = (lo.min(p), hi.max(p));
                     }
                 }
             }

@@ -148,7 +148,8 @@ impl Flat {
                 // Triangles, disks and cylinders: tested one by one.
                 Primitive::Triangle { .. }
                 | Primitive::Disk { .. }
-                | Primitive::Cylinder { .. } => triangles.push(i),
+                | Primitive::Cylinder { .. }
+                | Primitive::SdfVoxel { .. } => triangles.push(i),
             }
         }
         assert!(Isa::available().contains(&isa), "{isa:?} is not available");

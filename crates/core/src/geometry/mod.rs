@@ -6,6 +6,7 @@ pub mod primitive;
 pub mod quad;
 pub mod quadric;
 pub mod ray;
+pub mod sdf;
 pub mod soa;
 pub mod sphere;
 pub mod triangle;

@@ -4,6 +4,7 @@
 
 use super::quad::Parallelogram;
 use super::quadric::{cylinder_bounds, disk_bounds, intersect_cylinder, intersect_disk, Affine};
+use super::sdf::SdfVoxel;
 use super::sphere::intersect_sphere;
 use super::triangle::{intersect_triangle, ShearedRay};
 use crate::math::Vec3;
@@ -34,6 +35,8 @@ pub enum Primitive {
     Disk { to_object: Affine, shape: u32 },
     /// Mitsuba's open cylinder: the unit cylinder under the inverse of `to_object`.
     Cylinder { to_object: Affine, shape: u32 },
+    /// One voxel of an `sdfgrid` that the surface may cross (`sdf.rs`).
+    SdfVoxel { voxel: SdfVoxel, shape: u32 },
 }
 
 impl Primitive {
@@ -43,7 +46,8 @@ impl Primitive {
             | Primitive::Quad { shape, .. }
             | Primitive::Sphere { shape, .. }
             | Primitive::Disk { shape, .. }
-            | Primitive::Cylinder { shape, .. } => shape,
+            | Primitive::Cylinder { shape, .. }
+            | Primitive::SdfVoxel { shape, .. } => shape,
         }
     }
 
@@ -59,6 +63,7 @@ impl Primitive {
             }
             Primitive::Disk { to_object, .. } => intersect_disk(o, d, t_max, to_object),
             Primitive::Cylinder { to_object, .. } => intersect_cylinder(o, d, t_max, to_object),
+            Primitive::SdfVoxel { voxel, .. } => voxel.intersect(o, d, t_max),
         }
     }
 }
@@ -87,6 +92,10 @@ impl Boundable for Primitive {
             }
             Primitive::Cylinder { to_object, .. } => {
                 let (lo, hi) = cylinder_bounds(&to_object.inverse());
+                Aabb::new(lo.into(), hi.into())
+            }
+            Primitive::SdfVoxel { voxel, .. } => {
+                let (lo, hi) = voxel.bounds();
                 Aabb::new(lo.into(), hi.into())
             }
         }

@@ -128,6 +128,8 @@ impl AreaLight {
             &ShapeGeometry::Cylinder { to_world } => {
                 (Emitter::Cylinder { to_world }, cylinder_area(&to_world))
             }
+            // The loaders refuse an emitting sdfgrid, as Mitsuba does.
+            ShapeGeometry::SdfGrid { .. } => unreachable!("an sdfgrid cannot emit"),
         };
         AreaLight {
             shape,

@@ -6,6 +6,7 @@ use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::geometry::quad::Parallelogram;
 use crate::geometry::quadric;
+use crate::geometry::sdf::SdfVoxel;
 use crate::geometry::{Accel, Primitive};
 use crate::light::{Light, LightDesc, LightSampler};
 use crate::math::{Color, Vec3};
@@ -69,6 +70,13 @@ fn scene_origin(shapes: &[(ShapeGeometry, u32, Option<Texture>, bool)]) -> Vec3 
             ShapeGeometry::Cylinder { to_world } => {
                 let (a, b) = quadric::cylinder_bounds(to_world);
                 (lo, hi) = (lo.min(a), hi.max(b));
+            }
+            ShapeGeometry::SdfGrid { to_world, .. } => {
+                for i in 0..8 {
+                    let c = Vec3::new((i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32);
+                    let p = to_world.point(c);
+                    (lo, hi) = (lo.min(p), hi.max(p));
+                }
             }
         }
     }
@@ -158,9 +166,9 @@ impl SceneBuilder {
                 match geometry {
                     ShapeGeometry::Mesh(m) => m.positions.iter_mut().for_each(|p| *p -= origin),
                     ShapeGeometry::Sphere { center, .. } => *center -= origin,
-                    ShapeGeometry::Disk { to_world } | ShapeGeometry::Cylinder { to_world } => {
-                        to_world.t -= origin
-                    }
+                    ShapeGeometry::Disk { to_world }
+                    | ShapeGeometry::Cylinder { to_world }
+                    | ShapeGeometry::SdfGrid { to_world, .. } => to_world.t -= origin,
                 }
             }
             for light in &mut self.lights {
@@ -190,6 +198,14 @@ impl SceneBuilder {
                     to_object: to_world.inverse(),
                     shape: shape_id,
                 }),
+                ShapeGeometry::SdfGrid { grid, to_world } => {
+                    for v in grid.surface_voxels() {
+                        prims.push(Primitive::SdfVoxel {
+                            voxel: SdfVoxel::new(grid, v, to_world),
+                            shape: shape_id,
+                        });
+                    }
+                }
             }
             let light = emission.map(|e| {
                 lights.push(Light::area(shape_id, &geometry, &e, flip_normals));

@@ -95,6 +95,25 @@ impl SurfaceHit {
                 analytic = Some((q.dpdu, q.dpdv));
                 (q.p, q.p_err, q.n, q.n, q.uv, 0, [1.0, 0.0, 0.0])
             }
+            Primitive::SdfVoxel { voxel, .. } => {
+                let ShapeGeometry::SdfGrid { grid, to_world } = &shape.geometry else {
+                    unreachable!("an sdf voxel of another shape")
+                };
+                let (p, p_err) = sdf_hit_point(ray, h.t, &voxel, to_world);
+                let to_object = to_world.inverse();
+                let local = to_object.point(p);
+                // Normals transform by the inverse transpose of to_world: to_object's transpose.
+                let normal = |g: Vec3| (to_object.m.transpose() * g).normalize_or_zero();
+                let ng = normal(grid.gradient(local));
+                let ng = if ng == Vec3::ZERO { -ray.d } else { ng };
+                let ns = if grid.smooth {
+                    normal(grid.smooth_normal(local))
+                } else {
+                    ng
+                };
+                let ns = if ns == Vec3::ZERO { ng } else { ns };
+                (p, p_err, ng, ns, Vec2::ZERO, 0, [1.0, 0.0, 0.0])
+            }
         };
         let uv = TexPoint {
             uv,
@@ -168,6 +187,29 @@ impl SurfaceHit {
             t_max: len * (1.0 - SHADOW_EPSILON),
         }
     }
+}
+
+/// An sdf hit: the point along the ray, with a bound that covers its rounding and the
+/// uncertainty of the computed zero set — a thousandth of the voxel's smallest world edge, far
+/// above the rounding of a voxel's local coordinates, so a ray spawned off it never finds the
+/// root it leaves (`SdfVoxel::intersect`).
+fn sdf_hit_point(
+    ray: &Ray,
+    t: f32,
+    voxel: &crate::geometry::sdf::SdfVoxel,
+    to_world: &crate::shape::Affine,
+) -> (Vec3, Vec3) {
+    let p = ray.at(t);
+    let w = voxel.to_voxel.inverse();
+    let edge =
+        w.m.x_axis
+            .length()
+            .min(w.m.y_axis.length())
+            .min(w.m.z_axis.length());
+    let err = (ray.o.abs() + (ray.d * t).abs()) * crate::math::gamma(3)
+        + to_world.point_error(Vec3::ONE)
+        + Vec3::splat(1e-3 * edge);
+    (p, err)
 }
 
 /// ∂p/∂u and ∂p/∂v at `p` on a primitive, in the parameterisation `uv` comes from: a mesh

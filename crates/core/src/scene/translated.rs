@@ -35,6 +35,10 @@ impl Scene {
                 &ShapeGeometry::Cylinder { to_world } => ShapeGeometry::Cylinder {
                     to_world: Affine::new(to_world.m, moved(to_world.t)),
                 },
+                ShapeGeometry::SdfGrid { grid, to_world } => ShapeGeometry::SdfGrid {
+                    grid: grid.clone(),
+                    to_world: Affine::new(to_world.m, moved(to_world.t)),
+                },
             };
             let radiance = s.light.and_then(|l| match &self.lights[l as usize] {
                 Light::Area(a) => Some(a.radiance()),

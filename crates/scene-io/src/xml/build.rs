@@ -1280,6 +1280,34 @@ impl<'a> Loader<'a> {
                 }
                 quadric_in_range(&p, e, &full, "cylinder")?
             }
+            // Mitsuba's SDF grid: its file's values over the unit cube, under to_world.
+            "sdfgrid" => {
+                let Some((file, fe)) = p.string("filename")? else {
+                    return Err(p.err(e, "shape `sdfgrid` needs a `filename`"));
+                };
+                let smooth = match p.string("normals")? {
+                    None | Some(("smooth", _)) => true,
+                    Some(("analytic", _)) => false,
+                    Some((other, ne)) => {
+                        return Err(p.err(ne, format!("sdfgrid `normals` must be `smooth` or `analytic`, got `{other}`")))
+                    }
+                };
+                let path = doc.resolver.resolve(file).map_err(|looked| {
+                    p.err(fe, Resolver::not_found("volume grid file", file, &looked))
+                })?;
+                let resolved = Ctx { base_dir: PathBuf::new(), ..doc.ctx(e.src) };
+                let spanned =
+                    toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
+                let grid = crate::mesh::vol::load_sdf_grid(&resolved, &spanned, smooth)?;
+                self.meshes.push(path);
+                match quadric_in_range(&p, e, &m, "sdfgrid")? {
+                    WorldGeometry::Cylinder { to_world } => WorldGeometry::SdfGrid {
+                        grid: std::sync::Arc::new(grid),
+                        to_world,
+                    },
+                    _ => unreachable!(),
+                }
+            }
             "obj" | "ply" | "serialized" => {
                 let Some((file, fe)) = p.string("filename")? else {
                     return Err(p.err(e, format!("shape `{}` needs a `filename`", p.kind)));
@@ -1328,7 +1356,7 @@ impl<'a> Loader<'a> {
             other => {
                 return Err(p.err(
                     e,
-                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, disk, cylinder, obj, ply and serialized)"),
+                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, disk, cylinder, sdfgrid, obj, ply and serialized)"),
                 ))
             }
         };
@@ -1413,6 +1441,12 @@ impl<'a> Loader<'a> {
                     ),
                 ));
             }
+        }
+        if radiance.is_some() && matches!(geometry, WorldGeometry::SdfGrid { .. }) {
+            return Err(p.err(
+                p.elem,
+                "an sdfgrid cannot be an area emitter (Mitsuba's cannot either)",
+            ));
         }
         let ignored: &[&str] = match p.kind {
             "obj" | "ply" => &["flip_tex_coords"],
