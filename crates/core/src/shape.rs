@@ -133,10 +133,9 @@ impl TriangleMesh {
                 let v = n.cross(u);
                 let base = positions.len() as u32;
                 for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                    positions.push(n + u * a + v * b);
-                    // Each face its own [0, 1]² (Mitsuba's cube mesh has per-face uvs too; its
-                    // orientation per face is not checked against Mitsuba's).
-                    uvs.push(Vec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0)));
+                    let p = n + u * a + v * b;
+                    positions.push(p);
+                    uvs.push(mitsuba_cube_uv(n, p));
                 }
                 indices.push([base, base + 1, base + 2]);
                 indices.push([base, base + 2, base + 3]);
@@ -170,6 +169,42 @@ impl TriangleMesh {
         }
         self
     }
+}
+
+/// Mitsuba's cube parameterisation: each face its own [0, 1]², oriented as in Mitsuba 3's cube
+/// mesh (per face, its corners V0…V3 carry uv (0,1), (1,1), (1,0), (0,0)), so uv is affine on the
+/// face: u along V2 − V3, v along V0 − V3 (edges of length 2). Listed per face: (normal, V0, V2, V3).
+fn mitsuba_cube_uv(n: Vec3, p: Vec3) -> Vec2 {
+    const FACES: [[[f32; 3]; 4]; 6] = [
+        [
+            [0., -1., 0.],
+            [1., -1., -1.],
+            [-1., -1., 1.],
+            [-1., -1., -1.],
+        ],
+        [[0., 1., 0.], [1., 1., -1.], [-1., 1., 1.], [1., 1., 1.]],
+        [[1., 0., 0.], [1., -1., -1.], [1., 1., 1.], [1., -1., 1.]],
+        [[0., 0., 1.], [1., -1., 1.], [-1., 1., 1.], [-1., -1., 1.]],
+        [
+            [-1., 0., 0.],
+            [-1., -1., 1.],
+            [-1., 1., -1.],
+            [-1., -1., -1.],
+        ],
+        [
+            [0., 0., -1.],
+            [1., 1., -1.],
+            [-1., -1., -1.],
+            [-1., 1., -1.],
+        ],
+    ];
+    let f = FACES
+        .iter()
+        .find(|f| Vec3::from_array(f[0]) == n)
+        .expect("a cube face normal");
+    let [v0, v2, v3] = [f[1], f[2], f[3]].map(Vec3::from_array);
+    let q = p - v3;
+    Vec2::new(q.dot(v2 - v3) / 4.0, q.dot(v0 - v3) / 4.0)
 }
 
 #[derive(Clone, Debug)]

@@ -1245,7 +1245,9 @@ impl<'a> Loader<'a> {
             // Exact disk: the unit disk under `to_world` (an ellipse under a non-uniform scale).
             "disk" => {
                 check_quad(&ctx, &m, span.clone())?;
-                quadric_in_range(&p, e, &m, "disk")?
+                WorldGeometry::Disk {
+                    to_world: checked_map(&p, e, &m, "disk")?,
+                }
             }
             // Mitsuba's cylinder: to_world · translate(p0) · to_frame(p1 − p0) · scale(r, r, |p1 −
             // p0|) maps the unit cylinder; Mitsuba then keeps only that map's rotation and its
@@ -1278,7 +1280,9 @@ impl<'a> Loader<'a> {
                         "a cylinder's to_world must be a rotation, a scale equal along x and y, and a translation (Mitsuba drops shear and unequal x/y scales, with a warning)",
                     ));
                 }
-                quadric_in_range(&p, e, &full, "cylinder")?
+                WorldGeometry::Cylinder {
+                    to_world: checked_map(&p, e, &full, "cylinder")?,
+                }
             }
             // Mitsuba's SDF grid: its file's values over the unit cube, under to_world.
             "sdfgrid" => {
@@ -1300,12 +1304,9 @@ impl<'a> Loader<'a> {
                     toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
                 let grid = crate::mesh::vol::load_sdf_grid(&resolved, &spanned, smooth)?;
                 self.meshes.push(path);
-                match quadric_in_range(&p, e, &m, "sdfgrid")? {
-                    WorldGeometry::Cylinder { to_world } => WorldGeometry::SdfGrid {
-                        grid: std::sync::Arc::new(grid),
-                        to_world,
-                    },
-                    _ => unreachable!(),
+                WorldGeometry::SdfGrid {
+                    grid: std::sync::Arc::new(grid),
+                    to_world: checked_map(&p, e, &m, "sdfgrid")?,
                 }
             }
             "obj" | "ply" | "serialized" => {
@@ -1739,14 +1740,9 @@ fn projector_tan_half_x(p: &Plugin, aspect: f64) -> Result<f64, SceneError> {
     Ok(tan_half * to_x)
 }
 
-/// A disk or cylinder under `m` (the unit shape's object-to-world map), refused when its map
-/// is singular or reaches beyond the coordinates the scene can hold.
-fn quadric_in_range(
-    p: &Plugin,
-    e: &Elem,
-    m: &DMat4,
-    what: &str,
-) -> Result<WorldGeometry, SceneError> {
+/// The object-to-world map `m` of a disk, cylinder or sdfgrid (of its unit shape), refused when
+/// singular or reaching beyond the coordinates the scene can hold.
+fn checked_map(p: &Plugin, e: &Elem, m: &DMat4, what: &str) -> Result<DMat4, SceneError> {
     let corner = m.transform_point3(DVec3::ONE);
     let det = glam::DMat3::from_mat4(*m).determinant();
     if !crate::world::in_range(corner) || !crate::world::in_range(m.w_axis.truncate()) {
@@ -1758,10 +1754,7 @@ fn quadric_in_range(
             format!("the {what}'s to_world is singular (determinant {det})"),
         ));
     }
-    Ok(match what {
-        "disk" => WorldGeometry::Disk { to_world: *m },
-        _ => WorldGeometry::Cylinder { to_world: *m },
-    })
+    Ok(*m)
 }
 
 /// Angle-weighted vertex normals (each face's unit normal weighted by its angle at the vertex),
