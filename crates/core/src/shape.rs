@@ -214,6 +214,14 @@ pub enum ShapeGeometry {
         center: Vec3,
         radius: f32,
     },
+    /// A sphere whose `to_world` also rotates it (or reflects it): the same surface, but its uv
+    /// and ∂p/∂u follow the rotated object frame, as Mitsuba's do. `rotation` is orthonormal,
+    /// object to world.
+    RotatedSphere {
+        center: Vec3,
+        radius: f32,
+        rotation: glam::Mat3,
+    },
     /// Mitsuba's disk: the unit disk (z = 0, normal +z) under `to_world`, any invertible affine
     /// map (a non-uniform scale makes an ellipse).
     Disk {
@@ -233,8 +241,20 @@ pub enum ShapeGeometry {
     },
 }
 
-/// Mitsuba's sphere parameterisation from the unit outward normal (object frame = world axes:
-/// a sphere's rotation is not kept): u = φ / 2π with φ = atan2(y, x) in [0, 2π), v = θ / π.
+impl ShapeGeometry {
+    /// A sphere's world-to-object rotation (the identity for an unrotated one and for any other
+    /// shape): its uv and tangents are read in that frame.
+    #[inline]
+    pub fn sphere_to_object(&self) -> glam::Mat3 {
+        match self {
+            ShapeGeometry::RotatedSphere { rotation, .. } => rotation.transpose(),
+            _ => glam::Mat3::IDENTITY,
+        }
+    }
+}
+
+/// Mitsuba's sphere parameterisation from the unit outward normal in the sphere's object frame
+/// (`ShapeGeometry::sphere_to_object`): u = φ / 2π with φ = atan2(y, x) in [0, 2π), v = θ / π.
 pub fn sphere_uv(n: Vec3) -> Vec2 {
     let phi = n.y.atan2(n.x);
     let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };

@@ -97,6 +97,9 @@ pub enum WorldGeometry {
     Sphere {
         center: DVec3,
         radius: f64,
+        /// The rotation (orthonormal, object to world) of its `to_world`, when not the identity:
+        /// uv and tangents follow it (`ShapeGeometry::RotatedSphere`).
+        rotation: Option<DMat3>,
     },
     /// Mitsuba's disk: the unit disk under this object-to-world map (`ShapeGeometry::Disk`).
     Disk {
@@ -217,9 +220,22 @@ impl WorldBuilder {
                     indices: m.indices,
                     attributes: m.attributes,
                 }),
-                WorldGeometry::Sphere { center, radius } => ShapeGeometry::Sphere {
+                WorldGeometry::Sphere {
+                    center,
+                    radius,
+                    rotation: None,
+                } => ShapeGeometry::Sphere {
                     center: local(center),
                     radius: radius as f32,
+                },
+                WorldGeometry::Sphere {
+                    center,
+                    radius,
+                    rotation: Some(r),
+                } => ShapeGeometry::RotatedSphere {
+                    center: local(center),
+                    radius: radius as f32,
+                    rotation: r.as_mat3(),
                 },
                 WorldGeometry::Disk { to_world } => ShapeGeometry::Disk {
                     to_world: local_affine(&to_world, origin),
@@ -256,7 +272,7 @@ impl WorldBuilder {
                         (lo, hi) = (lo.min(p), hi.max(p));
                     }
                 }
-                &WorldGeometry::Sphere { center, radius } => {
+                &WorldGeometry::Sphere { center, radius, .. } => {
                     (lo, hi) = (lo.min(center - radius), hi.max(center + radius));
                 }
                 WorldGeometry::Disk { to_world } => {

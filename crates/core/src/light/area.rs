@@ -58,6 +58,8 @@ pub struct AreaLight {
     texture: Option<Texture>,
     pub area: f32,
     flip: bool,
+    /// A sphere's world-to-object rotation, for its uv (`ShapeGeometry::sphere_to_object`).
+    sphere_to_object: glam::Mat3,
     emitter: Emitter,
 }
 
@@ -114,7 +116,8 @@ impl AreaLight {
                     total as f32,
                 )
             }
-            &ShapeGeometry::Sphere { center, radius } => (
+            &ShapeGeometry::Sphere { center, radius }
+            | &ShapeGeometry::RotatedSphere { center, radius, .. } => (
                 Emitter::Sphere { center, radius },
                 4.0 * PI * radius * radius,
             ),
@@ -137,6 +140,7 @@ impl AreaLight {
             texture,
             area,
             flip: flip_normals,
+            sphere_to_object: geometry.sphere_to_object(),
             emitter,
         }
     }
@@ -210,7 +214,7 @@ impl AreaLight {
     #[inline]
     fn sphere_uv(&self, n: Vec3) -> Vec2 {
         match self.texture {
-            Some(_) => crate::shape::sphere_uv(n),
+            Some(_) => crate::shape::sphere_uv(self.sphere_to_object * n),
             None => Vec2::ZERO,
         }
     }

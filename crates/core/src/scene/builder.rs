@@ -60,7 +60,8 @@ fn scene_origin(shapes: &[(ShapeGeometry, u32, Option<Texture>, bool)]) -> Vec3 
                     (lo, hi) = (lo.min(p), hi.max(p));
                 }
             }
-            &ShapeGeometry::Sphere { center, radius } => {
+            &ShapeGeometry::Sphere { center, radius }
+            | &ShapeGeometry::RotatedSphere { center, radius, .. } => {
                 (lo, hi) = (lo.min(center - radius), hi.max(center + radius));
             }
             ShapeGeometry::Disk { to_world } => {
@@ -165,7 +166,8 @@ impl SceneBuilder {
             for (geometry, ..) in &mut self.shapes {
                 match geometry {
                     ShapeGeometry::Mesh(m) => m.positions.iter_mut().for_each(|p| *p -= origin),
-                    ShapeGeometry::Sphere { center, .. } => *center -= origin,
+                    ShapeGeometry::Sphere { center, .. }
+                    | ShapeGeometry::RotatedSphere { center, .. } => *center -= origin,
                     ShapeGeometry::Disk { to_world }
                     | ShapeGeometry::Cylinder { to_world }
                     | ShapeGeometry::SdfGrid { to_world, .. } => to_world.t -= origin,
@@ -185,11 +187,14 @@ impl SceneBuilder {
             let shape_id = shapes.len() as u32;
             match &geometry {
                 ShapeGeometry::Mesh(m) => push_mesh_primitives(m, shape_id, &mut prims),
-                &ShapeGeometry::Sphere { center, radius } => prims.push(Primitive::Sphere {
-                    center,
-                    radius,
-                    shape: shape_id,
-                }),
+                &ShapeGeometry::Sphere { center, radius }
+                | &ShapeGeometry::RotatedSphere { center, radius, .. } => {
+                    prims.push(Primitive::Sphere {
+                        center,
+                        radius,
+                        shape: shape_id,
+                    })
+                }
                 ShapeGeometry::Disk { to_world } => prims.push(Primitive::Disk {
                     to_object: to_world.inverse(),
                     shape: shape_id,

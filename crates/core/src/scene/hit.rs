@@ -83,7 +83,8 @@ impl SurfaceHit {
             Primitive::Sphere { center, radius, .. } => {
                 let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
                 let n = (p - center).normalize();
-                (p, err, n, n, crate::shape::sphere_uv(n), 0, [1.0, 0.0, 0.0])
+                let uv = crate::shape::sphere_uv(shape.geometry.sphere_to_object() * n);
+                (p, err, n, n, uv, 0, [1.0, 0.0, 0.0])
             }
             Primitive::Disk { to_object, .. } | Primitive::Cylinder { to_object, .. } => {
                 let local = to_object.point(ray.at(h.t));
@@ -246,14 +247,16 @@ fn tangents(
             }
         }
         (Primitive::Sphere { center, radius, .. }, _) => {
-            // p(u, v) = c + r (sin θ cos φ, sin θ sin φ, cos θ), φ = 2πu, θ = πv.
-            let d = p - *center;
+            // p(u, v) = c + R r (sin θ cos φ, sin θ sin φ, cos θ), φ = 2πu, θ = πv, in the
+            // sphere's object frame (R its rotation, the identity unless it has one).
+            let r = geometry.sphere_to_object().transpose();
+            let d = geometry.sphere_to_object() * (p - *center);
             let (sin_t, cos_t) = ((d.x * d.x + d.y * d.y).sqrt() / radius, d.z / radius);
             let phi = d.y.atan2(d.x);
             let dpdu = Vec3::new(-d.y, d.x, 0.0) * (2.0 * PI);
             let dpdv = Vec3::new(cos_t * phi.cos(), cos_t * phi.sin(), -sin_t) * (PI * radius);
             if dpdu.length_squared() > 0.0 {
-                (dpdu, dpdv)
+                (r * dpdu, r * dpdv)
             } else {
                 fallback() // at a pole
             }

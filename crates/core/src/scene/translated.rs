@@ -25,6 +25,15 @@ impl Scene {
                     positions: m.positions.iter().map(|&p| moved(p)).collect(),
                     ..m.clone()
                 }),
+                &ShapeGeometry::RotatedSphere {
+                    center,
+                    radius,
+                    rotation,
+                } => ShapeGeometry::RotatedSphere {
+                    center: moved(center),
+                    radius,
+                    rotation,
+                },
                 &ShapeGeometry::Sphere { center, radius } => ShapeGeometry::Sphere {
                     center: moved(center),
                     radius,

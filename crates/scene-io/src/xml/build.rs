@@ -1228,19 +1228,27 @@ impl<'a> Loader<'a> {
                 if !(r > 0.0) {
                     return Err(p.err(e, format!("sphere `radius` must be positive, got {r}")));
                 }
-                let (center, radius) = match &xform {
-                    None => (c, r),
+                let (center, radius, rotation) = match &xform {
+                    None => (c, r, None),
                     Some((x, te)) => {
                         let s = similarity_scale(&x.m).ok_or_else(|| {
                             p.err(te, "a sphere's to_world must be a rotation, uniform scale and translation (an ellipsoid is not supported)")
                         })?;
-                        (x.m.transform_point3(c), r * s)
+                        // The rotation is kept for uv and tangents (Mitsuba's are in the
+                        // sphere's object frame); none when there is none.
+                        let rot = glam::DMat3::from_mat4(x.m) * (1.0 / s);
+                        let rotation = (rot != glam::DMat3::IDENTITY).then_some(rot);
+                        (x.m.transform_point3(c), r * s, rotation)
                     }
                 };
                 if !crate::world::in_range(center) || !(radius as f32).is_finite() {
                     return Err(p.err(e, out_of_range_message("the sphere", center + radius)));
                 }
-                WorldGeometry::Sphere { center, radius }
+                WorldGeometry::Sphere {
+                    center,
+                    radius,
+                    rotation,
+                }
             }
             // Exact disk: the unit disk under `to_world` (an ellipse under a non-uniform scale).
             "disk" => {
