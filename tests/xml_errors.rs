@@ -95,12 +95,19 @@ fn xml_bad_files_give_one_clear_error() {
         line_of(&text, "measured"),
         &["BSDF `measured` is not supported"],
     );
+    let text = scene_xml("    <shape type=\"bsplinecurve\"/>");
+    fails(
+        &d,
+        &text,
+        line_of(&text, "bsplinecurve"),
+        &["shape `bsplinecurve` is not supported"],
+    );
     let text = scene_xml("    <shape type=\"sdfgrid\"/>");
     fails(
         &d,
         &text,
         line_of(&text, "sdfgrid"),
-        &["shape `sdfgrid` is not supported"],
+        &["sdfgrid", "needs a `filename`"],
     );
     // A sheared cylinder: Mitsuba would drop the shear; refused at its transform.
     let text = scene_xml(
