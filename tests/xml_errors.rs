@@ -95,12 +95,29 @@ fn xml_bad_files_give_one_clear_error() {
         line_of(&text, "measured"),
         &["BSDF `measured` is not supported"],
     );
-    let text = scene_xml("    <shape type=\"cylinder\"/>");
+    let text = scene_xml("    <shape type=\"bsplinecurve\"/>");
     fails(
         &d,
         &text,
-        line_of(&text, "cylinder"),
-        &["shape `cylinder` is not supported"],
+        line_of(&text, "bsplinecurve"),
+        &["shape `bsplinecurve` is not supported"],
+    );
+    let text = scene_xml("    <shape type=\"sdfgrid\"/>");
+    fails(
+        &d,
+        &text,
+        line_of(&text, "sdfgrid"),
+        &["sdfgrid", "needs a `filename`"],
+    );
+    // A sheared cylinder: Mitsuba would drop the shear; refused at its transform.
+    let text = scene_xml(
+        "    <shape type=\"cylinder\">\n        <transform name=\"to_world\"><scale x=\"1\" y=\"2\" z=\"1\"/></transform>\n    </shape>",
+    );
+    fails(
+        &d,
+        &text,
+        line_of(&text, "y=\"2\""),
+        &["cylinder", "to_world", "equal along x and y"],
     );
 
     // A texture whose image is missing: named as resolved, at the filename; an unknown texture.
@@ -559,37 +576,30 @@ fn xml_fields_of_view_are_mitsubas() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// A disk is refused, and with `--approximate` becomes an inscribed 256-gon of nearly its area
-/// (π r² (1 − 1.0e-4)), facing +z like Mitsuba's.
+/// A disk is exact (no `--approximate`): Mitsuba's unit disk under `to_world`, an ellipse of area
+/// π·0.5·1.5 under a non-uniform scale, facing +z, and a camera ray through its centre hits it.
 #[test]
-fn xml_disk_is_an_approximation() {
+fn xml_disk_is_exact() {
     let d = dir("disk");
     let text = scene_xml(
-        "    <shape type=\"disk\">\n        <transform name=\"to_world\"><scale value=\"0.5\"/></transform>\n    </shape>",
+        "    <shape type=\"disk\">\n        <transform name=\"to_world\"><scale x=\"0.5\" y=\"1.5\" z=\"1\"/></transform>\n        <emitter type=\"area\"/>\n    </shape>",
     );
-    fails(
-        &d,
-        &text,
-        line_of(&text, "disk"),
-        &["disk", "--approximate"],
-    );
-    let opts = LoadOptions {
-        approximate: true,
-        ..Default::default()
+    let (scene, report) = load_in(&d, "scene.xml", &text, LoadOptions::default()).unwrap();
+    assert!(report.substitutions.is_empty(), "{report:?}");
+    let ShapeGeometry::Disk { to_world } = &scene.shapes[0].geometry else {
+        panic!("not a disk: {:?}", scene.shapes[0].geometry)
     };
-    let (scene, report) = load_in(&d, "scene.xml", &text, opts.clone()).unwrap();
-    assert_eq!(report.substitutions.len(), 1, "{report:?}");
-    let ShapeGeometry::Mesh(m) = &scene.shapes[0].geometry else {
+    assert_eq!(to_world.m.x_axis.x, 0.5);
+    assert_eq!(to_world.m.y_axis.y, 1.5);
+    let lt_core::light::Light::Area(a) = &scene.lights[0] else {
         panic!()
     };
-    let area: f32 = (0..m.indices.len()).map(|i| m.triangle_area(i)).sum();
-    let exact = std::f32::consts::PI * 0.25;
+    let exact = std::f32::consts::PI * 0.75;
     assert!(
-        ((area - exact) / exact + 1.0e-4).abs() < 2e-6,
-        "{area} vs {exact}"
+        (a.area - exact).abs() < 1e-5 * exact,
+        "{} vs {exact}",
+        a.area
     );
-    let [a, b, c] = m.triangle(0);
-    assert!((b - a).cross(c - a).z > 0.0);
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -2,6 +2,8 @@
 //! and cube as meshes) and exact spheres. The scene indexes them for ray queries; area lights
 //! sample them.
 
+pub use crate::geometry::quadric::Affine;
+pub use crate::geometry::sdf::SdfGrid;
 use crate::math::{Color, Vec2, Vec3, PI};
 
 /// A triangle mesh in world space.
@@ -131,10 +133,9 @@ impl TriangleMesh {
                 let v = n.cross(u);
                 let base = positions.len() as u32;
                 for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                    positions.push(n + u * a + v * b);
-                    // Each face its own [0, 1]² (Mitsuba's cube mesh has per-face uvs too; its
-                    // orientation per face is not checked against Mitsuba's).
-                    uvs.push(Vec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0)));
+                    let p = n + u * a + v * b;
+                    positions.push(p);
+                    uvs.push(mitsuba_cube_uv(n, p));
                 }
                 indices.push([base, base + 1, base + 2]);
                 indices.push([base, base + 2, base + 3]);
@@ -170,14 +171,90 @@ impl TriangleMesh {
     }
 }
 
+/// Mitsuba's cube parameterisation: each face its own [0, 1]², oriented as in Mitsuba 3's cube
+/// mesh (per face, its corners V0…V3 carry uv (0,1), (1,1), (1,0), (0,0)), so uv is affine on the
+/// face: u along V2 − V3, v along V0 − V3 (edges of length 2). Listed per face: (normal, V0, V2, V3).
+fn mitsuba_cube_uv(n: Vec3, p: Vec3) -> Vec2 {
+    const FACES: [[[f32; 3]; 4]; 6] = [
+        [
+            [0., -1., 0.],
+            [1., -1., -1.],
+            [-1., -1., 1.],
+            [-1., -1., -1.],
+        ],
+        [[0., 1., 0.], [1., 1., -1.], [-1., 1., 1.], [1., 1., 1.]],
+        [[1., 0., 0.], [1., -1., -1.], [1., 1., 1.], [1., -1., 1.]],
+        [[0., 0., 1.], [1., -1., 1.], [-1., 1., 1.], [-1., -1., 1.]],
+        [
+            [-1., 0., 0.],
+            [-1., -1., 1.],
+            [-1., 1., -1.],
+            [-1., -1., -1.],
+        ],
+        [
+            [0., 0., -1.],
+            [1., 1., -1.],
+            [-1., -1., -1.],
+            [-1., 1., -1.],
+        ],
+    ];
+    let f = FACES
+        .iter()
+        .find(|f| Vec3::from_array(f[0]) == n)
+        .expect("a cube face normal");
+    let [v0, v2, v3] = [f[1], f[2], f[3]].map(Vec3::from_array);
+    let q = p - v3;
+    Vec2::new(q.dot(v2 - v3) / 4.0, q.dot(v0 - v3) / 4.0)
+}
+
 #[derive(Clone, Debug)]
 pub enum ShapeGeometry {
     Mesh(TriangleMesh),
-    Sphere { center: Vec3, radius: f32 },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    /// A sphere whose `to_world` also rotates it (or reflects it): the same surface, but its uv
+    /// and ∂p/∂u follow the rotated object frame, as Mitsuba's do. `rotation` is orthonormal,
+    /// object to world.
+    RotatedSphere {
+        center: Vec3,
+        radius: f32,
+        rotation: glam::Mat3,
+    },
+    /// Mitsuba's disk: the unit disk (z = 0, normal +z) under `to_world`, any invertible affine
+    /// map (a non-uniform scale makes an ellipse).
+    Disk {
+        to_world: Affine,
+    },
+    /// Mitsuba's open cylinder: x² + y² = 1, 0 ≤ z ≤ 1 under `to_world`, a rotation (or
+    /// reflection) times diag(r, r, l) plus a translation (what `quadric::is_round_cylinder_map`
+    /// accepts; area sampling assumes it).
+    Cylinder {
+        to_world: Affine,
+    },
+    /// Mitsuba's `sdfgrid`: the grid's unit cube under `to_world` (any invertible affine map).
+    /// Not an emitter (Mitsuba's cannot be one either).
+    SdfGrid {
+        grid: std::sync::Arc<SdfGrid>,
+        to_world: Affine,
+    },
 }
 
-/// Mitsuba's sphere parameterisation from the unit outward normal (object frame = world axes:
-/// a sphere's rotation is not kept): u = φ / 2π with φ = atan2(y, x) in [0, 2π), v = θ / π.
+impl ShapeGeometry {
+    /// A sphere's world-to-object rotation (the identity for an unrotated one and for any other
+    /// shape): its uv and tangents are read in that frame.
+    #[inline]
+    pub fn sphere_to_object(&self) -> glam::Mat3 {
+        match self {
+            ShapeGeometry::RotatedSphere { rotation, .. } => rotation.transpose(),
+            _ => glam::Mat3::IDENTITY,
+        }
+    }
+}
+
+/// Mitsuba's sphere parameterisation from the unit outward normal in the sphere's object frame
+/// (`ShapeGeometry::sphere_to_object`): u = φ / 2π with φ = atan2(y, x) in [0, 2π), v = θ / π.
 pub fn sphere_uv(n: Vec3) -> Vec2 {
     let phi = n.y.atan2(n.x);
     let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };

@@ -7,7 +7,7 @@ use lt_scene_io::LoadOptions;
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct LoadArgs {
     /// Where a Mitsuba XML scene asks for something lt lacks (a Gaussian pixel
-    /// filter, unbounded max_depth, a disk), substitute the nearest it has and list each
+    /// filter, unbounded max_depth), substitute the nearest it has and list each
     /// substitution, instead of refusing the scene.
     #[arg(long, global = true)]
     pub approximate: bool,

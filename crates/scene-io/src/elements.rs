@@ -764,6 +764,7 @@ fn shape(
             WorldGeometry::Sphere {
                 center,
                 radius: radius.into(),
+                rotation: None,
             }
         }
         "quad" | "cube" => {

@@ -12,6 +12,7 @@ use lt_core::camera::{Camera, FovAxis};
 use lt_core::light::LightDesc;
 use lt_core::math::Vec3;
 use lt_core::scene::{RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
+use lt_core::shape::Affine;
 use lt_core::texture::Texture;
 
 /// Largest world coordinate a scene may hold. f32 products of two coordinates (squared distances,
@@ -93,7 +94,42 @@ pub fn out_of_range_message(what: &str, p: DVec3) -> String {
 #[derive(Clone, Debug)]
 pub enum WorldGeometry {
     Mesh(WorldMesh),
-    Sphere { center: DVec3, radius: f64 },
+    Sphere {
+        center: DVec3,
+        radius: f64,
+        /// The rotation (orthonormal, object to world) of its `to_world`, when not the identity:
+        /// uv and tangents follow it (`ShapeGeometry::RotatedSphere`).
+        rotation: Option<DMat3>,
+    },
+    /// Mitsuba's disk: the unit disk under this object-to-world map (`ShapeGeometry::Disk`).
+    Disk {
+        to_world: DMat4,
+    },
+    /// Mitsuba's open cylinder: the unit cylinder under this map (`ShapeGeometry::Cylinder`).
+    Cylinder {
+        to_world: DMat4,
+    },
+    /// Mitsuba's `sdfgrid`: the grid's unit cube under this map (`ShapeGeometry::SdfGrid`).
+    SdfGrid {
+        grid: std::sync::Arc<lt_core::shape::SdfGrid>,
+        to_world: DMat4,
+    },
+}
+
+/// The world box of the unit disk at height `z` under `m`: per axis, the centre ± √(m_i0² + m_i1²).
+fn disk_box(m: &DMat4, z: f64) -> (DVec3, DVec3) {
+    let c = m.transform_point3(DVec3::new(0.0, 0.0, z));
+    let (x, y) = (m.x_axis.truncate(), m.y_axis.truncate());
+    let e = (x * x + y * y).map(f64::sqrt);
+    (c - e, c + e)
+}
+
+/// The scene's affine map from a world one, translation recentred (subtracted in f64).
+fn local_affine(m: &DMat4, origin: DVec3) -> Affine {
+    Affine::new(
+        DMat3::from_mat4(*m).as_mat3(),
+        (m.w_axis.truncate() - origin).as_vec3(),
+    )
 }
 
 struct WorldShape {
@@ -184,9 +220,32 @@ impl WorldBuilder {
                     indices: m.indices,
                     attributes: m.attributes,
                 }),
-                WorldGeometry::Sphere { center, radius } => ShapeGeometry::Sphere {
+                WorldGeometry::Sphere {
+                    center,
+                    radius,
+                    rotation: None,
+                } => ShapeGeometry::Sphere {
                     center: local(center),
                     radius: radius as f32,
+                },
+                WorldGeometry::Sphere {
+                    center,
+                    radius,
+                    rotation: Some(r),
+                } => ShapeGeometry::RotatedSphere {
+                    center: local(center),
+                    radius: radius as f32,
+                    rotation: r.as_mat3(),
+                },
+                WorldGeometry::Disk { to_world } => ShapeGeometry::Disk {
+                    to_world: local_affine(&to_world, origin),
+                },
+                WorldGeometry::Cylinder { to_world } => ShapeGeometry::Cylinder {
+                    to_world: local_affine(&to_world, origin),
+                },
+                WorldGeometry::SdfGrid { grid, to_world } => ShapeGeometry::SdfGrid {
+                    grid,
+                    to_world: local_affine(&to_world, origin),
                 },
             };
             b.add_emitting_shape(geometry, s.material, s.radiance, s.flip_normals);
@@ -213,8 +272,26 @@ impl WorldBuilder {
                         (lo, hi) = (lo.min(p), hi.max(p));
                     }
                 }
-                &WorldGeometry::Sphere { center, radius } => {
+                &WorldGeometry::Sphere { center, radius, .. } => {
                     (lo, hi) = (lo.min(center - radius), hi.max(center + radius));
+                }
+                WorldGeometry::Disk { to_world } => {
+                    let (a, b) = disk_box(to_world, 0.0);
+                    (lo, hi) = (lo.min(a), hi.max(b));
+                }
+                WorldGeometry::Cylinder { to_world } => {
+                    for z in [0.0, 1.0] {
+                        let (a, b) = disk_box(to_world, z);
+                        (lo, hi) = (lo.min(a), hi.max(b));
+                    }
+                }
+                WorldGeometry::SdfGrid { to_world, .. } => {
+                    for i in 0..8 {
+                        let c =
+                            DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2 & 1) as f64);
+                        let p = to_world.transform_point3(c);
+                        (lo, hi) = (lo.min(p), hi.max(p));
+                    }
                 }
             }
         }

@@ -364,14 +364,27 @@ mod tests {
     use crate::geometry::quad::Parallelogram;
     use crate::sampling::{sample_uniform_sphere, Sampler};
 
-    /// Random triangles, parallelograms and spheres at scale `scale`, `n` of them.
+    /// Random triangles, parallelograms, spheres, disks and cylinders at scale `scale`, `n` of them.
     fn random_primitives(s: &mut Sampler, n: u32, scale: f32) -> Vec<Primitive> {
         (0..n)
             .map(|i| {
                 let c = (s.next_2d().extend(s.next_f32()) - 0.5) * 10.0 * scale;
                 let e1 = sample_uniform_sphere(s.next_2d()) * scale;
                 let e2 = sample_uniform_sphere(s.next_2d()) * scale;
-                match i % 3 {
+                // A disk or cylinder: e1, e2 and their normal (length 0.5) as its axes.
+                let quadric = || {
+                    let m = glam::Mat3::from_cols(e1, e2, 0.5 * e1.cross(e2).normalize() * scale);
+                    crate::geometry::quadric::Affine::new(m, c).inverse()
+                };
+                match i % 5 {
+                    3 => Primitive::Disk {
+                        to_object: quadric(),
+                        shape: i,
+                    },
+                    4 => Primitive::Cylinder {
+                        to_object: quadric(),
+                        shape: i,
+                    },
                     0 => Primitive::Sphere {
                         center: c,
                         radius: (0.3 * s.next_f32() + 0.01) * scale,
@@ -448,6 +461,13 @@ mod tests {
                         Primitive::Quad { q, .. } => q.p0 + 0.3 * q.e1 + 0.6 * q.e2,
                         Primitive::Sphere { center, radius, .. } => {
                             center + Vec3::X * radius * 1.001
+                        }
+                        Primitive::Disk { to_object, .. }
+                        | Primitive::Cylinder { to_object, .. } => {
+                            to_object.inverse().point(Vec3::new(0.5, 0.5, 0.5))
+                        }
+                        Primitive::SdfVoxel { voxel, .. } => {
+                            voxel.to_voxel.inverse().point(Vec3::splat(0.5))
                         }
                     }
                 };

@@ -81,7 +81,7 @@ pub struct Flat {
     quad_ids: Vec<u32>,
     spheres: SphereSoa,
     sphere_ids: Vec<u32>,
-    /// Indices of the triangles, tested one by one.
+    /// Indices of the triangles, disks and cylinders, tested one by one.
     triangles: Vec<u32>,
     isa: Isa,
 }
@@ -145,7 +145,11 @@ impl Flat {
                     spheres.push((center, radius));
                     sphere_ids.push(i);
                 }
-                Primitive::Triangle { .. } => triangles.push(i),
+                // Triangles, disks and cylinders: tested one by one.
+                Primitive::Triangle { .. }
+                | Primitive::Disk { .. }
+                | Primitive::Cylinder { .. }
+                | Primitive::SdfVoxel { .. } => triangles.push(i),
             }
         }
         assert!(Isa::available().contains(&isa), "{isa:?} is not available");

@@ -3,6 +3,8 @@
 //! the flat loops (`flat.rs`), share them.
 
 use super::quad::Parallelogram;
+use super::quadric::{cylinder_bounds, disk_bounds, intersect_cylinder, intersect_disk, Affine};
+use super::sdf::SdfVoxel;
 use super::sphere::intersect_sphere;
 use super::triangle::{intersect_triangle, ShearedRay};
 use crate::math::Vec3;
@@ -29,6 +31,12 @@ pub enum Primitive {
         radius: f32,
         shape: u32,
     },
+    /// Mitsuba's disk: the unit disk under the inverse of `to_object` (`quadric.rs`).
+    Disk { to_object: Affine, shape: u32 },
+    /// Mitsuba's open cylinder: the unit cylinder under the inverse of `to_object`.
+    Cylinder { to_object: Affine, shape: u32 },
+    /// One voxel of an `sdfgrid` that the surface may cross (`sdf.rs`).
+    SdfVoxel { voxel: SdfVoxel, shape: u32 },
 }
 
 impl Primitive {
@@ -36,7 +44,10 @@ impl Primitive {
         match *self {
             Primitive::Triangle { shape, .. }
             | Primitive::Quad { shape, .. }
-            | Primitive::Sphere { shape, .. } => shape,
+            | Primitive::Sphere { shape, .. }
+            | Primitive::Disk { shape, .. }
+            | Primitive::Cylinder { shape, .. }
+            | Primitive::SdfVoxel { shape, .. } => shape,
         }
     }
 
@@ -50,6 +61,9 @@ impl Primitive {
             &Primitive::Sphere { center, radius, .. } => {
                 intersect_sphere(o, d, t_max, center, radius)
             }
+            Primitive::Disk { to_object, .. } => intersect_disk(o, d, t_max, to_object),
+            Primitive::Cylinder { to_object, .. } => intersect_cylinder(o, d, t_max, to_object),
+            Primitive::SdfVoxel { voxel, .. } => voxel.intersect(o, d, t_max),
         }
     }
 }
@@ -71,6 +85,18 @@ impl Boundable for Primitive {
             Primitive::Sphere { center, radius, .. } => {
                 let c = Vec3A::from(center);
                 Aabb::new(c - radius, c + radius)
+            }
+            Primitive::Disk { to_object, .. } => {
+                let (lo, hi) = disk_bounds(&to_object.inverse());
+                Aabb::new(lo.into(), hi.into())
+            }
+            Primitive::Cylinder { to_object, .. } => {
+                let (lo, hi) = cylinder_bounds(&to_object.inverse());
+                Aabb::new(lo.into(), hi.into())
+            }
+            Primitive::SdfVoxel { voxel, .. } => {
+                let (lo, hi) = voxel.bounds();
+                Aabb::new(lo.into(), hi.into())
             }
         }
     }

@@ -1,4 +1,5 @@
-//! Area lights: any triangle mesh or sphere with `emission`, one-sided on its normal side.
+//! Area lights: any triangle mesh, sphere, disk or cylinder with `emission`, one-sided on its
+//! normal side. Disks and cylinders are sampled uniformly by area.
 //! Meshes are sampled uniformly by area (triangle chosen by area). Spheres are sampled by the cone
 //! they subtend when the shading point is outside (much less variance for small, far spheres) and
 //! uniformly by area from inside. A textured radiance (Mitsuba's area emitter with a `radiance`
@@ -7,11 +8,12 @@
 
 use super::{LightLeSample, LightLiSample};
 use crate::geometry::quad::Parallelogram;
+use crate::geometry::quadric::{cylinder_area, cylinder_at, disk_area, disk_at, Affine};
 use crate::geometry::{offset_ray_origin, Ray};
 use crate::math::{gamma, luminance, Color, Frame, Vec2, Vec3, PI};
 use crate::sampling::{
-    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere,
-    sample_uniform_triangle, uniform_cone_pdf, Distribution1D,
+    cosine_hemisphere_pdf, sample_concentric_disk, sample_cosine_hemisphere, sample_uniform_cone,
+    sample_uniform_sphere, sample_uniform_triangle, uniform_cone_pdf, Distribution1D,
 };
 use crate::shape::{ShapeGeometry, TriangleMesh};
 use crate::texture::{TexPoint, Texture};
@@ -37,6 +39,14 @@ enum Emitter {
         center: Vec3,
         radius: f32,
     },
+    /// A disk or cylinder (`quadric.rs`): sampled uniformly by area through its affine map.
+    Disk {
+        to_world: Affine,
+        to_object: Affine,
+    },
+    Cylinder {
+        to_world: Affine,
+    },
 }
 
 #[derive(Clone, Debug)]
@@ -48,6 +58,8 @@ pub struct AreaLight {
     texture: Option<Texture>,
     pub area: f32,
     flip: bool,
+    /// A sphere's world-to-object rotation, for its uv (`ShapeGeometry::sphere_to_object`).
+    sphere_to_object: glam::Mat3,
     emitter: Emitter,
 }
 
@@ -104,10 +116,23 @@ impl AreaLight {
                     total as f32,
                 )
             }
-            &ShapeGeometry::Sphere { center, radius } => (
+            &ShapeGeometry::Sphere { center, radius }
+            | &ShapeGeometry::RotatedSphere { center, radius, .. } => (
                 Emitter::Sphere { center, radius },
                 4.0 * PI * radius * radius,
             ),
+            &ShapeGeometry::Disk { to_world } => (
+                Emitter::Disk {
+                    to_world,
+                    to_object: to_world.inverse(),
+                },
+                disk_area(&to_world),
+            ),
+            &ShapeGeometry::Cylinder { to_world } => {
+                (Emitter::Cylinder { to_world }, cylinder_area(&to_world))
+            }
+            // The loaders refuse an emitting sdfgrid, as Mitsuba does.
+            ShapeGeometry::SdfGrid { .. } => unreachable!("an sdfgrid cannot emit"),
         };
         AreaLight {
             shape,
@@ -115,6 +140,7 @@ impl AreaLight {
             texture,
             area,
             flip: flip_normals,
+            sphere_to_object: geometry.sphere_to_object(),
             emitter,
         }
     }
@@ -156,15 +182,39 @@ impl AreaLight {
                 let uv = self.sphere_uv(n);
                 (p, n, (p.abs() + center.abs()) * gamma(6), uv)
             }
+            // An affine map has a constant area scale on the plane, so the image of a uniform
+            // point on the unit disk is uniform on the ellipse (density 1/area).
+            Emitter::Disk {
+                to_world,
+                to_object,
+            } => {
+                let q = disk_at(sample_concentric_disk(u).extend(0.0), to_world, to_object);
+                (q.p, q.n, q.p_err, self.quadric_uv(q.uv))
+            }
+            // z and φ uniform: uniform by area on a round cylinder (area element r l dφ dz).
+            Emitter::Cylinder { to_world } => {
+                let (sin, cos) = (2.0 * PI * u.y).sin_cos();
+                let q = cylinder_at(Vec3::new(cos, sin, u.x), to_world);
+                (q.p, q.n, q.p_err, self.quadric_uv(q.uv))
+            }
         };
         (p, if self.flip { -n } else { n }, err, TexPoint::at(uv))
+    }
+
+    /// A disk's or cylinder's uv when the light is textured (zero otherwise, as for spheres).
+    #[inline]
+    fn quadric_uv(&self, uv: Vec2) -> Vec2 {
+        match self.texture {
+            Some(_) => uv,
+            None => Vec2::ZERO,
+        }
     }
 
     /// The sphere's uv at outward normal `n` when the light is textured (zero otherwise).
     #[inline]
     fn sphere_uv(&self, n: Vec3) -> Vec2 {
         match self.texture {
-            Some(_) => crate::shape::sphere_uv(n),
+            Some(_) => crate::shape::sphere_uv(self.sphere_to_object * n),
             None => Vec2::ZERO,
         }
     }

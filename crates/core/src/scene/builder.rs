@@ -5,6 +5,8 @@ use super::{RenderSettings, Scene, Shape};
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::geometry::quad::Parallelogram;
+use crate::geometry::quadric;
+use crate::geometry::sdf::SdfVoxel;
 use crate::geometry::{Accel, Primitive};
 use crate::light::{Light, LightDesc, LightSampler};
 use crate::math::{Color, Vec3};
@@ -58,8 +60,24 @@ fn scene_origin(shapes: &[(ShapeGeometry, u32, Option<Texture>, bool)]) -> Vec3 
                     (lo, hi) = (lo.min(p), hi.max(p));
                 }
             }
-            &ShapeGeometry::Sphere { center, radius } => {
+            &ShapeGeometry::Sphere { center, radius }
+            | &ShapeGeometry::RotatedSphere { center, radius, .. } => {
                 (lo, hi) = (lo.min(center - radius), hi.max(center + radius));
+            }
+            ShapeGeometry::Disk { to_world } => {
+                let (a, b) = quadric::disk_bounds(to_world);
+                (lo, hi) = (lo.min(a), hi.max(b));
+            }
+            ShapeGeometry::Cylinder { to_world } => {
+                let (a, b) = quadric::cylinder_bounds(to_world);
+                (lo, hi) = (lo.min(a), hi.max(b));
+            }
+            ShapeGeometry::SdfGrid { to_world, .. } => {
+                for i in 0..8 {
+                    let c = Vec3::new((i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32);
+                    let p = to_world.point(c);
+                    (lo, hi) = (lo.min(p), hi.max(p));
+                }
             }
         }
     }
@@ -148,7 +166,11 @@ impl SceneBuilder {
             for (geometry, ..) in &mut self.shapes {
                 match geometry {
                     ShapeGeometry::Mesh(m) => m.positions.iter_mut().for_each(|p| *p -= origin),
-                    ShapeGeometry::Sphere { center, .. } => *center -= origin,
+                    ShapeGeometry::Sphere { center, .. }
+                    | ShapeGeometry::RotatedSphere { center, .. } => *center -= origin,
+                    ShapeGeometry::Disk { to_world }
+                    | ShapeGeometry::Cylinder { to_world }
+                    | ShapeGeometry::SdfGrid { to_world, .. } => to_world.t -= origin,
                 }
             }
             for light in &mut self.lights {
@@ -165,11 +187,30 @@ impl SceneBuilder {
             let shape_id = shapes.len() as u32;
             match &geometry {
                 ShapeGeometry::Mesh(m) => push_mesh_primitives(m, shape_id, &mut prims),
-                &ShapeGeometry::Sphere { center, radius } => prims.push(Primitive::Sphere {
-                    center,
-                    radius,
+                &ShapeGeometry::Sphere { center, radius }
+                | &ShapeGeometry::RotatedSphere { center, radius, .. } => {
+                    prims.push(Primitive::Sphere {
+                        center,
+                        radius,
+                        shape: shape_id,
+                    })
+                }
+                ShapeGeometry::Disk { to_world } => prims.push(Primitive::Disk {
+                    to_object: to_world.inverse(),
                     shape: shape_id,
                 }),
+                ShapeGeometry::Cylinder { to_world } => prims.push(Primitive::Cylinder {
+                    to_object: to_world.inverse(),
+                    shape: shape_id,
+                }),
+                ShapeGeometry::SdfGrid { grid, to_world } => {
+                    for v in grid.surface_voxels() {
+                        prims.push(Primitive::SdfVoxel {
+                            voxel: SdfVoxel::new(grid, v, to_world),
+                            shape: shape_id,
+                        });
+                    }
+                }
             }
             let light = emission.map(|e| {
                 lights.push(Light::area(shape_id, &geometry, &e, flip_normals));

@@ -2,6 +2,7 @@
 
 use super::{Scene, ShapeGeometry};
 use crate::bsdf::ShadingFrame;
+use crate::geometry::quadric::{cylinder_at, disk_at};
 use crate::geometry::ray::barycentric_error;
 use crate::geometry::sphere::refine_sphere_hit;
 use crate::geometry::triangle::{intersect_triangle, ShearedRay};
@@ -38,6 +39,8 @@ impl SurfaceHit {
         let prim = *scene.accel.primitive(h.prim);
         let shape = &scene.shapes[prim.shape() as usize];
         // `tri`: the mesh triangle holding the point (a parallelogram's source triangle).
+        // `analytic`: a disk's or cylinder's own ∂p/∂u, ∂p/∂v.
+        let mut analytic = None;
         let (p, p_err, mut ng, mut ns, uv, tri, bary) = match prim {
             Primitive::Triangle {
                 p: [p0, p1, p2],
@@ -54,7 +57,7 @@ impl SurfaceHit {
                         m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng),
                         m.uv(index as usize, b0, b1, b2),
                     ),
-                    ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
+                    _ => (ng, Vec2::ZERO),
                 };
                 (p, err, ng, ns, uv, index, [b0, b1, b2])
             }
@@ -73,14 +76,44 @@ impl SurfaceHit {
                             .unwrap_or(ng),
                         m.uv(tri as usize, b[0], b[1], b[2]),
                     ),
-                    ShapeGeometry::Sphere { .. } => (ng, Vec2::ZERO),
+                    _ => (ng, Vec2::ZERO),
                 };
                 (p, err, ng, ns, uv, tri, b)
             }
             Primitive::Sphere { center, radius, .. } => {
                 let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
                 let n = (p - center).normalize();
-                (p, err, n, n, crate::shape::sphere_uv(n), 0, [1.0, 0.0, 0.0])
+                let uv = crate::shape::sphere_uv(shape.geometry.sphere_to_object() * n);
+                (p, err, n, n, uv, 0, [1.0, 0.0, 0.0])
+            }
+            Primitive::Disk { to_object, .. } | Primitive::Cylinder { to_object, .. } => {
+                let local = to_object.point(ray.at(h.t));
+                let q = match shape.geometry {
+                    ShapeGeometry::Disk { to_world } => disk_at(local, &to_world, &to_object),
+                    ShapeGeometry::Cylinder { to_world } => cylinder_at(local, &to_world),
+                    _ => unreachable!("a disk or cylinder primitive of another shape"),
+                };
+                analytic = Some((q.dpdu, q.dpdv));
+                (q.p, q.p_err, q.n, q.n, q.uv, 0, [1.0, 0.0, 0.0])
+            }
+            Primitive::SdfVoxel { voxel, .. } => {
+                let ShapeGeometry::SdfGrid { grid, to_world } = &shape.geometry else {
+                    unreachable!("an sdf voxel of another shape")
+                };
+                let (p, p_err) = sdf_hit_point(ray, h.t, &voxel, to_world);
+                let to_object = to_world.inverse();
+                let local = to_object.point(p);
+                // Normals transform by the inverse transpose of to_world: to_object's transpose.
+                let normal = |g: Vec3| (to_object.m.transpose() * g).normalize_or_zero();
+                let ng = normal(grid.gradient(local));
+                let ng = if ng == Vec3::ZERO { -ray.d } else { ng };
+                let ns = if grid.smooth {
+                    normal(grid.smooth_normal(local))
+                } else {
+                    ng
+                };
+                let ns = if ns == Vec3::ZERO { ng } else { ns };
+                (p, p_err, ng, ns, Vec2::ZERO, 0, [1.0, 0.0, 0.0])
             }
         };
         let uv = TexPoint {
@@ -107,7 +140,8 @@ impl SurfaceHit {
         let mut tangent = Vec3::ZERO;
         let oriented = material.needs_tangent();
         if perturbation.is_some() || oriented {
-            let (dpdu, dpdv) = tangents(&shape.geometry, &prim, tri as usize, p, ng);
+            let (dpdu, dpdv) =
+                analytic.unwrap_or_else(|| tangents(&shape.geometry, &prim, tri as usize, p, ng));
             if oriented {
                 tangent = (dpdu - ns * ns.dot(dpdu))
                     .try_normalize()
@@ -156,6 +190,29 @@ impl SurfaceHit {
     }
 }
 
+/// An sdf hit: the point along the ray, with a bound that covers its rounding and the
+/// uncertainty of the computed zero set — a thousandth of the voxel's smallest world edge, far
+/// above the rounding of a voxel's local coordinates, so a ray spawned off it never finds the
+/// root it leaves (`SdfVoxel::intersect`).
+fn sdf_hit_point(
+    ray: &Ray,
+    t: f32,
+    voxel: &crate::geometry::sdf::SdfVoxel,
+    to_world: &crate::shape::Affine,
+) -> (Vec3, Vec3) {
+    let p = ray.at(t);
+    let w = voxel.to_voxel.inverse();
+    let edge =
+        w.m.x_axis
+            .length()
+            .min(w.m.y_axis.length())
+            .min(w.m.z_axis.length());
+    let err = (ray.o.abs() + (ray.d * t).abs()) * crate::math::gamma(3)
+        + to_world.point_error(Vec3::ONE)
+        + Vec3::splat(1e-3 * edge);
+    (p, err)
+}
+
 /// ∂p/∂u and ∂p/∂v at `p` on a primitive, in the parameterisation `uv` comes from: a mesh
 /// triangle's from its vertex uvs (Mitsuba's (b1, b2) without them), solved from the triangle's
 /// edges (pbrt-v4 §6.5.1, Mitsuba's mesh); a sphere's analytically. Where the uvs are degenerate,
@@ -190,14 +247,16 @@ fn tangents(
             }
         }
         (Primitive::Sphere { center, radius, .. }, _) => {
-            // p(u, v) = c + r (sin θ cos φ, sin θ sin φ, cos θ), φ = 2πu, θ = πv.
-            let d = p - *center;
+            // p(u, v) = c + R r (sin θ cos φ, sin θ sin φ, cos θ), φ = 2πu, θ = πv, in the
+            // sphere's object frame (R its rotation, the identity unless it has one).
+            let r = geometry.sphere_to_object().transpose();
+            let d = geometry.sphere_to_object() * (p - *center);
             let (sin_t, cos_t) = ((d.x * d.x + d.y * d.y).sqrt() / radius, d.z / radius);
             let phi = d.y.atan2(d.x);
             let dpdu = Vec3::new(-d.y, d.x, 0.0) * (2.0 * PI);
             let dpdv = Vec3::new(cos_t * phi.cos(), cos_t * phi.sin(), -sin_t) * (PI * radius);
             if dpdu.length_squared() > 0.0 {
-                (dpdu, dpdv)
+                (r * dpdu, r * dpdv)
             } else {
                 fallback() // at a pole
             }

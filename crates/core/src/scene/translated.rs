@@ -2,6 +2,7 @@
 //! the scene sits in floating-point space (large coordinates leave fewer bits for the geometry).
 
 use super::{LightDesc, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
+use crate::geometry::quadric::Affine;
 use crate::light::Light;
 use crate::math::Vec3;
 
@@ -24,9 +25,28 @@ impl Scene {
                     positions: m.positions.iter().map(|&p| moved(p)).collect(),
                     ..m.clone()
                 }),
+                &ShapeGeometry::RotatedSphere {
+                    center,
+                    radius,
+                    rotation,
+                } => ShapeGeometry::RotatedSphere {
+                    center: moved(center),
+                    radius,
+                    rotation,
+                },
                 &ShapeGeometry::Sphere { center, radius } => ShapeGeometry::Sphere {
                     center: moved(center),
                     radius,
+                },
+                &ShapeGeometry::Disk { to_world } => ShapeGeometry::Disk {
+                    to_world: Affine::new(to_world.m, moved(to_world.t)),
+                },
+                &ShapeGeometry::Cylinder { to_world } => ShapeGeometry::Cylinder {
+                    to_world: Affine::new(to_world.m, moved(to_world.t)),
+                },
+                ShapeGeometry::SdfGrid { grid, to_world } => ShapeGeometry::SdfGrid {
+                    grid: grid.clone(),
+                    to_world: Affine::new(to_world.m, moved(to_world.t)),
                 },
             };
             let radiance = s.light.and_then(|l| match &self.lights[l as usize] {

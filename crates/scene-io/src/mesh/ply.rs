@@ -44,14 +44,16 @@ pub(crate) fn load_ply(ctx: &Ctx, file: &Spanned<String>) -> Result<TriangleMesh
             }
             _ => normals = None,
         }
-        // Texture coordinates under any of the names PLY writers use, v flipped as for OBJ.
+        // Texture coordinates under any of the names PLY writers use, as stored: Mitsuba flips v
+        // for OBJ files only (checked on the suite's various_shapes, whose PLY, OBJ and
+        // serialized rectangles carry the same texture).
         let uv = [("u", "v"), ("s", "t"), ("texture_u", "texture_v")]
             .iter()
             .find_map(|(a, b)| Some((scalar(v, a)?, scalar(v, b)?)));
         match uv {
             Some((a, b)) => {
                 if let Some(t) = &mut uvs {
-                    t.push(Vec2::new(a, 1.0 - b));
+                    t.push(Vec2::new(a, b));
                 }
             }
             None => uvs = None,

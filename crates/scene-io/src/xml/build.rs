@@ -7,7 +7,7 @@ use super::resolve::Resolver;
 use super::values::Xform;
 use crate::error::Ctx;
 use crate::image_file::{filter_type_named, read_bitmap, read_environment_map, wrap_mode_named};
-use crate::mesh::ply;
+use crate::mesh::{ply, serialized};
 use crate::transform::{check_quad, check_solid};
 use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
 use crate::SceneError;
@@ -1231,34 +1231,108 @@ impl<'a> Loader<'a> {
                 if !(r > 0.0) {
                     return Err(p.err(e, format!("sphere `radius` must be positive, got {r}")));
                 }
-                let (center, radius) = match &xform {
-                    None => (c, r),
+                let (center, radius, rotation) = match &xform {
+                    None => (c, r, None),
                     Some((x, te)) => {
                         let s = similarity_scale(&x.m).ok_or_else(|| {
                             p.err(te, "a sphere's to_world must be a rotation, uniform scale and translation (an ellipsoid is not supported)")
                         })?;
-                        (x.m.transform_point3(c), r * s)
+                        // The rotation is kept for uv and tangents (Mitsuba's are in the
+                        // sphere's object frame); none when there is none.
+                        let rot = glam::DMat3::from_mat4(x.m) * (1.0 / s);
+                        let rotation = (rot != glam::DMat3::IDENTITY).then_some(rot);
+                        (x.m.transform_point3(c), r * s, rotation)
                     }
                 };
                 if !crate::world::in_range(center) || !(radius as f32).is_finite() {
                     return Err(p.err(e, out_of_range_message("the sphere", center + radius)));
                 }
-                WorldGeometry::Sphere { center, radius }
+                WorldGeometry::Sphere {
+                    center,
+                    radius,
+                    rotation,
+                }
             }
+            // Exact disk: the unit disk under `to_world` (an ellipse under a non-uniform scale).
             "disk" => {
                 check_quad(&ctx, &m, span.clone())?;
-                self.substitute(
-                    e,
-                    "the analytic disk is not supported (lt has no disk primitive)".into(),
-                    format!("use a {DISK_SIDES}-gon inscribed in it (area {:.1e} smaller)", disk_area_deficit()),
-                )?;
-                placed(WorldMesh::place(&unit_disk_fan(), &m), span)?
+                WorldGeometry::Disk {
+                    to_world: checked_map(&p, e, &m, "disk")?,
+                }
             }
-            "obj" | "ply" => {
+            // Mitsuba's cylinder: to_world · translate(p0) · to_frame(p1 − p0) · scale(r, r, |p1 −
+            // p0|) maps the unit cylinder; Mitsuba then keeps only that map's rotation and its
+            // diagonal stretch (r, l), so a shear or unequal x/y scale is refused here rather
+            // than rendered differently.
+            "cylinder" => {
+                let r = p.float("radius")?.unwrap_or(1.0);
+                let p0 = DVec3::from_array(p.vec3("p0")?.unwrap_or([0.0; 3]));
+                let p1 = DVec3::from_array(p.vec3("p1")?.unwrap_or([0.0, 0.0, 1.0]));
+                let axis = p1 - p0;
+                let len = axis.length();
+                if !(len > 0.0) || !(r != 0.0) || !r.is_finite() {
+                    return Err(p.err(e, format!("a cylinder needs p0 ≠ p1 and a non-zero radius (got radius {r}, |p1 − p0| = {len})")));
+                }
+                // Duff et al.'s orthonormal basis around the axis (Mitsuba's Frame, lt's Frame::from_z).
+                let f = lt_core::math::Frame::from_z(axis.normalize().as_vec3());
+                let frame = DMat4::from_cols(
+                    f.x.as_dvec3().extend(0.0),
+                    f.y.as_dvec3().extend(0.0),
+                    (axis / len).extend(0.0),
+                    glam::DVec4::W,
+                );
+                let full = m
+                    * DMat4::from_translation(p0)
+                    * frame
+                    * DMat4::from_scale(DVec3::new(r, r, len));
+                if !lt_core::geometry::quadric::is_round_cylinder_map(&glam::DMat3::from_mat4(full), 1e-5) {
+                    return Err(p.err(
+                        xform.as_ref().map_or(e, |(_, te)| te),
+                        "a cylinder's to_world must be a rotation, a scale equal along x and y, and a translation (Mitsuba drops shear and unequal x/y scales, with a warning)",
+                    ));
+                }
+                WorldGeometry::Cylinder {
+                    to_world: checked_map(&p, e, &full, "cylinder")?,
+                }
+            }
+            // Mitsuba's SDF grid: its file's values over the unit cube, under to_world.
+            "sdfgrid" => {
+                let Some((file, fe)) = p.string("filename")? else {
+                    return Err(p.err(e, "shape `sdfgrid` needs a `filename`"));
+                };
+                let smooth = match p.string("normals")? {
+                    None | Some(("smooth", _)) => true,
+                    Some(("analytic", _)) => false,
+                    Some((other, ne)) => {
+                        return Err(p.err(ne, format!("sdfgrid `normals` must be `smooth` or `analytic`, got `{other}`")))
+                    }
+                };
+                let path = doc.resolver.resolve(file).map_err(|looked| {
+                    p.err(fe, Resolver::not_found("volume grid file", file, &looked))
+                })?;
+                let resolved = Ctx { base_dir: PathBuf::new(), ..doc.ctx(e.src) };
+                let spanned =
+                    toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
+                let grid = crate::mesh::vol::load_sdf_grid(&resolved, &spanned, smooth)?;
+                self.meshes.push(path);
+                WorldGeometry::SdfGrid {
+                    grid: std::sync::Arc::new(grid),
+                    to_world: checked_map(&p, e, &m, "sdfgrid")?,
+                }
+            }
+            "obj" | "ply" | "serialized" => {
                 let Some((file, fe)) = p.string("filename")? else {
                     return Err(p.err(e, format!("shape `{}` needs a `filename`", p.kind)));
                 };
-                let face_normals = p.boolean("face_normals")?.unwrap_or(false);
+                let mut face_normals = p.boolean("face_normals")?.unwrap_or(false);
+                let shape_index = match p.kind {
+                    "serialized" => p.integer("shape_index")?.map_or(Ok(0), |i| {
+                        u32::try_from(i).map_err(|_| {
+                            p.err(e, format!("`shape_index` must be a non-negative integer, got {i}"))
+                        })
+                    })?,
+                    _ => 0,
+                };
                 check_solid(&ctx, &m, span.clone(), "mesh")?;
                 let path = doc.resolver.resolve(file).map_err(|looked| {
                     p.err(fe, Resolver::not_found("mesh file", file, &looked))
@@ -1268,10 +1342,15 @@ impl<'a> Loader<'a> {
                 let resolved = Ctx { base_dir: PathBuf::new(), ..doc.ctx(e.src) };
                 let spanned =
                     toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
-                let mut mesh = if p.kind == "obj" {
-                    crate::mesh::obj::load_obj(&resolved, &spanned)?
-                } else {
-                    ply::load_ply(&resolved, &spanned)?
+                let mut mesh = match p.kind {
+                    "obj" => crate::mesh::obj::load_obj(&resolved, &spanned)?,
+                    "ply" => ply::load_ply(&resolved, &spanned)?,
+                    _ => {
+                        // The file's own "face normals" flag is the same as `face_normals`.
+                        let s = serialized::load_serialized(&resolved, &spanned, shape_index)?;
+                        face_normals |= s.face_normals;
+                        s.mesh
+                    }
                 };
                 self.meshes.push(path);
                 if face_normals {
@@ -1289,7 +1368,7 @@ impl<'a> Loader<'a> {
             other => {
                 return Err(p.err(
                     e,
-                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, obj and ply, and disk with --approximate)"),
+                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, disk, cylinder, sdfgrid, obj, ply and serialized)"),
                 ))
             }
         };
@@ -1388,6 +1467,12 @@ impl<'a> Loader<'a> {
                     ),
                 ));
             }
+        }
+        if radiance.is_some() && matches!(geometry, WorldGeometry::SdfGrid { .. }) {
+            return Err(p.err(
+                p.elem,
+                "an sdfgrid cannot be an area emitter (Mitsuba's cannot either)",
+            ));
         }
         let ignored: &[&str] = match p.kind {
             "obj" | "ply" => &["flip_tex_coords"],
@@ -1680,32 +1765,21 @@ fn projector_tan_half_x(p: &Plugin, aspect: f64) -> Result<f64, SceneError> {
     Ok(tan_half * to_x)
 }
 
-/// Sides of the polygon `--approximate` puts in place of a disk.
-const DISK_SIDES: u32 = 256;
-
-/// The relative area a regular `DISK_SIDES`-gon inscribed in a circle lacks.
-fn disk_area_deficit() -> f64 {
-    let t = std::f64::consts::TAU / DISK_SIDES as f64;
-    1.0 - DISK_SIDES as f64 * t.sin() / std::f64::consts::TAU
-}
-
-/// Mitsuba's disk (radius 1 in the z = 0 plane, normal +z) as a fan of triangles.
-fn unit_disk_fan() -> TriangleMesh {
-    let mut positions = vec![glam::Vec3::ZERO];
-    for k in 0..DISK_SIDES {
-        let (s, c) = (std::f64::consts::TAU * k as f64 / DISK_SIDES as f64).sin_cos();
-        positions.push(glam::Vec3::new(c as f32, s as f32, 0.0));
+/// The object-to-world map `m` of a disk, cylinder or sdfgrid (of its unit shape), refused when
+/// singular or reaching beyond the coordinates the scene can hold.
+fn checked_map(p: &Plugin, e: &Elem, m: &DMat4, what: &str) -> Result<DMat4, SceneError> {
+    let corner = m.transform_point3(DVec3::ONE);
+    let det = glam::DMat3::from_mat4(*m).determinant();
+    if !crate::world::in_range(corner) || !crate::world::in_range(m.w_axis.truncate()) {
+        return Err(p.err(e, out_of_range_message(&format!("the {what}"), corner)));
     }
-    let indices = (0..DISK_SIDES)
-        .map(|k| [0, 1 + k, 1 + (k + 1) % DISK_SIDES])
-        .collect();
-    TriangleMesh {
-        positions,
-        normals: None,
-        uvs: None,
-        indices,
-        attributes: Vec::new(),
+    if !(det.abs() > 0.0) || !det.is_finite() {
+        return Err(p.err(
+            e,
+            format!("the {what}'s to_world is singular (determinant {det})"),
+        ));
     }
+    Ok(*m)
 }
 
 /// Angle-weighted vertex normals (each face's unit normal weighted by its angle at the vertex),
