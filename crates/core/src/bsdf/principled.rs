@@ -214,11 +214,19 @@ impl LocalBsdf for Principled {
         let front = wo.z > 0.0;
         let (brdf, bsdf) = self.weights();
         let [p_d, p_cc, p_s] = self.lobe_probabilities(front, brdf, bsdf)?;
+        // A microfacet lobe's direction counts only if it leaves on the side the lobe scatters
+        // to and both directions see m from their side (as Mitsuba's sampler rejects it); the
+        // pdf leaves such directions out of that lobe, so a sample there would be one no lobe
+        // accounts for.
         let wi = if u_lobe < p_d {
             sample_cosine_hemisphere(u)
         } else if u_lobe < p_d + p_cc {
             let m = Gtr1::for_gloss(self.clearcoat_gloss).sample(u);
-            reflect(wo, m)
+            let wi = reflect(wo, m);
+            if !(wi.z > 0.0) || self.half_vector(wo, wi).is_none() {
+                return None;
+            }
+            wi
         } else {
             let m = self.distribution().sample_normal(Self::observer(wo), u);
             let cos_om = wo.dot(m);
@@ -230,13 +238,17 @@ impl LocalBsdf for Principled {
             let p_reflect = if front { 1.0 - bsdf * (1.0 - f) } else { f };
             // u_lobe rescaled to [0, 1) within the specular lobe chooses reflection or refraction.
             let u_spec = (u_lobe - (p_d + p_cc)) / p_s;
-            if u_spec < p_reflect {
-                reflect(wo, m)
+            let (wi, reflects) = if u_spec < p_reflect {
+                (reflect(wo, m), true)
             } else {
                 // Snell through m, on wo's side of it.
                 let m_o = if cos_om > 0.0 { m } else { -m };
-                -wo / eta + (cos_om.abs() / eta - cos_t) * m_o
+                (-wo / eta + (cos_om.abs() / eta - cos_t) * m_o, false)
+            };
+            if (wi.z * wo.z > 0.0) != reflects || self.half_vector(wo, wi).is_none() {
+                return None;
             }
+            wi
         };
         if wi.z == 0.0 {
             return None;

@@ -146,11 +146,21 @@ impl LocalBsdf for PrincipledThin {
         }
         let [p_sr, p_st, p_dr, _] = self.lobe_probabilities()?;
         let a = if wo.z < 0.0 { -wo } else { wo };
+        // A specular lobe's direction counts only on its side and where both directions see m
+        // from theirs (Mitsuba's sampler rejects the rest, and the pdf leaves it out).
         let b = if u_lobe < p_sr {
-            reflect(a, self.reflection_distribution().sample_normal(a, u))
+            let b = reflect(a, self.reflection_distribution().sample_normal(a, u));
+            if !(b.z > 0.0) || Self::half_vector(a, b).is_none() {
+                return None;
+            }
+            b
         } else if u_lobe < p_sr + p_st {
             let r = reflect(a, self.transmission_distribution().sample_normal(a, u));
-            Vec3::new(r.x, r.y, -r.z)
+            let b = Vec3::new(r.x, r.y, -r.z);
+            if !(b.z < 0.0) || Self::half_vector(a, b).is_none() {
+                return None;
+            }
+            b
         } else if u_lobe < p_sr + p_st + p_dr {
             sample_cosine_hemisphere(u)
         } else {
