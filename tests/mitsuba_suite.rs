@@ -63,6 +63,12 @@ const EXPECTED_PASSING: &[(&str, &str)] = &[
     ),
     ("mesh_attributes/test_mesh_attributes_1_face_direct", "pt"),
     ("mesh_attributes/test_mesh_attributes_1_face_direct", "bdpt"),
+    ("bsdf_spheres/test_texturedprincipled1_path", "pt"),
+    ("bsdf_spheres/test_texturedprincipled1_path", "bdpt"),
+    ("bsdf_spheres/test_texturedprincipled2_path", "pt"),
+    ("bsdf_spheres/test_texturedprincipled2_path", "bdpt"),
+    ("bsdf_spheres/test_texturedprincipledthin_path", "pt"),
+    ("bsdf_spheres/test_texturedprincipledthin_path", "bdpt"),
 ];
 
 #[test]

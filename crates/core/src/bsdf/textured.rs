@@ -3,6 +3,7 @@
 //! evaluated as usual. Untextured materials never come here, so they keep their bits and speed.
 
 use super::microfacet::Microfacet;
+use super::principled_common::PrincipledParam;
 use super::two_sided::FrontFacing;
 use super::{LocalBsdf, Material};
 use crate::math::Color;
@@ -21,6 +22,8 @@ pub enum TextureSlot {
     AlphaU,
     /// Roughness along y alone (`alpha_v`).
     AlphaV,
+    /// A parameter of `principled` or `principledthin`.
+    Principled(PrincipledParam),
 }
 
 impl TextureSlot {
@@ -30,6 +33,14 @@ impl TextureSlot {
             self,
             TextureSlot::Alpha | TextureSlot::AlphaU | TextureSlot::AlphaV
         )
+    }
+
+    /// A scalar parameter, read as Mitsuba's `eval_1` reads it (`Texture::eval_scalar`) and not
+    /// bounded by 1 as a reflectance is: the roughnesses and every principled parameter but
+    /// `base_color`.
+    pub fn is_scalar(self) -> bool {
+        self.is_roughness()
+            || matches!(self, TextureSlot::Principled(p) if p != PrincipledParam::BaseColor)
     }
 }
 
@@ -43,9 +54,14 @@ pub struct Textured {
 impl Textured {
     /// True when a texture drives one roughness axis alone: the frame must then follow ∂p/∂u.
     pub fn is_anisotropic(&self) -> bool {
-        self.slots
-            .iter()
-            .any(|(s, _)| matches!(s, TextureSlot::AlphaU | TextureSlot::AlphaV))
+        self.slots.iter().any(|(s, _)| {
+            matches!(
+                s,
+                TextureSlot::AlphaU
+                    | TextureSlot::AlphaV
+                    | TextureSlot::Principled(PrincipledParam::Anisotropic)
+            )
+        })
     }
 
     /// Calls `f` with the plain local BSDF at texture coordinates `uv`. The resolved material
@@ -65,8 +81,8 @@ impl Textured {
     /// `m` with every textured parameter set from its texture at `uv`.
     fn resolved(&self, mut m: Material, uv: TexPoint) -> Material {
         for (slot, texture) in &self.slots {
-            // A roughness is a scalar parameter: Mitsuba reads it with `eval_1`.
-            let value = if slot.is_roughness() {
+            // A roughness (any scalar parameter) is read with Mitsuba's `eval_1`.
+            let value = if slot.is_scalar() {
                 Color::splat(texture.eval_scalar(uv))
             } else {
                 texture.eval(uv)
@@ -99,6 +115,8 @@ pub fn set_parameter(m: &mut Material, slot: TextureSlot, value: Color) -> bool 
             r.distribution = with_alpha(r.distribution, slot, value.x)
         }
         (Material::ThinDielectric(t), SpecularReflectance) => t.specular_reflectance = value,
+        (Material::Principled(p), Principled(param)) => return p.set(param, value),
+        (Material::PrincipledThin(p), Principled(param)) => return p.set(param, value),
         (Material::TwoSided(t), slot) => return set_parameter(&mut t.inner, slot, value),
         _ => return false,
     }

@@ -22,7 +22,7 @@ use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, RoughDielectric,
     ThinDielectric, TwoSided,
 };
-use lt_core::bsdf::{Plastic, RoughPlastic};
+use lt_core::bsdf::{Plastic, Principled, PrincipledParam, PrincipledThin, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::math::{Color, Vec2};
 use lt_core::scene::{LightDesc, RenderSettings, Scene, TriangleMesh};
@@ -714,6 +714,13 @@ impl<'a> Loader<'a> {
                     one_sided
                 }
             }
+            "principled" | "principledthin" => {
+                let m = self.principled(&p, &mut slots)?;
+                if in_twosided {
+                    return Err(p.err(e, format!("twosided cannot wrap {} (it transmits, and its back side is its own)", p.kind)));
+                }
+                m
+            }
             "normalmap" | "bumpmap" => {
                 let inner = match p.nested(&["bsdf"])[..] {
                     [one] => self.bsdf(one, in_twosided)?,
@@ -793,7 +800,7 @@ impl<'a> Loader<'a> {
             other => {
                 return Err(p.err(
                     e,
-                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, plastic, roughplastic, twosided, normalmap, bumpmap, mask and blendbsdf)"),
+                    format!("BSDF `{other}` is not supported (lt reads diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, plastic, roughplastic, principled, principledthin, twosided, normalmap, bumpmap, mask and blendbsdf)"),
                 ))
             }
         };
@@ -816,7 +823,7 @@ impl<'a> Loader<'a> {
     ) -> Result<Option<Color>, SceneError> {
         if let Some(t) = p.texture(name) {
             let texture = self.texture(t)?;
-            if !slot.is_roughness() && texture.max_value() > 1.0 {
+            if !slot.is_scalar() && texture.max_value() > 1.0 {
                 return Err(p.err(
                     t,
                     format!(
@@ -828,7 +835,7 @@ impl<'a> Loader<'a> {
             slots.push((slot, texture));
             return Ok(None);
         }
-        let usage = if slot.is_roughness() {
+        let usage = if slot.is_scalar() {
             ColorUse::Emission
         } else {
             ColorUse::Reflectance
@@ -1001,6 +1008,154 @@ impl<'a> Loader<'a> {
             m.specular_sampling_weight = weight;
             Material::RoughPlastic(m)
         })
+    }
+
+    /// Mitsuba's `principled` and `principledthin`: `base_color` (0.5) and the scalars
+    /// `roughness` (0.5), `anisotropic`, `metallic`*, `spec_trans`, `spec_tint`, `sheen`,
+    /// `sheen_tint`, `flatness`, `clearcoat`*, `clearcoat_gloss`* (0), `diff_trans`† (0, range
+    /// 0–2), each a number or a texture; principled's `eta` or `specular` (0.5, one of the two;
+    /// numbers), principledthin's `eta` (1.5, a number or a texture); the sampling rates (1).
+    /// (* principled only, † principledthin only.)
+    fn principled(
+        &mut self,
+        p: &Plugin<'a>,
+        slots: &mut Vec<(TextureSlot, Texture)>,
+    ) -> Result<Material, SceneError> {
+        use PrincipledParam::*;
+        let e = p.elem;
+        let thin = p.kind == "principledthin";
+        let base_color = self
+            .color_or_texture(p, "base_color", TextureSlot::Principled(BaseColor), slots)?
+            .unwrap_or(Color::splat(0.5));
+        // A scalar: a number in [0, max], or a texture whose values stay there.
+        let mut scalar = |this: &mut Self, name: &str, param, default: f32, max: f32| {
+            if let Some(t) = p.texture(name) {
+                let texture = this.texture(t)?;
+                let top = texture.max_value();
+                if !(top <= max) {
+                    return Err(p.err(
+                        t,
+                        format!("the texture of `{name}` reaches {top} (at most {max})"),
+                    ));
+                }
+                slots.push((TextureSlot::Principled(param), texture));
+                return Ok((default, true));
+            }
+            match p.float(name)? {
+                None => Ok((default, false)),
+                Some(x) if (0.0..=max as f64).contains(&x) => Ok((x as f32, x != 0.0)),
+                Some(x) => Err(p.err(e, format!("`{name}` must lie in [0, {max}], got {x}"))),
+            }
+        };
+        let (roughness, _) = scalar(self, "roughness", Roughness, 0.5, 1.0)?;
+        let (anisotropic, _) = scalar(self, "anisotropic", Anisotropic, 0.0, 1.0)?;
+        let (spec_trans, has_spec_trans) = scalar(self, "spec_trans", SpecTrans, 0.0, 1.0)?;
+        let (spec_tint, _) = scalar(self, "spec_tint", SpecTint, 0.0, 1.0)?;
+        let (sheen, _) = scalar(self, "sheen", Sheen, 0.0, 1.0)?;
+        let (sheen_tint, _) = scalar(self, "sheen_tint", SheenTint, 0.0, 1.0)?;
+        let (flatness, _) = scalar(self, "flatness", Flatness, 0.0, 1.0)?;
+        let rate = |name: &str| -> Result<f32, SceneError> {
+            match p.float(name)? {
+                None => Ok(1.0),
+                Some(x) if x >= 0.0 && x.is_finite() => Ok(x as f32),
+                Some(x) => Err(p.err(
+                    e,
+                    format!("`{name}` must be a non-negative number, got {x}"),
+                )),
+            }
+        };
+        if thin {
+            let (diff_trans, _) = scalar(self, "diff_trans", DiffTrans, 0.0, 2.0)?;
+            let eta = match p.texture("eta") {
+                Some(t) => {
+                    let texture = self.texture(t)?;
+                    slots.push((TextureSlot::Principled(Eta), texture));
+                    1.5
+                }
+                None => match p.float("eta")? {
+                    None => 1.5,
+                    Some(x) if x > 0.0 && x.is_finite() => x as f32,
+                    Some(x) => {
+                        return Err(p.err(e, format!("`eta` must be a positive number, got {x}")))
+                    }
+                },
+            };
+            let sampling_rates = [
+                rate("specular_reflectance_sampling_rate")?,
+                rate("specular_transmittance_sampling_rate")?,
+                rate("diffuse_reflectance_sampling_rate")?,
+                rate("diffuse_transmittance_sampling_rate")?,
+            ];
+            return Ok(Material::PrincipledThin(PrincipledThin {
+                base_color,
+                roughness,
+                anisotropic,
+                spec_trans,
+                diff_trans,
+                eta,
+                spec_tint,
+                sheen,
+                sheen_tint,
+                flatness,
+                sampling_rates,
+            }));
+        }
+        let (metallic, _) = scalar(self, "metallic", Metallic, 0.0, 1.0)?;
+        let (clearcoat, _) = scalar(self, "clearcoat", Clearcoat, 0.0, 1.0)?;
+        let (clearcoat_gloss, _) = scalar(self, "clearcoat_gloss", ClearcoatGloss, 0.0, 1.0)?;
+        // `eta` and `specular` name one quantity: Mitsuba refuses both. A transmitting lobe
+        // moves η = 1 (specular 0) off the index-matched interface, as Mitsuba does.
+        let eta = match (p.float("eta")?, p.float("specular")?) {
+            (Some(_), Some(_)) => {
+                return Err(p.err(
+                    e,
+                    "give `eta` or `specular`, not both (they set one quantity)",
+                ))
+            }
+            (Some(x), None) if x > 0.0 && x.is_finite() => {
+                if has_spec_trans && x == 1.0 {
+                    1.001
+                } else {
+                    x as f32
+                }
+            }
+            (Some(x), None) => {
+                return Err(p.err(e, format!("`eta` must be a positive number, got {x}")))
+            }
+            (None, specular) => {
+                let s = specular.unwrap_or(0.5);
+                if !(0.0..1.0 / 0.08).contains(&s) {
+                    return Err(p.err(e, format!("`specular` must lie in [0, 12.5), got {s}")));
+                }
+                let s = if has_spec_trans && s == 0.0 {
+                    1e-3
+                } else {
+                    s as f32
+                };
+                Principled::eta_from_specular(s)
+            }
+        };
+        let sampling_rates = [
+            rate("diffuse_reflectance_sampling_rate")?,
+            rate("clearcoat_sampling_rate")?,
+            rate("main_specular_sampling_rate")?,
+        ];
+        Ok(Material::Principled(Principled {
+            base_color,
+            roughness,
+            anisotropic,
+            metallic,
+            spec_trans,
+            eta,
+            spec_tint,
+            sheen,
+            sheen_tint,
+            flatness,
+            clearcoat,
+            clearcoat_gloss,
+            sampling_rates,
+            has_spec_trans,
+        }))
     }
 
     /// An IOR given as a number or by one of Mitsuba's names.
