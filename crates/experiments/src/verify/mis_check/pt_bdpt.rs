@@ -279,14 +279,14 @@ fn unit_towards(from: &PathVertex, to: &PathVertex) -> lt_core::Vec3 {
 
 /// The `delta` flag a walk stores: a delta surface, or a surface the path leaves through a delta
 /// lobe beside smooth ones (plastic: the oracle's `connectable` is false there), or a light delta
-/// in direction.
+/// in direction, or a camera delta in direction (orthographic: `PathVertex::camera_at`).
 fn is_delta(scene: &Scene, v: &PathVertex, d: &lt_core::path::Densities, i: usize) -> bool {
     match v.kind {
         VertexKind::Surface { material } => {
             scene.material(material).is_delta() || !d.connectable[i]
         }
         VertexKind::Light { light, .. } => scene.lights[light as usize].delta_direction(),
-        VertexKind::Camera => false,
+        VertexKind::Camera => scene.camera.is_delta_direction(),
     }
 }
 
