@@ -2,6 +2,10 @@
 //! why they are one binary and which stay apart). Run one file's checks with, for example,
 //! `cargo test --release --test checks agreement::`.
 
+// The statistics here walk blocks × channels of several parallel arrays at once (run means,
+// references, weights); index loops say that plainest.
+#![allow(clippy::needless_range_loop)]
+
 mod agreement;
 mod consistency;
 mod directional;

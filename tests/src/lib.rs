@@ -151,6 +151,8 @@ pub fn runs_at(
 }
 
 /// Σ over blocks and channels of w [(x̄ − r)² − s²/K], over the runs `keep` selects.
+// Block and channel index four parallel arrays at once; an index loop says it plainest.
+#[allow(clippy::needless_range_loop)]
 pub fn bias2_without_reference(
     blocks: &[Image],
     reference: &BlockEstimate,
@@ -200,6 +202,8 @@ pub fn inverse_variance_weights(last: &[Image], reference: &BlockEstimate) -> Ve
 }
 
 /// Δ = S(a) − S(b) and its standard error (jackknife over runs + the reference's cross term).
+// Block and channel index the runs, the reference and the weights at once.
+#[allow(clippy::needless_range_loop)]
 pub fn bias2_decrease(
     a: &[Image],
     b: &[Image],
