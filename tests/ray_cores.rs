@@ -18,7 +18,13 @@ fn images() -> Vec<(String, Vec<u64>)> {
     for name in shipped_scene_names() {
         let scene = shipped_scene(&name, Some((24, 24)));
         for info in INTEGRATORS {
-            let integ = make_integrator(info.name, &scene, &IntegratorParams::default()).unwrap();
+            let integ = match make_integrator(info.name, &scene, &IntegratorParams::default()) {
+                Ok(integ) => integ,
+                // An orthographic camera is refused by the estimators that splat to it
+                // (robustness.rs holds each refusal by name).
+                Err(_) if scene.camera.is_delta_direction() => continue,
+                Err(e) => panic!("{} on {name}: {e}", info.name),
+            };
             let opts = RenderOptions {
                 passes: 2,
                 time_limit: None,
