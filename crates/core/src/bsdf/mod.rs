@@ -28,7 +28,7 @@ pub mod plastic;
 mod principled;
 pub mod principled_common;
 mod principled_thin;
-mod quadrature;
+pub mod quadrature;
 pub mod refraction;
 mod rough_conductor;
 mod rough_dielectric;

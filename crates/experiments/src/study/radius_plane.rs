@@ -84,29 +84,13 @@ pub fn radiance(x: f64, y: f64) -> f64 {
     ALBEDO / std::f64::consts::PI * INTENSITY * HEIGHT / (d2 * d2.sqrt())
 }
 
-/// Gauss–Legendre nodes and weights on [0, 1] (Newton on P_n).
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 1.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-15 {
-                    break;
-                }
-            }
-            let w = 2.0 / ((1.0 - x * x) * dp * dp);
-            (0.5 * (x + 1.0), 0.5 * w)
-        })
+/// Gauss–Legendre nodes and weights on [0, 1]: the core's rule on [−1, 1], mapped.
+fn gauss_legendre_unit(n: usize) -> Vec<(f64, f64)> {
+    let (nodes, weights) = lt_core::bsdf::quadrature::gauss_legendre(n);
+    nodes
+        .iter()
+        .zip(&weights)
+        .map(|(x, w)| (0.5 * (x + 1.0), 0.5 * w))
         .collect()
 }
 
@@ -122,7 +106,7 @@ pub struct DiscAverage {
 impl DiscAverage {
     pub fn new(radial: usize, angular: usize) -> DiscAverage {
         DiscAverage {
-            radial: gauss_legendre(radial),
+            radial: gauss_legendre_unit(radial),
             angles: (0..angular)
                 .map(|k| {
                     let a = 2.0 * std::f64::consts::PI * k as f64 / angular as f64;
