@@ -395,7 +395,8 @@ fn xml_approximations_are_refused_or_listed() {
     let spectral = scene_xml("    <shape type=\"sphere\">\n        <bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0.2, 500:0.5, 600:0.8, 700:0.9\"/></bsdf>\n    </shape>");
     let (scene, report) = load_in(&d, "scene.xml", &spectral, LoadOptions::default()).unwrap();
     assert!(report.substitutions.is_empty(), "{report:?}");
-    let lt_core::bsdf::Material::Diffuse(diffuse) = scene.material(scene.shapes[0].material) else {
+    let lt_core::bsdf::Material::FrontDiffuse(diffuse) = scene.material(scene.shapes[0].material)
+    else {
         panic!()
     };
     // Mitsuba 3.9.1 holds (0.880858, 0.631926, 0.321875) for it (f32, printed to 6 digits).

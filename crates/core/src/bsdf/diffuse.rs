@@ -1,4 +1,7 @@
-//! Lambertian reflection: f = albedo / π, sampled by the cosine-weighted hemisphere.
+//! Lambertian reflection: f = albedo / π, sampled by the cosine-weighted hemisphere. `Diffuse`
+//! reflects alike on both sides (lt's own scenes); `FrontDiffuse` on the front only, as Mitsuba's
+//! `diffuse` does unless `twosided` wraps it: a back face is black (the inside of an open
+//! cylinder in Mitsuba's various_shapes test).
 
 use super::{LocalBsdf, LocalSample, TransportMode};
 use crate::math::{Color, Vec2, Vec3, INV_PI};
@@ -39,6 +42,45 @@ impl LocalBsdf for Diffuse {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z * wi.z > 0.0 {
             cosine_hemisphere_pdf(wi.z.abs())
+        } else {
+            0.0
+        }
+    }
+
+    fn is_delta(&self) -> bool {
+        false
+    }
+}
+
+/// Mitsuba's one-sided `diffuse`: `Diffuse` where wo and wi are both above the shading surface,
+/// nothing below it.
+#[derive(Clone, Debug)]
+pub struct FrontDiffuse {
+    pub albedo: Color,
+}
+
+impl LocalBsdf for FrontDiffuse {
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<LocalSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        Diffuse {
+            albedo: self.albedo,
+        }
+        .sample(wo, u_lobe, u, mode)
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> Color {
+        if wo.z > 0.0 && wi.z > 0.0 {
+            self.albedo * INV_PI
+        } else {
+            Color::ZERO
+        }
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z > 0.0 && wi.z > 0.0 {
+            cosine_hemisphere_pdf(wi.z)
         } else {
             0.0
         }

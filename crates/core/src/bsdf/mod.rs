@@ -40,7 +40,7 @@ mod two_sided;
 pub use blend::Blend;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
-pub use diffuse::Diffuse;
+pub use diffuse::{Diffuse, FrontDiffuse};
 pub use glossy::Glossy;
 pub use mask::Mask;
 pub use mirror::Mirror;
@@ -177,6 +177,8 @@ pub trait LocalBsdf {
 #[derive(Clone, Debug)]
 pub enum Material {
     Diffuse(Diffuse),
+    /// Mitsuba's `diffuse` outside `twosided`: black from behind.
+    FrontDiffuse(FrontDiffuse),
     Mirror(Mirror),
     Dielectric(Dielectric),
     Glossy(Glossy),
@@ -210,6 +212,7 @@ impl Material {
     fn local(&self) -> &dyn LocalBsdf {
         match self {
             Material::Diffuse(m) => m,
+            Material::FrontDiffuse(m) => m,
             Material::Mirror(m) => m,
             Material::Dielectric(m) => m,
             Material::Glossy(m) => m,
@@ -588,6 +591,10 @@ pub fn test_registry() -> Vec<(&'static str, Material)> {
     };
     vec![
         ("diffuse", Material::Diffuse(Diffuse { albedo: c })),
+        (
+            "diffuse-front",
+            Material::FrontDiffuse(FrontDiffuse { albedo: c }),
+        ),
         ("mirror", Material::Mirror(Mirror { reflectance: c })),
         ("glossy-0.05", glossy(0.05)),
         ("glossy-0.2", glossy(0.2)),

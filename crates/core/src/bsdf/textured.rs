@@ -98,6 +98,7 @@ pub fn set_parameter(m: &mut Material, slot: TextureSlot, value: Color) -> bool 
     use TextureSlot::*;
     match (m, slot) {
         (Material::Diffuse(d), Reflectance) => d.albedo = value,
+        (Material::FrontDiffuse(d), Reflectance) => d.albedo = value,
         (Material::Mirror(x), SpecularReflectance) => x.reflectance = value,
         (Material::Glossy(g), SpecularReflectance) => g.reflectance = value,
         (Material::Glossy(g), Alpha) => g.roughness = value.x.max(super::microfacet::MIN_ALPHA),

@@ -19,8 +19,8 @@ use lt_core::bsdf::microfacet::{Microfacet, MicrofacetType};
 use lt_core::bsdf::plastic::{channel_mean, specular_sampling_weight};
 use lt_core::bsdf::{Blend, Mask, NormalSource, Perturbed, TextureSlot, Textured};
 use lt_core::bsdf::{
-    Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, RoughConductor, RoughDielectric,
-    ThinDielectric, TwoSided,
+    Conductor, Dielectric, Diffuse, FrontDiffuse, Glossy, Material, Mirror, RoughConductor,
+    RoughDielectric, ThinDielectric, TwoSided,
 };
 use lt_core::bsdf::{Plastic, Principled, PrincipledParam, PrincipledThin, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
@@ -599,7 +599,12 @@ impl<'a> Loader<'a> {
                 let albedo = self
                     .color_or_texture(&p, "reflectance", TextureSlot::Reflectance, &mut slots)?
                     .unwrap_or(Color::splat(0.5));
-                Material::Diffuse(Diffuse { albedo })
+                // Mitsuba's BSDFs reflect on the front only unless `twosided` wraps them.
+                if in_twosided {
+                    Material::Diffuse(Diffuse { albedo })
+                } else {
+                    Material::FrontDiffuse(FrontDiffuse { albedo })
+                }
             }
             "twosided" => {
                 if in_twosided {
