@@ -620,6 +620,13 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_spot() {
     per_depth("cornell-spot", 1..=5);
 }
 
+/// Mitsuba's principled BSDFs from TOML: four to five lobes per material, each chosen per sample
+/// with its own probability, must sum to the same pdf and the same f in both transport modes.
+#[test]
+fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_principled() {
+    per_depth("cornell-principled", 1..=5);
+}
+
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_plastic() {
     per_depth("cornell-plastic", 1..=5);

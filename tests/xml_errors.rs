@@ -705,3 +705,80 @@ fn mesh_attribute_names_are_checked_against_the_mesh() {
         load_in(&d, "scene.xml", &with(ok), LoadOptions::default()).unwrap();
     }
 }
+
+/// TOML's `principled`/`principledthin` build the material Mitsuba's XML names build, with the
+/// same defaults, and refuse what the XML refuses (one shared set of checks).
+#[test]
+fn principled_reads_alike_from_toml_and_xml() {
+    let d = dir("principled-toml");
+    let toml = |material: &str| {
+        format!(
+            "[camera]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nfov = 40.0\nresolution = [32, 24]\n\n[materials.m]\n{material}\n\n[[shapes]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\n\n[[lights]]\ntype = \"point\"\nposition = [0.0, 2.0, 0.0]\nintensity = [5.0, 5.0, 5.0]\n"
+        )
+    };
+    let from_toml = |material: &str| {
+        let text = toml(material);
+        lt_scene_io::load_scene_str(&text, &d.join("scene.toml"))
+    };
+    let material_of = |s: &Scene| format!("{:?}", s.material(s.shapes[0].material));
+    let cases = [
+        (
+            "type = \"principled\"",
+            "<bsdf type=\"principled\"/>",
+        ),
+        (
+            "type = \"principled\"\nbase_color = [0.8, 0.2, 0.1]\nroughness = 0.3\nanisotropic = 0.5\nmetallic = 0.7\nspec_trans = 0.2\nspecular = 0.6\nspec_tint = 0.1\nsheen = 0.4\nsheen_tint = 0.2\nflatness = 0.3\nclearcoat = 0.5\nclearcoat_gloss = 0.9",
+            "<bsdf type=\"principled\"><rgb name=\"base_color\" value=\"0.8, 0.2, 0.1\"/><float name=\"roughness\" value=\"0.3\"/><float name=\"anisotropic\" value=\"0.5\"/><float name=\"metallic\" value=\"0.7\"/><float name=\"spec_trans\" value=\"0.2\"/><float name=\"specular\" value=\"0.6\"/><float name=\"spec_tint\" value=\"0.1\"/><float name=\"sheen\" value=\"0.4\"/><float name=\"sheen_tint\" value=\"0.2\"/><float name=\"flatness\" value=\"0.3\"/><float name=\"clearcoat\" value=\"0.5\"/><float name=\"clearcoat_gloss\" value=\"0.9\"/></bsdf>",
+        ),
+        (
+            "type = \"principled\"\nior = 1.0\nspec_trans = 1.0",
+            "<bsdf type=\"principled\"><float name=\"eta\" value=\"1.0\"/><float name=\"spec_trans\" value=\"1\"/></bsdf>",
+        ),
+        (
+            "type = \"principledthin\"",
+            "<bsdf type=\"principledthin\"/>",
+        ),
+        (
+            "type = \"principledthin\"\nbase_color = 0.3\nroughness = 0.2\ndiff_trans = 1.5\nspec_trans = 0.4\nior = 1.33\nsheen = 0.5",
+            "<bsdf type=\"principledthin\"><rgb name=\"base_color\" value=\"0.3\"/><float name=\"roughness\" value=\"0.2\"/><float name=\"diff_trans\" value=\"1.5\"/><float name=\"spec_trans\" value=\"0.4\"/><float name=\"eta\" value=\"1.33\"/><float name=\"sheen\" value=\"0.5\"/></bsdf>",
+        ),
+    ];
+    for (t, x) in cases {
+        let a = from_toml(t).unwrap_or_else(|e| panic!("{t}: {e}"));
+        let xml = scene_xml(&format!("    <shape type=\"sphere\">{x}</shape>"));
+        let (b, _) = load_in(&d, "scene.xml", &xml, LoadOptions::default()).unwrap();
+        assert_eq!(material_of(&a), material_of(&b), "{t}");
+    }
+    // A textured base colour becomes a textured principled material.
+    let checker = "type = \"principled\"\nbase_color_texture = { type = \"checkerboard\", color0 = 0.2, color1 = 0.8 }";
+    let m = material_of(&from_toml(checker).unwrap());
+    assert!(
+        m.starts_with("Textured") && m.contains("Principled(BaseColor)"),
+        "{m}"
+    );
+    // Refusals name the key and point at its line.
+    for (material, at, words) in [
+        ("type = \"principled\"\nmetallic = 1.5", "metallic", &["`metallic`", "[0, 1]"][..]),
+        ("type = \"principled\"\nior = 1.5\nspecular = 0.5", "specular", &["`ior` or `specular`"]),
+        ("type = \"principledthin\"\nclearcoat = 0.5", "clearcoat", &["`clearcoat`", "does not apply"]),
+        ("type = \"principled\"\ndiff_trans = 0.5", "diff_trans", &["`diff_trans`", "does not apply"]),
+        ("type = \"principledthin\"\ndiff_trans = 2.5", "diff_trans", &["`diff_trans`", "[0, 2]"]),
+        ("type = \"diffuse\"\nalbedo = 0.5\nsheen = 0.5", "sheen", &["`sheen`", "does not apply"]),
+        (
+            "type = \"principled\"\nbase_color = 0.5\nbase_color_texture = { type = \"checkerboard\" }",
+            "base_color_texture",
+            &["not both"],
+        ),
+    ] {
+        let text = toml(material);
+        let Err(e) = from_toml(material) else {
+            panic!("{material}: should not load")
+        };
+        let e = e.to_string();
+        let line = 1 + text.lines().position(|l| l.starts_with(at)).unwrap();
+        for w in words {
+            assert!(e.contains(w), "`{w}` missing from: {e}");
+        }
+        assert!(e.contains(&format!(":{line}:")), "line {line} not in: {e}");
+    }
+}

@@ -17,7 +17,7 @@ use lt_core::bsdf::{
     Conductor, Dielectric, Diffuse, Glossy, Material, Mirror, NormalSource, Perturbed,
     RoughConductor, RoughDielectric, TextureSlot, Textured, ThinDielectric, TwoSided,
 };
-use lt_core::bsdf::{Mask, Plastic, RoughPlastic};
+use lt_core::bsdf::{Mask, Plastic, PrincipledParam, RoughPlastic};
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::light::SunLight;
 use lt_core::math::{Color, Vec2, PI};
@@ -321,6 +321,11 @@ fn textured_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Mate
         (&d.alpha_texture, TextureSlot::Alpha, "alpha_texture"),
         (&d.alpha_u_texture, TextureSlot::AlphaU, "alpha_u_texture"),
         (&d.alpha_v_texture, TextureSlot::AlphaV, "alpha_v_texture"),
+        (
+            &d.base_color_texture,
+            TextureSlot::Principled(PrincipledParam::BaseColor),
+            "base_color_texture",
+        ),
     ] {
         let Some(t) = tex else { continue };
         let texture = crate::texture_def::texture(ctx, t)?;
@@ -378,6 +383,22 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
         ("alpha_u_texture", d.alpha_u_texture.as_ref().map(S::span)),
         ("alpha_v_texture", d.alpha_v_texture.as_ref().map(S::span)),
         ("nonlinear", d.nonlinear.as_ref().map(S::span)),
+        ("base_color", d.base_color.as_ref().map(S::span)),
+        (
+            "base_color_texture",
+            d.base_color_texture.as_ref().map(S::span),
+        ),
+        ("anisotropic", d.anisotropic.as_ref().map(S::span)),
+        ("metallic", d.metallic.as_ref().map(S::span)),
+        ("spec_trans", d.spec_trans.as_ref().map(S::span)),
+        ("specular", d.specular.as_ref().map(S::span)),
+        ("spec_tint", d.spec_tint.as_ref().map(S::span)),
+        ("sheen", d.sheen.as_ref().map(S::span)),
+        ("sheen_tint", d.sheen_tint.as_ref().map(S::span)),
+        ("flatness", d.flatness.as_ref().map(S::span)),
+        ("clearcoat", d.clearcoat.as_ref().map(S::span)),
+        ("clearcoat_gloss", d.clearcoat_gloss.as_ref().map(S::span)),
+        ("diff_trans", d.diff_trans.as_ref().map(S::span)),
     ];
     let reflectance = |default: f32| {
         d.reflectance
@@ -512,11 +533,14 @@ fn plain_material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Materia
             }
         }
         "plastic" | "roughplastic" => plastic(ctx, d, kind, &given, &what)?,
+        "principled" | "principledthin" => {
+            crate::principled_def::principled(ctx, d, &given, &what)?
+        }
         other => {
             return Err(ctx.at(
                 d.kind.span(),
                 format!(
-                "unknown material type `{other}` (expected diffuse, mirror, dielectric, roughdielectric, thindielectric, glossy, conductor, roughconductor, plastic or roughplastic)"
+                "unknown material type `{other}` (expected diffuse, mirror, dielectric, roughdielectric, thindielectric, glossy, conductor, roughconductor, plastic, roughplastic, principled or principledthin)"
             ),
             ))
         }

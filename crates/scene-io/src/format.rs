@@ -142,6 +142,21 @@ pub struct MaterialDef {
     /// through with probability 1 − α), a number in [0, 1] or a texture (its luminance).
     pub opacity: Option<S<f64>>,
     pub opacity_texture: Option<S<TextureDef>>,
+    /// `principled` and `principledthin` (Mitsuba's names, `principled_def.rs`): `base_color`
+    /// or `base_color_texture`, `roughness` and `ior` as above, and these scalars.
+    pub base_color: Option<S<ColorDef>>,
+    pub base_color_texture: Option<S<TextureDef>>,
+    pub anisotropic: Option<S<f64>>,
+    pub metallic: Option<S<f64>>,
+    pub spec_trans: Option<S<f64>>,
+    pub specular: Option<S<f64>>,
+    pub spec_tint: Option<S<f64>>,
+    pub sheen: Option<S<f64>>,
+    pub sheen_tint: Option<S<f64>>,
+    pub flatness: Option<S<f64>>,
+    pub clearcoat: Option<S<f64>>,
+    pub clearcoat_gloss: Option<S<f64>>,
+    pub diff_trans: Option<S<f64>>,
 }
 
 /// A texture: `type = "bitmap"` with `file` (PNG, JPEG, BMP, HDR or EXR, relative to the scene

@@ -11,6 +11,8 @@ mod format;
 mod image_file;
 mod mesh;
 mod options;
+mod principled_def;
+mod principled_keys;
 mod texture_def;
 mod toml_file;
 mod transform;

@@ -8,6 +8,7 @@ use super::values::Xform;
 use crate::error::Ctx;
 use crate::image_file::{filter_type_named, read_bitmap, read_environment_map, wrap_mode_named};
 use crate::mesh::{ply, serialized};
+use crate::principled_keys::{principled_eta, scalar_in_range, thin_eta};
 use crate::transform::{check_quad, check_solid};
 use crate::world::{out_of_range_message, LookAt, WorldBuilder, WorldGeometry, WorldMesh};
 use crate::SceneError;
@@ -1048,8 +1049,9 @@ impl<'a> Loader<'a> {
             }
             match p.float(name)? {
                 None => Ok((default, false)),
-                Some(x) if (0.0..=max as f64).contains(&x) => Ok((x as f32, x != 0.0)),
-                Some(x) => Err(p.err(e, format!("`{name}` must lie in [0, {max}], got {x}"))),
+                Some(x) => scalar_in_range(name, x, max)
+                    .map(|v| (v, x != 0.0))
+                    .map_err(|m| p.err(e, m)),
             }
         };
         let (roughness, _) = scalar(self, "roughness", Roughness, 0.5, 1.0)?;
@@ -1077,13 +1079,7 @@ impl<'a> Loader<'a> {
                     slots.push((TextureSlot::Principled(Eta), texture));
                     1.5
                 }
-                None => match p.float("eta")? {
-                    None => 1.5,
-                    Some(x) if x > 0.0 && x.is_finite() => x as f32,
-                    Some(x) => {
-                        return Err(p.err(e, format!("`eta` must be a positive number, got {x}")))
-                    }
-                },
+                None => thin_eta(p.float("eta")?, "eta").map_err(|m| p.err(e, m))?,
             };
             let sampling_rates = [
                 rate("specular_reflectance_sampling_rate")?,
@@ -1108,38 +1104,8 @@ impl<'a> Loader<'a> {
         let (metallic, _) = scalar(self, "metallic", Metallic, 0.0, 1.0)?;
         let (clearcoat, _) = scalar(self, "clearcoat", Clearcoat, 0.0, 1.0)?;
         let (clearcoat_gloss, _) = scalar(self, "clearcoat_gloss", ClearcoatGloss, 0.0, 1.0)?;
-        // `eta` and `specular` name one quantity: Mitsuba refuses both. A transmitting lobe
-        // moves η = 1 (specular 0) off the index-matched interface, as Mitsuba does.
-        let eta = match (p.float("eta")?, p.float("specular")?) {
-            (Some(_), Some(_)) => {
-                return Err(p.err(
-                    e,
-                    "give `eta` or `specular`, not both (they set one quantity)",
-                ))
-            }
-            (Some(x), None) if x > 0.0 && x.is_finite() => {
-                if has_spec_trans && x == 1.0 {
-                    1.001
-                } else {
-                    x as f32
-                }
-            }
-            (Some(x), None) => {
-                return Err(p.err(e, format!("`eta` must be a positive number, got {x}")))
-            }
-            (None, specular) => {
-                let s = specular.unwrap_or(0.5);
-                if !(0.0..1.0 / 0.08).contains(&s) {
-                    return Err(p.err(e, format!("`specular` must lie in [0, 12.5), got {s}")));
-                }
-                let s = if has_spec_trans && s == 0.0 {
-                    1e-3
-                } else {
-                    s as f32
-                };
-                Principled::eta_from_specular(s)
-            }
-        };
+        let eta = principled_eta(p.float("eta")?, p.float("specular")?, has_spec_trans, "eta")
+            .map_err(|m| p.err(e, m))?;
         let sampling_rates = [
             rate("diffuse_reflectance_sampling_rate")?,
             rate("clearcoat_sampling_rate")?,
