@@ -38,9 +38,11 @@ pub fn markdown(rows: &[Row], budget: &Budget, command: &str) -> String {
          written (no `--approximate`), rendered with the estimators its file name implies (`_path`, \
          `_direct`: pt and bdpt; `_ptracer`: light and bdpt) and judged against Mitsuba's reference \
          by its own rule with lt's standard errors: per pixel value z = |mean − ref| / \
-         sqrt(max(se², 1e-4/spp) + max(var, 1e-4)/32000), a value passing when its two-sided \
-         p-value is above the Šidák level 1 − 0.99^(1/pixels), the image when at least {:.2} % of \
-         its values pass.\n\n\
+         sqrt(max(se², 1e-4/n) + max(var, 1e-4)/32000 + (1e-3·ref)²) with n = min(spp, \
+         2·10⁶/pixels) (Mitsuba's floor at no more than its own test's budget) and the reference's \
+         f32 accumulation precision 1e-3 (judge.rs says why), a value passing when its \
+         two-sided p-value is above the Šidák level 1 − 0.99^(1/pixels), the image when at least \
+         {:.2} % of its values pass.\n\n\
          Budget: {} independent passes of {} samples per pixel ({} spp) per estimator, at most {:.0} s \
          per estimator, seed {}; the standard errors are the spread of the passes.\n\n\
          {loads} of {} scenes load; {passing} of {run} renders pass.\n\n\
