@@ -25,7 +25,7 @@ use crate::connect::{
 };
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
-use crate::record::{Completed, NoRecord, Recorder};
+use crate::record::{Completed, NoRecord, Reached, Recorder};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::Integrator;
@@ -223,14 +223,6 @@ struct CameraSample<'a, R> {
     raster: Vec2,
     ratio: f64,
     rec: &'a mut R,
-}
-
-/// A camera walk (camera first) that reached light endpoint `x0` — an emitter it hit, or a light
-/// at infinity it escaped to — with unweighted contribution `value` (strategy s = 0).
-pub(crate) struct Reached<'a> {
-    pub camera: &'a [PathVertex],
-    pub x0: PathVertex,
-    pub value: Color,
 }
 
 impl Bdpt {

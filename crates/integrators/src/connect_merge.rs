@@ -15,14 +15,13 @@
 //! rate, as in SmallVCM, α = 0.75); r₀ is pixel-footprint relative by default (at the mean
 //! primary-hit distance: one radius for the whole pass, which η needs) or scene relative.
 
-use crate::bdpt::Reached;
 use crate::connect::{
     connect_to_camera, emission_densities, join, nee_density, next_event, Joined, NextEvent,
 };
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
 use crate::radius::InitialRadius;
-use crate::record::{Completed, Merged, NoRecord, Recorder};
+use crate::record::{Completed, Merged, NoRecord, Reached, Recorder};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::{ProgressLog, ProgressiveRun};
