@@ -236,15 +236,6 @@ impl Bdpt {
         self.light_paths(scene) as f64 / scene.camera.pixel_count() as f64
     }
 
-    fn limits(&self, camera: bool) -> WalkLimits {
-        let d = self.params.max_depth as usize;
-        WalkLimits {
-            // t ≤ k + 1 camera vertices (s = 0), s ≤ k light vertices (t = 1).
-            max_vertices: if camera { d + 1 } else { d },
-            rr_depth: self.params.rr_depth,
-        }
-    }
-
     /// One camera sample as `pair` says; returns the pixel's own estimate (strategies t ≥ 2).
     fn sample<R: Recorder>(
         &self,
@@ -269,7 +260,12 @@ impl Bdpt {
         let h = self.params.mis;
         let max_k = self.params.max_depth as usize;
         let mut ls = Sampler::for_item(Domain::Light, seed, light_index, pass as u64);
-        light_subpath(scene, &mut ls, self.limits(false), &mut scratch.light);
+        light_subpath(
+            scene,
+            &mut ls,
+            WalkLimits::light(self.params.max_depth, self.params.rr_depth),
+            &mut scratch.light,
+        );
         let y = &scratch.light.vertices;
         let light_nee = if y.len() >= 2 {
             nee_density(scene, &y[0], &y[1])
@@ -332,7 +328,7 @@ impl Bdpt {
             scene,
             raster,
             &mut cs,
-            self.limits(true),
+            WalkLimits::camera(self.params.max_depth, self.params.rr_depth),
             &mut scratch.camera,
         );
         let z = &scratch.camera.vertices;

@@ -127,14 +127,6 @@ impl VcmParams {
     pub fn radius_scale(&self, pass: u32) -> f64 {
         ((pass + 1) as f64).powf((self.alpha - 1.0) / 2.0)
     }
-
-    fn limits(&self, camera: bool) -> WalkLimits {
-        let d = self.max_depth as usize;
-        WalkLimits {
-            max_vertices: if camera { d + 1 } else { d },
-            rr_depth: self.rr_depth,
-        }
-    }
 }
 
 /// r₀ in scene units: footprint-relative radii use the footprint at the mean distance of primary
@@ -318,7 +310,12 @@ impl<'a> Engine<'a> {
                 chunk.starts.push(0);
                 for j in c * LIGHT_CHUNK..((c + 1) * LIGHT_CHUNK).min(m) {
                     let mut ls = Sampler::for_item(Domain::Light, seed, j, pass as u64);
-                    light_subpath(scene, &mut ls, self.params.limits(false), &mut sub);
+                    light_subpath(
+                        scene,
+                        &mut ls,
+                        WalkLimits::light(self.params.max_depth, self.params.rr_depth),
+                        &mut sub,
+                    );
                     light_records(scene, &setup.mis, &sub.vertices, &mut chunk.mis);
                     chunk.vertices.extend_from_slice(&sub.vertices);
                     chunk.starts.push(chunk.vertices.len() as u32);
@@ -500,7 +497,7 @@ impl<'a> Engine<'a> {
             scene,
             raster,
             &mut cs,
-            self.params.limits(true),
+            WalkLimits::camera(self.params.max_depth, self.params.rr_depth),
             &mut scratch.camera,
         );
         let z = &scratch.camera.vertices;

@@ -113,6 +113,25 @@ pub struct WalkLimits {
     pub rr_depth: u32,
 }
 
+impl WalkLimits {
+    /// The camera subpaths of a bidirectional estimator of paths of at most `max_depth`
+    /// segments: t ≤ k + 1 vertices (strategy s = 0).
+    pub fn camera(max_depth: u32, rr_depth: u32) -> WalkLimits {
+        WalkLimits {
+            max_vertices: max_depth as usize + 1,
+            rr_depth,
+        }
+    }
+
+    /// Its light subpaths: s ≤ k vertices (strategy t = 1).
+    pub fn light(max_depth: u32, rr_depth: u32) -> WalkLimits {
+        WalkLimits {
+            max_vertices: max_depth as usize,
+            rr_depth,
+        }
+    }
+}
+
 /// A camera walk that left the scene: the radiance of lights at infinity along `dir` completes
 /// it (technique s = 0 with x0 at infinity).
 #[derive(Clone, Copy, Debug)]
