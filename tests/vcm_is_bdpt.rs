@@ -5,10 +5,10 @@
 
 use lt_core::path::Heuristic;
 use lt_integrators::bdpt::{Bdpt, BdptParams};
-use lt_integrators::connect_merge::{initial_radius, Engine, VcmParams};
+use lt_integrators::connect_merge::{initial_radius, Engine, PassInputs, VcmParams};
 use lt_integrators::radius::InitialRadius;
 use lt_integrators::record::{Completed, Recorder};
-use lt_integrators::splat::Splats;
+use lt_integrators::splat::{Pass, Splats, Worker};
 use lt_integrators::{make_integrator, Estimator, Integrator, IntegratorParams};
 use lt_tests::{shipped_scene, shipped_scene_names};
 
@@ -64,17 +64,18 @@ fn vcm_without_merging_gives_every_path_bdpts_weight() {
             let mut scratch = engine.scratch();
             let mut splats = Splats::new(12, 12);
             let items = 144u64.max(vp.light_path_count(&scene));
+            let inputs = PassInputs {
+                setup: &setup,
+                lights: &lights,
+                pass: Pass { seed: 5, pass: 3 },
+            };
+            let mut worker = Worker {
+                splats: &mut splats,
+                scratch: &mut scratch,
+                rec: &mut got,
+            };
             for i in 0..items {
-                engine.item(
-                    &setup,
-                    &lights,
-                    5,
-                    3,
-                    i,
-                    &mut splats,
-                    &mut scratch,
-                    &mut got,
-                );
+                engine.item(&inputs, i, &mut worker);
             }
             assert_eq!(
                 got.0.len(),

@@ -25,8 +25,8 @@ use crate::connect::{
 };
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
-use crate::record::{Completed, NoRecord, Recorder};
-use crate::splat::{splat_pass_with, Splats};
+use crate::record::{Completed, NoRecord, Reached, Recorder};
+use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::bsdf::BsdfEval;
@@ -207,6 +207,24 @@ pub struct Scratch {
     prefix: Vec<PathVertex>,
 }
 
+/// What one camera sample pairs: the pixel it samples (none for items past the pixel count), the
+/// light subpath it connects to, and whether this sample splats that light subpath's t = 1
+/// strategies (each light subpath is splatted by exactly one sample).
+#[derive(Clone, Copy, Debug)]
+struct Pairing {
+    pixel: Option<u64>,
+    light_index: u64,
+    splat_light: bool,
+}
+
+/// What every strategy of one camera sample shares: its film position, the light-paths-per-pixel
+/// ratio MIS needs, and the recorder.
+struct CameraSample<'a, R> {
+    raster: Vec2,
+    ratio: f64,
+    rec: &'a mut R,
+}
+
 impl Bdpt {
     fn light_paths(&self, scene: &Scene) -> u64 {
         self.params
@@ -218,37 +236,36 @@ impl Bdpt {
         self.light_paths(scene) as f64 / scene.camera.pixel_count() as f64
     }
 
-    fn limits(&self, camera: bool) -> WalkLimits {
-        let d = self.params.max_depth as usize;
-        WalkLimits {
-            // t ≤ k + 1 camera vertices (s = 0), s ≤ k light vertices (t = 1).
-            max_vertices: if camera { d + 1 } else { d },
-            rr_depth: self.params.rr_depth,
-        }
-    }
-
-    /// One camera sample of pixel `pixel` paired with light subpath `light_index`; splats t = 1
-    /// contributions when `splat_light` (each light subpath is splatted by exactly one sample).
-    /// Returns the pixel's own estimate (strategies t ≥ 2).
-    #[allow(clippy::too_many_arguments)]
+    /// One camera sample as `pair` says; returns the pixel's own estimate (strategies t ≥ 2).
     fn sample<R: Recorder>(
         &self,
         scene: &Scene,
-        seed: u64,
-        pass: u32,
-        pixel: Option<u64>,
-        light_index: u64,
-        splat_light: bool,
-        splats: &mut Splats,
-        scratch: &mut Scratch,
-        rec: &mut R,
+        pass: Pass,
+        pair: Pairing,
+        worker: &mut Worker<'_, Scratch, R>,
     ) -> Color {
+        let Pass { seed, pass } = pass;
+        let Pairing {
+            pixel,
+            light_index,
+            splat_light,
+        } = pair;
+        let Worker {
+            splats,
+            scratch,
+            rec,
+        } = worker;
         let cam = &scene.camera;
         let ratio = self.ratio(scene);
         let h = self.params.mis;
         let max_k = self.params.max_depth as usize;
         let mut ls = Sampler::for_item(Domain::Light, seed, light_index, pass as u64);
-        light_subpath(scene, &mut ls, self.limits(false), &mut scratch.light);
+        light_subpath(
+            scene,
+            &mut ls,
+            WalkLimits::light(self.params.max_depth, self.params.rr_depth),
+            &mut scratch.light,
+        );
         let y = &scratch.light.vertices;
         let light_nee = if y.len() >= 2 {
             nee_density(scene, &y[0], &y[1])
@@ -311,10 +328,16 @@ impl Bdpt {
             scene,
             raster,
             &mut cs,
-            self.limits(true),
+            WalkLimits::camera(self.params.max_depth, self.params.rr_depth),
             &mut scratch.camera,
         );
         let z = &scratch.camera.vertices;
+        let prefix = &mut scratch.prefix;
+        let mut ctx = CameraSample {
+            raster,
+            ratio,
+            rec: &mut **rec,
+        };
         let mut l = Color::ZERO;
         for t in 2..=z.len() {
             let zv = &z[t - 1];
@@ -323,17 +346,12 @@ impl Bdpt {
                 if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter) {
                     let le = scene.lights[li as usize].emitted(x0.ng, x0.wo, x0.uv);
                     if le != Color::ZERO {
-                        let value = zv.beta * le;
-                        l += self.emitter_reached(
-                            scene,
-                            &z[..t - 1],
+                        let reached = Reached {
+                            camera: &z[..t - 1],
                             x0,
-                            value,
-                            raster,
-                            &mut scratch.prefix,
-                            ratio,
-                            rec,
-                        );
+                            value: zv.beta * le,
+                        };
+                        l += self.emitter_reached(scene, reached, prefix, &mut ctx);
                     }
                 }
             }
@@ -342,7 +360,7 @@ impl Bdpt {
             }
             // s = 1: next-event estimation from z_{t−1}.
             if t <= max_k {
-                l += self.next_event_weighted(scene, z, t, &mut cs, ratio, raster, rec);
+                l += self.next_event_weighted(scene, &z[..t], &mut cs, &mut ctx);
             }
             // s ≥ 2: shadow rays to the light subpath's vertices.
             for s in 2..=y.len().min(max_k + 1 - t) {
@@ -369,7 +387,7 @@ impl Bdpt {
                 };
                 let wgt = mis_weight(scene, split, evals, h, ratio);
                 if R::ACTIVE {
-                    rec.completed(Completed {
+                    ctx.rec.completed(Completed {
                         s,
                         light: &y[..s],
                         camera: &z[..t],
@@ -391,38 +409,27 @@ impl Bdpt {
                         continue;
                     }
                     let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
-                    let value = esc.beta * le;
-                    l += self.emitter_reached(
-                        scene,
-                        z,
+                    let reached = Reached {
+                        camera: z,
                         x0,
-                        value,
-                        raster,
-                        &mut scratch.prefix,
-                        ratio,
-                        rec,
-                    );
+                        value: esc.beta * le,
+                    };
+                    l += self.emitter_reached(scene, reached, prefix, &mut ctx);
                 }
             }
         }
         weighted(l, film.weight)
     }
 
-    /// Strategy s = 0: the camera walk `camera` (camera first) reached light endpoint `x0`
-    /// (an emitter it hit, or a light at infinity it escaped to) with unweighted contribution
-    /// `value`. Returns the weighted contribution.
-    #[allow(clippy::too_many_arguments)]
+    /// Strategy s = 0: the weighted contribution of the walk that `reached` a light.
     fn emitter_reached<R: Recorder>(
         &self,
         scene: &Scene,
-        camera: &[PathVertex],
-        x0: PathVertex,
-        value: Color,
-        raster: Vec2,
+        reached: Reached,
         prefix: &mut Vec<PathVertex>,
-        ratio: f64,
-        rec: &mut R,
+        ctx: &mut CameraSample<'_, R>,
     ) -> Color {
+        let Reached { camera, x0, value } = reached;
         prefix.clear();
         prefix.extend_from_slice(camera);
         prefix.push(x0);
@@ -431,34 +438,38 @@ impl Bdpt {
             camera: prefix,
             light_nee: 0.0,
         };
-        let w = mis_weight(scene, split, EndEvals::default(), self.params.mis, ratio);
+        let w = mis_weight(
+            scene,
+            split,
+            EndEvals::default(),
+            self.params.mis,
+            ctx.ratio,
+        );
         if R::ACTIVE {
             let n = prefix.len();
-            rec.completed(Completed {
+            ctx.rec.completed(Completed {
                 s: 0,
                 light: &prefix[n - 1..],
                 camera: &prefix[..n - 1],
                 weight: w,
                 value,
-                raster,
+                raster: ctx.raster,
                 alternatives: &[],
             });
         }
         value * w as f32
     }
 
-    /// Strategy s = 1 at camera vertex z_{t−1}: one light chosen by power and sampled towards it.
-    #[allow(clippy::too_many_arguments)]
+    /// Strategy s = 1 at the camera subpath's last vertex z_{t−1} (`z` = z_0 … z_{t−1}): one
+    /// light chosen by power and sampled towards it.
     fn next_event_weighted<R: Recorder>(
         &self,
         scene: &Scene,
         z: &[PathVertex],
-        t: usize,
         sampler: &mut Sampler,
-        ratio: f64,
-        raster: Vec2,
-        rec: &mut R,
+        ctx: &mut CameraSample<'_, R>,
     ) -> Color {
+        let t = z.len();
         let Some(NextEvent {
             x0,
             camera_end: ev_z,
@@ -476,15 +487,15 @@ impl Bdpt {
             light_end: None,
             camera_end: Some(ev_z),
         };
-        let w = mis_weight(scene, split, evals, self.params.mis, ratio);
+        let w = mis_weight(scene, split, evals, self.params.mis, ctx.ratio);
         if R::ACTIVE {
-            rec.completed(Completed {
+            ctx.rec.completed(Completed {
                 s: 1,
                 light: std::slice::from_ref(&x0),
                 camera: &z[..t],
                 weight: w,
                 value,
-                raster,
+                raster: ctx.raster,
                 alternatives: &[],
             });
         }
@@ -498,8 +509,13 @@ impl Bdpt {
         let m = self.light_paths(scene);
         let mut scratch = self.scratch();
         let mut splats = Splats::new(scene.camera.width, scene.camera.height);
+        let mut worker = Worker {
+            splats: &mut splats,
+            scratch: &mut scratch,
+            rec,
+        };
         for i in 0..n.max(m) {
-            self.item(scene, seed, pass, i, &mut splats, &mut scratch, rec);
+            self.item(scene, Pass { seed, pass }, i, &mut worker);
         }
     }
 
@@ -514,23 +530,23 @@ impl Bdpt {
 
     /// Work item i of a pass (0 … max(N, M)−1): pixel i (when i < N) with light subpath i mod M, splatting that
     /// light subpath when i < M; items N … M−1 (M > N) splat their light subpath only.
-    #[allow(clippy::too_many_arguments)]
     pub fn item<R: Recorder>(
         &self,
         scene: &Scene,
-        seed: u64,
-        pass: u32,
+        pass: Pass,
         i: u64,
-        splats: &mut Splats,
-        scratch: &mut Scratch,
-        rec: &mut R,
+        worker: &mut Worker<'_, Scratch, R>,
     ) {
         let n = scene.camera.pixel_count() as u64;
         let m = self.light_paths(scene);
-        let pixel = (i < n).then_some(i);
-        let l = self.sample(scene, seed, pass, pixel, i % m, i < m, splats, scratch, rec);
-        if let Some(p) = pixel {
-            splats.add_to_pixel(p as u32, l);
+        let pair = Pairing {
+            pixel: (i < n).then_some(i),
+            light_index: i % m,
+            splat_light: i < m,
+        };
+        let l = self.sample(scene, pass, pair, worker);
+        if let Some(p) = pair.pixel {
+            worker.splats.add_to_pixel(p as u32, l);
         }
     }
 }
@@ -554,7 +570,14 @@ impl Integrator for Bdpt {
             items,
             CHUNK,
             || self.scratch(),
-            |i, splats, scratch| self.item(scene, seed, pass, i, splats, scratch, &mut NoRecord),
+            |i, splats, scratch| {
+                let mut worker = Worker {
+                    splats,
+                    scratch,
+                    rec: &mut NoRecord,
+                };
+                self.item(scene, Pass { seed, pass }, i, &mut worker)
+            },
         )
     }
 }

@@ -21,13 +21,14 @@ use crate::connect::{
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
 use crate::radius::InitialRadius;
-use crate::record::{Completed, Merged, NoRecord, Recorder};
-use crate::splat::{splat_pass_with, Splats};
+use crate::record::{Completed, Merged, NoRecord, Reached, Recorder};
+use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::{ProgressLog, ProgressiveRun};
 use lt_core::bsdf::TransportMode;
 use lt_core::math::{Color, Vec2, Vec3, PI};
 use lt_core::path::scatter::{connectable, connectable_inside};
+use lt_core::path::subpath_mis::{ConnectionDensities, NextEventDensities, VertexTechniques};
 use lt_core::path::{
     CameraMis, Heuristic, LightMis, PathVertex, SubpathMis, TechniqueSet, VertexKind,
 };
@@ -125,14 +126,6 @@ impl VcmParams {
     /// r_i / r_0 of pass `pass` (0-based; iteration i = pass + 1).
     pub fn radius_scale(&self, pass: u32) -> f64 {
         ((pass + 1) as f64).powf((self.alpha - 1.0) / 2.0)
-    }
-
-    fn limits(&self, camera: bool) -> WalkLimits {
-        let d = self.max_depth as usize;
-        WalkLimits {
-            max_vertices: if camera { d + 1 } else { d },
-            rr_depth: self.rr_depth,
-        }
     }
 }
 
@@ -317,7 +310,12 @@ impl<'a> Engine<'a> {
                 chunk.starts.push(0);
                 for j in c * LIGHT_CHUNK..((c + 1) * LIGHT_CHUNK).min(m) {
                     let mut ls = Sampler::for_item(Domain::Light, seed, j, pass as u64);
-                    light_subpath(scene, &mut ls, self.params.limits(false), &mut sub);
+                    light_subpath(
+                        scene,
+                        &mut ls,
+                        WalkLimits::light(self.params.max_depth, self.params.rr_depth),
+                        &mut sub,
+                    );
                     light_records(scene, &setup.mis, &sub.vertices, &mut chunk.mis);
                     chunk.vertices.extend_from_slice(&sub.vertices);
                     chunk.starts.push(chunk.vertices.len() as u32);
@@ -385,36 +383,45 @@ impl<'a> Engine<'a> {
             CHUNK,
             || self.scratch(),
             |i, splats, scratch| {
-                self.item(setup, lights, seed, pass, i, splats, scratch, &mut NoRecord)
+                let inputs = PassInputs {
+                    setup,
+                    lights,
+                    pass: Pass { seed, pass },
+                };
+                let mut worker = Worker {
+                    splats,
+                    scratch,
+                    rec: &mut NoRecord,
+                };
+                self.item(&inputs, i, &mut worker)
             },
         )
     }
 
     /// Work item i: pixel i (i < N) with light subpath i mod M, splatting light subpath i (i < M),
     /// exactly as `bdpt` pairs them.
-    #[allow(clippy::too_many_arguments)]
     pub fn item<R: Recorder>(
         &self,
-        setup: &PassSetup,
-        lights: &LightPaths,
-        seed: u64,
-        pass: u32,
+        inputs: &PassInputs,
         i: u64,
-        splats: &mut Splats,
-        scratch: &mut Scratch,
-        rec: &mut R,
+        worker: &mut Worker<'_, Scratch, R>,
     ) {
+        let PassInputs {
+            setup,
+            lights,
+            pass: Pass { seed, pass },
+        } = *inputs;
         let n = self.scene.camera.pixel_count() as u64;
         let m = setup.light_paths;
         let light = lights.path((i % m) as usize);
         if i < m && self.params.connections {
             // A thin lens draws its lens points from the light path's own lens stream.
             let mut lens = Sampler::for_item(Domain::Lens, seed, i, pass as u64);
-            self.splat_light_path(setup, light, &mut lens, splats, rec);
+            self.splat_light_path(setup, light, &mut lens, worker.splats, worker.rec);
         }
         if i < n {
-            let l = self.camera_sample(setup, lights, light, seed, pass, i, scratch, rec);
-            splats.add_to_pixel(i as u32, l);
+            let l = self.camera_sample(inputs, light, i, worker);
+            worker.splats.add_to_pixel(i as u32, l);
         }
     }
 
@@ -465,18 +472,19 @@ impl<'a> Engine<'a> {
     }
 
     /// The camera sample of `pixel`: every technique with t ≥ 2 (merges included).
-    #[allow(clippy::too_many_arguments)]
     fn camera_sample<R: Recorder>(
         &self,
-        setup: &PassSetup,
-        lights: &LightPaths,
-        (y, ly): (&[PathVertex], &[LightMis]),
-        seed: u64,
-        pass: u32,
+        inputs: &PassInputs,
+        light: (&[PathVertex], &[LightMis]),
         pixel: u64,
-        scratch: &mut Scratch,
-        rec: &mut R,
+        worker: &mut Worker<'_, Scratch, R>,
     ) -> Color {
+        let PassInputs {
+            setup,
+            lights,
+            pass: Pass { seed, pass },
+        } = *inputs;
+        let scratch = &mut *worker.scratch;
         let scene = self.scene;
         let max_k = self.params.max_depth as usize;
         let mis = &setup.mis;
@@ -489,12 +497,18 @@ impl<'a> Engine<'a> {
             scene,
             raster,
             &mut cs,
-            self.params.limits(true),
+            WalkLimits::camera(self.params.max_depth, self.params.rr_depth),
             &mut scratch.camera,
         );
         let z = &scratch.camera.vertices;
         camera_records(scene, mis, z, &mut scratch.records);
         let zr = &scratch.records;
+        let cam = CameraWalk { z, zr };
+        let mut ctx = CameraSample {
+            mis,
+            raster,
+            rec: &mut *worker.rec,
+        };
         let mut l = Color::ZERO;
         for t in 2..=z.len() {
             let zv = &z[t - 1];
@@ -506,15 +520,12 @@ impl<'a> Engine<'a> {
                         let wgt = self.emitter_weight(mis, &z[..t - 1], zr, &x0, zv.pdf_fwd);
                         let value = zv.beta * le;
                         if R::ACTIVE {
-                            self.record_emitter(
-                                &z[..t - 1],
+                            let reached = Reached {
+                                camera: &z[..t - 1],
                                 x0,
                                 value,
-                                wgt,
-                                raster,
-                                &mut scratch.prefix,
-                                rec,
-                            );
+                            };
+                            record_emitter(reached, wgt, &mut scratch.prefix, &mut ctx);
                         }
                         l += value * wgt as f32;
                     }
@@ -525,14 +536,14 @@ impl<'a> Engine<'a> {
             }
             if self.params.connections {
                 if t <= max_k {
-                    l += self.next_event_weighted(mis, z, zr, t, &mut cs, raster, rec);
+                    l += self.next_event_weighted(cam, t, &mut cs, &mut ctx);
                 }
-                for s in 2..=y.len().min(max_k + 1 - t) {
-                    l += self.connect(mis, y, ly, z, zr, s, t, raster, rec);
+                for s in 2..=light.0.len().min(max_k + 1 - t) {
+                    l += self.connect(light, cam, (s, t), &mut ctx);
                 }
             }
             if self.params.merging && t <= max_k {
-                l += self.merge(setup, lights, z, zr, t, raster, rec);
+                l += self.merge(setup, lights, cam, t, &mut ctx);
             }
         }
         // s = 0 at infinity: the walk left the scene after its last vertex.
@@ -547,7 +558,12 @@ impl<'a> Engine<'a> {
                     let wgt = self.emitter_weight(mis, z, zr, &x0, esc.pdf_w);
                     let value = esc.beta * le;
                     if R::ACTIVE {
-                        self.record_emitter(z, x0, value, wgt, raster, &mut scratch.prefix, rec);
+                        let reached = Reached {
+                            camera: z,
+                            x0,
+                            value,
+                        };
+                        record_emitter(reached, wgt, &mut scratch.prefix, &mut ctx);
                     }
                     l += value * wgt as f32;
                 }
@@ -579,45 +595,16 @@ impl<'a> Engine<'a> {
         mis.emitter_hit(&records[camera.len() - 1], c0 as f64, l0, l1, nee, vc1)
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn record_emitter<R: Recorder>(
-        &self,
-        camera: &[PathVertex],
-        x0: PathVertex,
-        value: Color,
-        weight: f64,
-        raster: Vec2,
-        prefix: &mut Vec<PathVertex>,
-        rec: &mut R,
-    ) {
-        prefix.clear();
-        prefix.extend_from_slice(camera);
-        prefix.push(x0);
-        let n = prefix.len();
-        rec.completed(Completed {
-            s: 0,
-            light: &prefix[n - 1..],
-            camera: &prefix[..n - 1],
-            weight,
-            value,
-            raster,
-            alternatives: &[],
-        });
-    }
-
     /// s = 1 at camera vertex z_{t−1}: one light chosen by power and sampled towards it (the
     /// random numbers `bdpt` draws, in its order).
-    #[allow(clippy::too_many_arguments)]
     fn next_event_weighted<R: Recorder>(
         &self,
-        mis: &SubpathMis,
-        z: &[PathVertex],
-        zr: &[CameraMis],
+        cam: CameraWalk,
         t: usize,
         sampler: &mut Sampler,
-        raster: Vec2,
-        rec: &mut R,
+        ctx: &mut CameraSample<'_, R>,
     ) -> Color {
+        let CameraWalk { z, zr } = cam;
         let scene = self.scene;
         let zv = &z[t - 1];
         let Some(NextEvent {
@@ -636,35 +623,37 @@ impl<'a> Engine<'a> {
             0.0
         };
         let nee = x0.pdf_fwd as f64;
-        let w = mis.next_event(&zr[t - 1], &zr[t - 2], nee, c0, l0, l1, l2);
+        let d = NextEventDensities {
+            nee,
+            c0,
+            l0,
+            l1,
+            l_z_prev: l2,
+        };
+        let w = ctx.mis.next_event((&zr[t - 1], &zr[t - 2]), d);
         if R::ACTIVE {
-            rec.completed(Completed {
+            ctx.rec.completed(Completed {
                 s: 1,
                 light: std::slice::from_ref(&x0),
                 camera: &z[..t],
                 weight: w,
                 value,
-                raster,
+                raster: ctx.raster,
                 alternatives: &[],
             });
         }
         value * w as f32
     }
 
-    /// s ≥ 2, t ≥ 2: a shadow ray from z_{t−1} to y_{s−1}.
-    #[allow(clippy::too_many_arguments)]
+    /// Strategy (s, t), s ≥ 2, t ≥ 2: a shadow ray from z_{t−1} to y_{s−1}.
     fn connect<R: Recorder>(
         &self,
-        mis: &SubpathMis,
-        y: &[PathVertex],
-        ly: &[LightMis],
-        z: &[PathVertex],
-        zr: &[CameraMis],
-        s: usize,
-        t: usize,
-        raster: Vec2,
-        rec: &mut R,
+        (y, ly): (&[PathVertex], &[LightMis]),
+        cam: CameraWalk,
+        (s, t): (usize, usize),
+        ctx: &mut CameraSample<'_, R>,
     ) -> Color {
+        let CameraWalk { z, zr } = cam;
         let scene = self.scene;
         let (yv, zv) = (&y[s - 1], &z[t - 1]);
         if !connectable(scene, yv) {
@@ -686,23 +675,21 @@ impl<'a> Engine<'a> {
         } else {
             0.0
         };
-        let w = mis.connection(
-            &ly[s - 1],
-            &zr[t - 1],
-            &zr[t - 2],
+        let d = ConnectionDensities {
             c_y,
             c_y_prev,
             l_z,
             l_z_prev,
-        );
+        };
+        let w = ctx.mis.connection(&ly[s - 1], (&zr[t - 1], &zr[t - 2]), d);
         if R::ACTIVE {
-            rec.completed(Completed {
+            ctx.rec.completed(Completed {
                 s,
                 light: &y[..s],
                 camera: &z[..t],
                 weight: w,
                 value: c,
-                raster,
+                raster: ctx.raster,
                 alternatives: &[],
             });
         }
@@ -710,17 +697,15 @@ impl<'a> Engine<'a> {
     }
 
     /// Merges at z_{t−1} with every stored light vertex within the pass's radius (disk kernel).
-    #[allow(clippy::too_many_arguments)]
     fn merge<R: Recorder>(
         &self,
         setup: &PassSetup,
         lights: &LightPaths,
-        z: &[PathVertex],
-        zr: &[CameraMis],
+        cam: CameraWalk,
         t: usize,
-        raster: Vec2,
-        rec: &mut R,
+        ctx: &mut CameraSample<'_, R>,
     ) -> Color {
+        let CameraWalk { z, zr } = cam;
         let scene = self.scene;
         let zv = &z[t - 1];
         let Some(grid) = &lights.grid else {
@@ -771,13 +756,13 @@ impl<'a> Engine<'a> {
                 .merge(&y.mis, &zr[t - 1], &zr[t - 2], c_y_prev, l_z_prev);
             if R::ACTIVE {
                 let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
-                rec.merged(Merged {
+                ctx.rec.merged(Merged {
                     i: y.segments as usize,
                     light: &lights.chunks[y.chunk as usize].vertices[first..=vi],
                     camera: &z[..t],
                     weight: w,
                     value: value * setup.merge_norm,
-                    raster,
+                    raster: ctx.raster,
                     radius: setup.radius,
                 });
             }
@@ -785,6 +770,54 @@ impl<'a> Engine<'a> {
         });
         sum * setup.merge_norm
     }
+}
+
+/// Reports an s = 0 path (a walk that `reached` a light) with its weight, copying the walk and the
+/// light endpoint into `prefix`.
+fn record_emitter<R: Recorder>(
+    reached: Reached,
+    weight: f64,
+    prefix: &mut Vec<PathVertex>,
+    ctx: &mut CameraSample<'_, R>,
+) {
+    let Reached { camera, x0, value } = reached;
+    prefix.clear();
+    prefix.extend_from_slice(camera);
+    prefix.push(x0);
+    let n = prefix.len();
+    ctx.rec.completed(Completed {
+        s: 0,
+        light: &prefix[n - 1..],
+        camera: &prefix[..n - 1],
+        weight,
+        value,
+        raster: ctx.raster,
+        alternatives: &[],
+    });
+}
+
+/// One pass's inputs to its work items: the setup (MIS, radius), the pass's light subpaths, and
+/// the seed and pass that key every random stream.
+#[derive(Clone, Copy)]
+pub struct PassInputs<'a> {
+    pub setup: &'a PassSetup,
+    pub lights: &'a LightPaths,
+    pub pass: Pass,
+}
+
+/// A camera subpath z_0 … and its MIS records, one per vertex.
+#[derive(Clone, Copy)]
+struct CameraWalk<'a> {
+    z: &'a [PathVertex],
+    zr: &'a [CameraMis],
+}
+
+/// What every technique of one camera sample shares: the pass's MIS, the sample's film position,
+/// and the recorder.
+struct CameraSample<'a, R> {
+    mis: &'a SubpathMis,
+    raster: Vec2,
+    rec: &'a mut R,
 }
 
 /// The MIS records of a light subpath y_0 … (see `SubpathMis`), appended to `out`.
@@ -803,22 +836,18 @@ fn light_records(scene: &Scene, mis: &SubpathMis, y: &[PathVertex], out: &mut Ve
         let c_pp = if j >= 2 { y[j - 2].pdf_rev as f64 } else { 0.0 };
         let prev = out[base + j - 1];
         let surface = matches!(y[j].kind, VertexKind::Surface { .. });
-        let r = mis.light_vertex(
-            j,
-            y[j].pdf_fwd as f64,
-            &prev,
-            c_pp,
+        let vertex = VertexTechniques {
             // VC(1) is next-event estimation: the light samples x0 itself (`Chain::valid`).
             // VC(j) joins y_j, the end, to y_{j−1}, inside the path.
-            if j == 1 {
+            vc_valid: if j == 1 {
                 connectable(scene, &y[1])
             } else {
                 connectable_inside(scene, &y[j - 1]) && connectable(scene, &y[j])
             },
-            nee_over_l0,
-            surface && connectable(scene, &y[j]) && mis.merging(),
-            y[j].delta,
-        );
+            mergeable: surface && connectable(scene, &y[j]) && mis.merging(),
+            through_delta: y[j].delta,
+        };
+        let r = mis.light_vertex(j, y[j].pdf_fwd as f64, (&prev, c_pp), nee_over_l0, vertex);
         out.push(r);
     }
 }
@@ -829,15 +858,17 @@ fn camera_records(scene: &Scene, mis: &SubpathMis, z: &[PathVertex], out: &mut V
     out.push(mis.camera_origin());
     for m in 1..z.len() {
         let surface = matches!(z[m].kind, VertexKind::Surface { .. });
+        let vertex = VertexTechniques {
+            // VC(i+1) joins z_m, the end, to z_{m−1}, inside the path.
+            vc_valid: connectable(scene, &z[m]) && connectable_inside(scene, &z[m - 1]),
+            mergeable: surface && connectable(scene, &z[m]) && mis.merging(),
+            through_delta: z[m].delta,
+        };
         let r = mis.camera_vertex(
             m,
             z[m].pdf_fwd as f64,
-            &out[m - 1],
-            z[m - 1].pdf_rev as f64,
-            // VC(i+1) joins z_m, the end, to z_{m−1}, inside the path.
-            connectable(scene, &z[m]) && connectable_inside(scene, &z[m - 1]),
-            surface && connectable(scene, &z[m]) && mis.merging(),
-            z[m].delta,
+            (&out[m - 1], z[m - 1].pdf_rev as f64),
+            vertex,
         );
         out.push(r);
     }

@@ -205,70 +205,59 @@ impl PhotonMap {
         PhotonMap { batch, grid }
     }
 
-    /// The radiance estimate at `gp` from the photons within r, per unit of β_gp.
-    pub fn radiance_within(
-        &self,
-        scene: &Scene,
-        gp: &GatherPoint,
-        r: f32,
-        kernel: Kernel,
-        max_depth: u32,
-    ) -> Color {
+    /// The radiance estimate at `q.gp` from the photons within r, per unit of β_gp.
+    pub fn radiance_within(&self, q: &Gather, r: f32) -> Color {
         let r2 = r * r;
         let mut sum = Color::ZERO;
         self.grid
-            .for_each_within(&self.batch.positions, gp.p, r, |i, d2| {
-                sum += self.weighted(scene, gp, i, d2, r2, kernel, max_depth);
+            .for_each_within(&self.batch.positions, q.gp.p, r, |i, d2| {
+                sum += self.weighted(q, i, d2, r2);
             });
         sum / (PI * r2 * self.batch.paths as f32)
     }
 
-    /// One photon's kernel-weighted value at `gp` (before 1/(π r² N)).
-    #[allow(clippy::too_many_arguments)]
+    /// Photon `i`'s kernel-weighted value at `q.gp` (before 1/(π r² N)), at squared distance `d2`
+    /// in a disk of squared radius `r2`.
     #[inline]
-    fn weighted(
-        &self,
-        scene: &Scene,
-        gp: &GatherPoint,
-        i: u32,
-        d2: f32,
-        r2: f32,
-        kernel: Kernel,
-        max_depth: u32,
-    ) -> Color {
-        let w = kernel.shape(d2, r2);
+    fn weighted(&self, q: &Gather, i: u32, d2: f32, r2: f32) -> Color {
+        let w = q.kernel.shape(d2, r2);
         if w == 0.0 {
             return Color::ZERO;
         }
         let ph = &self.batch.photons[i as usize];
-        gp.photon_value(scene, ph, max_depth)
+        q.gp.photon_value(q.scene, ph, q.max_depth)
             .map_or(Color::ZERO, |v| v * w)
     }
 
-    /// The radiance estimate at `gp` from its k nearest photons (within `max_r`), the radius being
-    /// the distance to the k-th (Jensen's estimate). `scratch` is reused between calls.
-    #[allow(clippy::too_many_arguments)]
+    /// The radiance estimate at `q.gp` from its k nearest photons (within `max_r`), the radius
+    /// being the distance to the k-th (Jensen's estimate). `scratch` is reused between calls.
     pub fn radiance_knn(
         &self,
-        scene: &Scene,
-        gp: &GatherPoint,
+        q: &Gather,
         k: usize,
         max_r: f32,
-        kernel: Kernel,
-        max_depth: u32,
         scratch: &mut Vec<(u32, f32)>,
     ) -> Color {
         self.grid
-            .k_nearest(&self.batch.positions, gp.p, k, max_r, scratch);
+            .k_nearest(&self.batch.positions, q.gp.p, k, max_r, scratch);
         let Some(&(_, r2)) = scratch.last() else {
             return Color::ZERO;
         };
         if !(r2 > 0.0) {
             return Color::ZERO;
         }
-        let sum = scratch.iter().fold(Color::ZERO, |s, &(i, d2)| {
-            s + self.weighted(scene, gp, i, d2, r2, kernel, max_depth)
-        });
+        let sum = scratch
+            .iter()
+            .fold(Color::ZERO, |s, &(i, d2)| s + self.weighted(q, i, d2, r2));
         sum / (PI * r2 * self.batch.paths as f32)
     }
+}
+
+/// One density-estimation query: the gather point, the kernel, and the longest path a photon may
+/// complete there.
+pub struct Gather<'a> {
+    pub scene: &'a Scene,
+    pub gp: &'a GatherPoint,
+    pub kernel: Kernel,
+    pub max_depth: u32,
 }

@@ -21,7 +21,7 @@
 //! | `direct` | nee/photons | nee | direct light by next-event estimation (first photon hits not stored) or from photons |
 
 use crate::params::ParamReader;
-use crate::photons::{trace_photons, Kernel, PhotonMap, PhotonOptions};
+use crate::photons::{trace_photons, Gather, Kernel, PhotonMap, PhotonOptions};
 use crate::pixel::pixel_pass;
 use crate::radius::InitialRadius;
 use crate::visible::{trace_visible_point, Direct};
@@ -153,19 +153,17 @@ impl ProgressiveRun for PmRun<'_> {
                 return prefix.direct();
             };
             let r = p.radius.at(scene, &vp);
+            let q = Gather {
+                scene,
+                gp: &vp.gp,
+                kernel: p.kernel,
+                max_depth: p.max_depth,
+            };
             let l = match p.knn {
-                None => map.radiance_within(scene, &vp.gp, r, p.kernel, p.max_depth),
-                Some(k) => SCRATCH.with(|s| {
-                    map.radiance_knn(
-                        scene,
-                        &vp.gp,
-                        k as usize,
-                        8.0 * r,
-                        p.kernel,
-                        p.max_depth,
-                        &mut s.borrow_mut(),
-                    )
-                }),
+                None => map.radiance_within(&q, r),
+                Some(k) => {
+                    SCRATCH.with(|s| map.radiance_knn(&q, k as usize, 8.0 * r, &mut s.borrow_mut()))
+                }
             };
             if pass == 0 {
                 r_fixed.fetch_add(fixed(r), Ordering::Relaxed);

@@ -180,6 +180,14 @@ impl ProgressiveState {
             // (results/bench.md). Each visible point still sums its photons in photon order, so
             // the image keeps its bits.
             let grid = PointGrid::build(&positions, 2.0 * r_max);
+            let points = IndexedPoints {
+                prefixes,
+                pixel_of: &pixel_of,
+                positions: &positions,
+                radii2: &radii2,
+                grid: &grid,
+                r_max,
+            };
             let lists: Vec<Vec<(u32, Color)>> = batch
                 .positions
                 .par_chunks(PUSH_CHUNK)
@@ -187,10 +195,7 @@ impl ProgressiveState {
                 .map(|(ps, phs)| {
                     let mut list = Vec::new();
                     for (xp, ph) in ps.iter().zip(phs) {
-                        push_one(
-                            scene, prefixes, &pixel_of, &positions, &radii2, &grid, params, *xp,
-                            ph, r_max, &mut list,
-                        );
+                        push_one(scene, &points, params, *xp, ph, &mut list);
                     }
                     list
                 })
@@ -254,22 +259,37 @@ impl ProgressiveState {
     }
 }
 
-/// One photon's contributions to the visible points within their radii (appended to `list`).
-#[allow(clippy::too_many_arguments)]
+/// A pass's visible points as the photon push sees them: point k lies at `positions[k]` with
+/// squared radius `radii2[k]` and belongs to pixel `pixel_of[k]` (whose prefix holds it),
+/// indexed by `grid`; `r_max` is the largest radius.
+struct IndexedPoints<'a> {
+    prefixes: &'a [CameraPrefix],
+    pixel_of: &'a [u32],
+    positions: &'a [Vec3],
+    radii2: &'a [f32],
+    grid: &'a PointGrid,
+    r_max: f32,
+}
+
+/// One photon (at `xp`)'s contributions to the visible points within their radii (appended to
+/// `list`).
 #[inline]
 fn push_one(
     scene: &Scene,
-    prefixes: &[CameraPrefix],
-    pixel_of: &[u32],
-    positions: &[Vec3],
-    radii2: &[f32],
-    grid: &PointGrid,
+    points: &IndexedPoints,
     params: &ProgressiveParams,
     xp: Vec3,
     ph: &Photon,
-    r_max: f32,
     list: &mut Vec<(u32, Color)>,
 ) {
+    let IndexedPoints {
+        prefixes,
+        pixel_of,
+        positions,
+        radii2,
+        grid,
+        r_max,
+    } = *points;
     grid.for_each_within(positions, xp, r_max, |k, d2| {
         let r2 = radii2[k as usize];
         if !(d2 <= r2) {

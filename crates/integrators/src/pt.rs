@@ -20,13 +20,12 @@
 use crate::params::ParamReader;
 use crate::pixel::pixel_pass;
 use crate::record::{Completed, NoRecord, Recorder};
-use crate::walk::{continue_path, escaped_radiance};
+use crate::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
 use crate::Integrator;
-use lt_core::bsdf::{ShadingFrame, TransportMode};
+use lt_core::bsdf::TransportMode;
 use lt_core::math::Color;
 use lt_core::path::{Heuristic, PathVertex};
 use lt_core::sampling::Sampler;
-use lt_core::scene::SurfaceHit;
 use lt_core::{Scene, Vec2};
 use lt_estimators::Image;
 
@@ -51,6 +50,14 @@ impl Techniques {
             )),
         }
     }
+}
+
+/// Where NEE reports the path it completes when a recorder listens (`lt mis-check`): the
+/// recorder, the camera subpath so far and the pixel.
+struct Report<'a, R> {
+    rec: &'a mut R,
+    camera_path: &'a [PathVertex],
+    raster: Vec2,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -117,19 +124,20 @@ impl Pt {
         }
     }
 
-    /// Next-event estimation at `hit`: one light chosen by power, weighted against the BSDF.
-    #[allow(clippy::too_many_arguments)]
+    /// Next-event estimation at `at`: one light chosen by power, weighted against the BSDF.
     fn direct_light<R: Recorder>(
         &self,
         scene: &Scene,
-        hit: &SurfaceHit,
-        sf: &ShadingFrame,
-        wo: lt_core::Vec3,
+        at: &WalkPoint,
         sampler: &mut Sampler,
-        rec: &mut R,
-        camera_path: &[PathVertex],
-        raster: Vec2,
+        report: Report<'_, R>,
     ) -> Color {
+        let WalkPoint { hit, sf, wo } = *at;
+        let Report {
+            rec,
+            camera_path,
+            raster,
+        } = report;
         let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
             return Color::ZERO;
         };
@@ -187,6 +195,7 @@ impl Pt {
         rec: &mut R,
     ) -> Color {
         let nee = self.params.techniques != Techniques::Bsdf;
+        let rules = WalkRules::camera(self.params.rr_depth);
         let mut ray = scene.camera.sample_ray(raster, sampler);
         let mut beta = Color::ONE;
         let mut l = Color::ZERO;
@@ -256,21 +265,20 @@ impl Pt {
             }
             let material = scene.material(hit.material);
             let sf = hit.shading_frame();
-            if nee && !material.is_delta() {
-                l += beta * self.direct_light(scene, &hit, &sf, wo, sampler, rec, &verts, raster);
-            }
-            let Some(bs) = continue_path(
-                scene,
-                &hit,
-                &sf,
+            let at = WalkPoint {
+                hit: &hit,
+                sf: &sf,
                 wo,
-                &mut beta,
-                Color::ONE,
-                depth,
-                self.params.rr_depth,
-                TransportMode::Radiance,
-                sampler,
-            ) else {
+            };
+            if nee && !material.is_delta() {
+                let report = Report {
+                    rec: &mut *rec,
+                    camera_path: &verts,
+                    raster,
+                };
+                l += beta * self.direct_light(scene, &at, sampler, report);
+            }
+            let Some(bs) = continue_path(scene, &at, &rules, &mut beta, depth, sampler) else {
                 break;
             };
             if R::ACTIVE {

@@ -11,9 +11,8 @@
 
 use crate::params::ParamReader;
 use crate::pixel::pixel_pass;
-use crate::walk::{continue_path, escaped_radiance};
+use crate::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
 use crate::Integrator;
-use lt_core::bsdf::TransportMode;
 use lt_core::math::Color;
 use lt_core::sampling::Sampler;
 use lt_core::{Scene, Vec2};
@@ -55,18 +54,13 @@ impl PtBsdf {
             if depth == self.params.max_depth {
                 break;
             }
-            let Some(bs) = continue_path(
-                scene,
-                &hit,
-                &hit.shading_frame(),
+            let at = WalkPoint {
+                hit: &hit,
+                sf: &hit.shading_frame(),
                 wo,
-                &mut beta,
-                Color::ONE,
-                depth,
-                self.params.rr_depth,
-                TransportMode::Radiance,
-                sampler,
-            ) else {
+            };
+            let rules = WalkRules::camera(self.params.rr_depth);
+            let Some(bs) = continue_path(scene, &at, &rules, &mut beta, depth, sampler) else {
                 break;
             };
             ray = hit.spawn_ray(bs.wi);

@@ -146,3 +146,19 @@ mod tests {
         assert!(a.data.iter().all(|p| p[0] > 0.0));
     }
 }
+
+/// Which pass of which seed: every random stream of a work item is keyed by these two.
+#[derive(Clone, Copy, Debug)]
+pub struct Pass {
+    pub seed: u64,
+    pub pass: u32,
+}
+
+/// One worker's mutable state in a splatting pass: the splat buffer it writes, its scratch
+/// buffers `S`, and the recorder `R` that hears of every completed path (`NoRecord` when
+/// rendering).
+pub struct Worker<'a, S, R> {
+    pub splats: &'a mut Splats,
+    pub scratch: &'a mut S,
+    pub rec: &'a mut R,
+}

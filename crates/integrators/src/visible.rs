@@ -5,7 +5,7 @@
 //! at the visible point.
 
 use crate::photons::GatherPoint;
-use crate::walk::{continue_path, escaped_radiance};
+use crate::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
 use lt_core::bsdf::{ShadingFrame, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::sampling::Sampler;
@@ -149,19 +149,13 @@ pub fn trace_visible_point(
             ray = hit.spawn_ray(bs.wi);
             continue;
         }
-        let no_rr = u32::MAX;
-        let Some(bs) = continue_path(
-            scene,
-            &hit,
-            &sf,
+        let at = WalkPoint {
+            hit: &hit,
+            sf: &sf,
             wo,
-            &mut beta,
-            Color::ONE,
-            depth,
-            no_rr,
-            mode,
-            sampler,
-        ) else {
+        };
+        let no_rr = WalkRules::camera(u32::MAX);
+        let Some(bs) = continue_path(scene, &at, &no_rr, &mut beta, depth, sampler) else {
             return out;
         };
         ray = hit.spawn_ray(bs.wi);

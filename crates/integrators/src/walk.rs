@@ -54,31 +54,55 @@ pub fn escaped_radiance(scene: &Scene, dir: Vec3, mut weight: impl FnMut(u32) ->
     l
 }
 
-/// Continues a walk at `hit` by sampling its BSDF in `mode`: multiplies the throughput by the
-/// sample weight and plays Russian roulette relative to `rr_reference` (the walk's starting β).
-/// `None` ends the walk.
-#[allow(clippy::too_many_arguments)]
+/// The surface point a walk has reached: the hit, its shading frame, and `wo`, the direction back
+/// along the walk.
+#[derive(Clone, Copy)]
+pub struct WalkPoint<'a> {
+    pub hit: &'a SurfaceHit,
+    pub sf: &'a ShadingFrame,
+    pub wo: Vec3,
+}
+
+/// What stays fixed along one walk: its transport mode and its Russian roulette — the β it
+/// started with (the reference) and the depth from which roulette plays.
+#[derive(Clone, Copy, Debug)]
+pub struct WalkRules {
+    pub mode: TransportMode,
+    pub rr_reference: Color,
+    pub rr_depth: u32,
+}
+
+impl WalkRules {
+    /// A camera walk: radiance mode, β starting at 1.
+    pub fn camera(rr_depth: u32) -> WalkRules {
+        WalkRules {
+            mode: TransportMode::Radiance,
+            rr_reference: Color::ONE,
+            rr_depth,
+        }
+    }
+}
+
+/// Continues a walk at `at` by sampling its BSDF in `rules.mode`: multiplies the throughput by
+/// the sample weight and plays Russian roulette (`depth` segments so far). `None` ends the walk.
 #[inline]
 pub fn continue_path(
     scene: &Scene,
-    hit: &SurfaceHit,
-    sf: &ShadingFrame,
-    wo: Vec3,
+    at: &WalkPoint,
+    rules: &WalkRules,
     beta: &mut Color,
-    rr_reference: Color,
     depth: u32,
-    rr_depth: u32,
-    mode: TransportMode,
     sampler: &mut Sampler,
 ) -> Option<BsdfSample> {
     let u_lobe = sampler.next_f32();
     let u = sampler.next_2d();
     let bs = scene
-        .material(hit.material)
-        .sample(sf, wo, u_lobe, u, mode)?;
+        .material(at.hit.material)
+        .sample(at.sf, at.wo, u_lobe, u, rules.mode)?;
     *beta *= bs.weight;
-    (*beta != Color::ZERO && russian_roulette(beta, rr_reference, depth, rr_depth, sampler))
-        .then_some(bs)
+    (*beta != Color::ZERO
+        && russian_roulette(beta, rules.rr_reference, depth, rules.rr_depth, sampler))
+    .then_some(bs)
 }
 
 /// How long subpaths may grow.
@@ -87,6 +111,25 @@ pub struct WalkLimits {
     /// Most vertices in the subpath, its endpoint included.
     pub max_vertices: usize,
     pub rr_depth: u32,
+}
+
+impl WalkLimits {
+    /// The camera subpaths of a bidirectional estimator of paths of at most `max_depth`
+    /// segments: t ≤ k + 1 vertices (strategy s = 0).
+    pub fn camera(max_depth: u32, rr_depth: u32) -> WalkLimits {
+        WalkLimits {
+            max_vertices: max_depth as usize + 1,
+            rr_depth,
+        }
+    }
+
+    /// Its light subpaths: s ≤ k vertices (strategy t = 1).
+    pub fn light(max_depth: u32, rr_depth: u32) -> WalkLimits {
+        WalkLimits {
+            max_vertices: max_depth as usize,
+            rr_depth,
+        }
+    }
 }
 
 /// A camera walk that left the scene: the radiance of lights at infinity along `dir` completes
@@ -145,16 +188,13 @@ pub fn camera_subpath(
         return;
     }
     let pdf = scene.camera.pdf_dir(ray.o, ray.d);
-    random_walk(
-        scene,
+    let start = WalkStart {
         ray,
-        Color::ONE,
+        beta: Color::ONE,
         pdf,
-        TransportMode::Radiance,
-        sampler,
-        limits,
-        out,
-    );
+        mode: TransportMode::Radiance,
+    };
+    random_walk(scene, start, sampler, limits, out);
 }
 
 /// Traces a light subpath: y0 on a light chosen by power (`Light::sample_le`), then the surfaces
@@ -192,32 +232,44 @@ pub fn light_subpath(scene: &Scene, sampler: &mut Sampler, limits: WalkLimits, o
     } else {
         le.pdf_dir
     };
-    random_walk(
-        scene,
-        le.ray,
+    let start = WalkStart {
+        ray: le.ray,
         beta,
         pdf,
-        TransportMode::Importance,
-        sampler,
-        limits,
-        out,
-    );
+        mode: TransportMode::Importance,
+    };
+    random_walk(scene, start, sampler, limits, out);
 }
 
-/// Extends `out` (which holds at least its endpoint) along `ray`, which its last vertex sampled
-/// with density `pdf` (see `PathVertex::surface`), until the walk ends or fills `max_vertices`.
-#[allow(clippy::too_many_arguments)]
+/// The first ray of a subpath's walk, leaving its endpoint: the throughput it carries, the
+/// density with which the endpoint chose it (see `PathVertex::surface`) and the transport mode.
+struct WalkStart {
+    ray: Ray,
+    beta: Color,
+    pdf: f32,
+    mode: TransportMode,
+}
+
+/// Extends `out` (which holds at least its endpoint) along `start.ray` until the walk ends or
+/// fills `max_vertices`.
 fn random_walk(
     scene: &Scene,
-    mut ray: Ray,
-    mut beta: Color,
-    mut pdf: f32,
-    mode: TransportMode,
+    start: WalkStart,
     sampler: &mut Sampler,
     limits: WalkLimits,
     out: &mut Subpath,
 ) {
-    let rr_reference = beta;
+    let WalkStart {
+        mut ray,
+        mut beta,
+        mut pdf,
+        mode,
+    } = start;
+    let rules = WalkRules {
+        mode,
+        rr_reference: beta,
+        rr_depth: limits.rr_depth,
+    };
     loop {
         let Some(hit) = scene.intersect(&ray) else {
             if mode == TransportMode::Radiance && !scene.infinite_lights.is_empty() {
@@ -238,18 +290,12 @@ fn random_walk(
         }
         let sf = hit.shading_frame();
         let depth = out.vertices.len() as u32;
-        let Some(bs) = continue_path(
-            scene,
-            &hit,
-            &sf,
+        let at = WalkPoint {
+            hit: &hit,
+            sf: &sf,
             wo,
-            &mut beta,
-            rr_reference,
-            depth,
-            limits.rr_depth,
-            mode,
-            sampler,
-        ) else {
+        };
+        let Some(bs) = continue_path(scene, &at, &rules, &mut beta, depth, sampler) else {
             out.vertices.push(v);
             return;
         };

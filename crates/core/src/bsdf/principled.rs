@@ -24,8 +24,8 @@
 use super::fresnel::{fresnel_dielectric, fresnel_dielectric_signed};
 use super::microfacet::{reflect, Microfacet};
 use super::principled_common::{
-    clearcoat_g1, diffuse_shape, diffuse_value, normalised, schlick_fresnel, schlick_r0,
-    sheen_value, specular_distribution, tint, Gtr1, PrincipledParam,
+    clearcoat_g1, diffuse_shape, diffuse_value, lobe_mixture_sample, normalised, schlick_fresnel,
+    schlick_r0, sheen_value, specular_distribution, tint, Gtr1, PrincipledParam,
 };
 use super::refraction::refracted_throughput_scale;
 use super::{LocalBsdf, LocalSample, TransportMode};
@@ -250,21 +250,7 @@ impl LocalBsdf for Principled {
             }
             wi
         };
-        if wi.z == 0.0 {
-            return None;
-        }
-        let pdf_w = self.pdf(wo, wi);
-        if !(pdf_w > 0.0) {
-            return None;
-        }
-        let f = self.eval(wo, wi, mode);
-        Some(LocalSample {
-            wi,
-            weight: f * (wi.z.abs() / pdf_w),
-            pdf_w,
-            pdf_rev_w: self.pdf(wi, wo),
-            delta: false,
-        })
+        lobe_mixture_sample(self, wo, wi, mode)
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Color {

@@ -6,6 +6,7 @@
 //! fixed-roughness (0.25) Smith masking. Everything in the shading frame (z = normal).
 
 use super::microfacet::{Microfacet, MicrofacetType};
+use super::{LocalBsdf, LocalSample, TransportMode};
 use crate::math::{luminance, Color, Vec2, Vec3, INV_PI, PI};
 
 /// Which parameter of a principled material a texture drives (all but `BaseColor` are scalars,
@@ -180,4 +181,31 @@ pub fn clearcoat_g1(v: Vec3, m: Vec3) -> f32 {
 pub fn normalised<const N: usize>(p: [f32; N]) -> Option<[f32; N]> {
     let total: f32 = p.iter().sum();
     (total > 0.0).then(|| p.map(|x| x / total))
+}
+
+/// The sample in direction `wi` (already chosen by one of `bsdf`'s lobes) of a lobe mixture:
+/// its density is the whole mixture's `pdf_w` (solid angle, every lobe that could have chosen
+/// `wi`), so the weight is f |cos θi| / pdf_w, never one lobe's ratio. None where `wi` is
+/// grazing or no lobe could have chosen it.
+pub fn lobe_mixture_sample(
+    bsdf: &impl LocalBsdf,
+    wo: Vec3,
+    wi: Vec3,
+    mode: TransportMode,
+) -> Option<LocalSample> {
+    if wi.z == 0.0 {
+        return None;
+    }
+    let pdf_w = bsdf.pdf(wo, wi);
+    if !(pdf_w > 0.0) {
+        return None;
+    }
+    let f = bsdf.eval(wo, wi, mode);
+    Some(LocalSample {
+        wi,
+        weight: f * (wi.z.abs() / pdf_w),
+        pdf_w,
+        pdf_rev_w: bsdf.pdf(wi, wo),
+        delta: false,
+    })
 }

@@ -22,8 +22,8 @@
 use super::fresnel::fresnel_dielectric_signed;
 use super::microfacet::{reflect, Microfacet};
 use super::principled_common::{
-    diffuse_shape, diffuse_value, normalised, schlick_fresnel, schlick_r0, sheen_value,
-    specular_distribution, tint, PrincipledParam,
+    diffuse_shape, diffuse_value, lobe_mixture_sample, normalised, schlick_fresnel, schlick_r0,
+    sheen_value, specular_distribution, tint, PrincipledParam,
 };
 use super::{LocalBsdf, LocalSample, TransportMode};
 use crate::math::{Color, Vec2, Vec3, INV_PI};
@@ -167,21 +167,7 @@ impl LocalBsdf for PrincipledThin {
             -sample_cosine_hemisphere(u)
         };
         let wi = if wo.z < 0.0 { -b } else { b };
-        if wi.z == 0.0 {
-            return None;
-        }
-        let pdf_w = self.pdf(wo, wi);
-        if !(pdf_w > 0.0) {
-            return None;
-        }
-        let f = self.eval(wo, wi, mode);
-        Some(LocalSample {
-            wi,
-            weight: f * (wi.z.abs() / pdf_w),
-            pdf_w,
-            pdf_rev_w: self.pdf(wi, wo),
-            delta: false,
-        })
+        lobe_mixture_sample(self, wo, wi, mode)
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> Color {

@@ -174,21 +174,21 @@ impl SubpathMis {
     }
 
     /// The record of light vertex y_j (j ≥ 1) with density `l`, after `prev` = y_{j−1}'s record
-    /// and its stored `c_prev_prev` = c_{j−2} (Q_{j−1} = 1 for j = 1). `vc_valid`: VC(j) can join
-    /// y_{j−1} and y_j; `nee_over_l0`: nee / l_0 of the subpath (read for j = 1);
-    /// `through_delta`: see `LightMis`.
-    #[allow(clippy::too_many_arguments)]
+    /// and its stored `c_prev_prev` = c_{j−2} (Q_{j−1} = 1 for j = 1). `nee_over_l0`: nee / l_0
+    /// of the subpath (read for j = 1); `vertex.vc_valid`: VC(j) can join y_{j−1} and y_j.
     pub fn light_vertex(
         &self,
         j: usize,
         l: f64,
-        prev: &LightMis,
-        c_prev_prev: f64,
-        vc_valid: bool,
+        (prev, c_prev_prev): (&LightMis, f64),
         nee_over_l0: f64,
-        mergeable: bool,
-        through_delta: bool,
+        vertex: VertexTechniques,
     ) -> LightMis {
+        let VertexTechniques {
+            vc_valid,
+            mergeable,
+            through_delta,
+        } = vertex;
         let q_prev = if j == 1 {
             1.0
         } else {
@@ -218,19 +218,20 @@ impl SubpathMis {
     }
 
     /// The record of camera vertex z_m (m ≥ 1) with density `c`, after `prev` = z_{m−1}'s record,
-    /// whose stored pdf_rev (l of z_{m−1}) is `l_prev`. `vc_valid`: a connection can join z_m and
-    /// z_{m−1}; `through_delta`: see `CameraMis`.
-    #[allow(clippy::too_many_arguments)]
+    /// whose stored pdf_rev (l of z_{m−1}) is `l_prev`. `vertex.vc_valid`: a connection can join
+    /// z_m and z_{m−1}.
     pub fn camera_vertex(
         &self,
         m: usize,
         c: f64,
-        prev: &CameraMis,
-        l_prev: f64,
-        vc_valid: bool,
-        mergeable: bool,
-        through_delta: bool,
+        (prev, l_prev): (&CameraMis, f64),
+        vertex: VertexTechniques,
     ) -> CameraMis {
+        let VertexTechniques {
+            vc_valid,
+            mergeable,
+            through_delta,
+        } = vertex;
         let n = if m == 1 {
             self.light_tracing_ratio
         } else {
@@ -268,36 +269,34 @@ impl SubpathMis {
     }
 
     /// VC(s), s ≥ 2, t ≥ 2: light end y_{s−1} = `y`, camera end z_{t−1} = `z`, `z_prev` = z_{t−2};
-    /// the connection's c_{s−1}, c_{s−2} (light side) and l_s, l_{s+1} (camera side).
-    #[allow(clippy::too_many_arguments)]
+    /// `d` the densities the connection adds.
     pub fn connection(
         &self,
         y: &LightMis,
-        z: &CameraMis,
-        z_prev: &CameraMis,
-        c_y: f64,
-        c_y_prev: f64,
-        l_z: f64,
-        l_z_prev: f64,
+        (z, z_prev): (&CameraMis, &CameraMis),
+        d: ConnectionDensities,
     ) -> f64 {
+        let ConnectionDensities {
+            c_y,
+            c_y_prev,
+            l_z,
+            l_z_prev,
+        } = d;
         Self::weight(
             self.light_side(y, c_y, c_y_prev) + self.camera_side(z, z_prev, l_z / z.c, l_z_prev),
         )
     }
 
-    /// VC(1), next-event estimation from z = z_{t−1} (k ≥ 2): x0 drawn with `nee`, its camera
-    /// density `c0`, the light walk's l_0, l_1 of x0 and z, and l_2 of z_prev (`l_z_prev`).
-    #[allow(clippy::too_many_arguments)]
-    pub fn next_event(
-        &self,
-        z: &CameraMis,
-        z_prev: &CameraMis,
-        nee: f64,
-        c0: f64,
-        l0: f64,
-        l1: f64,
-        l_z_prev: f64,
-    ) -> f64 {
+    /// VC(1), next-event estimation from z = z_{t−1} (k ≥ 2), `z_prev` = z_{t−2}; `d` the
+    /// densities the light sample adds.
+    pub fn next_event(&self, (z, z_prev): (&CameraMis, &CameraMis), d: NextEventDensities) -> f64 {
+        let NextEventDensities {
+            nee,
+            c0,
+            l0,
+            l1,
+            l_z_prev,
+        } = d;
         let camera = self.camera_side(z, z_prev, l0 * l1 / (nee * z.c), l_z_prev);
         Self::weight(self.u(c0 / nee) + camera)
     }
@@ -358,6 +357,38 @@ impl SubpathMis {
     }
 }
 
+/// Which techniques a vertex's record allows: whether a connection can join it to the vertex
+/// before it (`vc_valid`), whether a merge can happen at it, and whether the walk left it
+/// through a delta lobe (see `LightMis`, `CameraMis`).
+#[derive(Clone, Copy, Debug)]
+pub struct VertexTechniques {
+    pub vc_valid: bool,
+    pub mergeable: bool,
+    pub through_delta: bool,
+}
+
+/// The densities a connection VC(s) (s ≥ 2, t ≥ 2) computes at its two ends: on the light side
+/// c_{s−1} (`c_y`) and c_{s−2} (`c_y_prev`), on the camera side l_s (`l_z`) and l_{s+1}
+/// (`l_z_prev`).
+#[derive(Clone, Copy, Debug)]
+pub struct ConnectionDensities {
+    pub c_y: f64,
+    pub c_y_prev: f64,
+    pub l_z: f64,
+    pub l_z_prev: f64,
+}
+
+/// The densities next-event estimation VC(1) computes: x0 drawn with `nee`, its camera density
+/// `c0`, the light walk's l_0 and l_1 of x0 and z, and l_2 of z_prev (`l_z_prev`).
+#[derive(Clone, Copy, Debug)]
+pub struct NextEventDensities {
+    pub nee: f64,
+    pub c0: f64,
+    pub l0: f64,
+    pub l1: f64,
+    pub l_z_prev: f64,
+}
+
 impl SubpathMis {
     /// The records the integrator would build for this path, light vertices x0 … x_{k−1} and camera
     /// vertices z_m = x_{k−m}, m = 0 … k, with the chain's densities as the stored ones.
@@ -368,36 +399,29 @@ impl SubpathMis {
         let mut light = vec![mis.light_origin(l[0])];
         for j in 1..k {
             let c_pp = if j >= 2 { c[j - 2] } else { 0.0 };
-            let y = mis.light_vertex(
-                j,
-                l[j],
-                &light[j - 1],
-                c_pp,
+            let vertex = VertexTechniques {
                 // VC(1) is next-event estimation: the light samples x0 itself (`Chain::valid`).
-                if j == 1 {
+                vc_valid: if j == 1 {
                     conn[1]
                 } else {
                     conn[j - 1] && conn[j]
                 },
-                d.nee / l[0],
-                conn[j],
+                mergeable: conn[j],
                 // The oracle's `connectable` already says where the path follows a delta lobe.
-                false,
-            );
+                through_delta: false,
+            };
+            let y = mis.light_vertex(j, l[j], (&light[j - 1], c_pp), d.nee / l[0], vertex);
             light.push(y);
         }
         let mut camera = vec![mis.camera_origin()];
         for m in 1..=k {
             let i = k - m;
-            let z = mis.camera_vertex(
-                m,
-                c[i],
-                &camera[m - 1],
-                l[i + 1],
-                conn[i] && conn[i + 1],
-                conn[i] && i >= 1,
-                false,
-            );
+            let vertex = VertexTechniques {
+                vc_valid: conn[i] && conn[i + 1],
+                mergeable: conn[i] && i >= 1,
+                through_delta: false,
+            };
+            let z = mis.camera_vertex(m, c[i], (&camera[m - 1], l[i + 1]), vertex);
             camera.push(z);
         }
         (light, camera)
@@ -417,20 +441,25 @@ impl SubpathMis {
             Technique::Connect(0) => mis.emitter_hit(&cz[k - 1], c[0], l[0], l[1], d.nee, conn[1]),
             Technique::Connect(1) if k == 1 => mis.light_tracing_origin(&ly[0], c[0]),
             Technique::Connect(1) => {
-                mis.next_event(&cz[k - 1], &cz[k - 2], d.nee, c[0], l[0], l[1], at(2))
+                let nd = NextEventDensities {
+                    nee: d.nee,
+                    c0: c[0],
+                    l0: l[0],
+                    l1: l[1],
+                    l_z_prev: at(2),
+                };
+                mis.next_event((&cz[k - 1], &cz[k - 2]), nd)
             }
             Technique::Connect(s) if s == k => mis.light_tracing(&ly[k - 1], c[k - 1], c[k - 2]),
             Technique::Connect(s) => {
                 let t = k + 1 - s;
-                mis.connection(
-                    &ly[s - 1],
-                    &cz[t - 1],
-                    &cz[t - 2],
-                    c[s - 1],
-                    c[s - 2],
-                    l[s],
-                    at(s + 1),
-                )
+                let cd = ConnectionDensities {
+                    c_y: c[s - 1],
+                    c_y_prev: c[s - 2],
+                    l_z: l[s],
+                    l_z_prev: at(s + 1),
+                };
+                mis.connection(&ly[s - 1], (&cz[t - 1], &cz[t - 2]), cd)
             }
             Technique::Merge(i) => {
                 mis.merge(&ly[i], &cz[k - i], &cz[k - i - 1], c[i - 1], at(i + 1))

@@ -95,7 +95,13 @@ pub fn camera_walk(
         let mut camera_sub = verts.clone();
         camera_sub.push(v);
         if !m.is_delta() && k < max_k {
-            nee(scene, rng, &hit, &camera_sub, wo, pdf, f, beta, out);
+            let so_far = WalkSoFar {
+                sub: &camera_sub,
+                pdf,
+                f,
+                beta,
+            };
+            nee(scene, rng, (&hit, wo), so_far, out);
         }
         let Some(bs) = m.sample(&sf, wo, rng.next_f32(), uv(rng), TransportMode::Radiance) else {
             return;
@@ -110,18 +116,24 @@ pub fn camera_walk(
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn nee(
-    scene: &Scene,
-    rng: &mut Sampler,
-    hit: &lt_core::scene::SurfaceHit,
-    sub: &[PathVertex],
-    wo: Vec3,
+/// A camera walk up to its last vertex: the vertices (camera first), the path's density, its
+/// contribution f, and the estimator's weight β.
+struct WalkSoFar<'a> {
+    sub: &'a [PathVertex],
     pdf: f64,
     f: DVec3,
     beta: DVec3,
+}
+
+/// Next-event estimation from `hit` (reached along -`wo`), the walk's last vertex.
+fn nee(
+    scene: &Scene,
+    rng: &mut Sampler,
+    (hit, wo): (&lt_core::scene::SurfaceHit, Vec3),
+    so_far: WalkSoFar,
     out: &mut dyn FnMut(Made),
 ) {
+    let WalkSoFar { sub, pdf, f, beta } = so_far;
     let Some((li, pmf, _)) = scene.light_sampler.sample(rng.next_f32()) else {
         return;
     };

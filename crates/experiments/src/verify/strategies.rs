@@ -23,6 +23,7 @@ use lt_integrators::bdpt::{Bdpt, BdptParams, Scratch};
 use lt_integrators::params::ParamReader;
 use lt_integrators::record::{Completed, Recorder};
 use lt_integrators::splat::splat_pass_with;
+use lt_integrators::splat::{Pass, Worker};
 use lt_integrators::{
     render, EstimatorRef, Integrator, IntegratorParams, PassReport, RenderOptions, RenderResult,
 };
@@ -193,7 +194,12 @@ pub fn pyramid_pass(
         },
         |i, splats, st| {
             st.rec.item = i;
-            bdpt.item(scene, seed, pass, i, splats, &mut st.scratch, &mut st.rec);
+            let mut worker = Worker {
+                splats,
+                scratch: &mut st.scratch,
+                rec: &mut st.rec,
+            };
+            bdpt.item(scene, Pass { seed, pass }, i, &mut worker);
         },
     );
     let mut lists = sink.into_inner().unwrap_or_else(|e| e.into_inner());

@@ -6,6 +6,7 @@
 //! dictionary: one offset per mesh (u64 in version 4, u32 in version 3) and a u32 mesh count.
 //! Texture coordinates are stored as Mitsuba uses them (no v flip, unlike OBJ and PLY files).
 
+use super::le_bytes::{f32s, f64s_as_f32, u16_at, u32_at, u32s, u64_at};
 use crate::error::Ctx;
 use crate::format::S;
 use crate::SceneError;
@@ -42,18 +43,6 @@ pub(crate) fn load_serialized(
             format!("malformed serialized mesh file {}: {msg}", path.display()),
         )
     })
-}
-
-fn u16_at(b: &[u8], at: usize) -> Option<u16> {
-    Some(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?))
-}
-
-fn u32_at(b: &[u8], at: usize) -> Option<u32> {
-    Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
-}
-
-fn u64_at(b: &[u8], at: usize) -> Option<u64> {
-    Some(u64::from_le_bytes(b.get(at..at + 8)?.try_into().ok()?))
 }
 
 /// The byte offset of mesh `index`'s header, from the end-of-file dictionary (mesh 0 is at 0).
@@ -106,11 +95,11 @@ impl Stream<'_> {
     }
 
     fn u32(&mut self, what: &str) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.bytes(4, what)?.try_into().unwrap()))
+        Ok(u32_at(&self.bytes(4, what)?, 0).expect("4 bytes read"))
     }
 
     fn u64(&mut self, what: &str) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(self.bytes(8, what)?.try_into().unwrap()))
+        Ok(u64_at(&self.bytes(8, what)?, 0).expect("8 bytes read"))
     }
 
     /// `count` × `dim` reals, f32 or f64 in the file, as f32 (Mitsuba rounds doubles the same).
@@ -126,14 +115,10 @@ impl Stream<'_> {
             .checked_mul(dim * size)
             .ok_or_else(|| format!("{what}: the vertex count {count} is absurd"))?;
         let raw = self.bytes(n, what)?;
-        let values: Vec<f32> = if double {
-            raw.chunks_exact(8)
-                .map(|c| f64::from_le_bytes(c.try_into().unwrap()) as f32)
-                .collect()
+        let values = if double {
+            f64s_as_f32(&raw)
         } else {
-            raw.chunks_exact(4)
-                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-                .collect()
+            f32s(&raw)
         };
         if values.iter().any(|x| !x.is_finite()) {
             return Err(format!("{what}: a value is NaN or infinite"));
@@ -210,9 +195,8 @@ fn parse(b: &[u8], shape_index: u32) -> Result<Serialized, String> {
         .ok_or_else(|| format!("the triangle count {nf} is absurd"))?;
     let raw = s.bytes(n, "the triangle indices")?;
     let mut indices = Vec::with_capacity(nf as usize);
-    for (i, t) in raw.chunks_exact(12).enumerate() {
-        let tri: [u32; 3] =
-            std::array::from_fn(|k| u32::from_le_bytes(t[4 * k..4 * k + 4].try_into().unwrap()));
+    for (i, t) in u32s(&raw).chunks_exact(3).enumerate() {
+        let tri = [t[0], t[1], t[2]];
         if let Some(&k) = tri.iter().find(|&&k| k as u64 >= nv) {
             return Err(format!(
                 "triangle {i}: vertex index {k} is out of range (0..{nv})"

@@ -3,6 +3,7 @@
 //! x, y, z resolution and channel count, six f32 of a bounding box (unused: an sdfgrid spans its
 //! unit cube), then the values, x fastest, then y, then z, channels interleaved.
 
+use super::le_bytes::{f32s, i32_at};
 use crate::error::Ctx;
 use crate::format::S;
 use crate::SceneError;
@@ -21,10 +22,6 @@ pub(crate) fn load_sdf_grid(
             format!("malformed volume grid file {}: {msg}", path.display()),
         )
     })
-}
-
-fn i32_at(b: &[u8], at: usize) -> Option<i32> {
-    Some(i32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
 }
 
 const HEADER: usize = 48;
@@ -78,10 +75,7 @@ fn parse(b: &[u8], smooth: bool) -> Result<SdfGrid, String> {
             b.len()
         ));
     }
-    let values: Vec<f32> = b[HEADER..need]
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-        .collect();
+    let values = f32s(&b[HEADER..need]);
     if let Some(k) = values.iter().position(|v| !v.is_finite()) {
         return Err(format!("value {k} is NaN or infinite"));
     }

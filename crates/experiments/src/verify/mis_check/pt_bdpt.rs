@@ -47,6 +47,7 @@ use lt_integrators::bdpt::{mis_weight, Bdpt, BdptParams, EndEvals, Split};
 use lt_integrators::connect::eval_towards;
 use lt_integrators::pt::{Pt, PtParams, Techniques};
 use lt_integrators::record::{Completed, Recorder};
+use lt_integrators::registry::{self, Weights};
 use std::collections::BTreeSet;
 use std::fmt;
 
@@ -57,21 +58,16 @@ pub enum Which {
 }
 
 impl Which {
-    pub fn parse(s: &str) -> Result<Which, String> {
-        match s {
-            "pt" => Ok(Which::Pt),
-            "bdpt" => Ok(Which::Bdpt),
-            _ => Err(format!(
-                "mis-check: unknown integrator '{s}' (known: pt, bdpt, vcm, bpm)"
-            )),
-        }
-    }
-
+    /// The registered integrator whose weights this checker holds (the registry's name, not a
+    /// copy of it).
     pub fn name(self) -> &'static str {
-        match self {
-            Which::Pt => "pt",
-            Which::Bdpt => "bdpt",
-        }
+        let weights = match self {
+            Which::Pt => Weights::PathTracing,
+            Which::Bdpt => Weights::Connections,
+        };
+        registry::with_weights(move |w| w == weights)
+            .next()
+            .expect("every checker's weights are registered")
     }
 }
 

@@ -20,10 +20,11 @@ use super::tolerance::{
 };
 use lt_core::path::{Densities, Heuristic, Path, PathVertex, SubpathMis, Technique, TechniqueSet};
 use lt_core::Scene;
-use lt_integrators::connect_merge::{initial_radius, Engine, VcmParams};
+use lt_integrators::connect_merge::{initial_radius, Engine, PassInputs, VcmParams};
 use lt_integrators::radius::InitialRadius;
 use lt_integrators::record::{Completed, Merged, Recorder};
-use lt_integrators::splat::Splats;
+use lt_integrators::registry::{self, Weights};
+use lt_integrators::splat::{Pass, Splats, Worker};
 use std::collections::BTreeMap;
 use std::fmt;
 
@@ -65,12 +66,14 @@ impl VcmOptions {
         }
     }
 
+    /// The registered integrator whose weights these options check.
     pub fn name(&self) -> &'static str {
-        if self.connections {
-            "vcm"
-        } else {
-            "bpm"
-        }
+        let weights = Weights::ConnectMerge {
+            connections: self.connections,
+        };
+        registry::with_weights(move |w| w == weights)
+            .next()
+            .expect("both connect-merge variants are registered")
     }
 
     fn params(&self) -> VcmParams {
@@ -220,17 +223,21 @@ pub fn collect(scene: &Scene, opts: &VcmOptions) -> (VcmCollector, u32) {
         c.eta = setup.eta;
         let items = (cam.pixel_count() as u64).max(params.light_path_count(scene));
         let mut splats = Splats::new(cam.width, cam.height);
+        let inputs = PassInputs {
+            setup: &setup,
+            lights: &lights,
+            pass: Pass {
+                seed: opts.seed,
+                pass: passes,
+            },
+        };
+        let mut worker = Worker {
+            splats: &mut splats,
+            scratch: &mut scratch,
+            rec: &mut c,
+        };
         for i in 0..items {
-            engine.item(
-                &setup,
-                &lights,
-                opts.seed,
-                passes,
-                i,
-                &mut splats,
-                &mut scratch,
-                &mut c,
-            );
+            engine.item(&inputs, i, &mut worker);
         }
         passes += 1;
     }
