@@ -103,8 +103,10 @@ impl Ctx {
         (a + c, b + d)
     }
 
+    /// The folder of `study`: RESULTS/<study><the scale's folder suffix>.
     pub fn study_dir(&self, study: &str) -> PathBuf {
-        self.results.join(study)
+        self.results
+            .join(format!("{study}{}", self.scale.folder_suffix))
     }
 
     /// A line above the progress bar.
@@ -158,7 +160,17 @@ impl Ctx {
         scene: &Path,
         max_depth: Option<u32>,
     ) -> Result<std::sync::Arc<Reference>, String> {
-        let spec = super::reference::spec(&self.scale, scene, max_depth)?;
+        self.reference_at(&self.scale, scene, max_depth)
+    }
+
+    /// The same at another scale's film and passes (the galleries': `Scale::gallery`).
+    pub fn reference_at(
+        &self,
+        scale: &Scale,
+        scene: &Path,
+        max_depth: Option<u32>,
+    ) -> Result<std::sync::Arc<Reference>, String> {
+        let spec = super::reference::spec(scale, scene, max_depth)?;
         let id = serde_json::to_string(&spec).unwrap_or_default();
         if let Some((_, r)) = self.loaded.lock().unwrap().iter().find(|(k, _)| *k == id) {
             return Ok(r.clone());
