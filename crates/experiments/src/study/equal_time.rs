@@ -113,7 +113,7 @@ fn passes_from_timings(
 pub fn specs(ctx: &Ctx) -> Result<Vec<RunSpec>, String> {
     let mut v = fixed_specs(&ctx.scale);
     let gallery = ctx.scale.gallery();
-    for scene in &ctx.scale.scenes {
+    for scene in &gallery.scenes {
         let Some(passes) = passes_from_timings(ctx, scene, false)? else {
             continue;
         };

@@ -49,6 +49,9 @@ pub struct Scale {
     pub gallery_width: u32,
     pub gallery_passes: u32,
     pub gallery_reference_passes: u32,
+    /// The galleries' scenes, when not `scenes`: a 256-px gallery of every integrator costs
+    /// minutes per scene, so the committed scale shows the scenes whose light paths differ most.
+    pub gallery_scenes: Option<Vec<PathBuf>>,
     /// Veach's MIS comparison's scene (pt by technique), when the scale has one.
     pub veach_scene: Option<PathBuf>,
     /// Appended to every study folder's name (`convergence-bitterli`), so a scale whose results
@@ -103,6 +106,7 @@ impl Scale {
             gallery_width: 32,
             gallery_passes: 32,
             gallery_reference_passes: 1024,
+            gallery_scenes: None,
             veach_scene: Some(scene("veach-mis")).filter(|p| p.is_file()),
             folder_suffix: "",
         };
@@ -140,6 +144,21 @@ impl Scale {
                 gallery_width: 256,
                 gallery_passes: 16,
                 gallery_reference_passes: 256,
+                // A caustic seen in a mirror, a light behind glass, sun through a window, light
+                // through a door's gap, Veach's plates, and the plain box to compare with.
+                gallery_scenes: Some(
+                    [
+                        "caustic-sds",
+                        "cornell-box",
+                        "cornell-glass-light",
+                        "sun-room",
+                        "veach-door",
+                        "veach-mis",
+                    ]
+                    .iter()
+                    .map(|n| scene(n))
+                    .collect(),
+                ),
                 ..base
             }),
             // Bitterli's three scenes (scenes/bitterli/, Mitsuba XML, `-D integrator=path`) at
@@ -157,7 +176,9 @@ impl Scale {
                     bitterli("veach-mis"),
                 ],
                 focus_scene: bitterli("cornell-box"),
-                length_scenes: vec![bitterli("cornell-box"), bitterli("veach-mis")],
+                // Veach's plates alone: max_depth 3 is the file's own, and per-length renders
+                // every integrator at every depth, which the cornell-box's 30 bounces make dear.
+                length_scenes: vec![bitterli("veach-mis")],
                 max_length: 3,
                 gallery_width: 256,
                 gallery_passes: 16,
@@ -215,6 +236,7 @@ impl Scale {
             width: self.gallery_width,
             max_passes: self.gallery_passes,
             reference_passes: self.gallery_reference_passes,
+            scenes: self.gallery_scenes.clone().unwrap_or(self.scenes.clone()),
             ..self.clone()
         }
     }
