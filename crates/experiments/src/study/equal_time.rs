@@ -324,8 +324,8 @@ const TUNGSTEN_NOTE_CORNELL: &str =
     "none beyond our reference's noise; the emitter's edge differs \
      (our tent-filtered 256-px film against Tungsten's 1024 px averaged down)";
 const TUNGSTEN_NOTE_BIDIR: &str =
-    "same look (lamp-lit ceiling, spotlight on the wall, glass egg's \
-     caustic on the table); our reference's noise dominates the difference, most on the \
+    "same look (the lamp-lit ceiling, the small lamp on the right \
+     wall, the glass egg on the table); our reference's noise dominates the difference, most on the \
      indirectly lit walls; ours ≈ 1.5 % brighter everywhere, within what Tungsten's unstated \
      settings allow";
 const TUNGSTEN_NOTE_MIS: &str = "same highlights on every plate; differences are our \
