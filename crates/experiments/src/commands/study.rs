@@ -10,12 +10,19 @@ use std::time::Instant;
 pub struct StudyArgs {
     /// convergence, unbiased-vs-consistent, radius-shrinkage, equal-time, per-length, or all.
     pub name: String,
-    /// Publication scale (larger images, more runs and passes) instead of the quick one.
+    /// Publication scale (larger images, more runs and passes) instead of the quick one: the
+    /// same as --scale full.
     #[arg(long)]
     pub full: bool,
-    /// Where the study folders (and index.html) are written.
-    #[arg(long, default_value = "results")]
-    pub results: PathBuf,
+    /// The scale: quick (a first run, minutes), committed (what the committed report shows for
+    /// convergence and the galleries), bitterli (the studies on scenes/bitterli/; give
+    /// -D integrator=path), full, test.
+    #[arg(long, default_value = "quick")]
+    pub scale: String,
+    /// Where the study folders (and index.html) are written. Default: results/quick for the
+    /// quick scale, so a first run never overwrites the committed report; results otherwise.
+    #[arg(long)]
+    pub results: Option<PathBuf>,
     /// The cache of finished renders (default: RESULTS/cache; references in RESULTS/references).
     #[arg(long)]
     pub cache: Option<PathBuf>,
@@ -43,11 +50,11 @@ impl StudyArgs {
         } else if self.full {
             "full"
         } else {
-            "quick"
+            self.scale.as_str()
         };
         StudySetup {
             scale: scale.into(),
-            results: self.results.clone(),
+            results: self.results_dir(scale),
             cache: self.cache.clone(),
             scenes: self.scenes.clone(),
             threads: self.threads,
@@ -57,15 +64,28 @@ impl StudyArgs {
     }
 }
 
+impl StudyArgs {
+    /// --results, or its default for `scale`.
+    pub fn results_dir(&self, scale: &str) -> PathBuf {
+        match &self.results {
+            Some(r) => r.clone(),
+            None if scale == "quick" => PathBuf::from("results/quick"),
+            None => PathBuf::from("results"),
+        }
+    }
+}
+
 pub fn run(args: &StudyArgs) -> Result<(), String> {
     registry::resolve(&args.name)?;
     let started = Instant::now();
-    let ctx = Ctx::new(&args.setup())?;
+    let setup = args.setup();
+    let results = setup.results.clone();
+    let ctx = Ctx::new(&setup)?;
     run_named(&args.name, &ctx)?;
     let (built, reused) = ctx.counts();
     ctx.finish();
     if args.name == "all" {
-        let index = report::write_report(&args.results)?;
+        let index = report::write_report(&results)?;
         eprintln!(
             "all studies done in {:.0} s ({built} renders made, {reused} found in the cache). \
              The report: {}",
@@ -78,7 +98,7 @@ pub fn run(args: &StudyArgs) -> Result<(), String> {
              `lt report` gathers it into {}",
             args.name,
             started.elapsed().as_secs_f64(),
-            args.results.join("index.html").display()
+            results.join("index.html").display()
         );
     }
     Ok(())

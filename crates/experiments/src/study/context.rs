@@ -35,6 +35,9 @@ pub struct Ctx {
     quiet: bool,
     stop_after: Option<u64>,
     bar: ProgressBar,
+    /// (core-seconds, renders) of every entry handed to a study so far, found in the cache or
+    /// rendered now: what the studies' results cost (`spent`).
+    spent: Mutex<(f64, u64)>,
     /// References loaded this process, by the key of their spec.
     loaded: Mutex<Vec<(String, std::sync::Arc<Reference>)>>,
 }
@@ -92,6 +95,7 @@ impl Ctx {
             quiet,
             stop_after,
             bar,
+            spent: Mutex::new((0.0, 0)),
             loaded: Mutex::new(Vec::new()),
         }
     }
@@ -103,8 +107,10 @@ impl Ctx {
         (a + c, b + d)
     }
 
+    /// The folder of `study`: RESULTS/<study><the scale's folder suffix>.
     pub fn study_dir(&self, study: &str) -> PathBuf {
-        self.results.join(study)
+        self.results
+            .join(format!("{study}{}", self.scale.folder_suffix))
     }
 
     /// A line above the progress bar.
@@ -142,7 +148,39 @@ impl Ctx {
         self.bar.set_message(spec.label());
         let e = self.runs.run(spec)?;
         self.bar.inc(1);
+        self.count(&e);
         Ok(e)
+    }
+
+    /// Adds an entry's cost, its recorded wall seconds times its threads, to `spent`.
+    fn count(&self, e: &RunEntry) {
+        let secs = e.record.seconds.last().copied().unwrap_or(0.0);
+        // 0 threads: one per core of the machine that rendered it (taken to be this one).
+        let threads = match e.record.threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            t => t,
+        };
+        let mut s = self.spent.lock().unwrap();
+        s.0 += secs * threads as f64;
+        s.1 += 1;
+    }
+
+    /// (core-seconds, renders) of the entries the studies were handed so far; a study states
+    /// the difference across its run as its compute.
+    pub fn spent(&self) -> (f64, u64) {
+        *self.spent.lock().unwrap()
+    }
+
+    /// The sentence a summary states its compute with, since `before` (`spent()` at its start).
+    pub fn compute_note(&self, before: (f64, u64)) -> String {
+        let (s, n) = self.spent();
+        format!(
+            "**Compute.** {:.1} core-minutes of rendering over {} renders (each render's recorded \
+             wall time × its threads, references included: an upper bound on a machine shared with \
+             other work; a render shared with another study is counted in both).",
+            (s - before.0) / 60.0,
+            n - before.1
+        )
     }
 
     /// All of `specs`, in order.
@@ -158,7 +196,17 @@ impl Ctx {
         scene: &Path,
         max_depth: Option<u32>,
     ) -> Result<std::sync::Arc<Reference>, String> {
-        let spec = super::reference::spec(&self.scale, scene, max_depth)?;
+        self.reference_at(&self.scale, scene, max_depth)
+    }
+
+    /// The same at another scale's film and passes (the galleries': `Scale::gallery`).
+    pub fn reference_at(
+        &self,
+        scale: &Scale,
+        scene: &Path,
+        max_depth: Option<u32>,
+    ) -> Result<std::sync::Arc<Reference>, String> {
+        let spec = super::reference::spec(scale, scene, max_depth)?;
         let id = serde_json::to_string(&spec).unwrap_or_default();
         if let Some((_, r)) = self.loaded.lock().unwrap().iter().find(|(k, _)| *k == id) {
             return Ok(r.clone());
@@ -168,6 +216,7 @@ impl Ctx {
         self.bar.set_message(format!("reference {}", spec.label()));
         let entry = self.references.run(&spec)?;
         self.bar.inc(1);
+        self.count(&entry);
         let r = std::sync::Arc::new(Reference::from_entry(&entry)?);
         self.loaded.lock().unwrap().push((id, r.clone()));
         Ok(r)

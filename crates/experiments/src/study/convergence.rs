@@ -153,19 +153,21 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
         scale,
     )?;
     out.para(&format!(
-        "Every integrator on every shipped scene at {} px wide, {} independent runs each, \
+        "Every integrator on every scene of the {} scale at {} px wide, {} independent runs each, \
          snapshots at 1, 2, 4, … {} passes. MSE is the mean over pixels and channels of \
          (I − R)² minus the reference's own mean variance (so it estimates the error against the \
          true image); relMSE divides each term by R² + {}; FLIP is NVIDIA's perceptual error on \
          the tone-mapped images. Points are means over runs with {} % t intervals; slopes are \
          fitted to ln MSE against ln N or ln t, with delete-one jackknife intervals over runs. An \
          unbiased estimator's slope against N is −1.",
+        scale.name,
         scale.width,
         scale.runs,
         scale.max_passes,
         super::metrics::REL_EPSILON,
         pct(conf)
     ));
+    let before = ctx.spent();
     let mut all_rows = Vec::new();
     let mut slope_rows = Vec::new();
     let mut eff_rows = Vec::new();
@@ -368,5 +370,6 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
         all_rows,
         false,
     )?;
+    out.para(&ctx.compute_note(before));
     out.finish()
 }

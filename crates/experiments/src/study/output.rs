@@ -32,10 +32,17 @@ pub fn pct(confidence: f64) -> String {
     num(confidence * 100.0)
 }
 
+/// A scene's name: its file's stem, or its folder's name for a Mitsuba scene kept as
+/// `<name>/scene.xml` (Bitterli's scenes), whose stems would all be `scene`.
 pub fn stem(path: &Path) -> String {
-    path.file_stem()
+    let file = path
+        .file_stem()
         .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_default()
+        .unwrap_or_default();
+    match path.parent().and_then(|d| d.file_name()) {
+        Some(dir) if file == "scene" => dir.to_string_lossy().to_string(),
+        _ => file,
+    }
 }
 
 /// A number as the tables print it: 3 significant digits, scientific outside [0.01, 1000).

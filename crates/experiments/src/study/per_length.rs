@@ -57,6 +57,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
         scale.max_length,
         pct(scale.confidence)
     ));
+    let before = ctx.spent();
     let mut rows = Vec::new();
     let mut winners = Vec::new();
     for scene in &scale.length_scenes {
@@ -151,5 +152,6 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
         rows,
         false,
     )?;
+    out.para(&ctx.compute_note(before));
     out.finish()
 }

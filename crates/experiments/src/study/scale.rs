@@ -1,6 +1,8 @@
 //! How big a study is: the film width, the independent runs, the pass counts, the scenes and
-//! integrators. `quick` is a newcomer's first run (all studies in minutes on 2 cores), `full` is
-//! publication scale, `test` is what the tests afford.
+//! integrators. `quick` is a newcomer's first run (all studies in minutes on 2 cores; `lt study`
+//! writes it under results/quick/, beside the committed report), `committed` is what the committed
+//! report shows for convergence and the galleries, `bitterli` runs the studies on Bitterli's
+//! scenes, `full` is publication scale, `test` is what the tests afford.
 
 use std::path::{Path, PathBuf};
 
@@ -40,6 +42,21 @@ pub struct Scale {
     /// Repetitions of the lecture's 1-D example per N.
     pub lecture_repetitions: usize,
     pub confidence: f64,
+    /// The equal-time galleries' film width, passes at equal samples and reference passes: a
+    /// gallery must be wide enough to show light paths, a convergence study only needs pixels
+    /// enough to average over. Equal to `width`, `max_passes`, `reference_passes` at the quick
+    /// scale, where the galleries reuse the convergence study's first runs.
+    pub gallery_width: u32,
+    pub gallery_passes: u32,
+    pub gallery_reference_passes: u32,
+    /// The galleries' scenes, when not `scenes`: a 256-px gallery of every integrator costs
+    /// minutes per scene, so the committed scale shows the scenes whose light paths differ most.
+    pub gallery_scenes: Option<Vec<PathBuf>>,
+    /// Veach's MIS comparison's scene (pt by technique), when the scale has one.
+    pub veach_scene: Option<PathBuf>,
+    /// Appended to every study folder's name (`convergence-bitterli`), so a scale whose results
+    /// sit beside another's in one report overwrites none of them.
+    pub folder_suffix: &'static str,
 }
 
 pub const ALL_ALPHAS: [f64; 6] = [0.3, 0.5, 2.0 / 3.0, 0.75, 0.9, 1.0];
@@ -86,7 +103,15 @@ impl Scale {
             plane_photons: 1000,
             lecture_repetitions: 20_000,
             confidence: 0.95,
+            gallery_width: 32,
+            gallery_passes: 32,
+            gallery_reference_passes: 1024,
+            gallery_scenes: None,
+            veach_scene: Some(scene("veach-mis")).filter(|p| p.is_file()),
+            folder_suffix: "",
         };
+        // Bitterli's scenes: one Mitsuba XML file per folder, rendered with `-D integrator=path`.
+        let bitterli = |n: &str| scenes_dir.join("bitterli").join(n).join("scene.xml");
         match name {
             "quick" => Ok(base),
             "full" => Ok(Scale {
@@ -102,6 +127,64 @@ impl Scale {
                 plane_passes: 1024,
                 plane_photons: 4000,
                 lecture_repetitions: 200_000,
+                gallery_width: 256,
+                gallery_passes: 64,
+                gallery_reference_passes: 4096,
+                ..base
+            }),
+            // What the committed report shows for convergence and the galleries: slopes fitted
+            // over 1 … 256 passes from 16 runs (the quick scale's 4 runs over 1 … 32 give
+            // intervals several units wide), at 32 px, where a run costs little; galleries at
+            // 256 px, where a reader sees the light paths.
+            "committed" => Ok(Scale {
+                name: "committed",
+                runs: 16,
+                max_passes: 256,
+                reference_passes: 8192,
+                gallery_width: 256,
+                gallery_passes: 16,
+                gallery_reference_passes: 256,
+                // A caustic seen in a mirror, a light behind glass, sun through a window, light
+                // through a door's gap, Veach's plates, and the plain box to compare with.
+                gallery_scenes: Some(
+                    [
+                        "caustic-sds",
+                        "cornell-box",
+                        "cornell-glass-light",
+                        "sun-room",
+                        "veach-door",
+                        "veach-mis",
+                    ]
+                    .iter()
+                    .map(|n| scene(n))
+                    .collect(),
+                ),
+                ..base
+            }),
+            // Bitterli's three scenes (scenes/bitterli/, Mitsuba XML, `-D integrator=path`) at
+            // 256 px, every study of one scene's light paths, on a budget one session affords
+            // (results/convergence-bitterli/summary.md states it).
+            "bitterli" => Ok(Scale {
+                name: "bitterli",
+                width: 256,
+                runs: 4,
+                max_passes: 16,
+                reference_passes: 128,
+                scenes: vec![
+                    bitterli("cornell-box"),
+                    bitterli("veach-bidir"),
+                    bitterli("veach-mis"),
+                ],
+                focus_scene: bitterli("cornell-box"),
+                // Veach's plates alone: max_depth 3 is the file's own, and per-length renders
+                // every integrator at every depth, which the cornell-box's 30 bounces make dear.
+                length_scenes: vec![bitterli("veach-mis")],
+                max_length: 3,
+                gallery_width: 256,
+                gallery_passes: 16,
+                gallery_reference_passes: 128,
+                veach_scene: Some(bitterli("veach-mis")),
+                folder_suffix: "-bitterli",
                 ..base
             }),
             "test" => Ok(Scale {
@@ -124,9 +207,14 @@ impl Scale {
                 // The tests check dozens of intervals; at 0.999 each, the chance that any of 50
                 // misses by luck is 1 − 0.999⁵⁰ ≈ 5 % (Šidák), which a fixed seed then pins.
                 confidence: 0.999,
+                gallery_width: 16,
+                gallery_passes: 16,
+                gallery_reference_passes: 512,
                 ..base
             }),
-            other => Err(format!("unknown scale '{other}' (quick, full, test)")),
+            other => Err(format!(
+                "unknown scale '{other}' (quick, committed, full, bitterli, test)"
+            )),
         }
     }
 
@@ -139,6 +227,18 @@ impl Scale {
             v.push(max);
         }
         v
+    }
+
+    /// This scale with the galleries' film, passes and references as its own: what the
+    /// equal-time study renders at. At the quick scale it is the scale itself.
+    pub fn gallery(&self) -> Scale {
+        Scale {
+            width: self.gallery_width,
+            max_passes: self.gallery_passes,
+            reference_passes: self.gallery_reference_passes,
+            scenes: self.gallery_scenes.clone().unwrap_or(self.scenes.clone()),
+            ..self.clone()
+        }
     }
 
     /// The film of a scene at this scale: `width` wide, the scene's aspect ratio kept.
