@@ -307,8 +307,8 @@ fn plane_study_matches_its_exact_model() {
     let rows = csv(&d.join("exact.csv"));
     assert_eq!(
         rows.len(),
-        5 * 7 * 2,
-        "5 α × 7 snapshots × (bias², variance)"
+        2 * 5 * 7 * 2,
+        "(ppm, vcm's merging) × 5 α × 7 snapshots × (bias², variance)"
     );
     for r in &rows {
         assert_eq!(r["inside"], "yes", "{r:?}");
