@@ -140,26 +140,28 @@ fn unbiased_estimators_converge_at_slope_minus_one() {
 
 #[test]
 fn fixed_radius_pm_is_biased_and_pt_is_not() {
-    let rows = csv(&results().join("unbiased-vs-consistent/final.csv"));
+    // At the test scale (16 runs of 16 passes) the unbiased claims hold and pm's bias² estimate
+    // stands above 0; that it excludes 0 is asserted on the committed full scale
+    // (`committed_unbiased_consistent_and_findings_hold_within_their_intervals`).
+    let rows = csv(&results().join("unbiased-vs-consistent/claims.csv"));
     let get = |label: &str| {
         rows.iter()
             .find(|r| r["estimator"] == label)
             .unwrap_or_else(|| panic!("no row {label}"))
     };
-    for unbiased in ["pt", "bdpt"] {
+    for unbiased in ["pt", "bdpt", "light"] {
         assert_eq!(
-            get(unbiased)["includes 0"],
+            get(unbiased)["holds"],
             "yes",
             "{unbiased}: {:?}",
             get(unbiased)
         );
     }
-    assert_eq!(
-        get("pm (fixed radius)")["includes 0"],
-        "no",
-        "{:?}",
-        get("pm (fixed radius)")
-    );
+    let pm = get("pm (fixed radius)");
+    for column in ["bias² at N = 1", "bias² at largest N"] {
+        let estimate: f64 = pm[column].split(' ').next().unwrap().parse().unwrap();
+        assert!(estimate > 0.0, "pm {column}: {pm:?}");
+    }
     // The lecture's example: the exact bias lies in every measured interval.
     for r in csv(&results().join("unbiased-vs-consistent/lecture.csv")) {
         assert_eq!(r["exact inside"], "yes", "lecture N = {}: {:?}", r["N"], r);
