@@ -26,6 +26,12 @@ const BLACK: &[(&str, &str, Black, &str)] = &[
     ),
     (
         "pt-bsdf",
+        "point-plane-pinhole",
+        Black::Exact,
+        "its only light is a point light, which BSDF sampling never hits",
+    ),
+    (
+        "pt-bsdf",
         "cornell-point-caustic",
         Black::Exact,
         "its only light is a point light, which BSDF sampling never hits",

@@ -140,26 +140,28 @@ fn unbiased_estimators_converge_at_slope_minus_one() {
 
 #[test]
 fn fixed_radius_pm_is_biased_and_pt_is_not() {
-    let rows = csv(&results().join("unbiased-vs-consistent/final.csv"));
+    // At the test scale (16 runs of 16 passes) the unbiased claims hold and pm's bias² estimate
+    // stands above 0; that it excludes 0 is asserted on the committed full scale
+    // (`committed_unbiased_consistent_and_findings_hold_within_their_intervals`).
+    let rows = csv(&results().join("unbiased-vs-consistent/claims.csv"));
     let get = |label: &str| {
         rows.iter()
             .find(|r| r["estimator"] == label)
             .unwrap_or_else(|| panic!("no row {label}"))
     };
-    for unbiased in ["pt", "bdpt"] {
+    for unbiased in ["pt", "bdpt", "light"] {
         assert_eq!(
-            get(unbiased)["includes 0"],
+            get(unbiased)["holds"],
             "yes",
             "{unbiased}: {:?}",
             get(unbiased)
         );
     }
-    assert_eq!(
-        get("pm (fixed radius)")["includes 0"],
-        "no",
-        "{:?}",
-        get("pm (fixed radius)")
-    );
+    let pm = get("pm (fixed radius)");
+    for column in ["bias² at N = 1", "bias² at largest N"] {
+        let estimate: f64 = pm[column].split(' ').next().unwrap().parse().unwrap();
+        assert!(estimate > 0.0, "pm {column}: {pm:?}");
+    }
     // The lecture's example: the exact bias lies in every measured interval.
     for r in csv(&results().join("unbiased-vs-consistent/lecture.csv")) {
         assert_eq!(r["exact inside"], "yes", "lecture N = {}: {:?}", r["N"], r);
@@ -224,7 +226,11 @@ fn an_interrupted_run_resumes_without_redoing_finished_renders() {
 #[test]
 fn committed_radius_shrinkage_claims_hold_within_their_intervals() {
     let root = lt_tests::scenes_dir().parent().unwrap().to_path_buf();
-    for study in ["radius-shrinkage", "radius-shrinkage-plane"] {
+    for study in [
+        "radius-shrinkage",
+        "radius-shrinkage-plane",
+        "unbiased-vs-consistent",
+    ] {
         let path = root.join(format!("results/{study}/rates.csv"));
         let checked = check_claims(&path);
         assert!(checked > 0, "{}: no claims found", path.display());
@@ -256,6 +262,92 @@ fn committed_radius_shrinkage_claims_hold_within_their_intervals() {
     }
 }
 
+/// The committed unbiased-vs-consistent study and the report's findings, against their own
+/// intervals: each family claim recomputed from bias-variance.csv (unbiased: 0 inside at every N;
+/// consistent: bias² at N = 1 above 0; fixed radius: above 0 at the first and last N) and held
+/// to what claims.csv says, and each must hold; the exact bias² inside its interval wherever the
+/// table gives one; and the rates the findings quote inside their intervals (pt, bdpt, light: MSE
+/// slope −1; sppm, vcm: −2/3; ppm's bias² slope: the exact one at these N; the plane study's α =
+/// 2/3 MSE slopes: −2/3). Planting a number outside its interval in any of these CSVs fails it.
+#[test]
+fn committed_unbiased_consistent_and_findings_hold_within_their_intervals() {
+    let root = lt_tests::scenes_dir().parent().unwrap().to_path_buf();
+    let dir = root.join("results/unbiased-vs-consistent");
+    let rows = csv(&dir.join("bias-variance.csv"));
+    let claims = csv(&dir.join("claims.csv"));
+    assert!(!claims.is_empty() && !rows.is_empty());
+    let num = |r: &HashMap<String, String>, k: &str| -> f64 {
+        r[k].parse().unwrap_or_else(|e| panic!("{k}: {e}: {r:?}"))
+    };
+    for c in &claims {
+        let mine: Vec<&HashMap<String, String>> = rows
+            .iter()
+            .filter(|r| r["estimator"] == c["estimator"])
+            .collect();
+        assert!(!mine.is_empty(), "no rows for {}", c["estimator"]);
+        let above = |r: &HashMap<String, String>| num(r, "bias2_lo") > 0.0;
+        let holds = match c["family"].as_str() {
+            "unbiased" => mine
+                .iter()
+                .all(|r| num(r, "bias2_lo") <= 0.0 && 0.0 <= num(r, "bias2_hi")),
+            "consistent" => above(mine[0]),
+            "fixed radius" => above(mine[0]) && above(mine[mine.len() - 1]),
+            f => panic!("unknown family {f}"),
+        };
+        assert_eq!(
+            holds,
+            c["holds"] == "yes",
+            "claim does not match its intervals: {c:?}"
+        );
+        assert!(holds, "the report claims it: {c:?}");
+    }
+    for r in &rows {
+        if let Ok(e) = r["exact_bias2"].parse::<f64>() {
+            assert!(
+                num(r, "bias2_lo") <= e && e <= num(r, "bias2_hi"),
+                "exact bias² outside its interval: {r:?}"
+            );
+        }
+    }
+    // The numbers the findings quote, each inside its own interval as the report says.
+    let rates = csv(&dir.join("rates.csv"));
+    let plane = csv(&root.join("results/radius-shrinkage-plane/rates.csv"));
+    let held = |table: &[HashMap<String, String>], who: &str, alpha: &str, q: &str, rate: f64| {
+        let r = table
+            .iter()
+            .find(|r| r["integrator"] == who && r["α"] == alpha && r["quantity"] == q)
+            .unwrap_or_else(|| panic!("no row {who} {alpha} {q}"));
+        let (lo, hi) = interval(&r["CI"]);
+        assert!(
+            lo <= rate && rate <= hi,
+            "findings: {who} α = {alpha} {q} slope [{lo}, {hi}] does not hold {rate}"
+        );
+    };
+    for who in ["pt", "bdpt", "light"] {
+        held(&rates, who, "—", "MSE", -1.0);
+    }
+    for who in ["sppm", "vcm"] {
+        held(&rates, who, "2/3", "MSE", -2.0 / 3.0);
+    }
+    let ppm_b2 = rates
+        .iter()
+        .find(|r| r["integrator"] == "ppm" && r["quantity"] == "bias²")
+        .unwrap();
+    held(
+        &rates,
+        "ppm",
+        "2/3",
+        "bias²",
+        ppm_b2["predicted at these N"].parse().unwrap(),
+    );
+    for who in ["ppm", "sppm (photon part)", "vcm (merging)"] {
+        held(&plane, who, "2/3", "MSE", -2.0 / 3.0);
+    }
+    // The findings section is built from these CSVs.
+    let f = lt_experiments::report::findings::findings(&root.join("results")).unwrap();
+    assert_eq!(f.len(), 3);
+}
+
 /// Checks every yes/no claim of a rates table against its own interval; returns how many.
 fn check_claims(path: &Path) -> usize {
     let rows = csv(path);
@@ -278,6 +370,12 @@ fn check_claims(path: &Path) -> usize {
                 continue;
             }
             let predicted = predicted.unwrap_or_else(|e| panic!("{}: {e}: {r:?}", path.display()));
+            // The table prints 3 decimals: a rate that equal to a printed bound is decided by
+            // digits the CSV does not hold, so either claim stands.
+            let near = |b: f64| (predicted - b).abs() <= 5e-4 * b.abs().max(1.0);
+            if near(lo) || near(hi) {
+                continue;
+            }
             let inside = lo <= predicted && predicted <= hi;
             assert_eq!(
                 inside,
@@ -307,8 +405,8 @@ fn plane_study_matches_its_exact_model() {
     let rows = csv(&d.join("exact.csv"));
     assert_eq!(
         rows.len(),
-        5 * 7 * 2,
-        "5 α × 7 snapshots × (bias², variance)"
+        2 * 5 * 7 * 2,
+        "(ppm, vcm's merging) × 5 α × 7 snapshots × (bias², variance)"
     );
     for r in &rows {
         assert_eq!(r["inside"], "yes", "{r:?}");

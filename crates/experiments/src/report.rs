@@ -10,6 +10,7 @@
 //! images, and writes a JSON line into `<pre id="lt-selfcheck" hidden>` — what
 //! `tests/report_browser.rs` reads from Chromium's dumped DOM.
 
+pub mod findings;
 mod html;
 mod markdown;
 
@@ -102,7 +103,18 @@ pub fn write_report(results: &Path) -> Result<PathBuf, String> {
             eprintln!("warning: {e}");
         }
     }
-    let page = html::page(&studies);
+    // The findings lead the page (and are written as findings.md) when the studies' CSVs exist.
+    let findings = match findings::findings(results) {
+        Ok(f) => {
+            write_atomic(
+                &results.join("findings.md"),
+                findings::markdown(&f).as_bytes(),
+            )?;
+            Some(f)
+        }
+        Err(_) => None,
+    };
+    let page = html::page(&studies, findings.as_deref());
     let path = results.join(INDEX_FILE);
     write_atomic(&path, page.as_bytes())?;
     Ok(path)

@@ -25,7 +25,7 @@ pub mod visible;
 pub mod walk;
 
 pub use params::IntegratorParams;
-pub use registry::{make_integrator, IntegratorInfo, INTEGRATORS};
+pub use registry::{make_integrator, IntegratorInfo, Radius, INTEGRATORS};
 pub use render::{
     render, render_runs, EstimatorRef, PassReport, PassState, RenderOptions, RenderResult,
     RunSummary, RunsResult,

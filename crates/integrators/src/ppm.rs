@@ -18,7 +18,7 @@
 //! | `radius_scene` | f32 | — | initial radius as a fraction of the scene's bounding-sphere diameter |
 //! | `radius` | f32 | — | initial radius in scene units (warned about when far from the pixel footprint) |
 //! | `alpha` | f64 | 2/3 | radius reduction α (see `radius`: r²ᵢ ∝ i^(α−1)) |
-//! | `radius_update` | global/local | global | Knaus & Zwicker's global schedule or Hachisuka's per-pixel update |
+//! | `radius_update` | global/local/power | global | Knaus & Zwicker's global schedule, Hachisuka's per-pixel update, or vcm's r²ᵢ = r²₁ i^(α−1) |
 //! | `kernel` | disk/epanechnikov | disk | density-estimation kernel, normalised over the disk |
 //! | `direct` | nee/photons | nee | direct light by next-event estimation or from photons |
 //! | `visible_seed` | u64 | the run's seed | seed of the one camera pass: runs that share it share their visible points and differ in photons only, so their spread is the variance at fixed points that Knaus & Zwicker's rates describe |

@@ -14,7 +14,7 @@
 
 use crate::params::ParamReader;
 use crate::photons::{trace_photons, Kernel, Photon, PhotonOptions};
-use crate::radius::{global_scale2, read_alpha, InitialRadius, Update};
+use crate::radius::{global_scale2, power_scale2, read_alpha, InitialRadius, Update};
 use crate::visible::{CameraPrefix, Direct};
 use crate::ProgressLog;
 use lt_core::math::{is_valid_color, Color, Vec3, PI};
@@ -117,7 +117,10 @@ impl ProgressiveState {
     ) -> u64 {
         let mut invalid = 0;
         let i = pass + 1; // Knaus & Zwicker count passes from 1
-        let scale2 = global_scale2(i, params.alpha);
+        let scale2 = match params.update {
+            Update::Power => power_scale2(i, params.alpha),
+            _ => global_scale2(i, params.alpha),
+        };
         // The visible points of this pass, their pixels and radii.
         let mut pixel_of = Vec::new();
         let mut positions = Vec::new();
@@ -133,7 +136,7 @@ impl ProgressiveState {
             let Some(vp) = &pre.vp else { continue };
             let r0 = params.radius.at(scene, vp) as f64;
             let r2 = match params.update {
-                Update::Global => r0 * r0 * scale2,
+                Update::Global | Update::Power => r0 * r0 * scale2,
                 Update::Local => {
                     let px = &mut self.pixels[j];
                     if px.r2 == 0.0 {
@@ -151,8 +154,10 @@ impl ProgressiveState {
         let count = positions.len().max(1) as f64;
         self.log.mean_radius.push(r_sum / count);
         self.log.radius_scale.push(match params.update {
-            Update::Global => scale2.sqrt(),
-            Update::Local => f64::NAN,
+            Update::Global | Update::Power => scale2.sqrt(),
+            // Per-point radii: the mean radius against the first pass's (a NaN here would be
+            // written as null and refused by the run record).
+            Update::Local => (r_sum / count) / self.log.mean_radius[0].max(f64::MIN_POSITIVE),
         });
         if pass == 0 {
             if let Some(w) = params.radius.warning(fp_sum / count) {
@@ -217,7 +222,7 @@ impl ProgressiveState {
                 continue;
             }
             match params.update {
-                Update::Global => {
+                Update::Global | Update::Power => {
                     let r2 = radii2[k] as f64;
                     let s = 1.0 / (paths as f64 * PI as f64 * r2);
                     add(&mut px.photons, c * s as f32);
@@ -248,7 +253,7 @@ impl ProgressiveState {
         for (out, px) in img.data.iter_mut().zip(&self.pixels) {
             for (c, out_c) in out.iter_mut().enumerate() {
                 let photons = match params.update {
-                    Update::Global => px.photons[c] / n,
+                    Update::Global | Update::Power => px.photons[c] / n,
                     Update::Local if px.r2 > 0.0 => px.tau[c] / (ne * PI as f64 * px.r2),
                     Update::Local => 0.0,
                 };

@@ -104,6 +104,9 @@ pub enum Update {
     Global,
     /// Hachisuka et al.'s per-point (per-pixel) statistics.
     Local,
+    /// vcm's pure power law r²ᵢ = r²₁ i^(α−1) (`connect_merge`, as in SmallVCM), the same for
+    /// every point: lets the radius study run vcm's merging schedule at frozen points.
+    Power,
 }
 
 impl Update {
@@ -111,8 +114,9 @@ impl Update {
         match s {
             "global" => Ok(Update::Global),
             "local" => Ok(Update::Local),
+            "power" => Ok(Update::Power),
             _ => Err(format!(
-                "unknown radius_update '{s}' (known: global, local)"
+                "unknown radius_update '{s}' (known: global, local, power)"
             )),
         }
     }
@@ -125,6 +129,11 @@ pub fn read_alpha(r: &ParamReader, who: &str) -> Result<f64, String> {
         return Err(format!("{who}: alpha must be in (0, 1], got {a}"));
     }
     Ok(a)
+}
+
+/// r²ᵢ / r²₁ of vcm's schedule for pass i (1-based): i^(α−1).
+pub fn power_scale2(pass: u32, alpha: f64) -> f64 {
+    (pass as f64).powf(alpha - 1.0)
 }
 
 /// r²ᵢ / r²₁ of the global schedule for pass i (1-based): Π_{j<i} (j + α)/(j + 1).

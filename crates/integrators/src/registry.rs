@@ -28,7 +28,45 @@ pub struct IntegratorInfo {
     /// Which MIS weights it applies, and so which checker of `lt mis-check` holds them to the
     /// path-space oracle.
     pub weights: Weights,
+    /// Its density-estimation radius, if any: what the studies of bias against N need to know.
+    pub radius: Radius,
     pub make: Constructor,
+}
+
+/// An integrator's gather radius and how it changes with the pass count N.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Radius {
+    /// No density estimation (the unbiased integrators).
+    None,
+    /// One radius for the whole run (pm): a bias no number of passes removes.
+    Fixed,
+    /// Knaus & Zwicker's global schedule r²ᵢ = r²₁ Π_{j<i}(j+α)/(j+1) by default (ppm, sppm;
+    /// `radius_update` offers the others).
+    KnausZwicker,
+    /// The pure power law rᵢ = r₁ i^((α−1)/2) (vcm, bpm: Georgiev et al. 2012, SmallVCM).
+    Power,
+}
+
+impl Radius {
+    /// r²ᵢ / r²₁ at pass i (1-based) with reduction α; `None` without a radius.
+    pub fn scale2(self, i: u32, alpha: f64) -> Option<f64> {
+        match self {
+            Radius::None => None,
+            Radius::Fixed => Some(1.0),
+            Radius::KnausZwicker => Some(crate::radius::global_scale2(i, alpha)),
+            Radius::Power => Some(crate::radius::power_scale2(i, alpha)),
+        }
+    }
+}
+
+impl IntegratorInfo {
+    /// Whether the integrator reads `key` (its source's key table, which the test below holds
+    /// to what it reads).
+    pub fn takes(&self, key: &str) -> bool {
+        crate::params::documented_keys(self.source)
+            .iter()
+            .any(|(k, _)| k == key)
+    }
 }
 
 /// The MIS weights an integrator applies to the paths it completes (through its `Recorder`).
@@ -52,6 +90,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Unbiased,
         weights: Weights::PathTracing,
         source: include_str!("pt.rs"),
+        radius: Radius::None,
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(Pt {
                 params: PtParams::read(s, r)?,
@@ -64,6 +103,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Unbiased,
         weights: Weights::None,
         source: include_str!("pt_bsdf.rs"),
+        radius: Radius::None,
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(PtBsdf {
                 params: PtBsdfParams::read(s, r)?,
@@ -76,6 +116,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Unbiased,
         weights: Weights::None,
         source: include_str!("light.rs"),
+        radius: Radius::None,
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(LightTracer {
                 params: LightParams::read(s, r)?,
@@ -88,6 +129,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Unbiased,
         weights: Weights::Connections,
         source: include_str!("bdpt.rs"),
+        radius: Radius::None,
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(Bdpt {
                 params: BdptParams::read(s, r)?,
@@ -100,6 +142,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Consistent,
         weights: Weights::None,
         source: include_str!("pm.rs"),
+        radius: Radius::Fixed,
         make: |s, r| {
             Ok(Estimator::Consistent(Box::new(Pm {
                 params: PmParams::read(s, r)?,
@@ -112,6 +155,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Consistent,
         weights: Weights::None,
         source: include_str!("ppm.rs"),
+        radius: Radius::KnausZwicker,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Ppm::read(s, r)?))),
     },
     IntegratorInfo {
@@ -120,6 +164,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Consistent,
         weights: Weights::None,
         source: include_str!("sppm.rs"),
+        radius: Radius::KnausZwicker,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Sppm::read(s, r)?))),
     },
     IntegratorInfo {
@@ -128,6 +173,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Consistent,
         weights: Weights::ConnectMerge { connections: false },
         source: include_str!("bpm.rs"),
+        radius: Radius::Power,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Bpm::read(s, r)?))),
     },
     IntegratorInfo {
@@ -136,6 +182,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         kind: Kind::Consistent,
         weights: Weights::ConnectMerge { connections: true },
         source: include_str!("vcm.rs"),
+        radius: Radius::Power,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Vcm::read(s, r)?))),
     },
 ];
@@ -223,6 +270,13 @@ mod tests {
                     info.name
                 );
             }
+            // A radius property exactly where the integrator takes a radius.
+            assert_eq!(
+                info.radius == Radius::None,
+                !info.takes("radius"),
+                "{}: radius property against its keys",
+                info.name
+            );
             let built = make_integrator(info.name, &scene, &none).unwrap();
             assert_eq!(built.kind(), info.kind, "{}: registry kind", info.name);
             assert_eq!(built.name(), info.name);

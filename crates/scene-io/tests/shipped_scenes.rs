@@ -105,7 +105,7 @@ fn every_scene_loads() {
             // SmallVCM's own defaults: 512², path length 10 (segments, as our max_depth).
             assert_eq!((s.camera.width, s.camera.height), (512, 512), "{name}");
             assert_eq!(s.settings.max_depth, 10, "{name}");
-        } else if name == "point-plane" {
+        } else if name == "point-plane" || name == "point-plane-pinhole" {
             // One plane under a point light: every path is light → plane → camera, so the
             // radius-shrinkage study's exact answer holds at any depth; 2 says so.
             assert_eq!(s.settings.max_depth, 2, "{name}");

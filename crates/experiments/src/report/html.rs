@@ -84,7 +84,8 @@ fn slug(s: &str) -> String {
     out.trim_matches('-').to_string()
 }
 
-pub fn page(studies: &[StudyDir]) -> String {
+/// The page, led by the findings when given.
+pub fn page(studies: &[StudyDir], findings: Option<&[super::findings::Finding]>) -> String {
     let mut h = String::new();
     h.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
     h.push_str("<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n");
@@ -124,6 +125,28 @@ pub fn page(studies: &[StudyDir]) -> String {
         h.push_str("</ol></nav>\n");
     }
     h.push_str("</header>\n<main>\n");
+    if let Some(fs) = findings {
+        h.push_str("<section class=\"study\" id=\"findings\">\n<h2>Findings</h2>\n");
+        h.push_str(
+            "<p class=\"meta\">Each with its figure and the number that proves it (95 % \
+             intervals from independent runs), read from the studies' CSVs below.</p>\n",
+        );
+        for (i, f) in fs.iter().enumerate() {
+            let svg = url(f.folder, &format!("{}.svg", f.figure));
+            let _ = writeln!(
+                h,
+                "<h3>{}. {}</h3>\n<figure class=\"chart\">\n<a href=\"#study-{}\"><img \
+                 src=\"{svg}\" alt=\"{}\" width=\"960\" height=\"600\"></a>\n<figcaption>{}\
+                 </figcaption>\n</figure>",
+                i + 1,
+                esc(f.title),
+                slug(f.folder),
+                esc(f.title),
+                markdown::render(&f.text, "")
+            );
+        }
+        h.push_str("</section>\n");
+    }
     for s in studies {
         study(&mut h, s);
     }

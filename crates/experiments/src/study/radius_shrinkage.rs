@@ -44,7 +44,8 @@ pub fn specs(scale: &Scale) -> Vec<RunSpec> {
     for i in INTEGRATORS {
         for &a in &scale.alphas {
             for fixed in [false, true] {
-                if fixed && i != "ppm" {
+                // Fixed visible points: only an integrator that takes a camera-pass seed.
+                if fixed && !takes(i, FIXED_POINTS.0) {
                     continue;
                 }
                 let p = params(i, a, fixed);
@@ -67,7 +68,7 @@ pub fn specs(scale: &Scale) -> Vec<RunSpec> {
 /// as 1/N whatever α, and Knaus & Zwicker's rates describe the photon estimate alone.
 pub fn params(integrator: &str, alpha: f64, fixed_points: bool) -> Vec<(&'static str, String)> {
     let mut p = vec![("alpha", alpha_param(alpha))];
-    if integrator != "vcm" {
+    if takes(integrator, "direct") {
         p.push(("direct", "photons".into()));
     }
     if fixed_points {
@@ -82,6 +83,19 @@ pub fn params(integrator: &str, alpha: f64, fixed_points: bool) -> Vec<(&'static
 /// rate Knaus & Zwicker predict.
 pub const FIXED_POINTS: (&str, &str) = ("visible_seed", "1");
 
+/// Whether the registry says `integrator` reads `key` (false for an unknown name).
+fn takes(integrator: &str, key: &str) -> bool {
+    lt_integrators::registry::find(integrator).is_ok_and(|i| i.takes(key))
+}
+
+/// r²ᵢ / r²₁ of the schedule the registry gives `integrator` (NaN without one).
+fn schedule(integrator: &str, i: u32, alpha: f64) -> f64 {
+    lt_integrators::registry::find(integrator)
+        .ok()
+        .and_then(|info| info.radius.scale2(i, alpha))
+        .unwrap_or(f64::NAN)
+}
+
 /// Predicted log-log slopes against N: (variance, bias², MSE, r²).
 pub fn predicted(alpha: f64) -> (f64, f64, f64, f64) {
     let b2 = -2.0 * (1.0 - alpha);
@@ -95,13 +109,7 @@ pub fn predicted(alpha: f64) -> (f64, f64, f64, f64) {
 /// Returns (variance slope, bias² slope, MSE slope = the one of the two that dominates, taken as
 /// the asymptotic rule min(α, 2(1 − α))).
 pub fn predicted_at(integrator: &str, alpha: f64, tail: &[u32]) -> (f64, f64) {
-    let s = |i: u32| {
-        if integrator == "vcm" {
-            (i as f64).powf(alpha - 1.0)
-        } else {
-            lt_integrators::radius::global_scale2(i, alpha)
-        }
-    };
+    let s = |i: u32| schedule(integrator, i, alpha);
     let xs: Vec<f64> = tail.iter().map(|&n| (n as f64).ln()).collect();
     let (mut var, mut b2) = (Vec::new(), Vec::new());
     for &n in tail {
@@ -215,11 +223,7 @@ pub fn rates(
         .enumerate()
         .map(|(i, v)| {
             let n = i as u32 + 1;
-            let exact = if integrator == "vcm" {
-                (n as f64).powf(alpha - 1.0)
-            } else {
-                lt_integrators::radius::global_scale2(n, alpha)
-            };
+            let exact = schedule(integrator, n, alpha);
             ((v - exact) / exact).abs()
         })
         .fold(0.0, f64::max);
@@ -284,7 +288,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                 ("bias²", pb, fb, r.slopes[1].clone()),
                 ("MSE", pm, pm, r.slopes[2].clone()),
             ];
-            if integrator == "ppm" {
+            if takes(integrator, FIXED_POINTS.0) {
                 let (f, fdec) = rates(ctx, integrator, alpha, true)?;
                 fixed_decs.push(fdec);
                 quantities.insert(1, ("variance at fixed points", pv, fv, f.slopes[0].clone()));
@@ -338,7 +342,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                 }
                 .into(),
             ]);
-            if integrator == "ppm" {
+            if takes(integrator, FIXED_POINTS.0) {
                 r2_series.push(Series {
                     name: format!("α = {}", alpha_text(alpha)),
                     points: r
