@@ -236,6 +236,31 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                 "<bsdf type=\"dielectric\" id=\"{id}\">\n        <float name=\"int_ior\" value=\"{}\"/>\n        <float name=\"ext_ior\" value=\"1\"/>\n    </bsdf>",
                 d.ior.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(1.0)
             ),
+            "principled" | "principledthin" => {
+                let kind = d.kind.get_ref();
+                let mut inner = format!("\n        <rgb name=\"base_color\" value=\"{}\"/>", rgb(&d.base_color, 0.5));
+                // Only the scalars the file gives: Mitsuba's defaults are lt's.
+                for (v, name) in [
+                    (&d.roughness, "roughness"),
+                    (&d.anisotropic, "anisotropic"),
+                    (&d.metallic, "metallic"),
+                    (&d.spec_trans, "spec_trans"),
+                    (&d.specular, "specular"),
+                    (&d.spec_tint, "spec_tint"),
+                    (&d.sheen, "sheen"),
+                    (&d.sheen_tint, "sheen_tint"),
+                    (&d.flatness, "flatness"),
+                    (&d.clearcoat, "clearcoat"),
+                    (&d.clearcoat_gloss, "clearcoat_gloss"),
+                    (&d.diff_trans, "diff_trans"),
+                    (&d.ior, "eta"),
+                ] {
+                    if let Some(v) = v {
+                        let _ = write!(inner, "\n        <float name=\"{name}\" value=\"{}\"/>", *v.get_ref() as f32);
+                    }
+                }
+                format!("<bsdf type=\"{kind}\" id=\"{id}\">{inner}\n    </bsdf>")
+            }
             other => {
                 return Err(ctx.at(d.kind.span(), format!("material type `{other}` has no Mitsuba counterpart here")))
             }
@@ -254,6 +279,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
             (&d.alpha_texture, "alpha"),
             (&d.alpha_u_texture, "alpha_u"),
             (&d.alpha_v_texture, "alpha_v"),
+            (&d.base_color_texture, "base_color"),
         ] {
             if let Some(t) = t {
                 textures.push_str(&texture_xml(&ctx, t.get_ref(), name, out_dir));
@@ -276,6 +302,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
                     (&d.alpha_texture, "name=\"alpha\""),
                     (&d.alpha_u_texture, "name=\"alpha_u\""),
                     (&d.alpha_v_texture, "name=\"alpha_v\""),
+                    (&d.base_color_texture, "name=\"base_color\""),
                 ]
                 .iter()
                 .any(|(t, key)| t.is_some() && line.contains(key) && !line.contains("<texture"))
