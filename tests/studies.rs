@@ -47,27 +47,9 @@ fn results() -> &'static PathBuf {
     &full_run().0
 }
 
-/// A CSV as rows of column → value.
+/// A CSV as rows of column → value (the report's reader, which the findings use).
 fn csv(path: &Path) -> Vec<HashMap<String, String>> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    lines
-        .map(|l| {
-            // The study tables quote cells holding commas ("[a, b]").
-            let mut cells = Vec::new();
-            let (mut cur, mut quoted) = (String::new(), false);
-            for ch in l.chars() {
-                match ch {
-                    '"' => quoted = !quoted,
-                    ',' if !quoted => cells.push(std::mem::take(&mut cur)),
-                    c => cur.push(c),
-                }
-            }
-            cells.push(cur);
-            header.iter().cloned().zip(cells).collect()
-        })
-        .collect()
+    lt_experiments::report::findings::csv(path).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// "[lo, hi]" → (lo, hi).

@@ -84,3 +84,12 @@ pub fn subset_bias_variance(images: &[Image], kept: &[usize], r: &Reference) -> 
     let n = (3 * r.image.data.len()).max(1) as f64;
     (b2 / n - r.mean_variance, var / n)
 }
+
+/// α as the studies print it: 2/3 by name, any other value as it reads.
+pub fn alpha_text(a: f64) -> String {
+    if (a - 2.0 / 3.0).abs() < 1e-12 {
+        "2/3".into()
+    } else {
+        format!("{a}")
+    }
+}

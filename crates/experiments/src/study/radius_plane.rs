@@ -114,9 +114,7 @@ pub fn plane_scale(scale: &Scale) -> (usize, u32, u64) {
     }
 }
 
-fn alpha_text(a: f64) -> String {
-    super::radius_shrinkage::alpha_text(a)
-}
+use super::metrics::alpha_text;
 
 /// The K runs of one estimator and α: photon seeds 1..=K, one shared camera pass.
 pub fn config_specs(scale: &Scale, est: Estimator, alpha: f64) -> Vec<RunSpec> {

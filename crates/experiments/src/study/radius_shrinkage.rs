@@ -24,13 +24,7 @@ pub const INTEGRATORS: [&str; 3] = ["ppm", "sppm", "vcm"];
 /// check allows 8 × 2⁻²⁴ ≈ 4.8e-7 relative.
 pub const SCHEDULE_TOLERANCE: f64 = 8.0 / 16_777_216.0;
 
-pub fn alpha_text(a: f64) -> String {
-    if (a - 2.0 / 3.0).abs() < 1e-12 {
-        "2/3".into()
-    } else {
-        format!("{a}")
-    }
-}
+pub use super::metrics::alpha_text;
 
 /// The parameter value passed to the integrator (the shortest text that reads back as `a`).
 fn alpha_param(a: f64) -> String {
