@@ -83,6 +83,7 @@ pub struct ShadingFrame {
 
 impl ShadingFrame {
     /// A frame around `ns` with an arbitrary tangent: all an isotropic material needs.
+    #[inline]
     pub fn new(ng: Vec3, ns: Vec3) -> ShadingFrame {
         ShadingFrame {
             ng,
@@ -100,6 +101,12 @@ impl ShadingFrame {
         if tangent == Vec3::ZERO {
             return ShadingFrame::new(ng, ns);
         }
+        Self::along(ng, ns, tangent)
+    }
+
+    /// `oriented` with a tangent: out of line, so the common isotropic case inlines small.
+    #[inline(never)]
+    fn along(ng: Vec3, ns: Vec3, tangent: Vec3) -> ShadingFrame {
         match (tangent - ns * ns.dot(tangent)).try_normalize() {
             Some(x) => ShadingFrame {
                 ng,
@@ -207,24 +214,35 @@ pub enum Material {
     Blend(Box<Blend>),
 }
 
+/// Matches `$material`'s plain variants with `$m` bound to its BSDF, each arm its own copy of
+/// `$body` (static dispatch: the BSDF's `sample`/`eval`/`pdf` inline into the frame code, where
+/// a `&dyn LocalBsdf` would cost an indirect call each); `$rest` are the wrapper arms.
+macro_rules! match_plain {
+    ($material:expr, $m:ident => $body:expr, $($rest:tt)*) => {
+        match $material {
+            Material::Diffuse($m) => $body,
+            Material::FrontDiffuse($m) => $body,
+            Material::Mirror($m) => $body,
+            Material::Dielectric($m) => $body,
+            Material::Glossy($m) => $body,
+            Material::Conductor($m) => $body,
+            Material::RoughConductor($m) => $body,
+            Material::Plastic($m) => $body,
+            Material::RoughPlastic($m) => $body,
+            Material::RoughDielectric($m) => $body,
+            Material::ThinDielectric($m) => $body,
+            Material::Principled($m) => $body,
+            Material::PrincipledThin($m) => $body,
+            Material::TwoSided($m) => $body,
+            $($rest)*
+        }
+    };
+}
+
 impl Material {
     #[inline]
     fn local(&self) -> &dyn LocalBsdf {
-        match self {
-            Material::Diffuse(m) => m,
-            Material::FrontDiffuse(m) => m,
-            Material::Mirror(m) => m,
-            Material::Dielectric(m) => m,
-            Material::Glossy(m) => m,
-            Material::Conductor(m) => m,
-            Material::RoughConductor(m) => m,
-            Material::Plastic(m) => m,
-            Material::RoughPlastic(m) => m,
-            Material::RoughDielectric(m) => m,
-            Material::ThinDielectric(m) => m,
-            Material::Principled(m) => m,
-            Material::PrincipledThin(m) => m,
-            Material::TwoSided(m) => m,
+        match_plain!(self, m => m,
             Material::Textured(t) => t.base.local(),
             Material::Perturbed(p) => p.inner.local(),
             // Only `is_delta` asks a mask's local BSDF: its pass-through is a delta lobe, so it
@@ -233,7 +251,7 @@ impl Material {
             // Never reached: every query a blend answers (`is_delta`, `has_delta_lobe`, `sample`,
             // `eval`, `pdf`) is answered before `local` is asked.
             Material::Blend(b) => b.first.local(),
-        }
+        )
     }
 
     /// The normal or bump map the material is under, if any: the hit replaces its shading
@@ -267,6 +285,19 @@ impl Material {
         }
     }
 
+    /// True when the material reads the shading point's uv: a texture, a normal or bump map, a
+    /// mask or a blend (conservatively) anywhere inside it.
+    pub fn reads_uv(&self) -> bool {
+        match self {
+            Material::Textured(_)
+            | Material::Perturbed(_)
+            | Material::Mask(_)
+            | Material::Blend(_) => true,
+            Material::TwoSided(t) => t.inner.reads_uv(),
+            _ => false,
+        }
+    }
+
     /// True when the material is anisotropic (α_u ≠ α_v, or either textured): its shading frame
     /// must then follow the surface's ∂p/∂u (`ShadingFrame::oriented`). Every other material
     /// keeps the arbitrary tangent of `Frame::from_z`, and so its bits and speed.
@@ -286,11 +317,21 @@ impl Material {
         }
     }
 
+    /// Inlined for the plain materials (each answer a constant); the wrappers recurse.
+    #[inline]
     pub fn is_delta(&self) -> bool {
-        if let Material::Blend(b) = self {
-            return b.first.is_delta() && b.second.is_delta();
-        }
-        self.local().is_delta()
+        match_plain!(self, m => m.is_delta(), _ => self.wrapper_is_delta(),)
+    }
+
+    #[inline(never)]
+    fn wrapper_is_delta(&self) -> bool {
+        match_plain!(self, m => m.is_delta(),
+            Material::Textured(t) => t.base.is_delta(),
+            Material::Perturbed(p) => p.inner.is_delta(),
+            // The pass-through is a delta lobe: all-delta exactly when the nested material is.
+            Material::Mask(m) => m.inner.is_delta(),
+            Material::Blend(b) => b.first.is_delta() && b.second.is_delta(),
+        )
     }
 
     /// See `LocalBsdf::has_delta_lobe`.
@@ -388,44 +429,41 @@ impl Material {
         u: Vec2,
         mode: TransportMode,
     ) -> Option<BsdfSample> {
-        match self {
+        match_plain!(self, m => sample_local(m, sf, wo, u_lobe, u, mode),
             Material::Textured(t) => {
                 t.with_local(sf.uv, |m| sample_local(m, sf, wo, u_lobe, u, mode))
             }
             Material::Perturbed(p) => p.sample(sf, wo, u_lobe, u, mode),
             Material::Mask(m) => m.sample(sf, wo, u_lobe, u, mode),
             Material::Blend(b) => b.sample(sf, wo, u_lobe, u, mode),
-            _ => sample_local(self.local(), sf, wo, u_lobe, u, mode),
-        }
+        )
     }
 
     pub fn eval(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3, mode: TransportMode) -> BsdfEval {
-        match self {
+        match_plain!(self, m => eval_local(m, sf, wo, wi, mode),
             Material::Textured(t) => t.with_local(sf.uv, |m| eval_local(m, sf, wo, wi, mode)),
             Material::Perturbed(p) => p.eval(sf, wo, wi, mode),
             Material::Mask(m) => m.eval(sf, wo, wi, mode),
             Material::Blend(b) => b.eval(sf, wo, wi, mode),
-            _ => eval_local(self.local(), sf, wo, wi, mode),
-        }
+        )
     }
 
     /// Solid-angle pdf of sampling wi given wo.
     pub fn pdf(&self, sf: &ShadingFrame, wo: Vec3, wi: Vec3) -> f32 {
-        match self {
+        match_plain!(self, m => pdf_local(m, sf, wo, wi),
             Material::Textured(t) => t.with_local(sf.uv, |m| pdf_local(m, sf, wo, wi)),
             Material::Perturbed(p) => p.pdf(sf, wo, wi),
             Material::Mask(m) => m.pdf(sf, wo, wi),
             Material::Blend(b) => b.pdf(sf, wo, wi),
-            _ => pdf_local(self.local(), sf, wo, wi),
-        }
+        )
     }
 }
 
 /// `Material::sample` for a material's local BSDF: to the shading frame and back, the side
 /// check and the adjoint correction.
 #[inline]
-fn sample_local(
-    m: &dyn LocalBsdf,
+fn sample_local<B: LocalBsdf + ?Sized>(
+    m: &B,
     sf: &ShadingFrame,
     wo: Vec3,
     u_lobe: f32,
@@ -453,8 +491,8 @@ fn sample_local(
 
 /// `Material::eval` for a material's local BSDF.
 #[inline]
-fn eval_local(
-    m: &dyn LocalBsdf,
+fn eval_local<B: LocalBsdf + ?Sized>(
+    m: &B,
     sf: &ShadingFrame,
     wo: Vec3,
     wi: Vec3,
@@ -476,7 +514,7 @@ fn eval_local(
 
 /// `Material::pdf` for a material's local BSDF.
 #[inline]
-fn pdf_local(m: &dyn LocalBsdf, sf: &ShadingFrame, wo: Vec3, wi: Vec3) -> f32 {
+fn pdf_local<B: LocalBsdf + ?Sized>(m: &B, sf: &ShadingFrame, wo: Vec3, wi: Vec3) -> f32 {
     let wo_l = sf.frame.to_local(wo);
     let wi_l = sf.frame.to_local(wi);
     if !consistent_sides(sf, wo, wi, wo_l.z, wi_l.z) {

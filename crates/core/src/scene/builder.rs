@@ -212,6 +212,7 @@ impl SceneBuilder {
                     }
                 }
             }
+            let textured_light = matches!(&emission, Some(e) if !matches!(e, Texture::Constant(_)));
             let light = emission.map(|e| {
                 lights.push(Light::area(shape_id, &geometry, &e, flip_normals));
                 (lights.len() - 1) as u32
@@ -224,7 +225,10 @@ impl SceneBuilder {
                 (ShapeGeometry::Mesh(m), Some(name)) => m.attribute_index(name),
                 _ => None,
             };
+            let m = &self.materials[material as usize];
             shapes.push(Shape {
+                reads_uv: m.reads_uv() || textured_light,
+                needs_tangent: m.needs_tangent(),
                 geometry,
                 material,
                 light,

@@ -36,12 +36,12 @@ pub struct SurfaceHit {
 
 impl SurfaceHit {
     pub(crate) fn new(scene: &Scene, ray: &Ray, h: PrimHit) -> SurfaceHit {
-        let prim = *scene.accel.primitive(h.prim);
+        let prim = scene.accel.primitive(h.prim);
         let shape = &scene.shapes[prim.shape() as usize];
         // `tri`: the mesh triangle holding the point (a parallelogram's source triangle).
         // `analytic`: a disk's or cylinder's own ∂p/∂u, ∂p/∂v.
         let mut analytic = None;
-        let (p, p_err, mut ng, mut ns, uv, tri, bary) = match prim {
+        let (p, p_err, mut ng, mut ns, uv, tri, bary) = match *prim {
             Primitive::Triangle {
                 p: [p0, p1, p2],
                 index,
@@ -55,7 +55,11 @@ impl SurfaceHit {
                 let (ns, uv) = match &shape.geometry {
                     ShapeGeometry::Mesh(m) => (
                         m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng),
-                        m.uv(index as usize, b0, b1, b2),
+                        if shape.reads_uv {
+                            m.uv(index as usize, b0, b1, b2)
+                        } else {
+                            Vec2::ZERO
+                        },
                     ),
                     _ => (ng, Vec2::ZERO),
                 };
@@ -74,7 +78,11 @@ impl SurfaceHit {
                     ShapeGeometry::Mesh(m) => (
                         m.shading_normal(tri as usize, b[0], b[1], b[2])
                             .unwrap_or(ng),
-                        m.uv(tri as usize, b[0], b[1], b[2]),
+                        if shape.reads_uv {
+                            m.uv(tri as usize, b[0], b[1], b[2])
+                        } else {
+                            Vec2::ZERO
+                        },
                     ),
                     _ => (ng, Vec2::ZERO),
                 };
@@ -83,7 +91,11 @@ impl SurfaceHit {
             Primitive::Sphere { center, radius, .. } => {
                 let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
                 let n = (p - center).normalize();
-                let uv = crate::shape::sphere_uv(shape.geometry.sphere_to_object() * n);
+                let uv = if shape.reads_uv {
+                    crate::shape::sphere_uv(shape.geometry.sphere_to_object() * n)
+                } else {
+                    Vec2::ZERO
+                };
                 (p, err, n, n, uv, 0, [1.0, 0.0, 0.0])
             }
             Primitive::Disk { to_object, .. } | Primitive::Cylinder { to_object, .. } => {
@@ -96,11 +108,11 @@ impl SurfaceHit {
                 analytic = Some((q.dpdu, q.dpdv));
                 (q.p, q.p_err, q.n, q.n, q.uv, 0, [1.0, 0.0, 0.0])
             }
-            Primitive::SdfVoxel { voxel, .. } => {
+            Primitive::SdfVoxel { ref voxel, .. } => {
                 let ShapeGeometry::SdfGrid { grid, to_world } = &shape.geometry else {
                     unreachable!("an sdf voxel of another shape")
                 };
-                let (p, p_err) = sdf_hit_point(ray, h.t, &voxel, to_world);
+                let (p, p_err) = sdf_hit_point(ray, h.t, voxel, to_world);
                 let to_object = to_world.inverse();
                 let local = to_object.point(p);
                 // Normals transform by the inverse transpose of to_world: to_object's transpose.
@@ -138,10 +150,10 @@ impl SurfaceHit {
         let material = scene.material(shape.material);
         let perturbation = material.perturbation();
         let mut tangent = Vec3::ZERO;
-        let oriented = material.needs_tangent();
+        let oriented = shape.needs_tangent;
         if perturbation.is_some() || oriented {
             let (dpdu, dpdv) =
-                analytic.unwrap_or_else(|| tangents(&shape.geometry, &prim, tri as usize, p, ng));
+                analytic.unwrap_or_else(|| tangents(&shape.geometry, prim, tri as usize, p, ng));
             if oriented {
                 tangent = (dpdu - ns * ns.dot(dpdu))
                     .try_normalize()

@@ -55,6 +55,11 @@ pub struct Shape {
     /// The mesh attribute (index into the mesh's `attributes`) the shape's material reads, if
     /// any: only then does a hit compute one.
     pub attribute: Option<u32>,
+    /// A hit computes texture coordinates only when something reads them: the material
+    /// (`Material::reads_uv`) or a textured emission. Others keep uv zero, and skip its cost.
+    pub reads_uv: bool,
+    /// `Material::needs_tangent`, asked once here instead of at every hit.
+    pub needs_tangent: bool,
 }
 
 pub struct Scene {
