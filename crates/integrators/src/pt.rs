@@ -200,8 +200,13 @@ impl Pt {
         let mut beta = Color::ONE;
         let mut l = Color::ZERO;
         // The previous vertex's BSDF pdf (solid angle) and whether it was a delta lobe; the camera
-        // counts as a delta so emitters seen directly get full weight.
-        let mut prev_pdf_w = scene.camera.pdf_dir(ray.o, ray.d);
+        // counts as a delta so emitters seen directly get full weight, and its pdf is only asked
+        // for the recorder's vertices (no weight reads it).
+        let mut prev_pdf_w = if R::ACTIVE {
+            scene.camera.pdf_dir(ray.o, ray.d)
+        } else {
+            0.0
+        };
         let mut prev_delta = true;
         let mut prev_p = ray.o;
         // The camera subpath so far, only kept for a recorder.

@@ -326,6 +326,7 @@ impl Camera {
 
     /// The ray through a raster position (pixel (i, j) covers [i, i+1) × [j, j+1)) from the
     /// centre of the lens.
+    #[inline]
     pub fn generate_ray(&self, raster: Vec2) -> Ray {
         let plane = self.plane_of_raster(raster);
         match self.lens {
@@ -358,6 +359,7 @@ impl Camera {
 
     /// The primary ray of a raster position: through a sampled lens point for a thin lens (two
     /// numbers from `sampler`), `generate_ray` otherwise. The ray's origin is the camera vertex.
+    #[inline]
     pub fn sample_ray(&self, raster: Vec2, sampler: &mut Sampler) -> Ray {
         let Some((lens, focus)) = self.lens_point(sampler) else {
             return self.generate_ray(raster);
