@@ -268,14 +268,13 @@ impl Pt {
             if depth == self.params.max_depth {
                 break;
             }
-            let material = scene.material(hit.material);
             let sf = hit.shading_frame();
             let at = WalkPoint {
                 hit: &hit,
                 sf: &sf,
                 wo,
             };
-            if nee && !material.is_delta() {
+            if nee && !scene.material_is_delta(hit.material) {
                 let report = Report {
                     rec: &mut *rec,
                     camera_path: &verts,

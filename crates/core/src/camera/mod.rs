@@ -380,6 +380,7 @@ impl Camera {
 
     /// Raster position of the ray from camera vertex `from` (a lens point; any point of the film
     /// rectangle for orthographic, whose direction is the axis) along `dir`, if on the film.
+    #[inline]
     pub fn raster_from(&self, from: Vec3, dir: Vec3) -> Option<Vec2> {
         match self.lens {
             Lens::Pinhole => {
@@ -414,6 +415,12 @@ impl Camera {
         if self.raster_from(from, dir).is_none() {
             return 0.0;
         }
+        self.importance_on_film(dir)
+    }
+
+    /// `importance` for a direction already known to reach the film (`connect` has its raster).
+    #[inline]
+    fn importance_on_film(&self, dir: Vec3) -> f32 {
         if self.is_delta_direction() {
             return self.pixel_count() as f32 / self.plane_area;
         }
@@ -463,7 +470,7 @@ impl Camera {
             dir,
             distance_squared,
             raster,
-            importance: self.importance(origin, dir),
+            importance: self.importance_on_film(dir),
             cos_lens: self.frame.z.dot(dir),
         })
     }
@@ -485,7 +492,7 @@ impl Camera {
             dir,
             distance_squared: 1.0,
             raster,
-            importance: self.importance(origin, dir),
+            importance: self.importance_on_film(dir),
             cos_lens: self.frame.z.dot(dir),
         })
     }

@@ -249,6 +249,7 @@ impl Light {
 
     /// A directional light: a delta in direction (its emitted rays have an area density on the
     /// bounding disk). The sun is not: its finite cone has a solid-angle pdf and takes part in MIS.
+    #[inline]
     pub fn delta_direction(&self) -> bool {
         matches!(self, Light::Directional(_))
     }

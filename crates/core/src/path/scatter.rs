@@ -145,6 +145,7 @@ const UNAMBIGUOUS_RATIO: f32 = 0.05;
 /// walking alone, while a connection at `v` evaluates the smooth lobes (pbrt-v3 and SmallVCM
 /// decide per sampled lobe too). The end vertices of a connection scatter by evaluation, hence
 /// smoothly, whatever their own walk did next: they take `connectable`.
+#[inline]
 pub fn connectable_inside(scene: &Scene, v: &PathVertex) -> bool {
     connectable(scene, v) && !v.delta
 }
@@ -155,9 +156,10 @@ pub fn connectable_inside(scene: &Scene, v: &PathVertex) -> bool {
 /// position, which an edge to it matches by construction). Next-event estimation is not a
 /// deterministic edge — the light samples its own Dirac — and `Chain::valid` lets technique 1
 /// through whatever x0 is.
+#[inline]
 pub fn connectable(scene: &Scene, v: &PathVertex) -> bool {
     match v.kind {
-        VertexKind::Surface { material } => !scene.material(material).is_delta(),
+        VertexKind::Surface { material } => !scene.material_is_delta(material),
         VertexKind::Light { light, .. } => !scene.lights[light as usize].delta_direction(),
         // An orthographic camera is a delta in direction (`PathVertex::camera_at`).
         VertexKind::Camera => !v.delta,

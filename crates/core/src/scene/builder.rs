@@ -254,6 +254,7 @@ impl SceneBuilder {
             origin,
             camera: self.camera,
             settings: self.settings,
+            delta_materials: self.materials.iter().map(Material::is_delta).collect(),
             materials: self.materials,
             shapes,
             lights,

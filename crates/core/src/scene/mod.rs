@@ -71,6 +71,9 @@ pub struct Scene {
     pub camera: Camera,
     pub settings: RenderSettings,
     pub materials: Vec<Material>,
+    /// `Material::is_delta` of each material, asked once at build: connections ask it of every
+    /// vertex of every technique (O(k²) per path), and through wrappers it recurses.
+    pub delta_materials: Vec<bool>,
     pub shapes: Vec<Shape>,
     pub lights: Vec<Light>,
     pub light_sampler: LightSampler,
@@ -95,6 +98,12 @@ impl Scene {
 
     pub fn material(&self, id: u32) -> &Material {
         &self.materials[id as usize]
+    }
+
+    /// `material(id).is_delta()`, from the table built with the scene.
+    #[inline]
+    pub fn material_is_delta(&self, id: u32) -> bool {
+        self.delta_materials[id as usize]
     }
 
     /// Number of primitives (for benchmarks and reports).
