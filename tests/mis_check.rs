@@ -180,3 +180,59 @@ fn a_wrong_light_tracing_ratio_fails() {
     let report = check(&scene, &opts, &c.records);
     assert!(!report.passed(), "{report}");
 }
+
+/// lvc-bdpt's options: N = `connections` cache vertices per camera vertex.
+fn lvc_options(scene: &lt_core::Scene, h: Heuristic, connections: u32) -> Options {
+    let mut o = options(scene, Which::Lvc, h);
+    o.connections = connections;
+    o
+}
+
+fn check_all_lvc(h: Heuristic, connections: u32) {
+    let mut failed = Vec::new();
+    for name in &shipped_scene_names() {
+        let mut scene = shipped_scene(name, None);
+        let opts = lvc_options(&scene, h, connections);
+        let report = check_scene(&mut scene, &opts, name);
+        assert!(report.checked() > 0, "{name}: no paths recorded\n{report}");
+        if !report.passed() {
+            failed.push(format!("{report}"));
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+#[test]
+fn lvc_power_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all_lvc(Heuristic::Power, 4);
+}
+
+#[test]
+fn lvc_balance_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all_lvc(Heuristic::Balance, 1);
+}
+
+#[test]
+fn an_lvc_connection_count_without_n_fails() {
+    // lvc-bdpt run with N = 4 connections, judged with n_conn = 1 / L̄ (N left out of the
+    // count): every path some connection could make has the wrong weight.
+    let mut scene = shipped_scene("cornell-box", None);
+    let mut opts = lvc_options(&scene, Heuristic::Power, 4);
+    opts.paths = 50;
+    opts.max_depth = 4;
+    prepare_scene(&mut scene, &opts);
+    let (c, _) = collect(&scene, &opts);
+    assert!(check(&scene, &opts, &c.records).passed());
+    opts.connections = 1;
+    let report = check(&scene, &opts, &c.records);
+    assert!(!report.passed(), "{report}");
+    // Paths of three segments or more have a connection technique; shorter ones none.
+    assert!(
+        report.rows.iter().all(|r| r.k >= 3 || r.over == 0),
+        "{report}"
+    );
+    assert!(
+        report.rows.iter().any(|r| r.k >= 3 && r.over > 0),
+        "{report}"
+    );
+}

@@ -90,6 +90,19 @@ const STACK_K: usize = 23;
 /// The MIS weight of strategy (s, t) for the path `split` forms (Veach 1997, eq. 10.9 with the
 /// ratios of §10.2), under `h`, with `ratio` = M/N light subpaths per camera sample.
 pub fn mis_weight(scene: &Scene, split: Split, evals: EndEvals, h: Heuristic, ratio: f64) -> f64 {
+    with_chain(scene, split, evals, ratio, |chain, s| chain.weight(s, h))
+}
+
+/// Builds the `Chain` of the path `split` forms (stored densities, the ≤ 4 entries the join
+/// changes patched) and hands it, with the technique s, to `f` — `mis_weight`, or an integrator
+/// whose sample counts differ from bdpt's (`lvc_bdpt`).
+pub fn with_chain<T>(
+    scene: &Scene,
+    split: Split,
+    evals: EndEvals,
+    ratio: f64,
+    f: impl FnOnce(&Chain, usize) -> T,
+) -> T {
     let (y, z) = (split.light, split.camera);
     let s = if z
         .last()
@@ -196,7 +209,7 @@ pub fn mis_weight(scene: &Scene, split: Split, evals: EndEvals, h: Heuristic, ra
         connectable: &conn[..=k],
         light_tracing_ratio: ratio,
     };
-    chain.weight(s, h)
+    f(&chain, s)
 }
 
 /// Per-thread buffers of one sample.

@@ -6,6 +6,7 @@ pub mod bpm;
 pub mod connect;
 pub mod connect_merge;
 pub mod light;
+pub mod lvc_bdpt;
 pub mod params;
 pub mod photons;
 pub mod pixel;

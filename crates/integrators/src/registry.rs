@@ -4,6 +4,7 @@
 use crate::bdpt::{Bdpt, BdptParams};
 use crate::bpm::Bpm;
 use crate::light::{LightParams, LightTracer};
+use crate::lvc_bdpt::{LvcBdpt, LvcParams};
 use crate::params::{IntegratorParams, ParamReader};
 use crate::pm::{Pm, PmParams};
 use crate::ppm::Ppm;
@@ -81,6 +82,8 @@ pub enum Weights {
     /// vcm's (`connections` true) or bpm's (false): merging, with or without connections, under
     /// one recursive MIS (`connect_merge`).
     ConnectMerge { connections: bool },
+    /// lvc-bdpt's: bdpt's techniques, connections counted N / L̄ times (`lvc_bdpt`).
+    VertexCache,
 }
 
 pub const INTEGRATORS: &[IntegratorInfo] = &[
@@ -134,6 +137,18 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
             Ok(Estimator::Unbiased(Box::new(Bdpt {
                 params: BdptParams::read(s, r)?,
             })))
+        },
+    },
+    IntegratorInfo {
+        name: "lvc-bdpt",
+        about: "bdpt with a light-vertex cache: each camera vertex joins N random cached light vertices",
+        kind: Kind::Unbiased,
+        weights: Weights::VertexCache,
+        source: include_str!("lvc_bdpt.rs"),
+        radius: Radius::None,
+        make: |s, r| {
+            let params = LvcParams::read(s, r)?;
+            Ok(Estimator::Unbiased(Box::new(LvcBdpt::new(s, params))))
         },
     },
     IntegratorInfo {

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 pub struct MisCheckArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    /// Integrator whose weights are checked: pt, bdpt, vcm or bpm.
+    /// Integrator whose weights are checked: pt, bdpt, lvc-bdpt, vcm or bpm.
     #[arg(long, default_value = "bdpt")]
     pub integrator: String,
     /// MIS heuristic: power (the integrators' default), balance, or none (bdpt only).
@@ -34,9 +34,12 @@ pub struct MisCheckArgs {
     /// Give up on lengths still short of `paths` after this many passes.
     #[arg(long, default_value_t = 2000)]
     pub max_passes: u32,
-    /// bdpt: light subpaths per pass (default: the pixel count).
+    /// bdpt, lvc-bdpt: light subpaths per pass (default: the pixel count).
     #[arg(long)]
     pub light_paths: Option<u64>,
+    /// lvc-bdpt: cache vertices each camera vertex connects to (N).
+    #[arg(long, default_value_t = 1)]
+    pub connections: u32,
     /// Multiplier on each path's tolerance, which is derived from the rounding of the walks'
     /// densities and vertex positions (see the module docs of verify::mis_check::tolerance).
     #[arg(long, default_value_t = DEFAULT_SLACK)]
@@ -48,6 +51,7 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
     let integrator = match registry::find(&args.integrator)?.weights {
         Weights::PathTracing => Which::Pt,
         Weights::Connections => Which::Bdpt,
+        Weights::VertexCache => Which::Lvc,
         Weights::ConnectMerge { connections } => return run_vcm_bpm(args, connections),
         Weights::None => {
             let checked: Vec<&str> = registry::with_weights(|w| w != Weights::None).collect();
@@ -83,6 +87,10 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
     opts.resolution = args.resolution.max(1);
     opts.max_passes = args.max_passes;
     opts.light_paths = args.light_paths;
+    if args.connections == 0 {
+        return Err("mis-check: connections must be at least 1".into());
+    }
+    opts.connections = args.connections;
     opts.slack = args.slack;
     let name = args.scene.display().to_string();
     let report = check_scene(&mut scene, &opts, &name);

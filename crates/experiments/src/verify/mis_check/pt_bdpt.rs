@@ -43,8 +43,9 @@ use lt_core::math::{Color, Vec2};
 use lt_core::path::{oracle_weight, Heuristic, Path, PathVertex, VertexKind};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
-use lt_integrators::bdpt::{mis_weight, Bdpt, BdptParams, EndEvals, Split};
+use lt_integrators::bdpt::{mis_weight, with_chain, Bdpt, BdptParams, EndEvals, Split};
 use lt_integrators::connect::eval_towards;
+use lt_integrators::lvc_bdpt::{lvc_weight, LvcBdpt, LvcParams};
 use lt_integrators::pt::{Pt, PtParams, Techniques};
 use lt_integrators::record::{Completed, Recorder};
 use lt_integrators::registry::{self, Weights};
@@ -55,6 +56,8 @@ use std::fmt;
 pub enum Which {
     Pt,
     Bdpt,
+    /// lvc-bdpt: bdpt's techniques with connections counted n_conn = N / L̄ times.
+    Lvc,
 }
 
 impl Which {
@@ -64,6 +67,7 @@ impl Which {
         let weights = match self {
             Which::Pt => Weights::PathTracing,
             Which::Bdpt => Weights::Connections,
+            Which::Lvc => Weights::VertexCache,
         };
         registry::with_weights(move |w| w == weights)
             .next()
@@ -84,6 +88,8 @@ pub struct Options {
     pub resolution: u32,
     pub max_passes: u32,
     pub light_paths: Option<u64>,
+    /// lvc-bdpt: cache vertices per camera vertex (N).
+    pub connections: u32,
     /// Multiplier on the derived tolerance of (a) (`tolerance::derived_tolerance`).
     pub slack: f64,
 }
@@ -101,6 +107,7 @@ impl Options {
             resolution: 16,
             max_passes: 2000,
             light_paths: None,
+            connections: 1,
             slack: DEFAULT_SLACK,
         }
     }
@@ -198,10 +205,40 @@ pub fn prepare_scene(scene: &mut Scene, opts: &Options) {
 pub fn light_tracing_ratio(scene: &Scene, opts: &Options) -> f64 {
     match opts.integrator {
         Which::Pt => 1.0,
-        Which::Bdpt => {
+        Which::Bdpt | Which::Lvc => {
             let n = scene.camera.pixel_count() as u64;
             opts.light_paths.unwrap_or(n) as f64 / n as f64
         }
+    }
+}
+
+fn lvc(scene: &Scene, opts: &Options) -> LvcBdpt {
+    LvcBdpt::new(
+        scene,
+        LvcParams {
+            max_depth: opts.max_depth,
+            rr_depth: opts.rr_depth,
+            mis: opts.heuristic,
+            light_paths: opts.light_paths,
+            connections: opts.connections,
+        },
+    )
+}
+
+/// The oracle's sample count of a connection technique (2 ≤ s ≤ k − 1) relative to a camera
+/// sample's: 1 for bdpt; for lvc-bdpt n_conn = N·L/|C| = N / L̄ (derived in `lvc_bdpt`'s module
+/// docs), computed here from N and the integrator's measured L̄ (its pilot), not taken from it.
+pub fn connection_count(scene: &Scene, opts: &Options) -> f64 {
+    match opts.integrator {
+        Which::Lvc => {
+            let mean = lvc(scene, opts).mean_cached;
+            if mean > 0.0 {
+                opts.connections as f64 / mean
+            } else {
+                0.0
+            }
+        }
+        _ => 1.0,
     }
 }
 
@@ -222,6 +259,13 @@ pub fn collect(scene: &Scene, opts: &Options) -> (Collector, u32) {
             };
             while passes < opts.max_passes && !c.full() {
                 bdpt.record_pass(scene, opts.seed, passes, &mut c);
+                passes += 1;
+            }
+        }
+        Which::Lvc => {
+            let lvc = lvc(scene, opts);
+            while passes < opts.max_passes && !c.full() {
+                lvc.record_pass(scene, opts.seed, passes, &mut c);
                 passes += 1;
             }
         }
@@ -295,6 +339,7 @@ fn replay_bdpt(
     sp: usize,
     h: Heuristic,
     ratio: f64,
+    n_conn: f64,
 ) -> f64 {
     let v = &path.vertices;
     let k = path.k();
@@ -358,13 +403,24 @@ fn replay_bdpt(
         light_end: light_end.flatten(),
         camera_end: camera_end.flatten(),
     };
-    mis_weight(scene, split, evals, h, ratio)
+    if n_conn == 1.0 {
+        mis_weight(scene, split, evals, h, ratio)
+    } else {
+        with_chain(scene, split, evals, ratio, |c, s| {
+            lvc_weight(c, s, h, n_conn)
+        })
+    }
 }
 
 /// The effective densities n_s·p_s of the techniques `which` runs (the others zeroed): every
-/// s = 0 … k+1 for bdpt; for pt 0 (BSDF hit) and, on paths of two segments or more, 1 (NEE).
-pub fn effective(d: &lt_core::path::Densities, which: Which) -> Vec<f64> {
+/// s = 0 … k+1 for bdpt and lvc-bdpt; for pt 0 (BSDF hit) and, on paths of two segments or
+/// more, 1 (NEE). Connections (2 ≤ s ≤ k − 1) count `n_conn` (`connection_count`).
+pub fn effective(d: &lt_core::path::Densities, which: Which, n_conn: f64) -> Vec<f64> {
     let mut eff = d.effective_all();
+    let k = d.k();
+    for e in eff.iter_mut().take(k).skip(2) {
+        *e *= n_conn;
+    }
     if which == Which::Pt {
         let keep = if d.k() >= 2 { 1 } else { 0 };
         for e in eff.iter_mut().skip(keep + 1) {
@@ -375,12 +431,18 @@ pub fn effective(d: &lt_core::path::Densities, which: Which) -> Vec<f64> {
 }
 
 /// Checks one recorded path (see the module docs).
-pub fn check_record(scene: &Scene, r: &Record, opts: &Options, ratio: f64) -> PathCheck {
+pub fn check_record(
+    scene: &Scene,
+    r: &Record,
+    opts: &Options,
+    ratio: f64,
+    n_conn: f64,
+) -> PathCheck {
     let path = r.path();
     let k = path.k();
     let mut d = path.densities(scene);
     d.light_tracing_ratio = ratio;
-    let eff = effective(&d, opts.integrator);
+    let eff = effective(&d, opts.integrator, n_conn);
     let h = opts.heuristic;
     let valid: Vec<usize> = (0..eff.len())
         .filter(|&s| d.valid(s) && eff[s] > 0.0)
@@ -397,18 +459,18 @@ pub fn check_record(scene: &Scene, r: &Record, opts: &Options, ratio: f64) -> Pa
             d.light_tracing_ratio = ratio;
             d
         },
-        |d| oracle_weight(&effective(d, opts.integrator), r.s, h),
+        |d| oracle_weight(&effective(d, opts.integrator, n_conn), r.s, h),
     );
     let (sum, replay_error) = match opts.integrator {
         Which::Pt => (
             r.weight + r.alternatives.iter().map(|a| a.1).sum::<f64>(),
             0.0,
         ),
-        Which::Bdpt => {
+        Which::Bdpt | Which::Lvc => {
             let mut sum = 0.0;
             let mut worst = 0.0f64;
             for &sp in &valid {
-                let w = replay_bdpt(scene, &path, &d, sp, h, ratio);
+                let w = replay_bdpt(scene, &path, &d, sp, h, ratio, n_conn);
                 worst = worst.max((w - oracle_weight(&eff, sp, h)).abs());
                 sum += w;
             }
@@ -518,12 +580,19 @@ fn kind_name(scene: &Scene, v: &PathVertex) -> String {
 }
 
 /// Describes a failing path: its vertices, the weights, the densities.
-pub fn describe(scene: &Scene, r: &Record, c: &PathCheck, opts: &Options, ratio: f64) -> String {
+pub fn describe(
+    scene: &Scene,
+    r: &Record,
+    c: &PathCheck,
+    opts: &Options,
+    ratio: f64,
+    n_conn: f64,
+) -> String {
     let path = r.path();
     let kinds: Vec<String> = path.vertices.iter().map(|v| kind_name(scene, v)).collect();
     let mut d = path.densities(scene);
     d.light_tracing_ratio = ratio;
-    let eff = effective(&d, opts.integrator);
+    let eff = effective(&d, opts.integrator, n_conn);
     let oracle_all: Vec<String> = (0..eff.len())
         .map(|s| format!("{:.6e}", oracle_weight(&eff, s, opts.heuristic)))
         .collect();
@@ -591,6 +660,7 @@ pub fn check_records(
     name: &str,
 ) -> Report {
     let ratio = light_tracing_ratio(scene, opts);
+    let n_conn = connection_count(scene, opts);
     let mut rows: Vec<Row> = (0..=opts.max_depth as usize)
         .map(|k| Row {
             k,
@@ -599,7 +669,7 @@ pub fn check_records(
         .collect();
     let mut examples = Vec::new();
     for r in records {
-        let c = check_record(scene, r, opts, ratio);
+        let c = check_record(scene, r, opts, ratio, n_conn);
         if c.k >= rows.len() {
             rows.resize_with(c.k + 1, Row::default);
             rows[c.k].k = c.k;
@@ -624,7 +694,7 @@ pub fn check_records(
         row.over += over as usize;
         row.sum_fail += sum_fail as usize;
         if (over || sum_fail) && examples.len() < 5 {
-            examples.push(describe(scene, r, &c, opts, ratio));
+            examples.push(describe(scene, r, &c, opts, ratio, n_conn));
         }
     }
     rows.retain(|r| r.k >= 1);
