@@ -98,17 +98,22 @@ pub fn verdict(c: &Curves, fit: &Result<lt_estimators::Jackknifed, String>) -> V
         ),
         _ => "the MSE is ≤ 0 over part of the range".into(),
     };
-    Verdict::NoSlope(if median > 0.0 && max > 4.0 * median {
+    let spread = format!(
+        "at N = {n_last} the largest of {} runs' MSE is {:.0}× their median",
+        c.runs(),
+        max / median
+    );
+    // An unbiased estimator's expected MSE is exactly c/N, so a bent or wide mean curve is a
+    // heavy tail over runs; a consistent one's can bend where bias² and variance trade places.
+    Verdict::NoSlope(if !c.consistent && max > 4.0 * median {
+        format!("heavy-tailed: rare paths carry the error; {spread}; {bend}")
+    } else if !c.consistent {
         format!(
-            "heavy-tailed: at N = {n_last} the largest of {} runs' MSE is {:.0}× their median \
-             ({bend})",
-            c.runs(),
-            max / median
+            "the mean curve bends ({bend}) while the runs agree at the largest N ({spread}): \
+             the line through it swings as runs are left out"
         )
-    } else if c.consistent {
-        format!("ln MSE is not a line: bias² and variance trade places ({bend})")
     } else {
-        format!("runs disagree ({bend})")
+        format!("ln MSE is not a line (bias² and variance trade places, or a heavy tail): {bend}; {spread}")
     })
 }
 
