@@ -556,16 +556,24 @@ fn draw<DB: DrawingBackend>(
         .collect();
     let legend_font = if legend.len() > 16 { 14.0 } else { 18.0 };
     let row = legend_font * 1.5;
-    let text_w = legend
+    let (w, _) = root.dim_in_pixel();
+    // The legend column is at most a third of the chart; a name wider than that wraps at spaces
+    // onto further rows rather than running off the image.
+    let measure = |t: &str| {
+        root.estimate_text_size(t, &font(legend_font))
+            .map(|(w, _)| w)
+            .unwrap_or(0)
+    };
+    let names: Vec<Vec<String>> = legend
         .iter()
-        .map(|&i| {
-            root.estimate_text_size(&chart.series[i].name, &font(legend_font))
-                .map(|(w, _)| w)
-                .unwrap_or(0)
-        })
+        .map(|&i| wrap_label(&chart.series[i].name, w / 3 - 60, &measure))
+        .collect();
+    let text_w = names
+        .iter()
+        .flatten()
+        .map(|l| measure(l))
         .max()
         .unwrap_or(0);
-    let (w, _) = root.dim_in_pixel();
     let legend_w = if legend.is_empty() {
         10
     } else {
@@ -633,10 +641,13 @@ fn draw<DB: DrawingBackend>(
 
     // The legend column: a line sample (with the marker) and the name per series.
     let (_, lh) = legend_area.dim_in_pixel();
-    let top = ((lh as f64 - row * legend.len() as f64) / 2.0).max(40.0) as i32;
+    let rows: usize = names.iter().map(Vec::len).sum();
+    let top = ((lh as f64 - row * rows as f64) / 2.0).max(40.0) as i32;
+    let mut used = 0;
     for (j, &i) in legend.iter().enumerate() {
         let look = looks[i];
-        let y = top + (row * j as f64) as i32;
+        let y = top + (row * used as f64) as i32;
+        used += names[j].len();
         let style = ShapeStyle::from(&look.color).stroke_width(2);
         if look.dashed {
             legend_area.draw(&DashedPathElement::new([(4, y), (40, y)], 7, 4, style))?;
@@ -647,13 +658,31 @@ fn draw<DB: DrawingBackend>(
             legend_area
                 .draw(&(EmptyElement::at((22, y)) + marker_shape(marker, filled, look.color)))?;
         }
-        legend_area.draw(&Text::new(
-            chart.series[i].name.clone(),
-            (48, y - (legend_font * 0.6) as i32),
-            font(legend_font),
-        ))?;
+        for (k, line) in names[j].iter().enumerate() {
+            legend_area.draw(&Text::new(
+                line.clone(),
+                (48, y - (legend_font * 0.6) as i32 + (row * k as f64) as i32),
+                font(legend_font),
+            ))?;
+        }
     }
     Ok(())
+}
+
+/// `name` in lines no wider than `max_w` (as `measure` says), broken at spaces; a single word
+/// wider than that keeps a line of its own. Joined by spaces, the lines are the name.
+pub fn wrap_label(name: &str, max_w: u32, measure: &dyn Fn(&str) -> u32) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in name.split(' ') {
+        match lines.last_mut() {
+            Some(l) if measure(&format!("{l} {word}")) <= max_w => {
+                l.push(' ');
+                l.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    lines
 }
 
 /// A marker centred on (0, 0) in pixels.
@@ -742,6 +771,22 @@ mod tests {
     fn png_size(path: &Path) -> (u32, u32) {
         let img = image::open(path).unwrap();
         (img.width(), img.height())
+    }
+
+    #[test]
+    fn long_legend_names_wrap_to_the_legend_column() {
+        // 10 px per character: a 40-px column takes four characters a line.
+        let measure = |t: &str| 10 * t.chars().count() as u32;
+        let name = "K&Z's model at these N, ppm's schedule (exact)";
+        let lines = wrap_label(name, 160, &measure);
+        assert!(lines.len() > 1, "{lines:?}");
+        assert!(lines.iter().all(|l| measure(l) <= 160), "{lines:?}");
+        assert_eq!(lines.join(" "), name);
+        assert_eq!(wrap_label("pt", 160, &measure), ["pt"]);
+        assert_eq!(
+            wrap_label("unbreakable-word", 40, &measure),
+            ["unbreakable-word"]
+        );
     }
 
     #[test]

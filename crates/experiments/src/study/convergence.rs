@@ -24,6 +24,151 @@ pub fn seed(run: usize) -> u64 {
     1 + run as u64
 }
 
+/// The widest 95 % interval a slope may have and still be reported as one: −1 is then told from
+/// −2/3 and −1/2 (issue 27). A wider one is reported as "no slope", with why.
+pub const SLOPE_WIDTH: f64 = 0.2;
+
+/// The slope of ln MSE against ln N a converging estimator should show at its default
+/// parameters: −1 when unbiased; for a progressive one Knaus & Zwicker's −min(α, 2(1−α))
+/// (2011, §4.2: bias² falls as N^(−2(1−α)), variance as N^(−α)) at ppm's and sppm's α = 2/3 and
+/// bpm's and vcm's 0.75 (their modules' defaults); none for fixed-radius pm, whose MSE levels
+/// off at its bias².
+pub fn expected_slope(integrator: &str, consistent: bool) -> Option<f64> {
+    let kz = |a: f64| -(a.min(2.0 * (1.0 - a)));
+    match integrator {
+        _ if !consistent => Some(-1.0),
+        "ppm" | "sppm" => Some(kz(2.0 / 3.0)),
+        "bpm" | "vcm" => Some(kz(lt_integrators::connect_merge::DEFAULT_ALPHA)),
+        _ => None,
+    }
+}
+
+/// What a fitted slope against N may be reported as.
+pub enum Verdict {
+    /// Narrower than `SLOPE_WIDTH` and told from 0.
+    Slope,
+    /// Narrow and not told from 0, or above it: the MSE does not fall (a fixed radius's bias²,
+    /// light the estimator cannot sample).
+    Flat,
+    /// No slope, and why.
+    NoSlope(String),
+}
+
+/// Judges one (scene, integrator)'s slope: a wide interval is not a slope. Why it is wide is
+/// told from the runs: one run's MSE far above the others' at the largest N (a heavy tail: rare
+/// paths carry the error, and ln of the mean MSE has no stable value over runs), or a curve that
+/// bends (the slopes over the first and the second half of the doublings differ, as when bias²
+/// and variance trade places).
+pub fn verdict(c: &Curves, fit: &Result<lt_estimators::Jackknifed, String>) -> Verdict {
+    let j = match fit {
+        Ok(j) => j,
+        Err(_) => {
+            return Verdict::NoSlope(
+                "an MSE ≤ 0 after subtracting the reference's noise: error below what the \
+                 reference resolves"
+                    .into(),
+            )
+        }
+    };
+    let width = j.interval.hi - j.interval.lo;
+    if width < SLOPE_WIDTH {
+        return if j.interval.hi < -0.05 {
+            Verdict::Slope
+        } else {
+            Verdict::Flat
+        };
+    }
+    let last = c.mse.last().cloned().unwrap_or_default();
+    let mut sorted = last.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(f64::NAN);
+    let max = sorted.last().copied().unwrap_or(f64::NAN);
+    let all: Vec<usize> = (0..c.runs()).collect();
+    let xs: Vec<f64> = c.passes.iter().map(|&p| p as f64).collect();
+    let mid = xs.len() / 2;
+    let half = |r: std::ops::Range<usize>| log_log_slope(&xs[r.clone()], &c.mse[r], &all).ok();
+    let (early, late) = (half(0..mid + 1), half(mid..xs.len()));
+    let n_last = c.passes.last().copied().unwrap_or(0);
+    let n_mid = c.passes.get(mid).copied().unwrap_or(0);
+    let bend = match (early, late) {
+        (Some(a), Some(b)) => format!(
+            "slope {} over 1 … {n_mid} passes, {} over {n_mid} … {n_last}",
+            num(a),
+            num(b)
+        ),
+        _ => "the MSE is ≤ 0 over part of the range".into(),
+    };
+    let spread = format!(
+        "at N = {n_last} the largest of {} runs' MSE is {:.0}× their median",
+        c.runs(),
+        max / median
+    );
+    // An unbiased estimator's expected MSE is exactly c/N, so a bent or wide mean curve is a
+    // heavy tail over runs; a consistent one's can bend where bias² and variance trade places.
+    Verdict::NoSlope(if !c.consistent && max > 4.0 * median {
+        format!("heavy-tailed: rare paths carry the error; {spread}; {bend}")
+    } else if !c.consistent {
+        format!(
+            "the mean curve bends ({bend}) while the runs agree at the largest N ({spread}): \
+             the line through it swings as runs are left out"
+        )
+    } else {
+        format!("ln MSE is not a line (bias² and variance trade places, or a heavy tail): {bend}; {spread}")
+    })
+}
+
+/// The figure the report's findings show (file stem inside the study folder).
+pub const FINDINGS_FIGURE: &str = "mse-findings";
+
+/// The scene of the findings' figure: the focus scene (the plain box, where every estimator
+/// converges), or the first scene when the scale lacks it.
+pub fn findings_scene(scale: &Scale) -> PathBuf {
+    if scale.scenes.contains(&scale.focus_scene) {
+        scale.focus_scene.clone()
+    } else {
+        scale.scenes.first().cloned().unwrap_or_default()
+    }
+}
+
+/// MSE against N of unbiased (pt, bdpt) and consistent (pm, ppm, sppm, vcm) estimators on one
+/// scene, each named with its slope and interval, or why it has none.
+fn findings_figure(scene: &str, curves: &[Curves], conf: f64) -> Chart {
+    let shown = ["pt", "bdpt", "pm", "ppm", "sppm", "vcm"];
+    let series = curves
+        .iter()
+        .filter(|c| shown.contains(&c.integrator.as_str()))
+        .map(|c| {
+            let fit = c.slope(false, conf);
+            let label = match (verdict(c, &fit), &fit) {
+                (Verdict::Slope, Ok(j)) => format!(
+                    "{}: {} [{}, {}]",
+                    c.integrator,
+                    num(j.estimate),
+                    num(j.interval.lo),
+                    num(j.interval.hi)
+                ),
+                (Verdict::Flat, _) => format!("{}: flat", c.integrator),
+                _ => format!("{}: no slope", c.integrator),
+            };
+            Series {
+                name: label,
+                ..series(c, false, conf)
+            }
+        })
+        .collect();
+    Chart {
+        title: format!(
+            "{scene}: MSE against N, slopes with {} % intervals",
+            pct(conf)
+        ),
+        x_label: "passes (spp)".into(),
+        y_label: "MSE".into(),
+        log_x: true,
+        log_y: true,
+        series,
+    }
+}
+
 pub fn integrators() -> Vec<&'static str> {
     lt_integrators::INTEGRATORS.iter().map(|i| i.name).collect()
 }
@@ -172,6 +317,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
     let mut slope_rows = Vec::new();
     let mut eff_rows = Vec::new();
     let mut ref_rows = Vec::new();
+    let mut findings_chart = None;
     for scene in &scale.scenes {
         let name = stem(scene);
         let reference = ctx.reference(scene, None)?;
@@ -216,8 +362,31 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                     "undefined (an MSE ≤ 0 after subtracting the reference's noise)".into(),
                 ),
             };
-            let (s_n, ci_n) = cell(c.slope(false, conf));
+            let fit_n = c.slope(false, conf);
+            let (mut s_n, ci_n) = cell(fit_n.clone());
             let (s_t, ci_t) = cell(c.slope(true, conf));
+            let width = fit_n
+                .as_ref()
+                .map_or("—".into(), |j| num(j.interval.hi - j.interval.lo));
+            let expected = expected_slope(&c.integrator, c.consistent);
+            let (inside, said) = match verdict(&c, &fit_n) {
+                Verdict::Slope => {
+                    let j = fit_n.as_ref().expect("a slope has a fit");
+                    let inside = expected.map_or("—", |e| {
+                        if j.interval.lo <= e && e <= j.interval.hi {
+                            "yes"
+                        } else {
+                            "no"
+                        }
+                    });
+                    (inside, "slope".to_string())
+                }
+                Verdict::Flat => ("—", "flat: the MSE does not fall over these N".into()),
+                Verdict::NoSlope(why) => {
+                    s_n = "no slope".into();
+                    ("—", format!("no slope: {why}"))
+                }
+            };
             slope_rows.push(vec![
                 name.clone(),
                 c.integrator.clone(),
@@ -229,10 +398,17 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                 .into(),
                 s_n,
                 ci_n,
+                width,
+                expected.map_or("—".into(), num),
+                inside.into(),
+                said,
                 s_t,
                 ci_t,
             ]);
             scene_curves.push(c);
+        }
+        if *scene == findings_scene(scale) {
+            findings_chart = Some(findings_figure(&name, &scene_curves, conf));
         }
         // Efficiency at the largest N, and time to the scene's target MSE: the median of the
         // integrators' final MSEs, so some reach it inside the measured range and some do not.
@@ -303,6 +479,20 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
             &format!("MSE against wall time on {name} ({} threads; timings vary ±20 % on this kind of machine).", if ctx.runs.threads == 0 { "all".to_string() } else { ctx.runs.threads.to_string() }),
         )?;
     }
+    if let Some(chart) = findings_chart {
+        out.chart(
+            FINDINGS_FIGURE,
+            &chart,
+            &format!(
+                "MSE against N on {}, unbiased and consistent estimators, mean of {} runs with {} % \
+                 intervals; each name carries its fitted slope and jackknife interval, or why it \
+                 has none (the slopes table).",
+                stem(&findings_scene(scale)),
+                scale.runs,
+                pct(conf)
+            ),
+        )?;
+    }
     out.table(
         "references",
         "References",
@@ -321,15 +511,26 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
     out.table(
         "slopes",
         "Fitted slopes",
-        "ln MSE against ln N and against ln t, with jackknife intervals over runs.",
+        "ln MSE against ln N and against ln t, with jackknife intervals over runs. A slope is \
+         reported only where its interval is narrower than 0.2 and told from 0 (`verdict`: \
+         slope); `expected` is −1 for an unbiased estimator and Knaus & Zwicker's \
+         −min(α, 2(1−α)) for a progressive one (ppm, sppm: α = 2/3; bpm, vcm: α = 0.75; an \
+         asymptotic rate, which sppm's camera resampling, falling as 1/N, hides at these N), \
+         `inside` whether the interval holds it. Where an interval is wider, the row says \
+         \"no slope\" and why: one run's MSE far above the others' (heavy tails) or the curve's \
+         bend between the first and second half of the doublings.",
         &[
             "scene",
             "integrator",
             "kind",
             "slope vs N",
-            "CI",
+            "CI vs N",
+            "width",
+            "expected",
+            "inside",
+            "verdict",
             "slope vs t",
-            "CI",
+            "CI vs t",
         ],
         slope_rows,
         true,

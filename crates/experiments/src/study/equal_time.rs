@@ -283,6 +283,11 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
 /// the scene file, or in `shared/scenes-bitterli/<scene>/` of a folder above it (the repository
 /// does not carry these 2–3 MB files; scenes/bitterli/SOURCE.md).
 pub fn tungsten_render(scene: &Path) -> Option<PathBuf> {
+    // Only Bitterli's own files (Mitsuba XML): a shipped .toml scene of the same name is a
+    // different scene, and Tungsten's render of the original says nothing about it.
+    if scene.extension().is_none_or(|e| e != "xml") {
+        return None;
+    }
     let name = stem(scene);
     let dir = std::fs::canonicalize(scene).ok()?.parent()?.to_path_buf();
     let here = dir.join("TungstenRender.exr");

@@ -59,6 +59,16 @@ pub struct Scale {
     pub folder_suffix: &'static str,
 }
 
+/// The committed convergence study's scenes (see `Scale::named("committed")`).
+pub const COMMITTED_CONVERGENCE: [&str; 6] = [
+    "caustic-sds",
+    "cornell-box",
+    "cornell-directional",
+    "cornell-env",
+    "sun-room",
+    "veach-mis",
+];
+
 pub const ALL_ALPHAS: [f64; 6] = [0.3, 0.5, 2.0 / 3.0, 0.75, 0.9, 1.0];
 
 /// The shipped scenes (every `.toml` in the folder), sorted by name.
@@ -138,6 +148,15 @@ impl Scale {
             // 256 px, where a reader sees the light paths.
             "committed" => Ok(Scale {
                 name: "committed",
+                // The scenes the report's claims rest on, cut from every shipped scene to what
+                // one session on 2 shared cores rendered (results/committed-scale.md): the plain
+                // box, the heavy-tailed caustic, Veach's plates, sun through a window, an
+                // environment, a directional light.
+                scenes: COMMITTED_CONVERGENCE
+                    .iter()
+                    .map(|n| scene(n))
+                    .filter(|p| p.is_file())
+                    .collect(),
                 runs: 16,
                 max_passes: 256,
                 reference_passes: 8192,
