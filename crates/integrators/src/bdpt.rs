@@ -20,19 +20,17 @@
 //! | `mis` | power/balance/none | power | heuristic over the strategies (none: uniform weights) |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
 
-use crate::connect::{
-    connect_to_camera, emission_densities, join, nee_density, next_event, Joined, NextEvent,
-};
+use crate::connect::{connect_to_camera, join, nee_density, next_event, Joined, NextEvent};
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
 use crate::record::{Completed, NoRecord, Reached, Recorder};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
-use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
+pub use crate::strategy_weight::{mis_weight, with_chain, EndEvals, Split};
+use crate::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
-use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
-use lt_core::path::scatter::{connectable, connectable_inside};
-use lt_core::path::{Chain, Heuristic, PathVertex, VertexKind};
+use lt_core::path::scatter::connectable;
+use lt_core::path::{Heuristic, PathVertex};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
 use lt_estimators::Image;
@@ -61,155 +59,6 @@ impl BdptParams {
 
 pub struct Bdpt {
     pub params: BdptParams,
-}
-
-/// The two subpath prefixes one strategy joins, as the MIS weight needs them.
-#[derive(Clone, Copy)]
-pub struct Split<'a> {
-    /// x0 … x_{s−1}. For s = 1 the light sample next-event estimation drew (pdf_fwd = its NEE
-    /// density); empty for s = 0.
-    pub light: &'a [PathVertex],
-    /// x_k … x_s, camera first. For s = 0 the last entry is the light endpoint x0 (an emitter
-    /// the walk hit, or a light at infinity it escaped to), with the walk's pdf_fwd.
-    pub camera: &'a [PathVertex],
-    /// For s ≥ 2: the density of x0 under next-event estimation from x1 (`nee_density`).
-    pub light_nee: f64,
-}
-
-/// The BSDFs at the two ends of a connection towards each other, as the contribution used them:
-/// `light_end` at x_{s−1} (importance mode, s ≥ 2), `camera_end` at x_s (radiance mode, t ≥ 2).
-#[derive(Clone, Copy, Default)]
-pub struct EndEvals {
-    pub light_end: Option<BsdfEval>,
-    pub camera_end: Option<BsdfEval>,
-}
-
-/// Longest path weighed without allocating (segments); longer ones use the heap.
-const STACK_K: usize = 23;
-
-/// The MIS weight of strategy (s, t) for the path `split` forms (Veach 1997, eq. 10.9 with the
-/// ratios of §10.2), under `h`, with `ratio` = M/N light subpaths per camera sample.
-pub fn mis_weight(scene: &Scene, split: Split, evals: EndEvals, h: Heuristic, ratio: f64) -> f64 {
-    with_chain(scene, split, evals, ratio, |chain, s| chain.weight(s, h))
-}
-
-/// Builds the `Chain` of the path `split` forms (stored densities, the ≤ 4 entries the join
-/// changes patched) and hands it, with the technique s, to `f` — `mis_weight`, or an integrator
-/// whose sample counts differ from bdpt's (`lvc_bdpt`).
-pub fn with_chain<T>(
-    scene: &Scene,
-    split: Split,
-    evals: EndEvals,
-    ratio: f64,
-    f: impl FnOnce(&Chain, usize) -> T,
-) -> T {
-    let (y, z) = (split.light, split.camera);
-    let s = if z
-        .last()
-        .is_some_and(|v| matches!(v.kind, VertexKind::Light { .. }))
-    {
-        0
-    } else {
-        y.len()
-    };
-    let t = z.len();
-    let k = s + t - 1;
-    debug_assert!(k >= 1);
-    let (mut light_a, mut camera_a, mut conn_a) = (
-        [0.0f64; STACK_K + 1],
-        [0.0f64; STACK_K + 1],
-        [false; STACK_K + 1],
-    );
-    let (mut light_v, mut camera_v, mut conn_v) = (Vec::new(), Vec::new(), Vec::new());
-    let (light, camera, conn): (&mut [f64], &mut [f64], &mut [bool]) = if k <= STACK_K {
-        (&mut light_a, &mut camera_a, &mut conn_a)
-    } else {
-        light_v.resize(k + 1, 0.0);
-        camera_v.resize(k + 1, 0.0);
-        conn_v.resize(k + 1, false);
-        (&mut light_v, &mut camera_v, &mut conn_v)
-    };
-    // x_i: light vertices below s, camera vertices from s up (for s = 0, z's last is x0).
-    let at = |i: usize| -> &PathVertex {
-        if i < s {
-            &y[i]
-        } else {
-            &z[k - i]
-        }
-    };
-    for i in 0..=k {
-        let v = at(i);
-        // The connection's two ends (x_{s−1}, x_s; x0 alone for s = 0) scatter by evaluation;
-        // inner vertices as their walk sampled (`connectable_inside`).
-        let end = i == s || i + 1 == s;
-        conn[i] = if end {
-            connectable(scene, v)
-        } else {
-            connectable_inside(scene, v)
-        };
-        if i < s {
-            light[i] = v.pdf_fwd as f64;
-            camera[i] = v.pdf_rev as f64;
-        } else {
-            camera[i] = v.pdf_fwd as f64;
-            light[i] = v.pdf_rev as f64;
-        }
-    }
-    // The pinhole: chosen with the discrete 1, never hit by a walk.
-    camera[k] = 1.0;
-    light[k] = 0.0;
-    let mut nee = split.light_nee;
-    match (s, t) {
-        (0, _) => {
-            // The camera walk made x0; the light walk's densities of x0 and x1 are emission's.
-            let x0 = &z[t - 1];
-            let x1 = (k >= 2).then(|| &z[t - 2]);
-            let (l0, l1) = emission_densities(scene, x0, x1);
-            light[0] = l0;
-            if k >= 2 {
-                light[1] = l1;
-                nee = nee_density(scene, x0, x1.unwrap());
-            }
-        }
-        (_, 1) => {
-            // x_{k−1} = y_{s−1} joined to the lens point z[0].
-            let yv = &y[s - 1];
-            let cam = &z[0];
-            let dir = cam.dir_to(yv);
-            camera[k - 1] = reverse_density(yv, cam, scene.camera.pdf_dir(cam.p, dir)) as f64;
-            if s >= 2 {
-                let ev = evals.light_end.expect("a surface connected to the camera");
-                camera[k - 2] = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
-            }
-        }
-        _ => {
-            let (yv, zv) = (&y[s - 1], &z[t - 1]);
-            let ev_z = evals.camera_end.expect("the camera end is a surface");
-            camera[s - 1] = reverse_density(yv, zv, ev_z.pdf_w) as f64;
-            if s + 1 < k {
-                light[s + 1] = reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64;
-            }
-            if s == 1 {
-                // x0 came from next-event estimation: its light-walk densities are emission's.
-                let (l0, l1) = emission_densities(scene, yv, Some(zv));
-                light[0] = l0;
-                light[1] = l1;
-                nee = yv.pdf_fwd as f64;
-            } else {
-                let ev_y = evals.light_end.expect("the light end is a surface");
-                light[s] = yv.convert_density(ev_y.pdf_w, zv) as f64;
-                camera[s - 2] = reverse_density(&y[s - 2], yv, ev_y.pdf_rev_w) as f64;
-            }
-        }
-    }
-    let chain = Chain {
-        light: &light[..=k],
-        camera: &camera[..=k],
-        nee,
-        connectable: &conn[..=k],
-        light_tracing_ratio: ratio,
-    };
-    f(&chain, s)
 }
 
 /// Per-thread buffers of one sample.

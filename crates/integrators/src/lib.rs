@@ -21,6 +21,7 @@ pub mod registry;
 pub mod render;
 pub mod splat;
 pub mod sppm;
+pub mod strategy_weight;
 pub mod vcm;
 pub mod visible;
 pub mod walk;

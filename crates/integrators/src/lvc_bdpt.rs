@@ -34,12 +34,12 @@
 //! | `light_paths` | u64 | the pixel count | light subpaths traced into the cache per pass |
 //! | `connections` | u32 | 1 | cache vertices each camera vertex connects to (N) |
 
-use crate::bdpt::{with_chain, EndEvals, Split};
 use crate::connect::{connect_to_camera, join, nee_density, next_event, Joined, NextEvent};
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
 use crate::record::{Completed, NoRecord, Reached, Recorder};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
+use crate::strategy_weight::{with_chain, EndEvals, Split};
 use crate::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::math::{Color, Vec2};

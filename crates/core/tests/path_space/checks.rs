@@ -1,8 +1,8 @@
 //! Holding recomputed p_s and f to what the walks accumulated, with tolerances from the
 //! vertices' own error bounds.
 
-use crate::scenes::rel_close;
-use crate::walks::{camera_walk, light_walk, Made};
+use super::scenes::rel_close;
+use super::walks::{camera_walk, light_walk, Made};
 use lt_core::bsdf::Material;
 use lt_core::path::{Path, PathVertex, VertexKind};
 use lt_core::sampling::Sampler;

@@ -1,7 +1,7 @@
 //! Techniques s = 0, 1, 2 estimating the same pixels of the analytic plane scenes.
 
-use crate::scenes::*;
-use crate::walks::{camera_walk, light_walk, Made};
+use super::scenes::*;
+use super::walks::{camera_walk, light_walk, Made};
 use lt_core::math::Vec2;
 use lt_core::sampling::Sampler;
 use lt_core::Scene;
