@@ -86,15 +86,34 @@ pub fn shipped_scenes(dir: &Path) -> Result<Vec<PathBuf>, String> {
     Ok(v)
 }
 
+/// The scenes every registered integrator accepts. A scene one of them refuses — `point-plane`'s
+/// orthographic camera, which light tracing, bpm and vcm cannot connect to — belongs to the study
+/// written for it (radius-shrinkage-plane), not to the comparisons of every estimator. A scene
+/// that does not load stays: its render reports the file, place and problem.
+fn every_integrator_renders(scenes: Vec<PathBuf>) -> Vec<PathBuf> {
+    let params = lt_integrators::IntegratorParams::new();
+    scenes
+        .into_iter()
+        .filter(|p| match lt_scene_io::load_scene(p) {
+            Ok(scene) => lt_integrators::INTEGRATORS
+                .iter()
+                .all(|i| lt_integrators::make_integrator(i.name, &scene, &params).is_ok()),
+            Err(_) => true,
+        })
+        .collect()
+}
+
 impl Scale {
     pub fn named(name: &str, scenes_dir: &Path) -> Result<Scale, String> {
-        let all = shipped_scenes(scenes_dir)?;
+        let all = every_integrator_renders(shipped_scenes(scenes_dir)?);
         let scene = |n: &str| scenes_dir.join(format!("{n}.toml"));
         let base = Scale {
             name: "quick",
             width: 32,
             runs: 4,
-            max_passes: 32,
+            // 16, not 32: with twelve integrators on every shipped scene, 32 passes took the
+            // quick run past five minutes on 2 cores (312 s measured 2026-12-04).
+            max_passes: 16,
             reference_passes: 1024,
             scenes: all.clone(),
             focus_scene: scene("cornell-box"),
