@@ -390,19 +390,7 @@ impl LvcBdpt {
                         light_end: None,
                         camera_end: Some(camera_end),
                     };
-                    let w = mis.weight(scene, split, evals);
-                    if R::ACTIVE {
-                        rec.completed(Completed {
-                            s: 1,
-                            light: std::slice::from_ref(&x0),
-                            camera: &z[..t],
-                            weight: w,
-                            value,
-                            raster,
-                            alternatives: &[],
-                        });
-                    }
-                    l += value * w as f32;
+                    l += weighted_join(scene, &mis, split, evals, value, raster, rec);
                 }
             }
             if cache.is_empty() || t + 1 > max_k {
@@ -433,19 +421,7 @@ impl LvcBdpt {
                     light_end: Some(light_end),
                     camera_end: Some(camera_end),
                 };
-                let w = mis.weight(scene, split, evals);
-                if R::ACTIVE {
-                    rec.completed(Completed {
-                        s,
-                        light: &y[..s],
-                        camera: &z[..t],
-                        weight: w,
-                        value,
-                        raster,
-                        alternatives: &[],
-                    });
-                }
-                l += value * w as f32;
+                l += weighted_join(scene, &mis, split, evals, value, raster, rec);
             }
         }
         if let Some(esc) = scratch.camera.escape {
@@ -515,6 +491,32 @@ fn uniform_index(s: &mut Sampler, n: usize) -> usize {
 }
 
 /// Strategy s = 0: the weighted contribution of a camera walk that `reached` a light.
+/// A strategy with s ≥ 1 (NEE or a cache connection): its weighted contribution, reported to
+/// `rec` with the split's own light and camera vertices.
+fn weighted_join<R: Recorder>(
+    scene: &Scene,
+    mis: &Mis,
+    split: Split,
+    evals: EndEvals,
+    value: Color,
+    raster: Vec2,
+    rec: &mut R,
+) -> Color {
+    let w = mis.weight(scene, split, evals);
+    if R::ACTIVE {
+        rec.completed(Completed {
+            s: split.light.len(),
+            light: split.light,
+            camera: split.camera,
+            weight: w,
+            value,
+            raster,
+            alternatives: &[],
+        });
+    }
+    value * w as f32
+}
+
 fn emitter_reached<R: Recorder>(
     scene: &Scene,
     mis: &Mis,
