@@ -155,6 +155,10 @@ pub struct RunRecord {
     /// Wall seconds at each snapshot (cumulative from the start of the run; with several runs,
     /// the seconds of all of them).
     pub seconds: Vec<f64>,
+    /// CPU seconds of the render's threads at each snapshot, as `seconds` (empty in records
+    /// written before it was kept, and in ones assembled from cluster parts).
+    #[serde(default)]
+    pub cpu_seconds: Vec<f64>,
     pub passes_done: u32,
     pub invalid_samples: u64,
     /// The mean over pixels and channels of `stderr.exr`, when there is one.
@@ -169,6 +173,14 @@ pub struct RunRecord {
 }
 
 impl RunRecord {
+    /// The threads it rendered with; 0 (one per core) is taken to mean this machine's cores.
+    pub fn effective_threads(&self) -> usize {
+        match self.threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            t => t,
+        }
+    }
+
     /// Whether its integrator is consistent, as the registry says.
     pub fn consistent(&self) -> bool {
         is_consistent(&self.spec.integrator)
@@ -224,6 +236,22 @@ impl RunEntry {
             .position(|&p| p == passes)?;
         self.record.seconds.get(i).copied()
     }
+
+    /// CPU seconds to reach snapshot `passes`: what equal-time budgets divide. A record without
+    /// them counts its wall seconds times its threads (0 threads: this machine's cores), which
+    /// is what those threads could have spent at most.
+    pub fn cpu_seconds_at(&self, passes: u32) -> Option<f64> {
+        let i = self
+            .record
+            .spec
+            .snapshots
+            .iter()
+            .position(|&p| p == passes)?;
+        match self.record.cpu_seconds.get(i) {
+            Some(&c) => Some(c),
+            None => Some(self.record.seconds.get(i)? * self.record.effective_threads() as f64),
+        }
+    }
 }
 
 /// How runs are executed: where the cache is and with how many threads (which changes no image).
@@ -274,7 +302,7 @@ fn render_into(spec: &RunSpec, scene: &Scene, threads: usize, dir: &Path) -> Res
         seed: spec.seed,
         threads,
     };
-    let mut seconds = Vec::new();
+    let (mut seconds, mut cpu_seconds) = (Vec::new(), Vec::new());
     let mut write_error = None;
     let result = render_runs(
         scene,
@@ -284,6 +312,7 @@ fn render_into(spec: &RunSpec, scene: &Scene, threads: usize, dir: &Path) -> Res
         |_, report| {
             if spec.runs == 1 && spec.snapshots.contains(&report.passes_done) {
                 seconds.push(report.elapsed.as_secs_f64());
+                cpu_seconds.push(report.cpu.as_secs_f64());
                 let path = dir.join(format!("snapshot-{}.exr", report.passes_done));
                 if let Err(e) = write_exr(&path, &report.estimate()) {
                     write_error = Some(e);
@@ -303,6 +332,7 @@ fn render_into(spec: &RunSpec, scene: &Scene, threads: usize, dir: &Path) -> Res
             &result.across_runs.mean(),
         )?;
         seconds = vec![result.elapsed.as_secs_f64()];
+        cpu_seconds = vec![result.cpu.as_secs_f64()];
         (Some(result.across_runs.std_error()), "independent runs")
     } else if let Some(p) = &result.per_pass {
         (Some(p.std_error()), "spread of passes")
@@ -320,6 +350,7 @@ fn render_into(spec: &RunSpec, scene: &Scene, threads: usize, dir: &Path) -> Res
             Kind::Consistent => "consistent".into(),
         },
         seconds,
+        cpu_seconds,
         passes_done: result.runs.iter().map(|r| r.passes).sum(),
         invalid_samples: result.invalid_samples,
         mean_std_error: se.as_ref().map(crate::image_io::mean_of),

@@ -5,6 +5,7 @@ pub mod bdpt;
 pub mod bpm;
 pub mod connect;
 pub mod connect_merge;
+pub mod cpu_clock;
 pub mod light;
 pub mod lvc_bdpt;
 pub mod params;

@@ -4,6 +4,7 @@
 //! estimate. `render_runs` repeats a render over independent seeds: the only honest error bars of
 //! a consistent estimator, and a cross-check of the per-pass ones of an unbiased estimator.
 
+use crate::cpu_clock::pool_cpu_time;
 use crate::{Estimator, Integrator, Kind, ProgressLog, Progressive, ProgressiveRun};
 use lt_core::Scene;
 use lt_estimators::running::RunningImage;
@@ -64,6 +65,8 @@ pub enum PassState<'a> {
 pub struct PassReport<'a> {
     pub passes_done: u32,
     pub elapsed: Duration,
+    /// CPU time of the render's threads so far (`cpu_clock::pool_cpu_time`).
+    pub cpu: Duration,
     pub state: PassState<'a>,
 }
 
@@ -103,6 +106,8 @@ pub struct RenderResult {
     pub per_pass: Option<RunningImage>,
     pub passes: u32,
     pub elapsed: Duration,
+    /// CPU time of the render's threads.
+    pub cpu: Duration,
     /// Samples an integrator produced as NaN, infinite or negative (dropped). Zero when correct.
     pub invalid_samples: u64,
     /// Consistent estimators: their schedule.
@@ -144,6 +149,8 @@ fn render_in(
 ) -> RenderResult {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let start = Instant::now();
+    let cpu_start = pool_cpu_time(pool);
+    let cpu_since_start = || pool_cpu_time(pool).saturating_sub(cpu_start);
     let mut invalid = 0;
     let mut pass = 0;
     // After each pass: false when the caller or the time budget says stop.
@@ -152,6 +159,7 @@ fn render_in(
         let report = PassReport {
             passes_done: pass,
             elapsed,
+            cpu: cpu_since_start(),
             state,
         };
         on_pass(&report).is_continue() && opts.time_limit.is_none_or(|t| elapsed < t)
@@ -178,6 +186,7 @@ fn render_in(
                 per_pass: Some(acc),
                 passes: pass,
                 elapsed: start.elapsed(),
+                cpu: cpu_since_start(),
                 invalid_samples: invalid,
                 log: None,
             }
@@ -197,6 +206,7 @@ fn render_in(
                 per_pass: None,
                 passes: pass,
                 elapsed: start.elapsed(),
+                cpu: cpu_since_start(),
                 invalid_samples: invalid,
                 log: Some(run.log()),
             }
@@ -261,6 +271,7 @@ pub struct RunSummary {
     pub seed: u64,
     pub passes: u32,
     pub elapsed: Duration,
+    pub cpu: Duration,
     pub invalid_samples: u64,
     pub log: Option<ProgressLog>,
 }
@@ -275,6 +286,8 @@ pub struct RunsResult {
     pub per_pass: Option<RunningImage>,
     pub runs: Vec<RunSummary>,
     pub elapsed: Duration,
+    /// CPU time of the finished runs' threads, summed.
+    pub cpu: Duration,
     pub invalid_samples: u64,
 }
 
@@ -303,6 +316,7 @@ pub fn render_runs<'a>(
         per_pass: (estimator.kind() == Kind::Unbiased).then(|| RunningImage::new(w, h)),
         runs: Vec::new(),
         elapsed: Duration::ZERO,
+        cpu: Duration::ZERO,
         invalid_samples: 0,
     };
     for k in 0..runs {
@@ -325,9 +339,11 @@ pub fn render_runs<'a>(
             seed,
             passes: r.passes,
             elapsed: r.elapsed,
+            cpu: r.cpu,
             invalid_samples: r.invalid_samples,
             log: r.log,
         });
+        out.cpu += r.cpu;
         out.elapsed = start.elapsed();
         on_run(&out);
         if stopped {

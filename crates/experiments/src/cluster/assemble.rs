@@ -88,6 +88,8 @@ pub fn assemble(plan: &Plan, a: &Assembly) -> Result<bool, String> {
             spec: spec.clone(),
             kind: "unbiased".into(),
             seconds,
+            // The parts ran on machines whose CPU clocks are not summed here.
+            cpu_seconds: Vec::new(),
             passes_done: spec.passes,
             invalid_samples: merged.invalid_samples,
             mean_std_error: se.as_ref().map(crate::image_io::mean_of),

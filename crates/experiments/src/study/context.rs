@@ -152,16 +152,11 @@ impl Ctx {
         Ok(e)
     }
 
-    /// Adds an entry's cost, its recorded wall seconds times its threads, to `spent`.
+    /// Adds an entry's cost, the CPU seconds its threads spent, to `spent`.
     fn count(&self, e: &RunEntry) {
-        let secs = e.record.seconds.last().copied().unwrap_or(0.0);
-        // 0 threads: one per core of the machine that rendered it (taken to be this one).
-        let threads = match e.record.threads {
-            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-            t => t,
-        };
+        let secs = e.cpu_seconds_at(e.record.spec.passes).unwrap_or(0.0);
         let mut s = self.spent.lock().unwrap();
-        s.0 += secs * threads as f64;
+        s.0 += secs;
         s.1 += 1;
     }
 

@@ -6,7 +6,8 @@
 //! convergence study (its first run), the budget is what `pt` took for the largest N there, and
 //! each integrator gets round(budget / its cost per pass) passes (at least 1). The images then
 //! depend on those pass counts only, which the table records; the timings behind them vary from
-//! machine to machine, as any equal-time comparison does.
+//! machine to machine, as any equal-time comparison does. Time is the CPU time of the render's
+//! threads (`cpu_clock`), so other work on a shared machine does not change the budgets.
 
 use super::convergence::{self, integrators};
 use super::metrics::mse;
@@ -85,7 +86,7 @@ fn passes_from_timings(
                 None => return Ok(None),
             }
         };
-        let secs = e.seconds_at(scale.max_passes).unwrap_or(f64::NAN);
+        let secs = e.cpu_seconds_at(scale.max_passes).unwrap_or(f64::NAN);
         cost.push((i, secs / scale.max_passes as f64));
     }
     let budget = cost
@@ -134,8 +135,9 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
     )?;
     out.para(&format!(
         "Every integrator on every scene ({} px wide), seed 1: at equal samples ({} passes) and at \
-         equal time (the time `pt` takes for {} passes; each integrator gets that budget divided \
-         by its own cost per pass, measured on its equal-samples render). MSE is against the \
+         equal time (the CPU time `pt`'s threads take for {} passes; each integrator gets that \
+         budget divided by its own CPU time per pass, measured on its equal-samples render: CPU \
+         time, because wall time on a shared machine counts other processes' work too). MSE is against the \
          scene's reference ({} passes of its reference integrator), corrected for the \
          reference's noise; crops are where the estimates differ most from it.",
         scale.width, scale.max_passes, scale.max_passes, scale.reference_passes
@@ -162,11 +164,12 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                     title.to_string(),
                     i.to_string(),
                     passes.to_string(),
+                    format!("{:.3}", e.cpu_seconds_at(passes).unwrap_or(f64::NAN)),
+                    format!("{budget:.3}"),
                     format!(
                         "{:.3}",
                         e.record.seconds.last().copied().unwrap_or(f64::NAN)
                     ),
-                    format!("{budget:.3}"),
                     num(m),
                 ]);
                 images.push((i, img, format!("{passes} spp, MSE {}", num(m))));
@@ -208,14 +211,16 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
     out.table(
         "galleries",
         "Equal samples and equal time",
-        "Passes, seconds actually taken, the time budget, and MSE per scene and integrator.",
+        "Passes, CPU seconds actually taken, the CPU-time budget, wall seconds (which count \
+         other work on the machine), and MSE per scene and integrator.",
         &[
             "scene",
             "comparison",
             "integrator",
             "passes",
-            "seconds",
-            "budget s",
+            "CPU s",
+            "budget CPU s",
+            "wall s",
             "MSE",
         ],
         rows,

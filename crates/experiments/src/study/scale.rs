@@ -59,16 +59,6 @@ pub struct Scale {
     pub folder_suffix: &'static str,
 }
 
-/// The committed convergence study's scenes (see `Scale::named("committed")`).
-pub const COMMITTED_CONVERGENCE: [&str; 6] = [
-    "caustic-sds",
-    "cornell-box",
-    "cornell-directional",
-    "cornell-env",
-    "sun-room",
-    "veach-mis",
-];
-
 pub const ALL_ALPHAS: [f64; 6] = [0.3, 0.5, 2.0 / 3.0, 0.75, 0.9, 1.0];
 
 /// The shipped scenes (every `.toml` in the folder), sorted by name.
@@ -161,42 +151,19 @@ impl Scale {
                 gallery_reference_passes: 4096,
                 ..base
             }),
-            // What the committed report shows for convergence and the galleries: slopes fitted
-            // over 1 … 256 passes from 16 runs (the quick scale's 4 runs over 1 … 32 give
-            // intervals several units wide), at 32 px, where a run costs little; galleries at
-            // 256 px, where a reader sees the light paths.
+            // What the committed report shows for convergence and the galleries, on every
+            // shipped scene every integrator renders: slopes fitted over 1 … 256 passes from 16
+            // runs (the quick scale's 4 runs over 1 … 16 give intervals several units wide), at
+            // 32 px, where a run costs little; galleries at 256 px, where a reader sees the light
+            // paths (results/committed-scale.md states the compute).
             "committed" => Ok(Scale {
                 name: "committed",
-                // The scenes the report's claims rest on, cut from every shipped scene to what
-                // one session on 2 shared cores rendered (results/committed-scale.md): the plain
-                // box, the heavy-tailed caustic, Veach's plates, sun through a window, an
-                // environment, a directional light.
-                scenes: COMMITTED_CONVERGENCE
-                    .iter()
-                    .map(|n| scene(n))
-                    .filter(|p| p.is_file())
-                    .collect(),
                 runs: 16,
                 max_passes: 256,
                 reference_passes: 8192,
                 gallery_width: 256,
                 gallery_passes: 16,
                 gallery_reference_passes: 256,
-                // A caustic seen in a mirror, a light behind glass, sun through a window, light
-                // through a door's gap, Veach's plates, and the plain box to compare with.
-                gallery_scenes: Some(
-                    [
-                        "caustic-sds",
-                        "cornell-box",
-                        "cornell-glass-light",
-                        "sun-room",
-                        "veach-door",
-                        "veach-mis",
-                    ]
-                    .iter()
-                    .map(|n| scene(n))
-                    .collect(),
-                ),
                 ..base
             }),
             // Bitterli's three scenes (scenes/bitterli/, Mitsuba XML, `-D integrator=path`) at
