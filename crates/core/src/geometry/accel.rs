@@ -32,6 +32,8 @@ pub enum RayCore {
     Flat,
     /// Every primitive tested one at a time: the reference `Flat` is held to.
     FlatScalar,
+    /// Intel's Embree 3 (`embree.rs`), where this build found it (`RayCore::available`).
+    Embree,
 }
 
 /// Above this many primitives a BVH beats testing them all (`benches/ray_cores.rs`; results/bench.md,
@@ -39,11 +41,12 @@ pub enum RayCore {
 pub const FLAT_MAX_PRIMITIVES: usize = 64;
 
 impl RayCore {
-    pub const ALL: [RayCore; 4] = [
+    pub const ALL: [RayCore; 5] = [
         RayCore::Auto,
         RayCore::Bvh,
         RayCore::Flat,
         RayCore::FlatScalar,
+        RayCore::Embree,
     ];
 
     pub fn name(self) -> &'static str {
@@ -52,11 +55,39 @@ impl RayCore {
             RayCore::Bvh => "bvh",
             RayCore::Flat => "flat",
             RayCore::FlatScalar => "flat-scalar",
+            RayCore::Embree => "embree",
         }
     }
 
     pub fn from_name(name: &str) -> Option<RayCore> {
         RayCore::ALL.into_iter().find(|c| c.name() == name)
+    }
+
+    /// Whether this build can run it: every core but Embree always; Embree when `build.rs`
+    /// found its library.
+    pub fn available(self) -> bool {
+        self != RayCore::Embree || cfg!(lt_embree)
+    }
+
+    /// The command line's `--ray-core`: a known name this build can run, else why not.
+    pub fn parse(name: &str) -> Result<RayCore, String> {
+        let names: Vec<&str> = RayCore::ALL
+            .iter()
+            .filter(|c| c.available())
+            .map(|c| c.name())
+            .collect();
+        match RayCore::from_name(name) {
+            Some(c) if c.available() => Ok(c),
+            Some(_) => Err(format!(
+                "the ray core '{name}' is not in this build: Embree 3 was not found when it was \
+                 compiled (install libembree-dev, or set LT_EMBREE_DIR, and rebuild); available: {}",
+                names.join(", ")
+            )),
+            None => Err(format!(
+                "unknown ray core '{name}' (available: {})",
+                names.join(", ")
+            )),
+        }
     }
 }
 
@@ -81,6 +112,8 @@ enum Structure {
     },
     Flat(Flat),
     FlatScalar,
+    #[cfg(lt_embree)]
+    Embree(super::embree::EmbreeScene),
 }
 
 pub struct Accel {
@@ -166,6 +199,14 @@ impl Accel {
             c => c,
         };
         let (structure, prims) = match core {
+            #[cfg(lt_embree)]
+            RayCore::Embree if !prims.is_empty() => match super::embree::EmbreeScene::new(&prims) {
+                Some(e) => (Structure::Embree(e), prims),
+                None => {
+                    eprintln!("warning: Embree could not build the scene; using the BVH");
+                    return Accel::build_with(prims, RayCore::Bvh);
+                }
+            },
             RayCore::Flat => (Structure::Flat(Flat::new(&prims)), prims),
             RayCore::FlatScalar => (Structure::FlatScalar, prims),
             _ if prims.is_empty() => (
@@ -210,6 +251,8 @@ impl Accel {
             Structure::Bvh { .. } => RayCore::Bvh,
             Structure::Flat(_) => RayCore::Flat,
             Structure::FlatScalar => RayCore::FlatScalar,
+            #[cfg(lt_embree)]
+            Structure::Embree(_) => RayCore::Embree,
         }
     }
 
@@ -266,6 +309,8 @@ impl Accel {
             }
             Structure::Bvh { bvh, shallow: true } => self.closest::<SMALL_STACK>(bvh, ray),
             Structure::Bvh { bvh, .. } => self.closest::<FULL_STACK>(bvh, ray),
+            #[cfg(lt_embree)]
+            Structure::Embree(e) => e.closest(&self.prims, ray, &self.sheared(ray.o, ray.d)),
         }
     }
 
@@ -320,6 +365,8 @@ impl Accel {
             }
             Structure::Bvh { bvh, shallow: true } => self.any_hit::<SMALL_STACK>(bvh, ray),
             Structure::Bvh { bvh, .. } => self.any_hit::<FULL_STACK>(bvh, ray),
+            #[cfg(lt_embree)]
+            Structure::Embree(e) => e.occluded(ray, &self.sheared(ray.o, ray.d)),
         }
     }
 
@@ -579,6 +626,42 @@ mod tests {
                 ),
             }
             assert_eq!(accel.occluded(&ray), expected.is_finite());
+        }
+    }
+
+    /// Embree names a primitive that lt's own test hits, at lt's own distance to it, which is the
+    /// closest distance of all primitives up to the rounding of two different triangle tests; it
+    /// loses no hit and finds the same occlusion.
+    #[cfg(lt_embree)]
+    #[test]
+    fn embree_agrees_with_every_primitive_at_every_scale() {
+        for scale in [1e-3f32, 1.0, 1e6] {
+            let mut s = Sampler::new(7, scale.to_bits() as u64, 0);
+            let mut prims = boxes(scale);
+            prims.extend(random_primitives(&mut s, 200, scale));
+            let accel = Accel::build_with(prims.clone(), RayCore::Embree);
+            assert_eq!(accel.core(), RayCore::Embree);
+            for ray in test_rays(&mut s, &prims, scale, 4000, false) {
+                let r = ShearedRay::new(ray.o, ray.d);
+                let expected =
+                    flat::closest_scalar(&prims, &ray, &r).map_or(f32::INFINITY, |h| h.t);
+                match accel.intersect(&ray) {
+                    Some(h) => {
+                        let p = accel.primitive(h.prim);
+                        assert_eq!(p.intersect(&r, ray.o, ray.d, ray.t_max), h.t);
+                        assert!(
+                            (h.t - expected).abs() <= 4.0 * f32::EPSILON * expected,
+                            "scale {scale}: {} vs {expected}, ray {ray:?}",
+                            h.t
+                        );
+                    }
+                    None => assert!(
+                        expected.is_infinite(),
+                        "scale {scale}: Embree missed a hit at {expected}, ray {ray:?}"
+                    ),
+                }
+                assert_eq!(accel.occluded(&ray), expected.is_finite(), "ray {ray:?}");
+            }
         }
     }
 

@@ -1,6 +1,8 @@
 //! Rays, primitives and the acceleration structure.
 
 pub mod accel;
+#[cfg(lt_embree)]
+pub mod embree;
 pub mod flat;
 pub mod primitive;
 pub mod quad;

@@ -13,15 +13,15 @@ struct Cli {
     #[command(flatten)]
     load: x::load_args::LoadArgs,
     /// How rays find primitives: auto (flat for scenes of at most 64 primitives and no triangles,
-    /// else bvh), bvh, flat (every primitive tested, vectorised) or flat-scalar (the same, one at
-    /// a time: the reference, bit for bit the same hits). See results/bench.md.
+    /// else bvh), bvh, flat (every primitive tested, vectorised), flat-scalar (the same, one at
+    /// a time: the reference, bit for bit the same hits) or embree (Intel's Embree 3, where the
+    /// build found it). See results/bench.md.
     #[arg(long, global = true, default_value = "auto", value_parser = parse_ray_core)]
     ray_core: lt_core::geometry::RayCore,
 }
 
 fn parse_ray_core(s: &str) -> Result<lt_core::geometry::RayCore, String> {
-    lt_core::geometry::RayCore::from_name(s)
-        .ok_or_else(|| format!("unknown ray core '{s}' (auto, bvh, flat, flat-scalar)"))
+    lt_core::geometry::RayCore::parse(s)
 }
 
 #[derive(Subcommand)]

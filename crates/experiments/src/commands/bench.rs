@@ -35,8 +35,7 @@ pub struct BenchArgs {
 }
 
 fn parse_core(s: &str) -> Result<RayCore, String> {
-    RayCore::from_name(s)
-        .ok_or_else(|| format!("unknown ray core '{s}' (auto, bvh, flat, flat-scalar)"))
+    RayCore::parse(s)
 }
 
 pub fn run(args: &BenchArgs) -> Result<String, String> {
