@@ -21,13 +21,45 @@ pub fn incoherent_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
         .collect()
 }
 
-/// Closest-hit rays per second on one thread, and the fraction that hit.
+/// Coherent rays: the camera's primary rays through the pixel centres, row by row, repeated to
+/// `count`.
+pub fn camera_rays(scene: &Scene, count: usize) -> Vec<Ray> {
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    (0..count)
+        .map(|i| {
+            let px = i % (w * h);
+            let raster = lt_core::math::Vec2::new((px % w) as f32 + 0.5, (px / w) as f32 + 0.5);
+            scene.camera.generate_ray(raster)
+        })
+        .collect()
+}
+
+/// Rays leaving surfaces, as a path's bounces do: from the hit of each of `rays` that hits, in a
+/// uniformly random direction on the side the ray arrived from, offset by the hit's rounding bound
+/// (`SurfaceHit::spawn_ray`) — most end a short way off, near where they start.
+pub fn surface_rays(scene: &Scene, rays: &[Ray], seed: u64) -> Vec<Ray> {
+    let mut s = Sampler::new(seed, 1, 0);
+    rays.iter()
+        .filter_map(|r| {
+            let h = scene.intersect(r)?;
+            let mut d = sample_uniform_sphere(s.next_2d());
+            if d.dot(h.ng) * r.d.dot(h.ng) > 0.0 {
+                d = -d;
+            }
+            Some(h.spawn_ray(d))
+        })
+        .collect()
+}
+
+/// Closest-hit rays per second on one thread, and the fraction that hit: the ray core's own
+/// query (traversal and primitive tests, no hit record), so ray cores are compared on what they do.
 pub fn closest_hit_rate(scene: &Scene, rays: &[Ray], repeats: usize) -> (f64, f64) {
     let mut hits = 0usize;
+    let accel = scene.accel();
     let start = Instant::now();
     for _ in 0..repeats {
         for r in rays {
-            hits += scene.intersect(r).is_some() as usize;
+            hits += accel.intersect(r).is_some() as usize;
         }
     }
     let secs = start.elapsed().as_secs_f64();
@@ -35,13 +67,22 @@ pub fn closest_hit_rate(scene: &Scene, rays: &[Ray], repeats: usize) -> (f64, f6
     (n / secs, hits as f64 / n)
 }
 
-/// Shadow (any-hit) rays per second on one thread.
+/// Shadow (any-hit) rays per second on one thread: each ray as a segment of length 1, asked of
+/// the ray core directly.
 pub fn shadow_rate(scene: &Scene, rays: &[Ray], repeats: usize) -> f64 {
     let mut blocked = 0usize;
+    let accel = scene.accel();
+    let segments: Vec<Ray> = rays
+        .iter()
+        .map(|r| Ray {
+            t_max: 1.0,
+            ..*r
+        })
+        .collect();
     let start = Instant::now();
     for _ in 0..repeats {
-        for r in rays {
-            blocked += scene.visible_between(r.o, r.at(1.0)) as usize;
+        for r in &segments {
+            blocked += accel.occluded(r) as usize;
         }
     }
     std::hint::black_box(blocked);

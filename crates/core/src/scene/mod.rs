@@ -90,6 +90,11 @@ pub struct Scene {
 impl Scene {
     /// The closest surface the ray hits.
     #[inline]
+    /// The ray core alone (no hit record): what `lt bench` times as raw traversal.
+    pub fn accel(&self) -> &Accel {
+        &self.accel
+    }
+
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
         ray_stats::count_closest();
         let h = self.accel.intersect(ray)?;
