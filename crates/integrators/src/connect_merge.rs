@@ -23,7 +23,7 @@ use crate::pixel::{pixel_sample, weighted};
 use crate::radius::InitialRadius;
 use crate::record::{Completed, Merged, NoRecord, Reached, Recorder, Work};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
-use crate::tally::{tallied_pass, PassClock, PassTally, Tally};
+use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
 use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::{ProgressLog, ProgressiveRun};
 use lt_core::bsdf::TransportMode;
@@ -937,11 +937,11 @@ impl Run<'_> {
     /// are one phase (`Work::LightWalk`).
     pub fn tally_pass(&mut self, pass: u32, every: u64) -> (u64, PassTally) {
         let clock = PassClock::start();
-        let t0 = std::time::Instant::now();
+        let cpu0 = pool_cpu_seconds();
         let setup = self.engine.setup(self.r0, pass);
         self.engine
             .trace_light_paths_into(&setup, self.seed, pass, &mut self.lights);
-        let walk = t0.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+        let walk = pool_cpu_seconds() - cpu0;
         let engine = &self.engine;
         let lights = &self.lights;
         let seed = self.seed;

@@ -40,7 +40,7 @@ use crate::pixel::{pixel_sample, weighted};
 use crate::record::{Completed, NoRecord, Reached, Recorder, Work};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::strategy_weight::{with_chain, EndEvals, Split};
-use crate::tally::{tallied_pass, PassClock, PassTally, Tally};
+use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
 use crate::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::math::{Color, Vec2};
@@ -588,9 +588,9 @@ impl LvcBdpt {
     ) -> (Image, u64, PassTally) {
         let clock = PassClock::start();
         let p = Pass { seed, pass };
-        let t0 = std::time::Instant::now();
+        let cpu0 = pool_cpu_seconds();
         let cache = self.build_cache(scene, p);
-        let walk = t0.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+        let walk = pool_cpu_seconds() - cpu0;
         let items = (scene.camera.pixel_count() as u64).max(self.light_paths(scene));
         let (img, invalid, tally) = tallied_pass(
             scene,

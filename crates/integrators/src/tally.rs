@@ -28,9 +28,11 @@
 //! untimed items read no clock. A technique's time in the pass is its timed cycles × (items /
 //! timed items), in seconds by the pass's own ticks per wall second. Phases outside the items
 //! (`lvc-bdpt`'s cache, `vcm`'s light subpaths and grid) are timed once per pass. What no lap
-//! covers — splat sums, the end of each item — is the pass's wall time minus the attributed
-//! time, reported as `other`. Seconds are wall seconds × threads: run on one thread (as the
-//! study does), they are CPU seconds.
+//! covers — splat sums, the end of each item — is the pass's CPU time minus the attributed
+//! time, reported as `other`. The pass and its phases are timed by the CPU clocks of the pool's
+//! threads (`pool_cpu_seconds`), so other work on a shared machine is not counted; a lap is a
+//! stretch of wall time, microseconds long, and a lap in which the thread was descheduled is
+//! dropped with its item (`VOID_LAP`).
 
 use crate::bdpt::{Bdpt, BdptParams};
 use crate::bpm::Bpm;
@@ -66,6 +68,27 @@ fn ticks() -> u64 {
         static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
         EPOCH.get_or_init(Instant::now).elapsed().as_nanos() as u64
     }
+}
+
+/// CPU seconds the calling thread has used (POSIX `CLOCK_THREAD_CPUTIME_ID`; 0 where missing).
+pub fn thread_cpu_seconds() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, exclusively borrowed out-parameter for the duration of the call.
+    let ok = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0;
+    if ok {
+        ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+    } else {
+        0.0
+    }
+}
+
+/// CPU seconds of every thread of the current pool, summed: what a pass or phase costs on a
+/// machine shared with other work (wall seconds would count the other work too).
+pub fn pool_cpu_seconds() -> f64 {
+    rayon::broadcast(|_| thread_cpu_seconds()).into_iter().sum()
 }
 
 /// A 64-bit mix (SplitMix64's finaliser): which items are timed.
@@ -229,7 +252,7 @@ pub struct TechniqueFigures {
     pub mean: f64,
     /// Mean over pixels of F_τ(j)².
     pub second_moment: f64,
-    /// Seconds (wall × threads) the technique took in the pass.
+    /// Seconds the technique took in the pass (summed over threads).
     pub seconds: f64,
 }
 
@@ -237,7 +260,7 @@ pub struct TechniqueFigures {
 #[derive(Clone, Debug, Default)]
 pub struct PassTally {
     pub techniques: BTreeMap<Work, TechniqueFigures>,
-    /// The pass's wall seconds × threads.
+    /// The pass's CPU seconds (every thread of the pool).
     pub seconds: f64,
     /// Seconds no lap and no phase covers.
     pub other_seconds: f64,
@@ -251,7 +274,7 @@ pub struct PassTally {
 pub struct PassClock {
     t0: Instant,
     c0: u64,
-    threads: usize,
+    cpu0: f64,
 }
 
 impl PassClock {
@@ -259,7 +282,7 @@ impl PassClock {
         PassClock {
             t0: Instant::now(),
             c0: ticks(),
-            threads: rayon::current_num_threads(),
+            cpu0: pool_cpu_seconds(),
         }
     }
 }
@@ -371,7 +394,7 @@ pub struct ItemTally {
 }
 
 impl ItemTally {
-    /// The pass's tally, with `phases` timed outside the items (seconds × threads).
+    /// The pass's tally, with `phases` timed outside the items (CPU seconds).
     pub fn finish(self, clock: PassClock, phases: &[(Work, f64)]) -> PassTally {
         let wall = clock.t0.elapsed().as_secs_f64();
         let ticks_per_second = ticks().wrapping_sub(clock.c0) as f64 / wall.max(1e-12);
@@ -392,7 +415,7 @@ impl ItemTally {
         for &(wk, s) in phases {
             techniques.entry(wk).or_default().seconds += s;
         }
-        let seconds = wall * clock.threads as f64;
+        let seconds = pool_cpu_seconds() - clock.cpu0;
         let attributed: f64 = techniques.values().map(|t| t.seconds).sum();
         PassTally {
             techniques,
