@@ -46,24 +46,23 @@ fn the_techniques_study_writes_its_files_and_its_techniques_add_up() {
         summary.contains("20 of 20 bit for bit equal"),
         "tallied images differ from the plain renders"
     );
-    let checks: Vec<serde_json::Value> =
-        serde_json::from_str(&std::fs::read_to_string(d.join("checks.json")).unwrap()).unwrap();
-    assert_eq!(checks.len(), 3, "bdpt, lvc-bdpt, vcm");
-    for c in &checks {
-        let f = |k: &str| c[k].as_f64().unwrap();
-        let who = format!("{} {}", c["scene"], c["integrator"]);
+    let rows = lt_experiments::report::findings::csv(&d.join("check.csv")).unwrap();
+    assert_eq!(rows.len(), 3, "bdpt, lvc-bdpt, vcm");
+    let parse = |t: &str| t.trim().parse::<f64>().unwrap_or(f64::NAN);
+    for r in &rows {
+        let who = format!("{} {}", r["scene"], r["integrator"]);
+        // "estimate [lo, hi]" (3 significant digits, as printed).
+        let sum = &r["Σ technique means"];
+        let inner = sum.split('[').nth(1).unwrap().trim_end_matches(']');
+        let mut it = inner.split(',').map(parse);
+        let (lo, hi) = (it.next().unwrap(), it.next().unwrap());
+        let image = parse(&r["image mean"]);
         assert!(
-            f("sum_lo") <= f("image") && f("image") <= f("sum_hi"),
-            "{who}: image mean {} outside the techniques' [{}, {}]",
-            f("image"),
-            f("sum_lo"),
-            f("sum_hi")
+            lo <= image && image <= hi,
+            "{who}: image mean {image} outside the techniques' [{lo}, {hi}]"
         );
-        assert!(
-            f("paired_rel") < 1e-5,
-            "{who}: Σ means off by {}",
-            f("paired_rel")
-        );
+        let paired = parse(&r["max |Σ − image| / image"]);
+        assert!(paired < 1e-5, "{who}: Σ means off by {paired} within a run");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
