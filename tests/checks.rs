@@ -20,6 +20,7 @@ mod pt_agreement;
 mod robustness;
 mod runs;
 mod studies;
+mod techniques_study;
 mod translation;
 mod vcm_consistency;
 mod vcm_is_bdpt;

@@ -23,9 +23,10 @@
 use crate::connect::{connect_to_camera, join, nee_density, next_event, Joined, NextEvent};
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
-use crate::record::{Completed, NoRecord, Reached, Recorder};
+use crate::record::{Completed, NoRecord, Reached, Recorder, Work};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 pub use crate::strategy_weight::{mis_weight, with_chain, EndEvals, Split};
+use crate::tally::{tallied_pass, ItemTally, PassClock, PassTally, Tally};
 use crate::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::math::{Color, Vec2};
@@ -134,6 +135,7 @@ impl Bdpt {
         } else {
             0.0
         };
+        rec.lap(Work::LightWalk);
 
         // t = 1: every connectable light vertex joined to the pinhole.
         if splat_light {
@@ -142,38 +144,41 @@ impl Bdpt {
             // does, so vcm without merging takes bdpt's paths).
             let mut lens = Sampler::for_item(Domain::Lens, seed, light_index, pass as u64);
             for s in 1..=y.len().min(max_k) {
-                let yv = &y[s - 1];
-                if !connectable(scene, yv) {
-                    continue;
-                }
-                let Some(c) = connect_to_camera(scene, yv, &mut lens) else {
-                    continue;
-                };
-                let camera_only = [c.camera];
-                let split = Split {
-                    light: &y[..s],
-                    camera: &camera_only,
-                    light_nee,
-                };
-                let evals = EndEvals {
-                    light_end: c.eval,
-                    camera_end: None,
-                };
-                let w = mis_weight(scene, split, evals, h, ratio);
-                if R::ACTIVE {
-                    rec.completed(Completed {
-                        s,
+                'attempt: {
+                    let yv = &y[s - 1];
+                    if !connectable(scene, yv) {
+                        break 'attempt;
+                    }
+                    let Some(c) = connect_to_camera(scene, yv, &mut lens) else {
+                        break 'attempt;
+                    };
+                    let camera_only = [c.camera];
+                    let split = Split {
                         light: &y[..s],
                         camera: &camera_only,
-                        weight: w,
-                        value: c.value * scale,
-                        raster: c.raster,
-                        alternatives: &[],
-                    });
+                        light_nee,
+                    };
+                    let evals = EndEvals {
+                        light_end: c.eval,
+                        camera_end: None,
+                    };
+                    let w = mis_weight(scene, split, evals, h, ratio);
+                    if R::ACTIVE {
+                        rec.completed(Completed {
+                            s,
+                            light: &y[..s],
+                            camera: &camera_only,
+                            weight: w,
+                            value: c.value * scale,
+                            raster: c.raster,
+                            alternatives: &[],
+                        });
+                    }
+                    if w > 0.0 {
+                        splats.add_filtered(cam.film(), c.raster, c.value * (w as f32 * scale));
+                    }
                 }
-                if w > 0.0 {
-                    splats.add_filtered(cam.film(), c.raster, c.value * (w as f32 * scale));
-                }
+                rec.lap(Work::Connection { s: s as u16, t: 1 });
             }
         }
         let Some(pixel) = pixel else {
@@ -193,6 +198,8 @@ impl Bdpt {
             WalkLimits::camera(self.params.max_depth, self.params.rr_depth),
             &mut scratch.camera,
         );
+        rec.begin_sample(pixel, film.weight);
+        rec.lap(Work::CameraWalk);
         let z = &scratch.camera.vertices;
         let prefix = &mut scratch.prefix;
         let mut ctx = CameraSample {
@@ -215,6 +222,7 @@ impl Bdpt {
                         };
                         l += self.emitter_reached(scene, reached, prefix, &mut ctx);
                     }
+                    ctx.rec.lap(Work::Connection { s: 0, t: t as u16 });
                 }
             }
             if !connectable(scene, zv) {
@@ -223,43 +231,50 @@ impl Bdpt {
             // s = 1: next-event estimation from z_{t−1}.
             if t <= max_k {
                 l += self.next_event_weighted(scene, &z[..t], &mut cs, &mut ctx);
+                ctx.rec.lap(Work::Connection { s: 1, t: t as u16 });
             }
             // s ≥ 2: shadow rays to the light subpath's vertices.
             for s in 2..=y.len().min(max_k + 1 - t) {
-                let yv = &y[s - 1];
-                if !connectable(scene, yv) {
-                    continue;
-                }
-                let Some(Joined {
-                    light_end: ev_y,
-                    camera_end: ev_z,
-                    value: c,
-                }) = join(scene, yv, zv)
-                else {
-                    continue;
-                };
-                let split = Split {
-                    light: &y[..s],
-                    camera: &z[..t],
-                    light_nee,
-                };
-                let evals = EndEvals {
-                    light_end: Some(ev_y),
-                    camera_end: Some(ev_z),
-                };
-                let wgt = mis_weight(scene, split, evals, h, ratio);
-                if R::ACTIVE {
-                    ctx.rec.completed(Completed {
-                        s,
+                'attempt: {
+                    let yv = &y[s - 1];
+                    if !connectable(scene, yv) {
+                        break 'attempt;
+                    }
+                    let Some(Joined {
+                        light_end: ev_y,
+                        camera_end: ev_z,
+                        value: c,
+                    }) = join(scene, yv, zv)
+                    else {
+                        break 'attempt;
+                    };
+                    let split = Split {
                         light: &y[..s],
                         camera: &z[..t],
-                        weight: wgt,
-                        value: c,
-                        raster,
-                        alternatives: &[],
-                    });
+                        light_nee,
+                    };
+                    let evals = EndEvals {
+                        light_end: Some(ev_y),
+                        camera_end: Some(ev_z),
+                    };
+                    let wgt = mis_weight(scene, split, evals, h, ratio);
+                    if R::ACTIVE {
+                        ctx.rec.completed(Completed {
+                            s,
+                            light: &y[..s],
+                            camera: &z[..t],
+                            weight: wgt,
+                            value: c,
+                            raster,
+                            alternatives: &[],
+                        });
+                    }
+                    l += c * wgt as f32;
                 }
-                l += c * wgt as f32;
+                ctx.rec.lap(Work::Connection {
+                    s: s as u16,
+                    t: t as u16,
+                });
             }
         }
         // s = 0 at infinity: the walk left the scene after its last vertex.
@@ -278,6 +293,10 @@ impl Bdpt {
                     };
                     l += self.emitter_reached(scene, reached, prefix, &mut ctx);
                 }
+                ctx.rec.lap(Work::Connection {
+                    s: 0,
+                    t: z.len() as u16 + 1,
+                });
             }
         }
         weighted(l, film.weight)
@@ -406,6 +425,7 @@ impl Bdpt {
             light_index: i % m,
             splat_light: i < m,
         };
+        worker.rec.begin_item(i);
         let l = self.sample(scene, pass, pair, worker);
         if let Some(p) = pair.pixel {
             worker.splats.add_to_pixel(p as u32, l);
@@ -415,6 +435,37 @@ impl Bdpt {
 
 /// Work items per splat chunk (fixed, so the image does not depend on the thread count).
 const CHUNK: u64 = 256;
+
+impl Bdpt {
+    /// `render_pass` with every technique's contributions and time tallied (`crate::tally`):
+    /// the same image, bit for bit.
+    pub fn tally_pass(
+        &self,
+        scene: &Scene,
+        seed: u64,
+        pass: u32,
+        every: u64,
+    ) -> (Image, u64, PassTally) {
+        let clock = PassClock::start();
+        let items = (scene.camera.pixel_count() as u64).max(self.light_paths(scene));
+        let (img, invalid, tally): (Image, u64, ItemTally) = tallied_pass(
+            scene,
+            pass,
+            every,
+            (items, CHUNK),
+            || self.scratch(),
+            |i, splats, scratch, rec: &mut Tally| {
+                let mut worker = Worker {
+                    splats,
+                    scratch,
+                    rec,
+                };
+                self.item(scene, Pass { seed, pass }, i, &mut worker)
+            },
+        );
+        (img, invalid, tally.finish(clock, &[]))
+    }
+}
 
 impl Integrator for Bdpt {
     fn name(&self) -> &'static str {

@@ -21,8 +21,9 @@ use crate::connect::{
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
 use crate::radius::InitialRadius;
-use crate::record::{Completed, Merged, NoRecord, Reached, Recorder};
+use crate::record::{Completed, Merged, NoRecord, Reached, Recorder, Work};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
+use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
 use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::{ProgressLog, ProgressiveRun};
 use lt_core::bsdf::TransportMode;
@@ -414,6 +415,7 @@ impl<'a> Engine<'a> {
         let n = self.scene.camera.pixel_count() as u64;
         let m = setup.light_paths;
         let light = lights.path((i % m) as usize);
+        worker.rec.begin_item(i);
         if i < m && self.params.connections {
             // A thin lens draws its lens points from the light path's own lens stream.
             let mut lens = Sampler::for_item(Domain::Lens, seed, i, pass as u64);
@@ -438,36 +440,40 @@ impl<'a> Engine<'a> {
         let cam = &scene.camera;
         let scale = 1.0 / setup.light_paths as f32;
         for s in 1..=y.len().min(self.params.max_depth as usize) {
-            let yv = &y[s - 1];
-            if !connectable(scene, yv) {
-                continue;
+            'attempt: {
+                let yv = &y[s - 1];
+                if !connectable(scene, yv) {
+                    break 'attempt;
+                }
+                let Some(c) = connect_to_camera(scene, yv, lens) else {
+                    break 'attempt;
+                };
+                let camera = c.camera;
+                let c_y =
+                    reverse_density(yv, &camera, cam.pdf_dir(camera.p, camera.dir_to(yv))) as f64;
+                let w = if s == 1 {
+                    setup.mis.light_tracing_origin(&ly[0], c_y)
+                } else {
+                    let ev = c.eval.expect("a surface connected to the camera");
+                    let c_prev = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
+                    setup.mis.light_tracing(&ly[s - 1], c_y, c_prev)
+                };
+                if R::ACTIVE {
+                    rec.completed(Completed {
+                        s,
+                        light: &y[..s],
+                        camera: std::slice::from_ref(&camera),
+                        weight: w,
+                        value: c.value * scale,
+                        raster: c.raster,
+                        alternatives: &[],
+                    });
+                }
+                if w > 0.0 {
+                    splats.add_filtered(cam.film(), c.raster, c.value * (w as f32 * scale));
+                }
             }
-            let Some(c) = connect_to_camera(scene, yv, lens) else {
-                continue;
-            };
-            let camera = c.camera;
-            let c_y = reverse_density(yv, &camera, cam.pdf_dir(camera.p, camera.dir_to(yv))) as f64;
-            let w = if s == 1 {
-                setup.mis.light_tracing_origin(&ly[0], c_y)
-            } else {
-                let ev = c.eval.expect("a surface connected to the camera");
-                let c_prev = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
-                setup.mis.light_tracing(&ly[s - 1], c_y, c_prev)
-            };
-            if R::ACTIVE {
-                rec.completed(Completed {
-                    s,
-                    light: &y[..s],
-                    camera: std::slice::from_ref(&camera),
-                    weight: w,
-                    value: c.value * scale,
-                    raster: c.raster,
-                    alternatives: &[],
-                });
-            }
-            if w > 0.0 {
-                splats.add_filtered(cam.film(), c.raster, c.value * (w as f32 * scale));
-            }
+            rec.lap(Work::Connection { s: s as u16, t: 1 });
         }
     }
 
@@ -502,6 +508,8 @@ impl<'a> Engine<'a> {
         );
         let z = &scratch.camera.vertices;
         camera_records(scene, mis, z, &mut scratch.records);
+        worker.rec.begin_sample(pixel, film.weight);
+        worker.rec.lap(Work::CameraWalk);
         let zr = &scratch.records;
         let cam = CameraWalk { z, zr };
         let mut ctx = CameraSample {
@@ -529,6 +537,7 @@ impl<'a> Engine<'a> {
                         }
                         l += value * wgt as f32;
                     }
+                    ctx.rec.lap(Work::Connection { s: 0, t: t as u16 });
                 }
             }
             if !connectable(scene, zv) {
@@ -537,13 +546,19 @@ impl<'a> Engine<'a> {
             if self.params.connections {
                 if t <= max_k {
                     l += self.next_event_weighted(cam, t, &mut cs, &mut ctx);
+                    ctx.rec.lap(Work::Connection { s: 1, t: t as u16 });
                 }
                 for s in 2..=light.0.len().min(max_k + 1 - t) {
                     l += self.connect(light, cam, (s, t), &mut ctx);
+                    ctx.rec.lap(Work::Connection {
+                        s: s as u16,
+                        t: t as u16,
+                    });
                 }
             }
             if self.params.merging && t <= max_k {
                 l += self.merge(setup, lights, cam, t, &mut ctx);
+                ctx.rec.lap(Work::Merge { t: t as u16 });
             }
         }
         // s = 0 at infinity: the walk left the scene after its last vertex.
@@ -567,6 +582,10 @@ impl<'a> Engine<'a> {
                     }
                     l += value * wgt as f32;
                 }
+                ctx.rec.lap(Work::Connection {
+                    s: 0,
+                    t: z.len() as u16 + 1,
+                });
             }
         }
         weighted(l, film.weight)
@@ -909,6 +928,53 @@ impl<'a> Run<'a> {
             log: ProgressLog::default(),
             lights: LightPaths::default(),
         }
+    }
+}
+
+impl Run<'_> {
+    /// `pass` with every technique's contributions and time tallied (`crate::tally`): the same
+    /// state and estimate, bit for bit. The light subpaths, their MIS records and the merge grid
+    /// are one phase (`Work::LightWalk`).
+    pub fn tally_pass(&mut self, pass: u32, every: u64) -> (u64, PassTally) {
+        let clock = PassClock::start();
+        let cpu0 = pool_cpu_seconds();
+        let setup = self.engine.setup(self.r0, pass);
+        self.engine
+            .trace_light_paths_into(&setup, self.seed, pass, &mut self.lights);
+        let walk = pool_cpu_seconds() - cpu0;
+        let engine = &self.engine;
+        let lights = &self.lights;
+        let seed = self.seed;
+        let scene = engine.scene;
+        let items = (scene.camera.pixel_count() as u64).max(setup.light_paths);
+        let (img, invalid, tally) = tallied_pass(
+            scene,
+            pass,
+            every,
+            (items, CHUNK),
+            || engine.scratch(),
+            |i, splats, scratch, rec: &mut Tally| {
+                let inputs = PassInputs {
+                    setup: &setup,
+                    lights,
+                    pass: Pass { seed, pass },
+                };
+                let mut worker = Worker {
+                    splats,
+                    scratch,
+                    rec,
+                };
+                engine.item(&inputs, i, &mut worker)
+            },
+        );
+        for (a, b) in self.sum.data.iter_mut().zip(&img.data) {
+            for c in 0..3 {
+                a[c] += b[c];
+            }
+        }
+        self.passes += 1;
+        log_pass(&mut self.log, &setup, self.r0);
+        (invalid, tally.finish(clock, &[(Work::LightWalk, walk)]))
     }
 }
 

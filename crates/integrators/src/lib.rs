@@ -23,6 +23,7 @@ pub mod render;
 pub mod splat;
 pub mod sppm;
 pub mod strategy_weight;
+pub mod tally;
 pub mod vcm;
 pub mod visible;
 pub mod walk;

@@ -37,9 +37,10 @@
 use crate::connect::{connect_to_camera, join, nee_density, next_event, Joined, NextEvent};
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
-use crate::record::{Completed, NoRecord, Reached, Recorder};
+use crate::record::{Completed, NoRecord, Reached, Recorder, Work};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::strategy_weight::{with_chain, EndEvals, Split};
+use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
 use crate::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::math::{Color, Vec2};
@@ -291,38 +292,45 @@ impl LvcBdpt {
         let (y, light_nee) = cache.path(i as usize);
         let mut lens = Sampler::for_item(Domain::Lens, pass.seed, i, pass.pass as u64);
         for s in 1..=y.len().min(max_k) {
-            let yv = &y[s - 1];
-            if !connectable(scene, yv) {
-                continue;
-            }
-            let Some(c) = connect_to_camera(scene, yv, &mut lens) else {
-                continue;
-            };
-            let camera_only = [c.camera];
-            let split = Split {
-                light: &y[..s],
-                camera: &camera_only,
-                light_nee,
-            };
-            let evals = EndEvals {
-                light_end: c.eval,
-                camera_end: None,
-            };
-            let w = mis.weight(scene, split, evals);
-            if R::ACTIVE {
-                rec.completed(Completed {
-                    s,
+            'attempt: {
+                let yv = &y[s - 1];
+                if !connectable(scene, yv) {
+                    break 'attempt;
+                }
+                let Some(c) = connect_to_camera(scene, yv, &mut lens) else {
+                    break 'attempt;
+                };
+                let camera_only = [c.camera];
+                let split = Split {
                     light: &y[..s],
                     camera: &camera_only,
-                    weight: w,
-                    value: c.value * scale,
-                    raster: c.raster,
-                    alternatives: &[],
-                });
+                    light_nee,
+                };
+                let evals = EndEvals {
+                    light_end: c.eval,
+                    camera_end: None,
+                };
+                let w = mis.weight(scene, split, evals);
+                if R::ACTIVE {
+                    rec.completed(Completed {
+                        s,
+                        light: &y[..s],
+                        camera: &camera_only,
+                        weight: w,
+                        value: c.value * scale,
+                        raster: c.raster,
+                        alternatives: &[],
+                    });
+                }
+                if w > 0.0 {
+                    splats.add_filtered(
+                        scene.camera.film(),
+                        c.raster,
+                        c.value * (w as f32 * scale),
+                    );
+                }
             }
-            if w > 0.0 {
-                splats.add_filtered(scene.camera.film(), c.raster, c.value * (w as f32 * scale));
-            }
+            rec.lap(Work::Connection { s: s as u16, t: 1 });
         }
     }
 
@@ -350,6 +358,8 @@ impl LvcBdpt {
             WalkLimits::camera(self.params.max_depth, self.params.rr_depth),
             &mut scratch.camera,
         );
+        rec.begin_sample(pixel, film.weight);
+        rec.lap(Work::CameraWalk);
         let z = &scratch.camera.vertices;
         let prefix = &mut scratch.prefix;
         let n = self.params.connections;
@@ -369,6 +379,7 @@ impl LvcBdpt {
                         };
                         l += emitter_reached(scene, &mis, reached, prefix, raster, rec);
                     }
+                    rec.lap(Work::Connection { s: 0, t: t as u16 });
                 }
             }
             if !connectable(scene, zv) {
@@ -392,6 +403,7 @@ impl LvcBdpt {
                     };
                     l += weighted_join(scene, &mis, split, evals, value, raster, rec);
                 }
+                rec.lap(Work::Connection { s: 1, t: t as u16 });
             }
             if cache.is_empty() || t + 1 > max_k {
                 continue;
@@ -403,25 +415,31 @@ impl LvcBdpt {
                 if s + t - 1 > max_k {
                     continue;
                 }
-                let Some(Joined {
-                    light_end,
-                    camera_end,
-                    value,
-                }) = join(scene, &y[s - 1], zv)
-                else {
-                    continue;
-                };
-                let value = value * pick_scale;
-                let split = Split {
-                    light: &y[..s],
-                    camera: &z[..t],
-                    light_nee,
-                };
-                let evals = EndEvals {
-                    light_end: Some(light_end),
-                    camera_end: Some(camera_end),
-                };
-                l += weighted_join(scene, &mis, split, evals, value, raster, rec);
+                'attempt: {
+                    let Some(Joined {
+                        light_end,
+                        camera_end,
+                        value,
+                    }) = join(scene, &y[s - 1], zv)
+                    else {
+                        break 'attempt;
+                    };
+                    let value = value * pick_scale;
+                    let split = Split {
+                        light: &y[..s],
+                        camera: &z[..t],
+                        light_nee,
+                    };
+                    let evals = EndEvals {
+                        light_end: Some(light_end),
+                        camera_end: Some(camera_end),
+                    };
+                    l += weighted_join(scene, &mis, split, evals, value, raster, rec);
+                }
+                rec.lap(Work::Connection {
+                    s: s as u16,
+                    t: t as u16,
+                });
             }
         }
         if let Some(esc) = scratch.camera.escape {
@@ -439,6 +457,10 @@ impl LvcBdpt {
                     };
                     l += emitter_reached(scene, &mis, reached, prefix, raster, rec);
                 }
+                rec.lap(Work::Connection {
+                    s: 0,
+                    t: z.len() as u16 + 1,
+                });
             }
         }
         weighted(l, film.weight)
@@ -453,6 +475,7 @@ impl LvcBdpt {
         i: u64,
         worker: &mut Worker<'_, Scratch, R>,
     ) {
+        worker.rec.begin_item(i);
         if i < self.light_paths(scene) {
             self.splat_light(scene, cache, pass, i, worker.splats, worker.rec);
         }
@@ -552,6 +575,45 @@ fn emitter_reached<R: Recorder>(
 
 /// Work items per splat chunk (fixed, so the image does not depend on the thread count).
 const CHUNK: u64 = 256;
+
+impl LvcBdpt {
+    /// `render_pass` with every technique's contributions and time tallied (`crate::tally`):
+    /// the same image, bit for bit. The cache's light walks are one phase (`Work::LightWalk`).
+    pub fn tally_pass(
+        &self,
+        scene: &Scene,
+        seed: u64,
+        pass: u32,
+        every: u64,
+    ) -> (Image, u64, PassTally) {
+        let clock = PassClock::start();
+        let p = Pass { seed, pass };
+        let cpu0 = pool_cpu_seconds();
+        let cache = self.build_cache(scene, p);
+        let walk = pool_cpu_seconds() - cpu0;
+        let items = (scene.camera.pixel_count() as u64).max(self.light_paths(scene));
+        let (img, invalid, tally) = tallied_pass(
+            scene,
+            pass,
+            every,
+            (items, CHUNK),
+            || self.scratch(),
+            |i, splats, scratch, rec: &mut Tally| {
+                let mut worker = Worker {
+                    splats,
+                    scratch,
+                    rec,
+                };
+                self.item(scene, &cache, p, i, &mut worker)
+            },
+        );
+        (
+            img,
+            invalid,
+            tally.finish(clock, &[(Work::LightWalk, walk)]),
+        )
+    }
+}
 
 impl Integrator for LvcBdpt {
     fn name(&self) -> &'static str {

@@ -51,12 +51,41 @@ pub struct Merged<'a> {
     pub radius: f32,
 }
 
+/// What one stretch of a work item's time went to, for `crate::tally` (per-technique cost): the
+/// code since the previous lap. Connections are keyed as `Completed` paths are — s light
+/// vertices, t camera vertices, k = s + t − 1 segments (s = 0 at a camera walk of k + 1 vertices
+/// whose end is the emitter) — merges by the camera vertex count t (every light length at once,
+/// as one range query serves them all).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Work {
+    /// Tracing the light subpath (and forming its MIS records, for `vcm`).
+    LightWalk,
+    /// The camera sample: film position, camera subpath, its MIS records.
+    CameraWalk,
+    Connection {
+        s: u16,
+        t: u16,
+    },
+    Merge {
+        t: u16,
+    },
+}
+
 pub trait Recorder {
     /// False for `NoRecord`: integrators skip building what only a recorder would read.
     const ACTIVE: bool;
     fn completed(&mut self, path: Completed);
     /// A path made by merging; recorders of connection-only integrators ignore it.
     fn merged(&mut self, _path: Merged) {}
+    /// Work item `item` starts (`crate::tally` decides here whether it times this item).
+    #[inline]
+    fn begin_item(&mut self, _item: u64) {}
+    /// The camera sample of `pixel` starts; its t ≥ 2 estimate is multiplied by `film_weight`.
+    #[inline]
+    fn begin_sample(&mut self, _pixel: u64, _film_weight: f32) {}
+    /// The code since the previous lap (or `begin_item`) did `work`.
+    #[inline]
+    fn lap(&mut self, _work: Work) {}
 }
 
 /// Records nothing.

@@ -5,3 +5,4 @@
 
 mod photons;
 mod subpaths;
+mod tally;

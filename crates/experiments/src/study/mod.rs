@@ -20,6 +20,7 @@ pub mod reference;
 pub mod registry;
 pub mod scale;
 pub mod smoke;
+pub mod techniques;
 pub mod unbiased_consistent;
 
 use crate::runs::RunSpec;

@@ -4,7 +4,8 @@
 use super::context::Ctx;
 use super::scale::Scale;
 use super::{
-    convergence, equal_time, per_length, radius_plane, radius_shrinkage, smoke, unbiased_consistent,
+    convergence, equal_time, per_length, radius_plane, radius_shrinkage, smoke, techniques,
+    unbiased_consistent,
 };
 use crate::runs::RunSpec;
 
@@ -65,6 +66,14 @@ pub const STUDIES: &[StudyInfo] = &[
         listed: true,
         specs: |scale, _| Ok(per_length::specs(scale)),
         run: per_length::run,
+    },
+    // Not in `all`: its tallied runs and references cost about ten core-minutes at the quick
+    // scale (128 px, three scenes), twice what `all` takes. Run it by name.
+    StudyInfo {
+        name: techniques::NAME,
+        listed: false,
+        specs: |scale, _| Ok(techniques::specs(scale)),
+        run: techniques::run,
     },
     StudyInfo {
         name: "smoke",
