@@ -27,6 +27,12 @@ pub fn pool_cpu_time(pool: &rayon::ThreadPool) -> Duration {
     workers + thread_cpu_time()
 }
 
+/// CPU time of every worker of the pool the caller runs in (rayon's global pool outside one),
+/// summed: for phases timed from inside a render.
+pub fn current_pool_cpu_time() -> Duration {
+    rayon::broadcast(|_| thread_cpu_time()).into_iter().sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

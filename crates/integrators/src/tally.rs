@@ -70,25 +70,10 @@ fn ticks() -> u64 {
     }
 }
 
-/// CPU seconds the calling thread has used (POSIX `CLOCK_THREAD_CPUTIME_ID`; 0 where missing).
-pub fn thread_cpu_seconds() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, exclusively borrowed out-parameter for the duration of the call.
-    let ok = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0;
-    if ok {
-        ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-    } else {
-        0.0
-    }
-}
-
-/// CPU seconds of every thread of the current pool, summed: what a pass or phase costs on a
-/// machine shared with other work (wall seconds would count the other work too).
+/// CPU seconds of every thread of the current pool, summed (`cpu_clock`): what a pass or phase
+/// costs on a machine shared with other work (wall seconds would count the other work too).
 pub fn pool_cpu_seconds() -> f64 {
-    rayon::broadcast(|_| thread_cpu_seconds()).into_iter().sum()
+    crate::cpu_clock::current_pool_cpu_time().as_secs_f64()
 }
 
 /// A 64-bit mix (SplitMix64's finaliser): which items are timed.
