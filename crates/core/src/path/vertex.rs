@@ -286,6 +286,7 @@ impl PathVertex {
     /// pbrt's `ConvertDensity`: a density with which this vertex chose the direction towards
     /// `next` (solid angle; for a vertex at infinity, the perpendicular-disk density) turned into
     /// the measure `next` is stored in. A vertex at infinity keeps solid angle.
+    #[inline]
     pub fn convert_density(&self, pdf: f32, next: &PathVertex) -> f32 {
         if next.is_infinite() {
             return pdf;
