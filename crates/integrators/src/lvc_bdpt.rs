@@ -369,7 +369,7 @@ impl LvcBdpt {
         for t in 2..=z.len() {
             let zv = &z[t - 1];
             if t - 1 <= max_k {
-                if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter) {
+                if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter()) {
                     let le = scene.lights[li as usize].emitted(x0.ng, x0.wo, x0.uv);
                     if le != Color::ZERO {
                         let reached = Reached {

@@ -282,30 +282,30 @@ fn random_walk(
             return;
         };
         let wo = -ray.d;
-        let prev = *out.vertices.last().expect("the endpoint is pushed first");
-        let mut v = PathVertex::surface(&hit, wo, beta, pdf, &prev);
-        if out.vertices.len() + 1 >= limits.max_vertices {
-            out.vertices.push(v);
+        // The new vertex is built in place and read by reference: a vertex is 136 bytes, and a
+        // copy of the one before plus a move into the vector were two `memcpy` calls per bounce.
+        let n = out.vertices.len();
+        let prev = out.vertices.last().expect("the endpoint is pushed first");
+        out.vertices
+            .push(PathVertex::surface(&hit, wo, beta, pdf, prev));
+        if n + 1 >= limits.max_vertices {
             return;
         }
         let sf = hit.shading_frame();
-        let depth = out.vertices.len() as u32;
         let at = WalkPoint {
             hit: &hit,
             sf: &sf,
             wo,
         };
-        let Some(bs) = continue_path(scene, &at, &rules, &mut beta, depth, sampler) else {
-            out.vertices.push(v);
+        let Some(bs) = continue_path(scene, &at, &rules, &mut beta, n as u32, sampler) else {
             return;
         };
-        v.delta = bs.delta;
         // The reverse density of the vertex before: how a walk from the other end, arriving along
         // bs.wi, would have chosen it.
-        let n = out.vertices.len();
-        let before = &mut out.vertices[n - 1];
-        before.pdf_rev = reverse_density(before, &v, bs.pdf_rev_w);
-        out.vertices.push(v);
+        let (before, v) = out.vertices.split_at_mut(n);
+        let (before, v) = (&mut before[n - 1], &mut v[0]);
+        v.delta = bs.delta;
+        before.pdf_rev = reverse_density(before, v, bs.pdf_rev_w);
         pdf = bs.pdf_w;
         ray = hit.spawn_ray(bs.wi);
     }

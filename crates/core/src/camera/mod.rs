@@ -464,14 +464,27 @@ impl Camera {
             return None;
         }
         let dir = d / distance_squared.sqrt();
-        let raster = self.raster_from(origin, dir)?;
+        // The direction in the camera frame, once: its z is the cosine at the lens that the
+        // raster position, We and `cos_lens` each read (`raster_from`, `importance_on_film` and
+        // `frame.z.dot(dir)` compute the same products in the same order, so the same bits).
+        let l = self.frame.to_local(dir);
+        let cos = l.z;
+        let raster = match self.lens {
+            Lens::Pinhole => {
+                if cos <= 0.0 {
+                    return None;
+                }
+                self.raster_of_plane(l.x / (cos * self.tan_half.x), l.y / (cos * self.tan_half.y))?
+            }
+            _ => self.raster_from(origin, dir)?,
+        };
         Some(LensConnection {
             origin,
             dir,
             distance_squared,
             raster,
-            importance: self.importance_on_film(dir),
-            cos_lens: self.frame.z.dot(dir),
+            importance: self.pixel_count() as f32 / (self.plane_area * cos * cos * cos * cos),
+            cos_lens: cos,
         })
     }
 

@@ -135,6 +135,7 @@ impl Chain<'_> {
     }
 
     /// p_s(x̄) (Russian roulette excluded), zero when technique s cannot produce the path.
+    #[inline]
     pub fn technique(&self, s: usize) -> f64 {
         if !self.valid(s) {
             return 0.0;
@@ -172,7 +173,8 @@ impl Chain<'_> {
         let k = self.k();
         let (l, c) = (self.light, self.camera);
         let r = &mut out[..k + 2];
-        r.fill(0.0);
+        // No fill: every entry 0 … k+1 is written below before it is read (r[s]; the chain up
+        // and down from it; r[0] and r[1] by the next-event cases) — a `memset` call per weight.
         r[s] = 1.0;
         let skip = self.one_is_nee();
         if skip && s == 1 {
@@ -206,14 +208,27 @@ impl Chain<'_> {
                 r[2] * self.nee * c[1] / (l[0] * l[1])
             };
         }
+        // `valid(i)` and `sample_count(i)` by position, without their per-entry dispatch: only
+        // technique k has a count other than 1, and x · 1 / 1 is x exactly, so the other entries
+        // are scaled only when n_s differs from 1 (the same operations, so the same bits).
         let ns = self.sample_count(s);
-        for (i, ri) in r.iter_mut().enumerate() {
-            *ri = if self.valid(i) {
-                *ri * self.sample_count(i) / ns
-            } else {
+        let conn = &self.connectable[..=k];
+        for i in 0..=k {
+            let valid = match i {
+                0 => conn[0],
+                1 if skip => conn[1],
+                _ => conn[i - 1] && conn[i],
+            };
+            r[i] = if !valid {
                 0.0
+            } else if i == k || ns != 1.0 {
+                r[i] * self.sample_count(i) / ns
+            } else {
+                r[i]
             };
         }
+        // Technique k+1 (a camera a walk hits) is never valid.
+        r[k + 1] = 0.0;
     }
 
     /// The weight of technique s under `h`; zero when s cannot produce the path.

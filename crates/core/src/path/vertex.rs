@@ -57,14 +57,23 @@ pub struct PathVertex {
     /// at endpoints). Connections evaluate the BSDF with it instead of rebuilding it from two f32
     /// positions, which is ill-conditioned for short segments and sharp (small-α GGX) lobes.
     pub wo: Vec3,
-    /// The light a surface vertex emits as, when it lies on an emitter (technique s = 0).
-    pub emitter: Option<u32>,
+    /// The light a surface vertex emits as, when it lies on an emitter (technique s = 0);
+    /// `NO_EMITTER` when none (read it with `emitter()`). A bare u32 instead of `Option<u32>`
+    /// keeps the vertex at 128 bytes, which the compiler copies inline: at 132 every push of a
+    /// vertex was a `memcpy` call (results/bench.md, "Per-sample costs").
+    emitter: u32,
     /// Texture point of a surface vertex (zero elsewhere).
     pub uv: crate::texture::TexPoint,
     /// The hit's `SurfaceHit::tangent` (zero unless the material is anisotropic), so frames
     /// rebuilt at this vertex agree with the one the walk sampled with.
     pub tangent: Vec3,
 }
+
+// Walks push a vertex per bounce; beyond 128 bytes each copy is a `memcpy` call.
+const _: () = assert!(std::mem::size_of::<PathVertex>() <= 128);
+
+/// `PathVertex::emitter` of a vertex on no emitter (no scene has 2³² − 1 lights).
+const NO_EMITTER: u32 = u32::MAX;
 
 impl PathVertex {
     fn endpoint(kind: VertexKind, p: Vec3, n: Vec3, beta: Color, pdf_fwd: f32) -> PathVertex {
@@ -79,7 +88,7 @@ impl PathVertex {
             pdf_rev: 0.0,
             delta: false,
             wo: Vec3::ZERO,
-            emitter: None,
+            emitter: NO_EMITTER,
             uv: Default::default(),
             tangent: Vec3::ZERO,
         }
@@ -123,7 +132,7 @@ impl PathVertex {
             pdf_rev: 0.0,
             delta: false,
             wo,
-            emitter: hit.light,
+            emitter: hit.light.unwrap_or(NO_EMITTER),
             uv: hit.uv,
             tangent: hit.tangent,
         };
@@ -140,7 +149,7 @@ impl PathVertex {
     /// The same surface as a light endpoint x0 (a camera walk hit an emitter: technique s = 0).
     /// `None` when the surface does not emit.
     pub fn as_light_endpoint(&self) -> Option<PathVertex> {
-        let light = self.emitter?;
+        let light = self.emitter()?;
         Some(PathVertex {
             kind: VertexKind::Light {
                 light,
@@ -235,6 +244,12 @@ impl PathVertex {
         v
     }
 
+    /// The light a surface vertex emits as, when it lies on an emitter (technique s = 0).
+    #[inline]
+    pub fn emitter(&self) -> Option<u32> {
+        (self.emitter != NO_EMITTER).then_some(self.emitter)
+    }
+
     /// True for a light vertex at infinity.
     #[inline]
     pub fn is_infinite(&self) -> bool {
@@ -271,6 +286,7 @@ impl PathVertex {
     /// pbrt's `ConvertDensity`: a density with which this vertex chose the direction towards
     /// `next` (solid angle; for a vertex at infinity, the perpendicular-disk density) turned into
     /// the measure `next` is stored in. A vertex at infinity keeps solid angle.
+    #[inline]
     pub fn convert_density(&self, pdf: f32, next: &PathVertex) -> f32 {
         if next.is_infinite() {
             return pdf;

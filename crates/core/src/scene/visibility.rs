@@ -32,6 +32,7 @@ struct End {
 impl End {
     /// The point moved out of its error box to the side `w` points into. Without a normal it moves
     /// along `w` itself, which leaves the box just as surely.
+    #[inline]
     fn towards(&self, w: Vec3) -> Vec3 {
         let n = if self.ng == Vec3::ZERO {
             w.normalize_or_zero()
