@@ -26,7 +26,10 @@ fn main() {
         .map(PathBuf::from),
     );
     if let Some(dir) = dirs.iter().find(|d| d.join("libembree3.so").is_file()) {
-        println!("cargo:rerun-if-changed={}", dir.join("libembree3.so").display());
+        println!(
+            "cargo:rerun-if-changed={}",
+            dir.join("libembree3.so").display()
+        );
         println!("cargo:rustc-link-search=native={}", dir.display());
         println!("cargo:rustc-link-lib=dylib=embree3");
         println!("cargo:rustc-cfg=lt_embree");

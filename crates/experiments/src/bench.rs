@@ -72,13 +72,7 @@ pub fn closest_hit_rate(scene: &Scene, rays: &[Ray], repeats: usize) -> (f64, f6
 pub fn shadow_rate(scene: &Scene, rays: &[Ray], repeats: usize) -> f64 {
     let mut blocked = 0usize;
     let accel = scene.accel();
-    let segments: Vec<Ray> = rays
-        .iter()
-        .map(|r| Ray {
-            t_max: 1.0,
-            ..*r
-        })
-        .collect();
+    let segments: Vec<Ray> = rays.iter().map(|r| Ray { t_max: 1.0, ..*r }).collect();
     let start = Instant::now();
     for _ in 0..repeats {
         for r in &segments {

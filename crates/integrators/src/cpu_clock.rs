@@ -14,7 +14,10 @@ pub fn thread_cpu_time() -> Duration {
     // SAFETY: `ts` is a valid, exclusively borrowed out-parameter for the duration of the call.
     let ok = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0;
     if ok {
-        Duration::new(ts.tv_sec.max(0) as u64, ts.tv_nsec.clamp(0, 999_999_999) as u32)
+        Duration::new(
+            ts.tv_sec.max(0) as u64,
+            ts.tv_nsec.clamp(0, 999_999_999) as u32,
+        )
     } else {
         Duration::ZERO
     }

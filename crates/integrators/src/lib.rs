@@ -24,6 +24,7 @@ pub mod splat;
 pub mod sppm;
 pub mod strategy_weight;
 pub mod tally;
+pub mod tally_run;
 pub mod vcm;
 pub mod visible;
 pub mod walk;

@@ -34,19 +34,11 @@
 //! stretch of wall time, microseconds long, and a lap in which the thread was descheduled is
 //! dropped with its item (`VOID_LAP`).
 
-use crate::bdpt::{Bdpt, BdptParams};
-use crate::bpm::Bpm;
-use crate::connect_merge::{Run, VcmParams};
-use crate::lvc_bdpt::{LvcBdpt, LvcParams};
-use crate::params::{IntegratorParams, ParamReader};
 use crate::record::{Completed, Merged, Recorder, Work};
 use crate::splat::{splat_pass_with, Splats};
-use crate::vcm::Vcm;
-use crate::ProgressiveRun;
 use lt_core::camera::FilmFilter;
 use lt_core::math::is_valid_color;
 use lt_core::{Color, Scene};
-use lt_estimators::running::RunningImage;
 use lt_estimators::Image;
 use std::collections::BTreeMap;
 use std::sync::Mutex;
@@ -425,7 +417,7 @@ pub struct RunTally {
 }
 
 impl RunTally {
-    fn add(&mut self, p: &PassTally) {
+    pub(crate) fn add(&mut self, p: &PassTally) {
         let n = self.passes as f64;
         let avg = |a: f64, b: f64| (a * n + b) / (n + 1.0);
         for (wk, f) in &p.techniques {
@@ -442,7 +434,7 @@ impl RunTally {
     }
 
     /// Sums to per-pass averages (a technique absent from a pass counts as zero there).
-    fn close(&mut self) {
+    pub(crate) fn close(&mut self) {
         let n = self.passes.max(1) as f64;
         for f in self.techniques.values_mut() {
             f.mean /= n;
@@ -450,84 +442,6 @@ impl RunTally {
             f.seconds /= n;
         }
     }
-}
-
-/// The integrators a tally covers, built from the registry's parameters.
-pub enum Tallied {
-    Bdpt(Bdpt),
-    LvcBdpt(LvcBdpt),
-    /// `vcm` or `bpm`.
-    Vcm(VcmParams),
-}
-
-/// The integrators `Tallied` covers.
-pub const TALLIED: [&str; 4] = ["bdpt", "lvc-bdpt", "vcm", "bpm"];
-
-impl Tallied {
-    pub fn make(name: &str, scene: &Scene, params: &IntegratorParams) -> Result<Tallied, String> {
-        let info = crate::registry::find(name)?;
-        let r = ParamReader::new(info.name, params);
-        let t = match info.name {
-            "bdpt" => Tallied::Bdpt(Bdpt {
-                params: BdptParams::read(scene, &r)?,
-            }),
-            "lvc-bdpt" => Tallied::LvcBdpt(LvcBdpt::new(scene, LvcParams::read(scene, &r)?)),
-            "vcm" => Tallied::Vcm(Vcm::read(scene, &r)?.params),
-            "bpm" => Tallied::Vcm(Bpm::read(scene, &r)?.params),
-            other => {
-                return Err(format!(
-                    "per-technique tallies cover {}, not {other}",
-                    TALLIED.join(", ")
-                ))
-            }
-        };
-        r.finish()?;
-        Ok(t)
-    }
-}
-
-/// `passes` passes of `t` under `seed`, on the current thread pool, timing items with
-/// probability 1/`every` (0: none): the image `render` makes (bit for bit) and the run's tally.
-pub fn tally_run(
-    scene: &Scene,
-    t: &Tallied,
-    seed: u64,
-    passes: u32,
-    every: u64,
-) -> (Image, RunTally) {
-    let cam = &scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let mut run = RunTally::default();
-    let image = match t {
-        Tallied::Bdpt(b) => {
-            let mut acc = RunningImage::new(w, h);
-            for pass in 0..passes {
-                let (img, _, tally) = b.tally_pass(scene, seed, pass, every);
-                acc.add(&img);
-                run.add(&tally);
-            }
-            acc.mean()
-        }
-        Tallied::LvcBdpt(l) => {
-            let mut acc = RunningImage::new(w, h);
-            for pass in 0..passes {
-                let (img, _, tally) = l.tally_pass(scene, seed, pass, every);
-                acc.add(&img);
-                run.add(&tally);
-            }
-            acc.mean()
-        }
-        Tallied::Vcm(p) => {
-            let mut r = Run::new(p, scene, seed);
-            for pass in 0..passes {
-                let (_, tally) = r.tally_pass(pass, every);
-                run.add(&tally);
-            }
-            r.estimate()
-        }
-    };
-    run.close();
-    (image, run)
 }
 
 /// A short name of a technique for tables: `s=2,t=3`, `merge t=2`, `light walk`, `camera walk`.

@@ -3,7 +3,8 @@
 
 use lt_core::Scene;
 use lt_integrators::record::Work;
-use lt_integrators::tally::{tally_run, RunTally, Tallied};
+use lt_integrators::tally::RunTally;
+use lt_integrators::tally_run::{tally_run, Tallied};
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
 use lt_scene_io::load_scene;
 use std::ops::ControlFlow;
