@@ -226,27 +226,21 @@ impl RunEntry {
         }
     }
 
+    /// Where snapshot `passes` is in the record's per-snapshot lists.
+    fn snapshot_index(&self, passes: u32) -> Option<usize> {
+        self.record.spec.snapshots.iter().position(|&p| p == passes)
+    }
+
     /// Seconds to reach snapshot `passes`.
     pub fn seconds_at(&self, passes: u32) -> Option<f64> {
-        let i = self
-            .record
-            .spec
-            .snapshots
-            .iter()
-            .position(|&p| p == passes)?;
-        self.record.seconds.get(i).copied()
+        self.record.seconds.get(self.snapshot_index(passes)?).copied()
     }
 
     /// CPU seconds to reach snapshot `passes`: what equal-time budgets divide. A record without
     /// them counts its wall seconds times its threads (0 threads: this machine's cores), which
     /// is what those threads could have spent at most.
     pub fn cpu_seconds_at(&self, passes: u32) -> Option<f64> {
-        let i = self
-            .record
-            .spec
-            .snapshots
-            .iter()
-            .position(|&p| p == passes)?;
+        let i = self.snapshot_index(passes)?;
         match self.record.cpu_seconds.get(i) {
             Some(&c) => Some(c),
             None => Some(self.record.seconds.get(i)? * self.record.effective_threads() as f64),
