@@ -101,7 +101,7 @@ fn every_integrator_gives_finite_non_negative_pixels_on_every_shipped_scene() {
     );
     for info in INTEGRATORS {
         for name in &names {
-            let scene = shipped_scene(name, Some((48, 48)));
+            let scene = shipped_scene(name, Some((32, 32)));
             if let Some((_, _, words)) = REFUSES
                 .iter()
                 .find(|(i, s, _)| *i == info.name && s == name)
@@ -117,7 +117,7 @@ fn every_integrator_gives_finite_non_negative_pixels_on_every_shipped_scene() {
                 continue;
             }
             let (result, _) =
-                lt_tests::render_blocks(&scene, info.name, IntegratorParams::default(), 16, 3, 48);
+                lt_tests::render_blocks(&scene, info.name, IntegratorParams::default(), 16, 3, 32);
             let who = format!("{} on {name}", info.name);
             assert_eq!(
                 result.invalid_samples, 0,

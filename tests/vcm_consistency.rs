@@ -37,13 +37,14 @@
 //!    agree with `pt` per 4×4 block on `cornell-box` (16×16), [`CONSISTENT_RUNS`] runs each,
 //!    Šidák over blocks × channels and the two integrators.
 //! 3. **The caustic seen in the mirror, at equal time.** On `caustic-sds` (64×48, full depth) the
-//!    block holding the caustic's mirror image (tests/photon_estimates.rs's block): K runs of
+//!    block holding the caustic's mirror image (tests/photon_estimates.rs's block): [`CAUSTIC_RUNS`] runs of
 //!    `vcm` (default settings, [`CAUSTIC_PASSES`] passes) and, interleaved with them, K runs of
 //!    `bdpt` each given the wall time the `vcm` run before it took. `bdpt` is unbiased, so its MSE
 //!    is its variance across its runs; `vcm`'s MSE is its variance plus its bias² against a long
 //!    BDPT reference (4096 passes). The χ² lower bound of BDPT's MSE must exceed the upper bound
 //!    of VCM's (χ² bound of its variance plus the square of the farther end of its bias's t
-//!    interval, Welch–Satterthwaite degrees of freedom).
+//!    interval, Welch–Satterthwaite degrees of freedom); three intervals per channel, Bonferroni,
+//!    over the channels that differ (one on a grey scene).
 //!
 //! All tests of this file take one lock, so they render one at a time (each render uses every
 //! core) and test 3's wall-clock budgets are not shared with another test's renders.
@@ -67,8 +68,11 @@ use std::time::{Duration, Instant};
 
 /// Family-wise false-alarm rate of every claim here.
 const ALPHA: f64 = 1e-3;
-/// Independent runs of test 1 and test 3.
+/// Independent runs of test 1.
 const RUNS: u64 = 16;
+/// Independent runs of each estimator in test 3. At K = 16 the χ² bounds of a variance lay at
+/// 0.33× and 6.8× its estimate, and a CI run fell short of the claim with a point ratio of 39.
+const CAUSTIC_RUNS: u64 = 32;
 /// Pass counts at which test 1 reads every run.
 const CHECKPOINTS: [u32; 3] = [2, 16, 128];
 /// SmallVCM's (and `vcm`'s default) radius reduction.
@@ -402,7 +406,7 @@ fn vcm_renders_the_mirrored_caustic_with_far_less_error_than_bdpt_at_equal_time(
     let (mut x, mut y) = (Vec::new(), Vec::new());
     let (mut vcm_time, mut bdpt_time, mut bdpt_passes) = (Duration::ZERO, Duration::ZERO, 0u32);
     // Interleaved, so that whatever else the machine does falls on both alike.
-    for k in 0..RUNS {
+    for k in 0..CAUSTIC_RUNS {
         let opts = RenderOptions {
             passes: CAUSTIC_PASSES,
             time_limit: None,
@@ -427,18 +431,26 @@ fn vcm_renders_the_mirrored_caustic_with_far_less_error_than_bdpt_at_equal_time(
         bdpt_passes += b.passes;
     }
     println!(
-        "caustic-sds 64×48, block ({bx},{by}): {RUNS} runs each; vcm {CAUSTIC_PASSES} passes in \
+        "caustic-sds 64×48, block ({bx},{by}): {CAUSTIC_RUNS} runs each; vcm {CAUSTIC_PASSES} passes in \
          {:.1?} per run; bdpt {:.1} passes in {:.1?} per run (the same budget); reference bdpt \
          {REFERENCE_PASSES} passes ({t_reference:.1?})",
-        vcm_time / RUNS as u32,
-        bdpt_passes as f64 / RUNS as f64,
-        bdpt_time / RUNS as u32
+        vcm_time / CAUSTIC_RUNS as u32,
+        bdpt_passes as f64 / CAUSTIC_RUNS as f64,
+        bdpt_time / CAUSTIC_RUNS as u32
     );
-    let k = RUNS as f64;
-    // Three intervals per channel (vcm variance, vcm bias, bdpt variance), Bonferroni.
-    let conf = 1.0 - ALPHA / 9.0;
+    let k = CAUSTIC_RUNS as f64;
+    // A grey scene gives the same numbers in every channel: one test, not three.
+    let same = |v: &[[f64; 3]], c: usize| v.iter().all(|p| p[c] == p[0]);
+    let grey =
+        (1..3).all(|c| same(&x, c) && same(&y, c) && reference.mean[i][c] == reference.mean[i][0]);
+    let channels = if grey { 1 } else { 3 };
+    // Three intervals per channel tested (vcm variance, vcm bias, bdpt variance), Bonferroni.
+    let conf = 1.0 - ALPHA / (3 * channels) as f64;
+    if grey {
+        println!("  a grey scene: R, G and B carry the same numbers; R is tested");
+    }
     let mut failures = Vec::new();
-    for c in 0..3 {
+    for c in 0..channels {
         let sx = RunningStat::from_slice(&x.iter().map(|v| v[c]).collect::<Vec<_>>());
         let sy = RunningStat::from_slice(&y.iter().map(|v| v[c]).collect::<Vec<_>>());
         let (r, se_r) = (reference.mean[i][c], reference.std_error[i][c]);
@@ -458,11 +470,7 @@ fn vcm_renders_the_mirrored_caustic_with_far_less_error_than_bdpt_at_equal_time(
         let var_y = variance_interval(sy.sample_variance(), k - 1.0, conf);
         let mse_y_ref = y.iter().map(|v| (v[c] - r).powi(2)).sum::<f64>() / k - se_r * se_r;
         let ch = ["R", "G", "B"][c];
-        let same = |v: &[[f64; 3]]| v.iter().all(|p| p[c] == p[0]);
-        let grey = c > 0 && same(&x) && same(&y) && reference.mean[i][c] == reference.mean[i][0];
-        if grey {
-            println!("  {ch}: the same numbers as R (a grey scene)");
-        } else {
+        {
             println!(
                 "  {ch}: reference {r:.5} ± {se_r:.5}; vcm {:.5}, MSE {mse_x:.3e} (variance \
                  {:.3e} [{:.3e}, {:.3e}] + bias² {bias2:.3e}, bias {:.5} in [{:.5}, {:.5}]) ≤ \

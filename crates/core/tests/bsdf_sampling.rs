@@ -183,7 +183,7 @@ fn sampled_directions_follow_the_pdf_chi2() {
         let (name, m) = &registry[index];
         let mut outcomes = Vec::new();
         let cfg = Chi2Test {
-            samples: 1_000_000,
+            samples: 500_000,
             seed,
         };
         let label = format!("{name} cosθo={cos} {}", mode_name(mode));
@@ -217,7 +217,7 @@ fn sampled_directions_follow_the_pdf_chi2() {
             let half_angle = (0.9 * elevation).min(10.0 * alpha) as f64;
             let grid = SphereGrid::cap(Frame::from_z(r), 1.0 - half_angle.cos(), 30, 40, 2.0);
             let cfg = Chi2Test {
-                samples: 1_000_000,
+                samples: 500_000,
                 seed: seed + 1_000,
             };
             outcomes.push(chi2::run(&format!("{label} lobe"), cfg, &grid, sample, pdf));
@@ -229,7 +229,7 @@ fn sampled_directions_follow_the_pdf_chi2() {
                 let half_angle = (0.9 * elevation.min(to_rim)).min(10.0 * alpha) as f64;
                 let grid = SphereGrid::cap(Frame::from_z(t), 1.0 - half_angle.cos(), 30, 40, 2.0);
                 let cfg = Chi2Test {
-                    samples: 1_000_000,
+                    samples: 500_000,
                     seed: seed + 2_000,
                 };
                 outcomes.push(chi2::run(
@@ -511,73 +511,88 @@ fn non_delta_materials_are_reciprocal() {
 fn energy_is_conserved_and_diffuse_returns_its_albedo() {
     let sf = flat_frame();
     let n = 200_000;
-    let mut report = Vec::new();
-    for (name, m) in test_registry() {
+    let registry = test_registry();
+    // Cases in a fixed order, each with its own seed, run on every core (as the χ² test does).
+    let mut cases = Vec::new();
+    for index in 0..registry.len() {
         for (cos, wo_l) in wo_cases() {
-            let wo = sf.frame.to_world(wo_l);
             for mode in MODES {
-                // Radiance is not conserved across refraction (it scales by 1/η²); only the
-                // adjoint (importance) direction of glass integrates to ≤ 1.
-                let refracts_radiance =
-                    m.refraction_ior().is_some() && mode == TransportMode::Radiance;
-                let mut s = Sampler::new(13, cos.to_bits() as u64, mode as u64);
-                let mut by_sampling = [MeanEstimate::default(); 3];
-                // The smooth lobes' share of the samples: what eval integrates to.
-                let mut smooth_by_sampling = [MeanEstimate::default(); 3];
-                let mut by_uniform = [MeanEstimate::default(); 3];
-                for _ in 0..n {
-                    let u_lobe = s.next_f32();
-                    let b = m.sample(&sf, wo, u_lobe, s.next_2d(), mode);
-                    let w = b.map_or(Vec3::ZERO, |b| b.weight);
-                    let smooth =
-                        b.map_or(Vec3::ZERO, |b| if b.delta { Vec3::ZERO } else { b.weight });
-                    let wi = sample_uniform_sphere(s.next_2d());
-                    let f = m.eval(&sf, wo, wi, mode).f_cos / UNIFORM_SPHERE_PDF;
-                    for c in 0..3 {
-                        by_sampling[c].add(w[c] as f64);
-                        smooth_by_sampling[c].add(smooth[c] as f64);
-                        by_uniform[c].add(f[c] as f64);
-                    }
-                }
-                let label = format!("{name} cosθo={cos} {}", mode_name(mode));
-                for c in 0..3 {
-                    let (a, b) = (by_sampling[c], by_uniform[c]);
-                    if !refracts_radiance && (a.mean() - 1.0) > Z_MAX * a.std_error() {
-                        report.push(format!(
-                            "{label}[{c}]: ∫f_cos = {:.5} ± {:.1e} exceeds 1",
-                            a.mean(),
-                            a.std_error()
-                        ));
-                    }
-                    if !m.is_delta() {
-                        // Two independent unbiased estimates of the same albedo (both exactly 0
-                        // for a one-sided material seen from behind), of its smooth lobes.
-                        let a = smooth_by_sampling[c];
-                        let se = (a.std_error().powi(2) + b.std_error().powi(2)).sqrt();
-                        let z = if se == 0.0 && a.mean() == b.mean() {
-                            0.0
-                        } else {
-                            (a.mean() - b.mean()) / se
-                        };
-                        if !(z.abs() < Z_MAX) {
-                            report.push(format!("{label}[{c}]: sampled albedo {:.5} vs uniform {:.5} ± {:.1e}: z = {z:.2}", a.mean(), b.mean(), b.std_error()));
-                        }
-                    }
-                    if let Material::Diffuse(d) = &m {
-                        let z = (b.mean() - d.albedo[c] as f64) / b.std_error();
-                        if !(z.abs() < Z_MAX) {
-                            report.push(format!(
-                                "{label}[{c}]: albedo {:.5} ± {:.1e} vs {}: z = {z:.2}",
-                                b.mean(),
-                                b.std_error(),
-                                d.albedo[c]
-                            ));
-                        }
-                    }
-                }
+                cases.push((index, cos, wo_l, mode));
             }
         }
     }
+    let run_case = |&(index, cos, wo_l, mode): &(usize, f32, Vec3, TransportMode)| {
+        let (name, m) = &registry[index];
+        let mut report = Vec::new();
+        let wo = sf.frame.to_world(wo_l);
+        // Radiance is not conserved across refraction (it scales by 1/η²); only the
+        // adjoint (importance) direction of glass integrates to ≤ 1.
+        let refracts_radiance = m.refraction_ior().is_some() && mode == TransportMode::Radiance;
+        let mut s = Sampler::new(13, cos.to_bits() as u64, mode as u64);
+        let mut by_sampling = [MeanEstimate::default(); 3];
+        // The smooth lobes' share of the samples: what eval integrates to.
+        let mut smooth_by_sampling = [MeanEstimate::default(); 3];
+        let mut by_uniform = [MeanEstimate::default(); 3];
+        for _ in 0..n {
+            let u_lobe = s.next_f32();
+            let b = m.sample(&sf, wo, u_lobe, s.next_2d(), mode);
+            let w = b.map_or(Vec3::ZERO, |b| b.weight);
+            let smooth = b.map_or(Vec3::ZERO, |b| if b.delta { Vec3::ZERO } else { b.weight });
+            let wi = sample_uniform_sphere(s.next_2d());
+            let f = m.eval(&sf, wo, wi, mode).f_cos / UNIFORM_SPHERE_PDF;
+            for c in 0..3 {
+                by_sampling[c].add(w[c] as f64);
+                smooth_by_sampling[c].add(smooth[c] as f64);
+                by_uniform[c].add(f[c] as f64);
+            }
+        }
+        let label = format!("{name} cosθo={cos} {}", mode_name(mode));
+        for c in 0..3 {
+            let (a, b) = (by_sampling[c], by_uniform[c]);
+            if !refracts_radiance && (a.mean() - 1.0) > Z_MAX * a.std_error() {
+                report.push(format!(
+                    "{label}[{c}]: ∫f_cos = {:.5} ± {:.1e} exceeds 1",
+                    a.mean(),
+                    a.std_error()
+                ));
+            }
+            if !m.is_delta() {
+                // Two independent unbiased estimates of the same albedo (both exactly 0
+                // for a one-sided material seen from behind), of its smooth lobes.
+                let a = smooth_by_sampling[c];
+                let se = (a.std_error().powi(2) + b.std_error().powi(2)).sqrt();
+                let z = if se == 0.0 && a.mean() == b.mean() {
+                    0.0
+                } else {
+                    (a.mean() - b.mean()) / se
+                };
+                if !(z.abs() < Z_MAX) {
+                    report.push(format!(
+                        "{label}[{c}]: sampled albedo {:.5} vs uniform {:.5} ± {:.1e}: z = {z:.2}",
+                        a.mean(),
+                        b.mean(),
+                        b.std_error()
+                    ));
+                }
+            }
+            if let Material::Diffuse(d) = m {
+                let z = (b.mean() - d.albedo[c] as f64) / b.std_error();
+                if !(z.abs() < Z_MAX) {
+                    report.push(format!(
+                        "{label}[{c}]: albedo {:.5} ± {:.1e} vs {}: z = {z:.2}",
+                        b.mean(),
+                        b.std_error(),
+                        d.albedo[c]
+                    ));
+                }
+            }
+        }
+        report
+    };
+    let report: Vec<String> = on_every_core(&cases, run_case)
+        .into_iter()
+        .flatten()
+        .collect();
     assert!(report.is_empty(), "{}", report.join("\n"));
 }
 

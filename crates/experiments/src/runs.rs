@@ -233,7 +233,10 @@ impl RunEntry {
 
     /// Seconds to reach snapshot `passes`.
     pub fn seconds_at(&self, passes: u32) -> Option<f64> {
-        self.record.seconds.get(self.snapshot_index(passes)?).copied()
+        self.record
+            .seconds
+            .get(self.snapshot_index(passes)?)
+            .copied()
     }
 
     /// CPU seconds to reach snapshot `passes`: what equal-time budgets divide. A record without

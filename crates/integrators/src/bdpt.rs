@@ -20,7 +20,7 @@
 //! | `mis` | power/balance/none | power | heuristic over the strategies (none: uniform weights) |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
 
-use crate::connect::{connect_to_camera, join, nee_density, next_event, Joined, NextEvent};
+use crate::connect::{join, nee_density, next_event, splat_light_subpath, Joined, NextEvent};
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
 use crate::record::{Completed, NoRecord, Reached, Recorder, Work};
@@ -118,7 +118,6 @@ impl Bdpt {
             scratch,
             rec,
         } = worker;
-        let cam = &scene.camera;
         let ratio = self.ratio(scene);
         let h = self.params.mis;
         let max_k = self.params.max_depth as usize;
@@ -143,43 +142,19 @@ impl Bdpt {
             // A thin lens draws its lens points from the light path's own lens stream (as vcm
             // does, so vcm without merging takes bdpt's paths).
             let mut lens = Sampler::for_item(Domain::Lens, seed, light_index, pass as u64);
-            for s in 1..=y.len().min(max_k) {
-                'attempt: {
-                    let yv = &y[s - 1];
-                    if !connectable(scene, yv) {
-                        break 'attempt;
-                    }
-                    let Some(c) = connect_to_camera(scene, yv, &mut lens) else {
-                        break 'attempt;
-                    };
-                    let camera_only = [c.camera];
-                    let split = Split {
-                        light: &y[..s],
-                        camera: &camera_only,
-                        light_nee,
-                    };
-                    let evals = EndEvals {
-                        light_end: c.eval,
-                        camera_end: None,
-                    };
-                    let w = mis_weight(scene, split, evals, h, ratio);
-                    if R::ACTIVE {
-                        rec.completed(Completed {
-                            s,
-                            light: &y[..s],
-                            camera: &camera_only,
-                            weight: w,
-                            value: c.value * scale,
-                            raster: c.raster,
-                            alternatives: &[],
-                        });
-                    }
-                    if w > 0.0 {
-                        splats.add_filtered(cam.film(), c.raster, c.value * (w as f32 * scale));
-                    }
-                }
-                rec.lap(Work::Connection { s: s as u16, t: 1 });
-            }
+            splat_light_subpath(scene, y, max_k, scale, &mut lens, splats, *rec, |s, c| {
+                let camera_only = [c.camera];
+                let split = Split {
+                    light: &y[..s],
+                    camera: &camera_only,
+                    light_nee,
+                };
+                let evals = EndEvals {
+                    light_end: c.eval,
+                    camera_end: None,
+                };
+                mis_weight(scene, split, evals, h, ratio)
+            });
         }
         let Some(pixel) = pixel else {
             return Color::ZERO;

@@ -3,8 +3,11 @@
 //! towards another vertex. Visibility is always `Scene::connection_visible`, which offsets both
 //! ends by their error bounds.
 
+use crate::record::{Completed, Recorder, Work};
+use crate::splat::Splats;
 use lt_core::bsdf::{BsdfEval, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3};
+use lt_core::path::scatter::connectable;
 use lt_core::path::{PathVertex, VertexKind};
 use lt_core::sampling::Sampler;
 use lt_core::Scene;
@@ -91,6 +94,50 @@ pub fn connect_to_camera(
         eval,
         camera,
     })
+}
+
+/// Light tracing (t = 1) for one light subpath `y`: each connectable vertex y_{s−1}, s ≤ `max_k`,
+/// joined to the lens (its point drawn from `lens`) and splatted as value · w · `scale`, with
+/// w = `weight(s, &connection)` the caller's MIS weight and `scale` = 1 / light paths per pass.
+/// bdpt, lvc-bdpt and vcm/bpm share this loop and differ only in how they weight.
+#[allow(clippy::too_many_arguments)]
+pub fn splat_light_subpath<R: Recorder>(
+    scene: &Scene,
+    y: &[PathVertex],
+    max_k: usize,
+    scale: f32,
+    lens: &mut Sampler,
+    splats: &mut Splats,
+    rec: &mut R,
+    mut weight: impl FnMut(usize, &CameraConnection) -> f64,
+) {
+    for s in 1..=y.len().min(max_k) {
+        'attempt: {
+            let yv = &y[s - 1];
+            if !connectable(scene, yv) {
+                break 'attempt;
+            }
+            let Some(c) = connect_to_camera(scene, yv, lens) else {
+                break 'attempt;
+            };
+            let w = weight(s, &c);
+            if R::ACTIVE {
+                rec.completed(Completed {
+                    s,
+                    light: &y[..s],
+                    camera: std::slice::from_ref(&c.camera),
+                    weight: w,
+                    value: c.value * scale,
+                    raster: c.raster,
+                    alternatives: &[],
+                });
+            }
+            if w > 0.0 {
+                splats.add_filtered(scene.camera.film(), c.raster, c.value * (w as f32 * scale));
+            }
+        }
+        rec.lap(Work::Connection { s: s as u16, t: 1 });
+    }
 }
 
 /// Density of x0 when next-event estimation from x1 chooses it: pmf · pdf_li in x0's measure

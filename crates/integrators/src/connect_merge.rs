@@ -16,7 +16,7 @@
 //! primary-hit distance: one radius for the whole pass, which η needs) or scene relative.
 
 use crate::connect::{
-    connect_to_camera, emission_densities, join, nee_density, next_event, Joined, NextEvent,
+    emission_densities, join, nee_density, next_event, splat_light_subpath, Joined, NextEvent,
 };
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
@@ -439,42 +439,19 @@ impl<'a> Engine<'a> {
         let scene = self.scene;
         let cam = &scene.camera;
         let scale = 1.0 / setup.light_paths as f32;
-        for s in 1..=y.len().min(self.params.max_depth as usize) {
-            'attempt: {
-                let yv = &y[s - 1];
-                if !connectable(scene, yv) {
-                    break 'attempt;
-                }
-                let Some(c) = connect_to_camera(scene, yv, lens) else {
-                    break 'attempt;
-                };
-                let camera = c.camera;
-                let c_y =
-                    reverse_density(yv, &camera, cam.pdf_dir(camera.p, camera.dir_to(yv))) as f64;
-                let w = if s == 1 {
-                    setup.mis.light_tracing_origin(&ly[0], c_y)
-                } else {
-                    let ev = c.eval.expect("a surface connected to the camera");
-                    let c_prev = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
-                    setup.mis.light_tracing(&ly[s - 1], c_y, c_prev)
-                };
-                if R::ACTIVE {
-                    rec.completed(Completed {
-                        s,
-                        light: &y[..s],
-                        camera: std::slice::from_ref(&camera),
-                        weight: w,
-                        value: c.value * scale,
-                        raster: c.raster,
-                        alternatives: &[],
-                    });
-                }
-                if w > 0.0 {
-                    splats.add_filtered(cam.film(), c.raster, c.value * (w as f32 * scale));
-                }
+        let max_k = self.params.max_depth as usize;
+        splat_light_subpath(scene, y, max_k, scale, lens, splats, rec, |s, c| {
+            let camera = c.camera;
+            let yv = &y[s - 1];
+            let c_y = reverse_density(yv, &camera, cam.pdf_dir(camera.p, camera.dir_to(yv))) as f64;
+            if s == 1 {
+                setup.mis.light_tracing_origin(&ly[0], c_y)
+            } else {
+                let ev = c.eval.expect("a surface connected to the camera");
+                let c_prev = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
+                setup.mis.light_tracing(&ly[s - 1], c_y, c_prev)
             }
-            rec.lap(Work::Connection { s: s as u16, t: 1 });
-        }
+        });
     }
 
     /// The camera sample of `pixel`: every technique with t ≥ 2 (merges included).

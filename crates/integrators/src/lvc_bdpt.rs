@@ -34,7 +34,7 @@
 //! | `light_paths` | u64 | the pixel count | light subpaths traced into the cache per pass |
 //! | `connections` | u32 | 1 | cache vertices each camera vertex connects to (N) |
 
-use crate::connect::{connect_to_camera, join, nee_density, next_event, Joined, NextEvent};
+use crate::connect::{join, nee_density, next_event, splat_light_subpath, Joined, NextEvent};
 use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
 use crate::record::{Completed, NoRecord, Reached, Recorder, Work};
@@ -291,47 +291,19 @@ impl LvcBdpt {
         let scale = 1.0 / self.light_paths(scene) as f32;
         let (y, light_nee) = cache.path(i as usize);
         let mut lens = Sampler::for_item(Domain::Lens, pass.seed, i, pass.pass as u64);
-        for s in 1..=y.len().min(max_k) {
-            'attempt: {
-                let yv = &y[s - 1];
-                if !connectable(scene, yv) {
-                    break 'attempt;
-                }
-                let Some(c) = connect_to_camera(scene, yv, &mut lens) else {
-                    break 'attempt;
-                };
-                let camera_only = [c.camera];
-                let split = Split {
-                    light: &y[..s],
-                    camera: &camera_only,
-                    light_nee,
-                };
-                let evals = EndEvals {
-                    light_end: c.eval,
-                    camera_end: None,
-                };
-                let w = mis.weight(scene, split, evals);
-                if R::ACTIVE {
-                    rec.completed(Completed {
-                        s,
-                        light: &y[..s],
-                        camera: &camera_only,
-                        weight: w,
-                        value: c.value * scale,
-                        raster: c.raster,
-                        alternatives: &[],
-                    });
-                }
-                if w > 0.0 {
-                    splats.add_filtered(
-                        scene.camera.film(),
-                        c.raster,
-                        c.value * (w as f32 * scale),
-                    );
-                }
-            }
-            rec.lap(Work::Connection { s: s as u16, t: 1 });
-        }
+        splat_light_subpath(scene, y, max_k, scale, &mut lens, splats, rec, |s, c| {
+            let camera_only = [c.camera];
+            let split = Split {
+                light: &y[..s],
+                camera: &camera_only,
+                light_nee,
+            };
+            let evals = EndEvals {
+                light_end: c.eval,
+                camera_end: None,
+            };
+            mis.weight(scene, split, evals)
+        });
     }
 
     /// The camera sample of `pixel`: s = 0, s = 1 and N cache connections at every vertex.
