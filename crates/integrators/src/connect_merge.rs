@@ -967,6 +967,9 @@ struct MergeDensities {
     l_z_prev: f64,
 }
 
+/// Longest merged path (segments, + 1) whose densities `merge_weight` keeps on the stack.
+const MERGE_STACK: usize = 24;
+
 /// The correlation-aware weight of merging light vertex y_i (`y` = y_0 … y_i) at z_{t−1} (`z` =
 /// z_0 … z_{t−1}): the full path's densities from the walks' stored ones, as
 /// `Densities::merged` defines them from scratch — the light side l_0 … l_i, c_0 … c_{i−2} from
@@ -981,9 +984,21 @@ fn merge_weight(
     let i = y.len() - 1;
     let t = z.len();
     let k = i + t - 1;
-    let mut light = vec![0.0f64; k + 1];
-    let mut camera = vec![0.0f64; k + 1];
-    let mut conn = vec![false; k + 1];
+    // On the stack up to k = MERGE_STACK − 1 (every merge of a pass builds one).
+    let (mut la, mut ca, mut na) = (
+        [0.0f64; MERGE_STACK],
+        [0.0f64; MERGE_STACK],
+        [false; MERGE_STACK],
+    );
+    let (mut lv, mut cv, mut nv) = (Vec::new(), Vec::new(), Vec::new());
+    let (light, camera, conn): (&mut [f64], &mut [f64], &mut [bool]) = if k < MERGE_STACK {
+        (&mut la[..=k], &mut ca[..=k], &mut na[..=k])
+    } else {
+        lv.resize(k + 1, 0.0);
+        cv.resize(k + 1, 0.0);
+        nv.resize(k + 1, false);
+        (&mut lv, &mut cv, &mut nv)
+    };
     for j in 0..=k {
         if j <= i {
             light[j] = y[j].pdf_fwd as f64;
@@ -1013,10 +1028,10 @@ fn merge_weight(
     camera[k] = 1.0;
     light[k] = 0.0;
     let chain = Chain {
-        light: &light,
-        camera: &camera,
+        light,
+        camera,
         nee: light_nee(scene, y),
-        connectable: &conn,
+        connectable: conn,
         light_tracing_ratio: camis.ratio,
     };
     camis.weight(&chain, Technique::Merge(i), primary)
