@@ -13,8 +13,15 @@ use lt_tests::{shipped_scene, shipped_scene_names};
 /// Paths per (length, technique).
 const PATHS: usize = 60;
 
-fn options(scene: &lt_core::Scene, connections: bool, h: Heuristic) -> VcmOptions {
+/// The check's options, with correlation-aware MIS for merging (`lt_core::path::camis`) on or off.
+fn options_with(
+    scene: &lt_core::Scene,
+    connections: bool,
+    h: Heuristic,
+    correlation_aware: bool,
+) -> VcmOptions {
     let mut o = VcmOptions::new(scene, connections);
+    o.correlation_aware = correlation_aware;
     o.heuristic = h;
     o.paths = PATHS;
     o.max_passes = 60;
@@ -23,11 +30,15 @@ fn options(scene: &lt_core::Scene, connections: bool, h: Heuristic) -> VcmOption
 }
 
 fn check_all(connections: bool, h: Heuristic) {
+    check_all_with(connections, h, false);
+}
+
+fn check_all_with(connections: bool, h: Heuristic, correlation_aware: bool) {
     let mut failed = Vec::new();
     let (mut paths, mut merges) = (0, 0);
     for name in &shipped_scene_names() {
         let mut scene = shipped_scene(name, None);
-        let opts = options(&scene, connections, h);
+        let opts = options_with(&scene, connections, h, correlation_aware);
         let report = check_scene(&mut scene, &opts, name);
         assert!(report.checked() > 0, "{name}: no paths recorded\n{report}");
         paths += report.checked();
@@ -59,10 +70,35 @@ fn bpm_power_weights_match_the_oracle_on_every_shipped_scene() {
     check_all(false, Heuristic::Power);
 }
 
+/// Correlation-aware MIS (`correlation_aware=true`): the same loop, the oracle's merges counted
+/// η ρ_i times, and the integrators' full-path routine (`camis::weight`) summed over every
+/// technique of each path.
+#[test]
+fn vcm_correlation_aware_power_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all_with(true, Heuristic::Power, true);
+}
+
+#[test]
+fn vcm_correlation_aware_balance_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all_with(true, Heuristic::Balance, true);
+}
+
+#[test]
+fn bpm_correlation_aware_power_weights_match_the_oracle_on_every_shipped_scene() {
+    check_all_with(false, Heuristic::Power, true);
+}
+
 /// Records of cornell-box by vcm (or bpm), with the options that made them.
 fn cornell_records(connections: bool) -> (lt_core::Scene, VcmOptions, Vec<VcmRecord>) {
+    cornell_records_with(connections, false)
+}
+
+fn cornell_records_with(
+    connections: bool,
+    correlation_aware: bool,
+) -> (lt_core::Scene, VcmOptions, Vec<VcmRecord>) {
     let mut scene = shipped_scene("cornell-box", None);
-    let mut opts = options(&scene, connections, Heuristic::Power);
+    let mut opts = options_with(&scene, connections, Heuristic::Power, correlation_aware);
     opts.paths = 30;
     opts.max_depth = 4;
     prepare_scene(&mut scene, &opts);
@@ -115,4 +151,25 @@ fn connections_judged_as_bpm_fail() {
     opts.connections = false;
     let report = check(&scene, &opts, &records);
     assert!(!report.passed(), "{report}");
+}
+
+#[test]
+fn correlation_aware_weights_judged_as_independent_fail() {
+    // vcm's and bpm's correlation-aware weights judged by the classic oracle (every merge η, no
+    // ρ_i), and the classic weights by the correlation-aware one: the discount must show.
+    for connections in [true, false] {
+        for on in [true, false] {
+            let (scene, mut opts, records) = cornell_records_with(connections, on);
+            assert!(check(&scene, &opts, &records).passed());
+            opts.correlation_aware = !on;
+            let report = check(&scene, &opts, &records);
+            let wrong = report.rows.iter().map(|r| r.over).sum::<usize>();
+            assert!(
+                wrong > records.len() / 20,
+                "connections {connections}, judged with correlation {}: {wrong} of {}\n{report}",
+                !on,
+                records.len()
+            );
+        }
+    }
 }

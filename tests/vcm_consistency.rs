@@ -33,9 +33,9 @@
 //!    pt 0.0183 ± 0.0013 (8192); vcm 0.0166 ± 0.0004 and sppm 0.0168 ± 0.0003 (8 runs × 256); at
 //!    max_depth 3 all agree to 0.1 %. A bias² sum against such a reference is dominated by the
 //!    reference's own error, constant in N.
-//! 2. **Agreement at fine settings.** `vcm` and `bpm` at r₀ = 0.5 footprints after 256 passes
-//!    agree with `pt` per 4×4 block on `cornell-box` (16×16), [`CONSISTENT_RUNS`] runs each,
-//!    Šidák over blocks × channels and the two integrators.
+//! 2. **Agreement at fine settings.** `vcm`, `bpm` and `vcm correlation_aware=true` at r₀ = 0.5
+//!    footprints after 256 passes agree with `pt` per 4×4 block on `cornell-box` (16×16),
+//!    [`CONSISTENT_RUNS`] runs each, Šidák over blocks × channels and the three runs.
 //! 3. **The caustic seen in the mirror, at equal time.** On `caustic-sds` (64×48, full depth) the
 //!    block holding the caustic's mirror image (tests/photon_estimates.rs's block): [`CAUSTIC_RUNS`] runs of
 //!    `vcm` (default settings, [`CAUSTIC_PASSES`] passes) and, interleaved with them, K runs of
@@ -330,13 +330,27 @@ fn vcm_and_bpm_agree_with_pt_at_fine_settings() {
     let t = Instant::now();
     let scene = cornell_box();
     let reference = &cornell_box_reference().1;
-    // Šidák over the two integrators; `agreement_t` corrects over blocks × channels.
-    let alpha_each = -((-ALPHA).ln_1p() / 2.0).exp_m1();
-    let params = IntegratorParams::new().with("radius_px", 0.5);
+    // Šidák over the three runs; `agreement_t` corrects over blocks × channels.
+    let cases = [
+        ("vcm", false, 4000),
+        ("bpm", false, 5000),
+        // Correlation-aware MIS for merging (`lt_core::path::camis`).
+        ("vcm", true, 6000),
+    ];
+    let alpha_each = -((-ALPHA).ln_1p() / cases.len() as f64).exp_m1();
     let passes = 256;
     let mut failures = Vec::new();
-    for (integrator, seed) in [("vcm", 4000), ("bpm", 5000)] {
-        let (r, b) = render_blocks(&scene, integrator, params.clone(), passes, seed, 4);
+    for (name, correlation_aware, seed) in cases {
+        let mut params = IntegratorParams::new().with("radius_px", 0.5);
+        if correlation_aware {
+            params.set("correlation_aware", true);
+        }
+        let integrator = if correlation_aware {
+            "vcm correlation_aware"
+        } else {
+            name
+        };
+        let (r, b) = render_blocks(&scene, name, params, passes, seed, 4);
         assert_eq!(r.invalid_samples, 0, "{integrator}: invalid samples");
         assert_eq!(
             b.count(),

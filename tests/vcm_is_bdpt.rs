@@ -44,6 +44,7 @@ fn params(
         alpha: 0.75,
         connections: true,
         merging: false,
+        correlation_aware: false,
     };
     (b, v)
 }

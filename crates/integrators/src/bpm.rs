@@ -14,6 +14,7 @@
 //! | `radius_scene` | f32 | — | initial radius as a fraction of the scene's bounding-sphere diameter |
 //! | `radius` | f32 | — | initial radius in scene units |
 //! | `alpha` | f64 | 0.75 | radius reduction α: rᵢ = r₀ i^((α−1)/2) |
+//! | `correlation_aware` | true/false | false | correlation-aware MIS for merging (Grittmann et al. 2021, `lt_core::path::camis`): merging at x_i counts η ρ_i; weights from the full path's densities (slower) |
 
 use crate::connect_merge::{Run, Techniques, VcmParams};
 use crate::params::ParamReader;

@@ -23,6 +23,7 @@ use crate::pixel::{pixel_sample, weighted};
 use crate::radius::InitialRadius;
 use crate::record::{Completed, Merged, NoRecord, Reached, Recorder, Work};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
+use crate::strategy_weight::{with_chain, EndEvals, Split};
 use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
 use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::{ProgressLog, ProgressiveRun};
@@ -31,7 +32,8 @@ use lt_core::math::{Color, Vec2, Vec3, PI};
 use lt_core::path::scatter::{connectable, connectable_inside};
 use lt_core::path::subpath_mis::{ConnectionDensities, NextEventDensities, VertexTechniques};
 use lt_core::path::{
-    CameraMis, Heuristic, LightMis, PathVertex, SubpathMis, TechniqueSet, VertexKind,
+    camis, CameraMis, Chain, Correlation, Heuristic, LightMis, PathVertex, SubpathMis, Technique,
+    TechniqueSet, VertexKind,
 };
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::spatial::PointGrid;
@@ -52,6 +54,9 @@ pub struct VcmParams {
     /// Connections s ≥ 1 (bdpt's techniques); s = 0 always runs.
     pub connections: bool,
     pub merging: bool,
+    /// Correlation-aware MIS for merging (`lt_core::path::camis`): every weight from the full
+    /// path's densities instead of the per-vertex recursion. Off by default.
+    pub correlation_aware: bool,
 }
 
 /// SmallVCM's radius reduction.
@@ -116,6 +121,7 @@ impl VcmParams {
             alpha,
             connections: techniques.connections,
             merging: techniques.merging,
+            correlation_aware: r.get::<bool>("correlation_aware")?.unwrap_or(false),
         })
     }
 
@@ -238,6 +244,34 @@ pub struct PassSetup {
     /// 1 / (M π r²): the density-estimation normalisation of one merge.
     merge_norm: f32,
     light_paths: u64,
+    /// With correlation-aware MIS: the techniques and sample counts its weights read.
+    camis: Option<CamisSetup>,
+}
+
+/// What correlation-aware weights (`camis::weight`) read besides a path's densities.
+#[derive(Clone, Copy, Debug)]
+struct CamisSetup {
+    set: TechniqueSet,
+    heuristic: Heuristic,
+    /// M, light subpaths per pass (N_VM).
+    light_paths: f64,
+    /// M/N.
+    ratio: f64,
+}
+
+impl CamisSetup {
+    /// The weight of `technique` on `chain`, whose primary hit lies `distance` from the camera.
+    fn weight(&self, chain: &Chain, technique: Technique, distance: f32) -> f64 {
+        let corr = Correlation::new(self.light_paths, distance as f64);
+        camis::weight(chain, self.set, &corr, technique, self.heuristic)
+    }
+
+    /// The weight of connection technique (s, t) formed by `split` (`strategy_weight`).
+    fn connection(&self, scene: &Scene, split: Split, evals: EndEvals, distance: f32) -> f64 {
+        with_chain(scene, split, evals, self.ratio, |chain, s| {
+            self.weight(chain, Technique::Connect(s), distance)
+        })
+    }
 }
 
 pub struct Engine<'a> {
@@ -277,6 +311,12 @@ impl<'a> Engine<'a> {
             eta,
             merge_norm: (1.0 / eta) as f32,
             light_paths: m,
+            camis: p.correlation_aware.then_some(CamisSetup {
+                set,
+                heuristic: p.mis,
+                light_paths: m as f64,
+                ratio: m as f64 / n,
+            }),
         }
     }
 
@@ -443,6 +483,18 @@ impl<'a> Engine<'a> {
         splat_light_subpath(scene, y, max_k, scale, lens, splats, rec, |s, c| {
             let camera = c.camera;
             let yv = &y[s - 1];
+            if let Some(camis) = &setup.camis {
+                let split = Split {
+                    light: &y[..s],
+                    camera: std::slice::from_ref(&camera),
+                    light_nee: light_nee(scene, y),
+                };
+                let evals = EndEvals {
+                    light_end: c.eval,
+                    camera_end: None,
+                };
+                return camis.connection(scene, split, evals, (camera.p - yv.p).length());
+            }
             let c_y = reverse_density(yv, &camera, cam.pdf_dir(camera.p, camera.dir_to(yv))) as f64;
             if s == 1 {
                 setup.mis.light_tracing_origin(&ly[0], c_y)
@@ -491,6 +543,12 @@ impl<'a> Engine<'a> {
         let cam = CameraWalk { z, zr };
         let mut ctx = CameraSample {
             mis,
+            camis: setup.camis.as_ref(),
+            primary: if z.len() >= 2 {
+                (z[1].p - z[0].p).length()
+            } else {
+                0.0
+            },
             raster,
             rec: &mut *worker.rec,
         };
@@ -502,7 +560,14 @@ impl<'a> Engine<'a> {
                 if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter()) {
                     let le = scene.lights[li as usize].emitted(x0.ng, x0.wo, x0.uv);
                     if le != Color::ZERO {
-                        let wgt = self.emitter_weight(mis, &z[..t - 1], zr, &x0, zv.pdf_fwd);
+                        let wgt = self.emitter_weight(
+                            (mis, &ctx),
+                            &z[..t - 1],
+                            zr,
+                            &x0,
+                            zv.pdf_fwd,
+                            &mut scratch.prefix,
+                        );
                         let value = zv.beta * le;
                         if R::ACTIVE {
                             let reached = Reached {
@@ -547,7 +612,14 @@ impl<'a> Engine<'a> {
                         continue;
                     }
                     let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
-                    let wgt = self.emitter_weight(mis, z, zr, &x0, esc.pdf_w);
+                    let wgt = self.emitter_weight(
+                        (mis, &ctx),
+                        z,
+                        zr,
+                        &x0,
+                        esc.pdf_w,
+                        &mut scratch.prefix,
+                    );
                     let value = esc.beta * le;
                     if R::ACTIVE {
                         let reached = Reached {
@@ -570,16 +642,36 @@ impl<'a> Engine<'a> {
 
     /// Weight of s = 0: the camera walk `camera` (camera first, ending at x1) reached light
     /// endpoint `x0` with density `c0`.
-    fn emitter_weight(
+    fn emitter_weight<R>(
         &self,
-        mis: &SubpathMis,
+        (mis, ctx): (&SubpathMis, &CameraSample<'_, R>),
         camera: &[PathVertex],
         records: &[CameraMis],
         x0: &PathVertex,
         c0: f32,
+        prefix: &mut Vec<PathVertex>,
     ) -> f64 {
         let scene = self.scene;
         let x1 = camera.last().expect("the pinhole");
+        if let Some(camis) = ctx.camis {
+            // x0 as the walk reached it, with its density c0 (`strategy_weight::Split`).
+            prefix.clear();
+            prefix.extend_from_slice(camera);
+            let mut x0 = *x0;
+            x0.pdf_fwd = c0;
+            prefix.push(x0);
+            let primary = if camera.len() == 1 {
+                (x0.p - x1.p).length()
+            } else {
+                ctx.primary
+            };
+            let split = Split {
+                light: &[],
+                camera: prefix,
+                light_nee: 0.0,
+            };
+            return camis.connection(scene, split, EndEvals::default(), primary);
+        }
         if camera.len() == 1 {
             let (l0, _) = emission_densities(scene, x0, None);
             return mis.emitter_seen(c0 as f64, l0, joinable(scene, x0, x1));
@@ -626,7 +718,21 @@ impl<'a> Engine<'a> {
             l1,
             l_z_prev: l2,
         };
-        let w = ctx.mis.next_event((&zr[t - 1], &zr[t - 2]), d);
+        let w = match ctx.camis {
+            Some(camis) => {
+                let split = Split {
+                    light: std::slice::from_ref(&x0),
+                    camera: &z[..t],
+                    light_nee: 0.0,
+                };
+                let evals = EndEvals {
+                    light_end: None,
+                    camera_end: Some(ev_z),
+                };
+                camis.connection(scene, split, evals, ctx.primary)
+            }
+            None => ctx.mis.next_event((&zr[t - 1], &zr[t - 2]), d),
+        };
         if R::ACTIVE {
             ctx.rec.completed(Completed {
                 s: 1,
@@ -677,7 +783,21 @@ impl<'a> Engine<'a> {
             l_z,
             l_z_prev,
         };
-        let w = ctx.mis.connection(&ly[s - 1], (&zr[t - 1], &zr[t - 2]), d);
+        let w = match ctx.camis {
+            Some(camis) => {
+                let split = Split {
+                    light: &y[..s],
+                    camera: &z[..t],
+                    light_nee: light_nee(scene, y),
+                };
+                let evals = EndEvals {
+                    light_end: Some(ev_y),
+                    camera_end: Some(ev_z),
+                };
+                camis.connection(scene, split, evals, ctx.primary)
+            }
+            None => ctx.mis.connection(&ly[s - 1], (&zr[t - 1], &zr[t - 2]), d),
+        };
         if R::ACTIVE {
             ctx.rec.completed(Completed {
                 s,
@@ -747,9 +867,17 @@ impl<'a> Engine<'a> {
             } else {
                 0.0
             };
-            let w = setup
-                .mis
-                .merge(&y.mis, &zr[t - 1], &zr[t - 2], c_y_prev, l_z_prev);
+            let w = match &setup.camis {
+                Some(camis) => {
+                    let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
+                    let ys = &lights.chunks[y.chunk as usize].vertices[first..=vi];
+                    let merge = MergeDensities { c_y_prev, l_z_prev };
+                    merge_weight(scene, camis, (ys, &z[..t]), merge, ctx.primary)
+                }
+                None => setup
+                    .mis
+                    .merge(&y.mis, &zr[t - 1], &zr[t - 2], c_y_prev, l_z_prev),
+            };
             if R::ACTIVE {
                 let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
                 ctx.rec.merged(Merged {
@@ -812,8 +940,101 @@ struct CameraWalk<'a> {
 /// and the recorder.
 struct CameraSample<'a, R> {
     mis: &'a SubpathMis,
+    /// Correlation-aware MIS, when on.
+    camis: Option<&'a CamisSetup>,
+    /// |z_1 − z_0|: the primary hit's distance (the footprint of correlation-aware MIS).
+    primary: f32,
     raster: Vec2,
     rec: &'a mut R,
+}
+
+/// Next-event estimation's density of y_0 from y_1 (0 for a one-vertex subpath): the density of
+/// technique 1 on a path y_0 y_1 … joined further up.
+fn light_nee(scene: &Scene, y: &[PathVertex]) -> f64 {
+    if y.len() >= 2 {
+        nee_density(scene, &y[0], &y[1])
+    } else {
+        0.0
+    }
+}
+
+/// The two densities a merge adds, as `SubpathMis::merge` takes them.
+#[derive(Clone, Copy)]
+struct MergeDensities {
+    /// c_{i−1}: z's BSDF towards y_{i−1}, given the light's incoming direction, in area at y_{i−1}.
+    c_y_prev: f64,
+    /// l_{i+1}: z's BSDF (importance) towards z_{t−2} given ω_y, in area at z_{t−2} (0 if t = 2).
+    l_z_prev: f64,
+}
+
+/// Longest merged path (segments, + 1) whose densities `merge_weight` keeps on the stack.
+const MERGE_STACK: usize = 24;
+
+/// The correlation-aware weight of merging light vertex y_i (`y` = y_0 … y_i) at z_{t−1} (`z` =
+/// z_0 … z_{t−1}): the full path's densities from the walks' stored ones, as
+/// `Densities::merged` defines them from scratch — the light side l_0 … l_i, c_0 … c_{i−2} from
+/// the light walk, c_i … c_k and l_{i+2} … from the camera walk, c_{i−1} and l_{i+1} the merge's.
+fn merge_weight(
+    scene: &Scene,
+    camis: &CamisSetup,
+    (y, z): (&[PathVertex], &[PathVertex]),
+    m: MergeDensities,
+    primary: f32,
+) -> f64 {
+    let i = y.len() - 1;
+    let t = z.len();
+    let k = i + t - 1;
+    // On the stack up to k = MERGE_STACK − 1 (every merge of a pass builds one).
+    let (mut la, mut ca, mut na) = (
+        [0.0f64; MERGE_STACK],
+        [0.0f64; MERGE_STACK],
+        [false; MERGE_STACK],
+    );
+    let (mut lv, mut cv, mut nv) = (Vec::new(), Vec::new(), Vec::new());
+    let (light, camera, conn): (&mut [f64], &mut [f64], &mut [bool]) = if k < MERGE_STACK {
+        (&mut la[..=k], &mut ca[..=k], &mut na[..=k])
+    } else {
+        lv.resize(k + 1, 0.0);
+        cv.resize(k + 1, 0.0);
+        nv.resize(k + 1, false);
+        (&mut lv, &mut cv, &mut nv)
+    };
+    for j in 0..=k {
+        if j <= i {
+            light[j] = y[j].pdf_fwd as f64;
+        }
+        if j + 2 <= i {
+            camera[j] = y[j].pdf_rev as f64;
+        }
+        if j >= i {
+            camera[j] = z[k - j].pdf_fwd as f64;
+        }
+        if j >= i + 2 {
+            light[j] = z[k - j].pdf_rev as f64;
+        }
+        // Inner vertices as their walk left them; x_i, the merge, by evaluation on both sides.
+        conn[j] = if j == i {
+            connectable(scene, &z[t - 1]) && connectable(scene, &y[i])
+        } else if j < i {
+            connectable_inside(scene, &y[j])
+        } else {
+            connectable_inside(scene, &z[k - j])
+        };
+    }
+    camera[i - 1] = m.c_y_prev;
+    if i + 1 < k {
+        light[i + 1] = m.l_z_prev;
+    }
+    camera[k] = 1.0;
+    light[k] = 0.0;
+    let chain = Chain {
+        light,
+        camera,
+        nee: light_nee(scene, y),
+        connectable: conn,
+        light_tracing_ratio: camis.ratio,
+    };
+    camis.weight(&chain, Technique::Merge(i), primary)
 }
 
 /// The MIS records of a light subpath y_0 … (see `SubpathMis`), appended to `out`.

@@ -12,6 +12,7 @@
 //! relative to a connection (one per camera sample) it counts N_VM times: the heuristics compare
 //! η · ∏ l · ∏ c with η = N_VM π r² (Georgiev et al.'s η_VCM) against n_s · p_s.
 
+use super::camis::Correlation;
 use super::densities::Densities;
 use super::mis::{oracle_weight, Heuristic};
 use super::path::Path;
@@ -114,10 +115,50 @@ impl Densities {
         (vc, vm)
     }
 
+    /// Correlation-aware MIS's ρ_i of merging at x_i (`path::camis`), from scratch: P_c,i and
+    /// P_l,i as their own products over the path's densities, ρ = 1 at the primary hit x_{k−1}.
+    pub fn correlation_ratio(&self, i: usize, corr: &Correlation) -> f64 {
+        let k = self.k();
+        if i + 1 >= k {
+            return 1.0;
+        }
+        let a = corr.footprint;
+        let p_camera: f64 = (i..k).map(|j| (a * self.camera[j]).min(1.0)).product();
+        let p_light: f64 = (0..=i).map(|j| (a * self.light[j]).min(1.0)).product();
+        corr.ratio(p_camera, p_light)
+    }
+
+    /// `effective_vcm` with merging at x_i counted η ρ_i times when `corr` is given
+    /// (correlation-aware MIS, `path::camis`), η times otherwise.
+    pub fn effective_vcm_with(
+        &self,
+        set: TechniqueSet,
+        corr: Option<&Correlation>,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let (vc, mut vm) = self.effective_vcm(set);
+        if let Some(corr) = corr {
+            for (i, p) in vm.iter_mut().enumerate() {
+                *p *= self.correlation_ratio(i, corr);
+            }
+        }
+        (vc, vm)
+    }
+
     /// The weight of `technique` under `h` over every technique of `set`, by brute force over
     /// the effective densities (`oracle_weight`).
     pub fn vcm_weight(&self, set: TechniqueSet, technique: Technique, h: Heuristic) -> f64 {
-        let (vc, vm) = self.effective_vcm(set);
+        self.vcm_weight_with(set, None, technique, h)
+    }
+
+    /// `vcm_weight`, correlation-aware when `corr` is given.
+    pub fn vcm_weight_with(
+        &self,
+        set: TechniqueSet,
+        corr: Option<&Correlation>,
+        technique: Technique,
+        h: Heuristic,
+    ) -> f64 {
+        let (vc, vm) = self.effective_vcm_with(set, corr);
         let index = match technique {
             Technique::Connect(s) => s,
             Technique::Merge(i) => vc.len() + i,

@@ -36,6 +36,7 @@
 //!   (`Densities::light_tracing_ratio`, `mis`). The `path_space` test proves the normalisation by
 //!   letting s = 0, 1 and 2 estimate the same pixels of an analytic scene.
 
+pub mod camis;
 pub mod densities;
 pub mod merging;
 pub mod mis;
@@ -45,6 +46,7 @@ pub mod scatter;
 pub mod subpath_mis;
 pub mod vertex;
 
+pub use camis::Correlation;
 pub use densities::Densities;
 pub use merging::{Technique, TechniqueSet};
 pub use mis::{balance_weight, oracle_weight, power_weight, Chain, Heuristic};

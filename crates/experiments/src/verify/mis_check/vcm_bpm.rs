@@ -18,7 +18,9 @@ use super::pt_bdpt::{median_and_max, slack_note};
 use super::tolerance::{
     derived_tolerance, relative, weight_error_bound, DEFAULT_SLACK, SUM_TOLERANCE,
 };
-use lt_core::path::{Densities, Heuristic, Path, PathVertex, SubpathMis, Technique, TechniqueSet};
+use lt_core::path::{
+    camis, Correlation, Densities, Heuristic, Path, PathVertex, SubpathMis, Technique, TechniqueSet,
+};
 use lt_core::Scene;
 use lt_integrators::connect_merge::{initial_radius, Engine, PassInputs, VcmParams};
 use lt_integrators::radius::InitialRadius;
@@ -45,6 +47,10 @@ pub struct VcmOptions {
     /// Multiplier on the derived tolerance of (a) (`tolerance::derived_tolerance`).
     pub slack: f64,
     pub radius: InitialRadius,
+    /// Correlation-aware MIS for merging (`lt_core::path::camis`): the integrator's option, and
+    /// the oracle's weights with ρ_i; the sum and replay then run `camis::weight` (the
+    /// integrator's full-path routine) on the oracle's densities.
+    pub correlation_aware: bool,
 }
 
 impl VcmOptions {
@@ -63,6 +69,7 @@ impl VcmOptions {
             // Large radii (relative to the 16² film's footprint) so merging techniques carry
             // weights far from 0 and 1, where a wrong density shows.
             radius: InitialRadius::Pixels(2.0),
+            correlation_aware: false,
         }
     }
 
@@ -86,6 +93,7 @@ impl VcmOptions {
             alpha: lt_integrators::connect_merge::DEFAULT_ALPHA,
             connections: self.connections,
             merging: true,
+            correlation_aware: self.correlation_aware,
         }
     }
 }
@@ -266,14 +274,31 @@ fn densities(scene: &Scene, path: &Path, ratio: f64) -> Densities {
     d
 }
 
-/// Checks one record.
-pub fn check_record(scene: &Scene, r: &VcmRecord, opts: &VcmOptions, ratio: f64) -> VcmCheck {
+/// The correlation-aware MIS inputs of `path` under `opts` (none with the option off): N_VM
+/// light subpaths, the footprint at the distance of the primary hit x_{k−1} from x_k.
+fn correlation(path: &Path, opts: &VcmOptions, light_paths: f64) -> Option<Correlation> {
+    opts.correlation_aware.then(|| {
+        let v = &path.vertices;
+        let k = v.len() - 1;
+        Correlation::new(light_paths, (v[k].p - v[k - 1].p).length() as f64)
+    })
+}
+
+/// Checks one record; `ratio` = M/N, `light_paths` = M.
+pub fn check_record(
+    scene: &Scene,
+    r: &VcmRecord,
+    opts: &VcmOptions,
+    (ratio, light_paths): (f64, f64),
+) -> VcmCheck {
     let set = TechniqueSet {
         connections: opts.connections,
         merging_eta: r.eta,
     };
     let h = opts.heuristic;
     let path = r.path();
+    let corr = correlation(&path, opts, light_paths);
+    let corr = corr.as_ref();
     let d = match r.technique {
         Technique::Merge(_) => {
             let mut d = Densities::merged(scene, &r.light, &r.camera);
@@ -282,9 +307,9 @@ pub fn check_record(scene: &Scene, r: &VcmRecord, opts: &VcmOptions, ratio: f64)
         }
         Technique::Connect(_) => densities(scene, &path, ratio),
     };
-    let oracle = d.vcm_weight(set, r.technique, h);
+    let oracle = d.vcm_weight_with(set, corr, r.technique, h);
     let mismatch = relative(r.weight, oracle);
-    let weight = |d: &Densities| d.vcm_weight(set, r.technique, h);
+    let weight = |d: &Densities| d.vcm_weight_with(set, corr, r.technique, h);
     let bound = match r.technique {
         Technique::Merge(_) => {
             let both: Vec<PathVertex> = r.light.iter().chain(&r.camera).copied().collect();
@@ -316,8 +341,11 @@ pub fn check_record(scene: &Scene, r: &VcmRecord, opts: &VcmOptions, ratio: f64)
     let mut sum = 0.0;
     let mut replay_error = 0.0f64;
     for &t in &techniques {
-        let w = mis.replay(&d, t);
-        replay_error = replay_error.max((w - d.vcm_weight(set, t, h)).abs());
+        let w = match corr {
+            Some(corr) => camis::weight(&d.chain(), set, corr, t, h),
+            None => mis.replay(&d, t),
+        };
+        replay_error = replay_error.max((w - d.vcm_weight_with(set, corr, t, h)).abs());
         sum += w;
     }
     VcmCheck {
@@ -406,7 +434,8 @@ pub fn check_records(
     name: &str,
 ) -> VcmReport {
     let n = scene.camera.pixel_count() as u64;
-    let ratio = opts.light_paths.unwrap_or(n) as f64 / n as f64;
+    let light_paths = opts.light_paths.unwrap_or(n) as f64;
+    let ratio = light_paths / n as f64;
     let mut rows: Vec<VcmRow> = (0..=opts.max_depth as usize)
         .map(|k| VcmRow {
             k,
@@ -415,7 +444,7 @@ pub fn check_records(
         .collect();
     let mut examples = Vec::new();
     for r in records {
-        let v = check_record(scene, r, opts, ratio);
+        let v = check_record(scene, r, opts, (ratio, light_paths));
         let row = &mut rows[v.k.min(opts.max_depth as usize)];
         match v.technique {
             Technique::Connect(_) => {
@@ -478,9 +507,14 @@ impl fmt::Display for VcmReport {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         writeln!(
             f,
-            "mis-check {} {} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ the path's derived tolerance{}; (b) |Σw−1| ≤ {:e} over connections and merges",
+            "mis-check {} {}{} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ the path's derived tolerance{}; (b) |Σw−1| ≤ {:e} over connections and merges",
             self.scene,
             self.options.name(),
+            if self.options.correlation_aware {
+                " correlation_aware"
+            } else {
+                ""
+            },
             self.options.heuristic.name(),
             self.passes,
             slack_note(self.options.slack),

@@ -1,0 +1,160 @@
+//! Correlation-aware MIS for merging (Grittmann, Georgiev & Slusallek, "Correlation-Aware
+//! Multiple Importance Sampling for Bidirectional Rendering Algorithms", EG 2021): the merges
+//! around one camera vertex share one set of N_VM light subpaths, so they are not N_VM independent
+//! samples. Merging at x_i is given the effective count N_VM ρ_i, i.e. η_i = N_VM π r² ρ_i in the
+//! heuristics in place of η, for that merge technique only (every other technique's weight changes
+//! only through the denominator):
+//!
+//!   ρ_i = P_c,i / (P_c,i + P_l,i − P_c,i P_l,i),   clamped to ≥ 1 / N_VM,   ρ = 1 at x_{k−1},
+//!
+//! with P_c,i = ∏_{i ≤ j ≤ k−1} min(1, A c_j) (the camera prefix reaching x_i, each area density
+//! turned into the probability of landing in a footprint of area A) and P_l,i = ∏_{j ≤ i}
+//! min(1, A l_j) (the light prefix reaching x_i), A = π r_c², r_c = |x_k − x_{k−1}| tan 1° (a
+//! footprint at the primary hit's distance). This is the form of the authors' public VCM
+//! re-implementation (pgrit/EfficiencyAwareMIS, `CorrelAwareVcm`), which the brief of this change
+//! states; the paper derives the correlation factor from the same prefix/suffix probabilities
+//! (§4–5). Whether a product includes x_i itself on both sides, and the primary hit's ρ = 1, follow
+//! that implementation: the paper's text could not be consulted from this machine, so no equation
+//! number is claimed here.
+//!
+//! ρ_i depends on both subpaths' products, which VCM's per-vertex recursion (`SubpathMis`) cannot
+//! carry: with the option on, integrators weigh every technique from the full path's per-vertex
+//! densities ([`weight`], O(k) per technique from prefix and suffix products). The oracle
+//! (`Densities::vcm_weight_with`, `Densities::correlation_ratio`) builds each technique's density
+//! from scratch, one product per technique, and is what [`weight`] is held to.
+
+use super::merging::{Technique, TechniqueSet};
+use super::mis::{Chain, Heuristic};
+
+/// What correlation-aware MIS needs besides the per-vertex densities.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Correlation {
+    /// N_VM, light subpaths per pass: the lower clamp 1 / N_VM of ρ (one independent sample).
+    pub light_paths: f64,
+    /// A = π r_c² of the path's footprint.
+    pub footprint: f64,
+}
+
+impl Correlation {
+    /// For a path whose primary hit x_{k−1} lies `primary_distance` from the camera vertex x_k.
+    pub fn new(light_paths: f64, primary_distance: f64) -> Correlation {
+        let r = primary_distance * 1f64.to_radians().tan();
+        Correlation {
+            light_paths,
+            footprint: std::f64::consts::PI * r * r,
+        }
+    }
+
+    /// ρ from the two prefix probabilities, clamped; 0/0 (a merge no walk makes: its density is 0
+    /// whatever ρ) gives the clamp.
+    #[inline]
+    pub fn ratio(&self, p_camera: f64, p_light: f64) -> f64 {
+        let rho = p_camera / (p_camera + p_light - p_camera * p_light);
+        let lo = 1.0 / self.light_paths;
+        if rho >= lo {
+            rho.min(1.0)
+        } else {
+            lo
+        }
+    }
+}
+
+/// Paths up to this many vertices (k ≤ 24) weigh without allocating.
+const STACK: usize = 26;
+
+/// The weight of `technique` under `h` over every technique of `set` with correlation-aware
+/// merging counts, from the full path's per-vertex densities in `chain`: O(k) through prefix
+/// products ∏_{j<s} l_j and suffix products ∏_{j≥s} c_j (what the integrators run; the oracle is
+/// `Densities::vcm_weight_with`).
+pub fn weight(
+    chain: &Chain,
+    set: TechniqueSet,
+    corr: &Correlation,
+    technique: Technique,
+    h: Heuristic,
+) -> f64 {
+    let k = chain.k();
+    let (mut la, mut ca, mut pa) = ([0.0f64; STACK], [0.0f64; STACK], [0.0f64; STACK]);
+    let (mut lv, mut cv, mut pv) = (Vec::new(), Vec::new(), Vec::new());
+    let (lpre, csuf, p): (&mut [f64], &mut [f64], &mut [f64]) = if 2 * k + 3 <= STACK {
+        (&mut la, &mut ca, &mut pa)
+    } else {
+        lv.resize(k + 2, 0.0);
+        cv.resize(k + 2, 0.0);
+        pv.resize(2 * k + 3, 0.0);
+        (&mut lv, &mut cv, &mut pv)
+    };
+    // lpre[s] = ∏_{j<s} l_j, csuf[s] = ∏_{j≥s} c_j, s = 0 … k+1.
+    lpre[0] = 1.0;
+    for j in 0..=k {
+        lpre[j + 1] = lpre[j] * chain.light[j];
+    }
+    csuf[k + 1] = 1.0;
+    for j in (0..=k).rev() {
+        csuf[j] = csuf[j + 1] * chain.camera[j];
+    }
+    // Connection techniques s = 0 … k+1 at p[s], merges i = 0 … k at p[k + 2 + i].
+    for s in 0..=k + 1 {
+        p[s] = if !chain.valid(s) || (s >= 1 && !set.connections) {
+            0.0
+        } else {
+            let prefix = if s == 1 && chain.one_is_nee() {
+                chain.nee
+            } else {
+                lpre[s]
+            };
+            chain.sample_count(s) * prefix * csuf[s]
+        };
+    }
+    let eta = set.merging_eta;
+    // P_c,i as a running suffix product from x_{k−1} down, P_l,i as a prefix product.
+    let mut p_camera = 1.0;
+    let mut p_light_below = 1.0;
+    let a = corr.footprint;
+    let mut p_light = [0.0f64; STACK];
+    let mut p_light_v = Vec::new();
+    let pl: &mut [f64] = if k < STACK {
+        &mut p_light[..=k]
+    } else {
+        p_light_v.resize(k + 1, 0.0);
+        &mut p_light_v
+    };
+    for (p_l, &l) in pl.iter_mut().zip(chain.light) {
+        p_light_below *= (a * l).min(1.0);
+        *p_l = p_light_below;
+    }
+    p[k + 2] = 0.0;
+    p[2 * k + 2] = 0.0;
+    for i in (1..k).rev() {
+        p_camera *= (a * chain.camera[i]).min(1.0);
+        let rho = if i + 1 == k {
+            1.0
+        } else {
+            corr.ratio(p_camera, pl[i])
+        };
+        p[k + 2 + i] = if eta > 0.0 && chain.connectable[i] {
+            eta * rho * lpre[i + 1] * csuf[i]
+        } else {
+            0.0
+        };
+    }
+    let own = match technique {
+        Technique::Connect(s) => p[s],
+        Technique::Merge(i) => p[k + 2 + i],
+    };
+    if own.is_nan() || own <= 0.0 {
+        return 0.0;
+    }
+    let all = &p[..2 * k + 3];
+    let sum: f64 = match h {
+        Heuristic::Balance => all.iter().map(|&x| x / own).sum(),
+        Heuristic::Power => all.iter().map(|&x| (x / own) * (x / own)).sum(),
+        Heuristic::Uniform => all.iter().filter(|&&x| x > 0.0).count() as f64,
+    };
+    let w = 1.0 / sum;
+    if w.is_finite() {
+        w
+    } else {
+        0.0
+    }
+}
