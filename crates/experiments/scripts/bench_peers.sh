@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# Issue 28's table in one run: lt against every peer built on this machine, back to back, and the
+# ratios beside the issue's targets. Run it on an otherwise idle machine (ratios are what carry
+# over: the absolute figures vary by ±20 % on a shared one).
+#
+#   crates/experiments/scripts/bench_peers.sh [--quick] [--out FILE.md]
+#
+# Peers, each skipped with a line saying so when absent (nothing of them is committed):
+# - Mitsuba 3 (`pip install mitsuba numpy`; `llvm_ad_rgb` needs Debian's libllvm): `path` against
+#   `pt` and `ptracer` against `light`, through bench_vs_mitsuba.py (its header says how it times).
+# - SmallVCM, built from its public source outside the repository:
+#     git clone https://github.com/SmallVCM/SmallVCM && cd SmallVCM &&
+#     g++ -o smallvcm ./src/smallvcm.cxx -O3 -std=c++0x -fopenmp
+#   and SMALLVCM=/path/to/smallvcm (default /work/peers/smallvcm/smallvcm): its vcm, bpt and bpm
+#   against our vcm, bdpt and bpm at its settings, time per iteration (vcm_vs_smallvcm.sh).
+# - Tungsten: its equal-error comparison (results/bench.md, "light and bdpt, side by side with
+#   Tungsten") needs its own scene conversion and is not part of this script yet; TUNGSTEN is
+#   reported as not run.
+#
+# Ratios: lt throughput / peer throughput (> 1: lt is faster); for SmallVCM the time ratio
+# lt / SmallVCM (< 1: lt is faster), as the issue states its target.
+set -euo pipefail
+REPO=$(cd "$(dirname "$0")/../../.." && pwd)
+SCRIPTS="$REPO/crates/experiments/scripts"
+QUICK=0
+OUT=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --quick) QUICK=1 ;;
+    --out) OUT="$2"; shift ;;
+    *) echo "bench_peers.sh: unknown argument '$1' (expected --quick or --out FILE)" >&2; exit 2 ;;
+  esac
+  shift
+done
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+cargo build --release -q -p lt-experiments --bin lt --manifest-path "$REPO/Cargo.toml"
+LT="$WORK/lt"
+cp "$REPO/target/release/lt" "$LT"
+
+REPORT="$WORK/report.md"
+{
+  echo "# lt against its peers, one run"
+  echo
+  echo "Date: $(date -u '+%Y-%m-%d %H:%M UTC'); repo $(git -C "$REPO" rev-parse --short HEAD)" \
+    "; machine: $(nproc) hardware threads; load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
+  echo
+  echo "| pair | ratio (median [min, max] over rounds) | target (issue 28) |"
+  echo "|---|---|---|"
+} >"$REPORT"
+
+# Mitsuba 3: median ratio rows of bench_vs_mitsuba.py's Markdown, one per (scene, pair).
+if python3 -c "import mitsuba" 2>/dev/null; then
+  mi_args=(--lt "$LT" --threads 2 --variants llvm_ad_rgb --out "$WORK/mitsuba.md" --work "$WORK/mi")
+  if [ "$QUICK" = 1 ]; then mi_args+=(--quick); else mi_args+=(--spp 64 --rounds 5); fi
+  python3 "$SCRIPTS/bench_vs_mitsuba.py" "${mi_args[@]}" >"$WORK/mitsuba.log" 2>&1 || {
+    echo "bench_peers.sh: bench_vs_mitsuba.py failed; its log:" >&2
+    tail -20 "$WORK/mitsuba.log" >&2
+    exit 1
+  }
+  # "### SCENE: Mitsuba VARIANT `peer` vs lt `ours`, …" then a table ending in the median row.
+  awk '
+    /^### / { split($0, a, "`"); scene = $2; sub(":", "", scene); pair = "lt `" a[4] "` / Mitsuba `" a[2] "` (" scene ")" }
+    /^\| \*\*median/ { n = split($0, c, "|"); r = c[10]; gsub(/^ +| +$/, "", r);
+      print "| " pair " | " r " | ≥ 1.0 |" }
+  ' "$WORK/mitsuba.md" >>"$REPORT"
+else
+  echo "| Mitsuba 3 | not run: \`import mitsuba\` fails (pip install mitsuba numpy) | |" >>"$REPORT"
+fi
+
+# SmallVCM: median over rounds of lt seconds / SmallVCM seconds, per algorithm.
+SMALLVCM=${SMALLVCM:-/work/peers/smallvcm/smallvcm}
+if [ -x "$SMALLVCM" ]; then
+  if [ "$QUICK" = 1 ]; then rounds=1; iters=1; else rounds=3; iters=8; fi
+  SMALLVCM="$SMALLVCM" "$SCRIPTS/vcm_vs_smallvcm.sh" "$rounds" "$iters" >"$WORK/smallvcm.txt"
+  cp "$WORK/smallvcm.txt" "$WORK/smallvcm.log"
+  for algo in vcm bdpt bpm; do
+    awk -v a="$algo" '$2 == a { print $5 }' "$WORK/smallvcm.txt" | sort -g | awk -v a="$algo" '
+      { v[NR] = $1 } END {
+        if (NR == 0) exit; m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2;
+        t = (a == "vcm") ? "≤ 0.7" : "—";
+        printf "| lt `%s` / SmallVCM time per iteration (its scene 1, its settings) | %.2f [%.2f, %.2f] | %s |\n", a, m, v[1], v[NR], t }' >>"$REPORT"
+  done
+else
+  echo "| SmallVCM | not run: no executable at \$SMALLVCM ($SMALLVCM) | ≤ 0.7 (vcm) |" >>"$REPORT"
+fi
+
+echo "| Tungsten (equal error) | not run by this script (see results/bench.md) | pt ≥ 1, bdpt ≥ 2, sppm ≤ 0.67 |" >>"$REPORT"
+{
+  echo
+  echo "Mitsuba ratios are spp/s of lt over spp/s of Mitsuba (> 1: lt faster); SmallVCM ratios are"
+  echo "seconds of lt over seconds of SmallVCM (< 1: lt faster). Full tables of every round follow."
+  if [ -f "$WORK/mitsuba.md" ]; then echo; echo "## Mitsuba 3, every round"; echo; cat "$WORK/mitsuba.md"; fi
+  if [ -f "$WORK/smallvcm.log" ]; then echo; echo "## SmallVCM, every round"; echo; echo '```'; cat "$WORK/smallvcm.log"; echo '```'; fi
+} >>"$REPORT"
+
+if [ -n "$OUT" ]; then
+  # Atomic: a reader never sees half a report.
+  cp "$REPORT" "$OUT.tmp.$$" && mv "$OUT.tmp.$$" "$OUT"
+fi
+sed -n '1,/^Mitsuba ratios/p' "$REPORT"
