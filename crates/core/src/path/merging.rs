@@ -12,7 +12,7 @@
 //! relative to a connection (one per camera sample) it counts N_VM times: the heuristics compare
 //! η · ∏ l · ∏ c with η = N_VM π r² (Georgiev et al.'s η_VCM) against n_s · p_s.
 
-use super::camis::Correlation;
+use super::correlation::Correlation;
 use super::densities::Densities;
 use super::mis::{oracle_weight, Heuristic};
 use super::path::Path;

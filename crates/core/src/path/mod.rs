@@ -37,6 +37,7 @@
 //!   letting s = 0, 1 and 2 estimate the same pixels of an analytic scene.
 
 pub mod camis;
+pub mod correlation;
 pub mod densities;
 pub mod merging;
 pub mod mis;
@@ -46,7 +47,7 @@ pub mod scatter;
 pub mod subpath_mis;
 pub mod vertex;
 
-pub use camis::Correlation;
+pub use correlation::Correlation;
 pub use densities::Densities;
 pub use merging::{Technique, TechniqueSet};
 pub use mis::{balance_weight, oracle_weight, power_weight, Chain, Heuristic};
