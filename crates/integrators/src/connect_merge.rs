@@ -480,6 +480,12 @@ impl<'a> Engine<'a> {
         let cam = &scene.camera;
         let scale = 1.0 / setup.light_paths as f32;
         let max_k = self.params.max_depth as usize;
+        // One value per light subpath, read by every correlation-aware t = 1 weight.
+        let nee = if setup.camis.is_some() {
+            light_nee(scene, y)
+        } else {
+            0.0
+        };
         splat_light_subpath(scene, y, max_k, scale, lens, splats, rec, |s, c| {
             let camera = c.camera;
             let yv = &y[s - 1];
@@ -487,7 +493,7 @@ impl<'a> Engine<'a> {
                 let split = Split {
                     light: &y[..s],
                     camera: std::slice::from_ref(&camera),
-                    light_nee: light_nee(scene, y),
+                    light_nee: nee,
                 };
                 let evals = EndEvals {
                     light_end: c.eval,
