@@ -59,18 +59,6 @@ pub struct Scale {
     pub folder_suffix: &'static str,
 }
 
-/// The committed convergence study's scenes (see `Scale::named("committed")`): the plain box,
-/// the heavy-tailed caustic, Veach's plates, sun through a window, an environment, a directional
-/// light — cut from every shipped scene to what one session on 2 shared cores rendered
-/// (results/committed-scale.md).
-pub const COMMITTED_CONVERGENCE: [&str; 6] = [
-    "caustic-sds",
-    "cornell-box",
-    "cornell-directional",
-    "cornell-env",
-    "sun-room",
-    "veach-mis",
-];
 
 pub const ALL_ALPHAS: [f64; 6] = [0.3, 0.5, 2.0 / 3.0, 0.75, 0.9, 1.0];
 
@@ -167,16 +155,12 @@ impl Scale {
             // What the committed report shows for convergence and the galleries: slopes fitted
             // over 1 … 256 passes from 16 runs (the quick scale's 4 runs over 1 … 16 give
             // intervals several units wide), at 32 px, where a run costs little, on
-            // `COMMITTED_CONVERGENCE`; galleries at 256 px, where a reader sees the light paths,
+            // every shipped scene; galleries at 256 px, where a reader sees the light paths,
             // of every shipped scene every integrator renders (results/committed-scale.md states
             // the compute).
             "committed" => Ok(Scale {
                 name: "committed",
-                scenes: COMMITTED_CONVERGENCE
-                    .iter()
-                    .map(|n| scene(n))
-                    .filter(|p| p.is_file())
-                    .collect(),
+                scenes: all.clone(),
                 gallery_scenes: Some(all.clone()),
                 runs: 16,
                 max_passes: 256,
