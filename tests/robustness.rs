@@ -79,10 +79,11 @@ const BLACK: &[(&str, &str, Black, &str)] = &[
 
 /// Integrators that refuse a shipped scene, with the words their error must contain: what
 /// they cannot do is said at load, not rendered wrong.
-const REFUSES: [(&str, &str, &str); 3] = [
+const REFUSES: [(&str, &str, &str); 4] = [
     ("light", "point-plane", "orthographic"),
     ("vcm", "point-plane", "orthographic"),
     ("bpm", "point-plane", "orthographic"),
+    ("eamis", "point-plane", "orthographic"),
 ];
 
 fn black(integrator: &str, scene: &str) -> Option<(Black, &'static str)> {

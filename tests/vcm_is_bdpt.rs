@@ -45,6 +45,7 @@ fn params(
         connections: true,
         merging: false,
         correlation_aware: false,
+        vertex_connections: true,
     };
     (b, v)
 }

@@ -153,7 +153,7 @@ impl Bdpt {
                     light_end: c.eval,
                     camera_end: None,
                 };
-                mis_weight(scene, split, evals, h, ratio)
+                (mis_weight(scene, split, evals, h, ratio), None)
             });
         }
         let Some(pixel) = pixel else {

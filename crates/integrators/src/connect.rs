@@ -8,6 +8,7 @@ use crate::splat::Splats;
 use lt_core::bsdf::{BsdfEval, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::path::scatter::connectable;
+use lt_core::path::camis::Mixture;
 use lt_core::path::{PathVertex, VertexKind};
 use lt_core::sampling::Sampler;
 use lt_core::Scene;
@@ -98,7 +99,8 @@ pub fn connect_to_camera(
 
 /// Light tracing (t = 1) for one light subpath `y`: each connectable vertex y_{s−1}, s ≤ `max_k`,
 /// joined to the lens (its point drawn from `lens`) and splatted as value · w · `scale`, with
-/// w = `weight(s, &connection)` the caller's MIS weight and `scale` = 1 / light paths per pass.
+/// (w, mixture) = `weight(s, &connection)` the caller's MIS weight (and, from full-path
+/// weights, the effective densities it came from) and `scale` = 1 / light paths per pass.
 /// bdpt, lvc-bdpt and vcm/bpm share this loop and differ only in how they weight.
 #[allow(clippy::too_many_arguments)]
 pub fn splat_light_subpath<R: Recorder>(
@@ -109,7 +111,7 @@ pub fn splat_light_subpath<R: Recorder>(
     lens: &mut Sampler,
     splats: &mut Splats,
     rec: &mut R,
-    mut weight: impl FnMut(usize, &CameraConnection) -> f64,
+    mut weight: impl FnMut(usize, &CameraConnection) -> (f64, Option<Mixture>),
 ) {
     for s in 1..=y.len().min(max_k) {
         'attempt: {
@@ -120,8 +122,11 @@ pub fn splat_light_subpath<R: Recorder>(
             let Some(c) = connect_to_camera(scene, yv, lens) else {
                 break 'attempt;
             };
-            let w = weight(s, &c);
+            let (w, mixture) = weight(s, &c);
             if R::ACTIVE {
+                if let Some(m) = mixture {
+                    rec.mixture(m);
+                }
                 rec.completed(Completed {
                     s,
                     light: &y[..s],

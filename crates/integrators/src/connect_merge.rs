@@ -35,6 +35,8 @@ use lt_core::path::{
     camis, CameraMis, Chain, Correlation, Heuristic, LightMis, PathVertex, SubpathMis, Technique,
     TechniqueSet, VertexKind,
 };
+use lt_core::path::camis::{Mixture, Weighed};
+use std::sync::Arc;
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::spatial::PointGrid;
 use lt_core::Scene;
@@ -57,6 +59,9 @@ pub struct VcmParams {
     /// Correlation-aware MIS for merging (`lt_core::path::camis`): every weight from the full
     /// path's densities instead of the per-vertex recursion. Off by default.
     pub correlation_aware: bool,
+    /// Vertex connections s ≥ 2, t ≥ 2 (with `connections`); off keeps next-event estimation
+    /// and light tracing. Off needs full-path weights (`SubpathMis` counts every connection).
+    pub vertex_connections: bool,
 }
 
 /// SmallVCM's radius reduction.
@@ -122,7 +127,19 @@ impl VcmParams {
             connections: techniques.connections,
             merging: techniques.merging,
             correlation_aware: r.get::<bool>("correlation_aware")?.unwrap_or(false),
+            // bpm has no connections to turn off.
+            vertex_connections: if techniques.connections {
+                r.get::<bool>("vertex_connections")?.unwrap_or(true)
+            } else {
+                true
+            },
         })
+    }
+
+    /// Whether weights come from the full path's densities (`camis::weigh`) rather than the
+    /// per-vertex recursion: the recursion counts every connection and one η for every pixel.
+    pub fn full_path_weights(&self) -> bool {
+        self.correlation_aware || (self.connections && !self.vertex_connections)
     }
 
     pub fn light_path_count(&self, scene: &Scene) -> u64 {
@@ -244,39 +261,79 @@ pub struct PassSetup {
     /// 1 / (M π r²): the density-estimation normalisation of one merge.
     merge_norm: f32,
     light_paths: u64,
-    /// With correlation-aware MIS: the techniques and sample counts its weights read.
-    camis: Option<CamisSetup>,
+    /// With full-path weights: the techniques and sample counts they read.
+    camis: Option<FullPathSetup>,
 }
 
-/// What correlation-aware weights (`camis::weight`) read besides a path's densities.
-#[derive(Clone, Copy, Debug)]
-struct CamisSetup {
+/// Which pixels merge (row-major, one flag per pixel): merging's count η is that of the pixel the
+/// path lands in, 0 where the flag is off (efficiency-aware MIS's per-pixel choice).
+pub type MergeMask = Arc<[bool]>;
+
+/// What full-path weights (`camis::weigh`) read besides a path's densities.
+#[derive(Clone, Debug)]
+struct FullPathSetup {
     set: TechniqueSet,
     heuristic: Heuristic,
     /// M, light subpaths per pass (N_VM).
     light_paths: f64,
     /// M/N.
     ratio: f64,
+    /// Merging at x_i counted η ρ_i (correlation-aware) instead of η.
+    correlation: bool,
+    merge_mask: Option<MergeMask>,
+    width: u32,
+    height: u32,
 }
 
-impl CamisSetup {
-    /// The weight of `technique` on `chain`, whose primary hit lies `distance` from the camera.
-    fn weight(&self, chain: &Chain, technique: Technique, distance: f32) -> f64 {
-        let corr = Correlation::new(self.light_paths, distance as f64);
-        camis::weight(chain, self.set, &corr, technique, self.heuristic)
+impl FullPathSetup {
+    /// Whether merging runs for paths landing at `raster`.
+    fn merges_at(&self, raster: Vec2) -> bool {
+        match &self.merge_mask {
+            None => true,
+            Some(mask) => mask[pixel_of(raster, self.width, self.height)],
+        }
+    }
+
+    /// The weight of `technique` on `chain`, whose primary hit lies `distance` from the camera
+    /// and which lands at `raster`.
+    fn weigh(&self, chain: &Chain, technique: Technique, distance: f32, raster: Vec2) -> Weighed {
+        let corr = self
+            .correlation
+            .then(|| Correlation::new(self.light_paths, distance as f64));
+        let mut set = self.set;
+        if !self.merges_at(raster) {
+            set.merging_eta = 0.0;
+        }
+        camis::weigh(chain, set, corr.as_ref(), technique, self.heuristic)
     }
 
     /// The weight of connection technique (s, t) formed by `split` (`strategy_weight`).
-    fn connection(&self, scene: &Scene, split: Split, evals: EndEvals, distance: f32) -> f64 {
+    fn connection(
+        &self,
+        scene: &Scene,
+        split: Split,
+        evals: EndEvals,
+        distance: f32,
+        raster: Vec2,
+    ) -> Weighed {
         with_chain(scene, split, evals, self.ratio, |chain, s| {
-            self.weight(chain, Technique::Connect(s), distance)
+            self.weigh(chain, Technique::Connect(s), distance, raster)
         })
     }
 }
 
+/// The pixel (row-major) holding raster point `raster`, clamped to the film.
+pub fn pixel_of(raster: Vec2, width: u32, height: u32) -> usize {
+    let x = (raster.x.max(0.0) as u32).min(width - 1);
+    let y = (raster.y.max(0.0) as u32).min(height - 1);
+    (y * width + x) as usize
+}
+
 pub struct Engine<'a> {
-    pub params: &'a VcmParams,
+    pub params: VcmParams,
     pub scene: &'a Scene,
+    /// Per-pixel merging (`MergeMask`); every pixel merges without one.
+    pub merge_mask: Option<MergeMask>,
 }
 
 /// Per-thread buffers of one camera sample.
@@ -287,8 +344,12 @@ pub struct Scratch {
 }
 
 impl<'a> Engine<'a> {
-    pub fn new(params: &'a VcmParams, scene: &'a Scene) -> Engine<'a> {
-        Engine { params, scene }
+    pub fn new(params: &VcmParams, scene: &'a Scene) -> Engine<'a> {
+        Engine {
+            params: *params,
+            scene,
+            merge_mask: None,
+        }
     }
 
     pub fn setup(&self, r0: f32, pass: u32) -> PassSetup {
@@ -302,20 +363,25 @@ impl<'a> Engine<'a> {
             0.0
         };
         let set = TechniqueSet {
-            connections: p.connections,
-            merging_eta: eta,
+            vertex_connections: p.connections && p.vertex_connections,
+            ..TechniqueSet::new(p.connections, eta)
         };
+        let cam = &self.scene.camera;
         PassSetup {
             mis: SubpathMis::new(p.mis, set, m as f64 / n),
             radius,
             eta,
             merge_norm: (1.0 / eta) as f32,
             light_paths: m,
-            camis: p.correlation_aware.then_some(CamisSetup {
+            camis: (p.full_path_weights() || self.merge_mask.is_some()).then(|| FullPathSetup {
                 set,
                 heuristic: p.mis,
                 light_paths: m as f64,
                 ratio: m as f64 / n,
+                correlation: p.correlation_aware,
+                merge_mask: self.merge_mask.clone(),
+                width: cam.width,
+                height: cam.height,
             }),
         }
     }
@@ -499,16 +565,19 @@ impl<'a> Engine<'a> {
                     light_end: c.eval,
                     camera_end: None,
                 };
-                return camis.connection(scene, split, evals, (camera.p - yv.p).length());
+                let distance = (camera.p - yv.p).length();
+                let wd = camis.connection(scene, split, evals, distance, c.raster);
+                return (wd.weight, Some(wd.mixture));
             }
             let c_y = reverse_density(yv, &camera, cam.pdf_dir(camera.p, camera.dir_to(yv))) as f64;
-            if s == 1 {
+            let w = if s == 1 {
                 setup.mis.light_tracing_origin(&ly[0], c_y)
             } else {
                 let ev = c.eval.expect("a surface connected to the camera");
                 let c_prev = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
                 setup.mis.light_tracing(&ly[s - 1], c_y, c_prev)
-            }
+            };
+            (w, None)
         });
     }
 
@@ -547,6 +616,7 @@ impl<'a> Engine<'a> {
         worker.rec.lap(Work::CameraWalk);
         let zr = &scratch.records;
         let cam = CameraWalk { z, zr };
+        let merges_here = setup.camis.as_ref().is_none_or(|c| c.merges_at(raster));
         let mut ctx = CameraSample {
             mis,
             camis: setup.camis.as_ref(),
@@ -566,7 +636,7 @@ impl<'a> Engine<'a> {
                 if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter()) {
                     let le = scene.lights[li as usize].emitted(x0.ng, x0.wo, x0.uv);
                     if le != Color::ZERO {
-                        let wgt = self.emitter_weight(
+                        let (wgt, mixture) = self.emitter_weight(
                             (mis, &ctx),
                             &z[..t - 1],
                             zr,
@@ -581,7 +651,7 @@ impl<'a> Engine<'a> {
                                 x0,
                                 value,
                             };
-                            record_emitter(reached, wgt, &mut scratch.prefix, &mut ctx);
+                            record_emitter(reached, (wgt, mixture), &mut scratch.prefix, &mut ctx);
                         }
                         l += value * wgt as f32;
                     }
@@ -596,7 +666,12 @@ impl<'a> Engine<'a> {
                     l += self.next_event_weighted(cam, t, &mut cs, &mut ctx);
                     ctx.rec.lap(Work::Connection { s: 1, t: t as u16 });
                 }
-                for s in 2..=light.0.len().min(max_k + 1 - t) {
+                let joins = if self.params.vertex_connections {
+                    light.0.len().min(max_k + 1 - t)
+                } else {
+                    1
+                };
+                for s in 2..=joins {
                     l += self.connect(light, cam, (s, t), &mut ctx);
                     ctx.rec.lap(Work::Connection {
                         s: s as u16,
@@ -604,7 +679,7 @@ impl<'a> Engine<'a> {
                     });
                 }
             }
-            if self.params.merging && t <= max_k {
+            if self.params.merging && t <= max_k && merges_here {
                 l += self.merge(setup, lights, cam, t, &mut ctx);
                 ctx.rec.lap(Work::Merge { t: t as u16 });
             }
@@ -618,7 +693,7 @@ impl<'a> Engine<'a> {
                         continue;
                     }
                     let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
-                    let wgt = self.emitter_weight(
+                    let (wgt, mixture) = self.emitter_weight(
                         (mis, &ctx),
                         z,
                         zr,
@@ -633,7 +708,7 @@ impl<'a> Engine<'a> {
                             x0,
                             value,
                         };
-                        record_emitter(reached, wgt, &mut scratch.prefix, &mut ctx);
+                        record_emitter(reached, (wgt, mixture), &mut scratch.prefix, &mut ctx);
                     }
                     l += value * wgt as f32;
                 }
@@ -656,7 +731,7 @@ impl<'a> Engine<'a> {
         x0: &PathVertex,
         c0: f32,
         prefix: &mut Vec<PathVertex>,
-    ) -> f64 {
+    ) -> (f64, Option<Mixture>) {
         let scene = self.scene;
         let x1 = camera.last().expect("the pinhole");
         if let Some(camis) = ctx.camis {
@@ -676,17 +751,19 @@ impl<'a> Engine<'a> {
                 camera: prefix,
                 light_nee: 0.0,
             };
-            return camis.connection(scene, split, EndEvals::default(), primary);
+            let wd = camis.connection(scene, split, EndEvals::default(), primary, ctx.raster);
+            return (wd.weight, Some(wd.mixture));
         }
         if camera.len() == 1 {
             let (l0, _) = emission_densities(scene, x0, None);
-            return mis.emitter_seen(c0 as f64, l0, joinable(scene, x0, x1));
+            return (mis.emitter_seen(c0 as f64, l0, joinable(scene, x0, x1)), None);
         }
         // VC(1) is next-event estimation from x1 (`Chain::valid`); x1 is inside this path.
         let vc1 = connectable_inside(scene, x1);
         let (l0, l1) = emission_densities(scene, x0, Some(x1));
         let nee = nee_density(scene, x0, x1);
-        mis.emitter_hit(&records[camera.len() - 1], c0 as f64, l0, l1, nee, vc1)
+        let w = mis.emitter_hit(&records[camera.len() - 1], c0 as f64, l0, l1, nee, vc1);
+        (w, None)
     }
 
     /// s = 1 at camera vertex z_{t−1}: one light chosen by power and sampled towards it (the
@@ -724,7 +801,7 @@ impl<'a> Engine<'a> {
             l1,
             l_z_prev: l2,
         };
-        let w = match ctx.camis {
+        let (w, mixture) = match ctx.camis {
             Some(camis) => {
                 let split = Split {
                     light: std::slice::from_ref(&x0),
@@ -735,11 +812,15 @@ impl<'a> Engine<'a> {
                     light_end: None,
                     camera_end: Some(ev_z),
                 };
-                camis.connection(scene, split, evals, ctx.primary)
+                let wd = camis.connection(scene, split, evals, ctx.primary, ctx.raster);
+                (wd.weight, Some(wd.mixture))
             }
-            None => ctx.mis.next_event((&zr[t - 1], &zr[t - 2]), d),
+            None => (ctx.mis.next_event((&zr[t - 1], &zr[t - 2]), d), None),
         };
         if R::ACTIVE {
+            if let Some(m) = mixture {
+                ctx.rec.mixture(m);
+            }
             ctx.rec.completed(Completed {
                 s: 1,
                 light: std::slice::from_ref(&x0),
@@ -789,7 +870,7 @@ impl<'a> Engine<'a> {
             l_z,
             l_z_prev,
         };
-        let w = match ctx.camis {
+        let (w, mixture) = match ctx.camis {
             Some(camis) => {
                 let split = Split {
                     light: &y[..s],
@@ -800,11 +881,15 @@ impl<'a> Engine<'a> {
                     light_end: Some(ev_y),
                     camera_end: Some(ev_z),
                 };
-                camis.connection(scene, split, evals, ctx.primary)
+                let wd = camis.connection(scene, split, evals, ctx.primary, ctx.raster);
+                (wd.weight, Some(wd.mixture))
             }
-            None => ctx.mis.connection(&ly[s - 1], (&zr[t - 1], &zr[t - 2]), d),
+            None => (ctx.mis.connection(&ly[s - 1], (&zr[t - 1], &zr[t - 2]), d), None),
         };
         if R::ACTIVE {
+            if let Some(m) = mixture {
+                ctx.rec.mixture(m);
+            }
             ctx.rec.completed(Completed {
                 s,
                 light: &y[..s],
@@ -873,18 +958,25 @@ impl<'a> Engine<'a> {
             } else {
                 0.0
             };
-            let w = match &setup.camis {
+            let (w, mixture) = match &setup.camis {
                 Some(camis) => {
                     let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
                     let ys = &lights.chunks[y.chunk as usize].vertices[first..=vi];
                     let merge = MergeDensities { c_y_prev, l_z_prev };
-                    merge_weight(scene, camis, (ys, &z[..t]), merge, ctx.primary)
+                    let wd = merge_weight(scene, camis, (ys, &z[..t]), merge, ctx);
+                    (wd.weight, Some(wd.mixture))
                 }
-                None => setup
-                    .mis
-                    .merge(&y.mis, &zr[t - 1], &zr[t - 2], c_y_prev, l_z_prev),
+                None => (
+                    setup
+                        .mis
+                        .merge(&y.mis, &zr[t - 1], &zr[t - 2], c_y_prev, l_z_prev),
+                    None,
+                ),
             };
             if R::ACTIVE {
+                if let Some(m) = mixture {
+                    ctx.rec.mixture(m);
+                }
                 let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
                 ctx.rec.merged(Merged {
                     i: y.segments as usize,
@@ -906,11 +998,14 @@ impl<'a> Engine<'a> {
 /// light endpoint into `prefix`.
 fn record_emitter<R: Recorder>(
     reached: Reached,
-    weight: f64,
+    (weight, mixture): (f64, Option<Mixture>),
     prefix: &mut Vec<PathVertex>,
     ctx: &mut CameraSample<'_, R>,
 ) {
     let Reached { camera, x0, value } = reached;
+    if let Some(m) = mixture {
+        ctx.rec.mixture(m);
+    }
     prefix.clear();
     prefix.extend_from_slice(camera);
     prefix.push(x0);
@@ -946,8 +1041,8 @@ struct CameraWalk<'a> {
 /// and the recorder.
 struct CameraSample<'a, R> {
     mis: &'a SubpathMis,
-    /// Correlation-aware MIS, when on.
-    camis: Option<&'a CamisSetup>,
+    /// Full-path weights, when on.
+    camis: Option<&'a FullPathSetup>,
     /// |z_1 − z_0|: the primary hit's distance (the footprint of correlation-aware MIS).
     primary: f32,
     raster: Vec2,
@@ -976,17 +1071,17 @@ struct MergeDensities {
 /// Longest merged path (segments, + 1) whose densities `merge_weight` keeps on the stack.
 const MERGE_STACK: usize = 24;
 
-/// The correlation-aware weight of merging light vertex y_i (`y` = y_0 … y_i) at z_{t−1} (`z` =
+/// The full-path weight of merging light vertex y_i (`y` = y_0 … y_i) at z_{t−1} (`z` =
 /// z_0 … z_{t−1}): the full path's densities from the walks' stored ones, as
 /// `Densities::merged` defines them from scratch — the light side l_0 … l_i, c_0 … c_{i−2} from
 /// the light walk, c_i … c_k and l_{i+2} … from the camera walk, c_{i−1} and l_{i+1} the merge's.
-fn merge_weight(
+fn merge_weight<R>(
     scene: &Scene,
-    camis: &CamisSetup,
+    camis: &FullPathSetup,
     (y, z): (&[PathVertex], &[PathVertex]),
     m: MergeDensities,
-    primary: f32,
-) -> f64 {
+    ctx: &CameraSample<'_, R>,
+) -> Weighed {
     let i = y.len() - 1;
     let t = z.len();
     let k = i + t - 1;
@@ -1040,7 +1135,7 @@ fn merge_weight(
         connectable: conn,
         light_tracing_ratio: camis.ratio,
     };
-    camis.weight(&chain, Technique::Merge(i), primary)
+    camis.weigh(&chain, Technique::Merge(i), ctx.primary, ctx.raster)
 }
 
 /// The MIS records of a light subpath y_0 … (see `SubpathMis`), appended to `out`.
@@ -1121,7 +1216,7 @@ pub struct Run<'a> {
 }
 
 impl<'a> Run<'a> {
-    pub fn new(params: &'a VcmParams, scene: &'a Scene, seed: u64) -> Run<'a> {
+    pub fn new(params: &VcmParams, scene: &'a Scene, seed: u64) -> Run<'a> {
         let cam = &scene.camera;
         Run {
             engine: Engine::new(params, scene),
@@ -1136,6 +1231,66 @@ impl<'a> Run<'a> {
 }
 
 impl Run<'_> {
+    /// Merging only where `mask` is on (efficiency-aware MIS's per-pixel choice); every weight
+    /// then comes from the full path's densities.
+    pub fn with_merge_mask(mut self, mask: MergeMask) -> Self {
+        self.engine.merge_mask = Some(mask);
+        self
+    }
+
+    /// `pass` run on one thread, item after item, every path reported to `rec` (efficiency-aware
+    /// MIS's pilot): one chunk, so what `rec` sums does not depend on the thread count.
+    pub fn recorded_pass<R: Recorder + Send>(&mut self, pass: u32, rec: &mut R) -> u64 {
+        let setup = self.engine.setup(self.r0, pass);
+        self.engine
+            .trace_light_paths_into(&setup, self.seed, pass, &mut self.lights);
+        let engine = &self.engine;
+        let lights = &self.lights;
+        let seed = self.seed;
+        let cam = &engine.scene.camera;
+        let items = (cam.pixel_count() as u64).max(setup.light_paths);
+        let rec = std::sync::Mutex::new(rec);
+        let (img, invalid) = splat_pass_with(
+            cam.width as usize,
+            cam.height as usize,
+            items,
+            items,
+            || engine.scratch(),
+            |i, splats, scratch| {
+                let mut rec = rec.lock().unwrap_or_else(|e| e.into_inner());
+                let inputs = PassInputs {
+                    setup: &setup,
+                    lights,
+                    pass: Pass { seed, pass },
+                };
+                let mut worker = Worker {
+                    splats,
+                    scratch,
+                    rec: &mut **rec,
+                };
+                engine.item(&inputs, i, &mut worker)
+            },
+        );
+        for (a, b) in self.sum.data.iter_mut().zip(&img.data) {
+            for c in 0..3 {
+                a[c] += b[c];
+            }
+        }
+        self.passes += 1;
+        log_pass(&mut self.log, &setup, self.r0);
+        invalid
+    }
+
+    /// Light vertices stored for merging in the last pass (the light walk's cost, counted).
+    pub fn stored_light_vertices(&self) -> usize {
+        self.lights.merge_candidates()
+    }
+
+    /// Passes done and their summed images (the estimate is the sum over the passes).
+    pub fn sum(&self) -> (&Image, u32) {
+        (&self.sum, self.passes)
+    }
+
     /// `pass` with every technique's contributions and time tallied (`crate::tally`): the same
     /// state and estimate, bit for bit. The light subpaths, their MIS records and the merge grid
     /// are one phase (`Work::LightWalk`).

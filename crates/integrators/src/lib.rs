@@ -6,6 +6,7 @@ pub mod bpm;
 pub mod connect;
 pub mod connect_merge;
 pub mod cpu_clock;
+pub mod eamis;
 pub mod light;
 pub mod lvc_bdpt;
 pub mod params;

@@ -302,7 +302,7 @@ impl LvcBdpt {
                 light_end: c.eval,
                 camera_end: None,
             };
-            mis.weight(scene, split, evals)
+            (mis.weight(scene, split, evals), None)
         });
     }
 

@@ -3,6 +3,7 @@
 //! which compiles to nothing.
 
 use lt_core::math::{Color, Vec2};
+use lt_core::path::camis::Mixture;
 use lt_core::path::PathVertex;
 
 /// A camera walk (camera first) that reached light endpoint `x0` — an emitter it hit, or a light
@@ -77,6 +78,10 @@ pub trait Recorder {
     fn completed(&mut self, path: Completed);
     /// A path made by merging; recorders of connection-only integrators ignore it.
     fn merged(&mut self, _path: Merged) {}
+    /// The effective densities of every technique of the path reported next (`completed` or
+    /// `merged`), where its weight was computed from the full path (`lt_core::path::camis`).
+    #[inline]
+    fn mixture(&mut self, _m: Mixture) {}
     /// Work item `item` starts (`crate::tally` decides here whether it times this item).
     #[inline]
     fn begin_item(&mut self, _item: u64) {}

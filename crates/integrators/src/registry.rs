@@ -11,6 +11,7 @@ use crate::ppm::Ppm;
 use crate::pt::{Pt, PtParams};
 use crate::pt_bsdf::{PtBsdf, PtBsdfParams};
 use crate::sppm::Sppm;
+use crate::eamis::Eamis;
 use crate::vcm::Vcm;
 use crate::{Estimator, Kind};
 use lt_core::Scene;
@@ -84,6 +85,9 @@ pub enum Weights {
     ConnectMerge { connections: bool },
     /// lvc-bdpt's: bdpt's techniques, connections counted N / L̄ times (`lvc_bdpt`).
     VertexCache,
+    /// eamis's: vcm's full-path weights with the counts its pilot chose (`eamis`); `lt mis-check`
+    /// holds those weights through vcm with the same counts (`vertex_connections`).
+    EfficiencyAware,
 }
 
 pub const INTEGRATORS: &[IntegratorInfo] = &[
@@ -199,6 +203,16 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         source: include_str!("vcm.rs"),
         radius: Radius::Power,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Vcm::read(s, r)?))),
+    },
+    IntegratorInfo {
+        name: "eamis",
+        about: "efficiency-aware MIS over vcm's techniques: a pilot chooses light paths, \
+                vertex connections and per-pixel merging",
+        kind: Kind::Consistent,
+        weights: Weights::EfficiencyAware,
+        source: include_str!("eamis.rs"),
+        radius: Radius::Power,
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Eamis::read(s, r)?))),
     },
 ];
 

@@ -18,6 +18,7 @@
 //! | `alpha` | f64 | 0.75 | radius reduction α: rᵢ = r₀ i^((α−1)/2) |
 //! | `correlation_aware` | true/false | false | correlation-aware MIS for merging (Grittmann et al. 2021, `lt_core::path::camis`): merging at x_i counts η ρ_i; weights from the full path's densities (slower) |
 //! | `merging` | true/false | true | false: connections only (BDPT) |
+//! | `vertex_connections` | true/false | true | false: no connections s ≥ 2, t ≥ 2 (next-event estimation and light tracing stay); weights from the full path's densities |
 
 use crate::connect_merge::{Run, Techniques, VcmParams};
 use crate::params::ParamReader;

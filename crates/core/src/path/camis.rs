@@ -30,17 +30,62 @@ use super::mis::{Chain, Heuristic};
 /// Paths up to this many vertices (k ≤ 24) weigh without allocating.
 const STACK: usize = 26;
 
-/// The weight of `technique` under `h` over every technique of `set` with correlation-aware
-/// merging counts, from the full path's per-vertex densities in `chain`: O(k) through prefix
-/// products ∏_{j<s} l_j and suffix products ∏_{j≥s} c_j (what the integrators run; the oracle is
-/// `Densities::vcm_weight_with`).
+/// The effective densities n_u·p_u of one path's techniques, summed by how their sample counts
+/// scale with a configuration's choices (efficiency-aware MIS, `path::efficiency`): what is
+/// fixed per camera sample, what scales with the light subpath count M, what a vertex
+/// connection adds, what merging adds. Their sum is the balance heuristic's denominator.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Mixture {
+    /// n·p of the technique that made the path.
+    pub own: f64,
+    /// s = 0 (the camera walk reached the light) and s = 1 (next-event estimation): once per
+    /// camera sample whatever the configuration.
+    pub fixed: f64,
+    /// s = k, light tracing: M/N per camera sample.
+    pub light_tracing: f64,
+    /// s = 2 … k−1, vertex connections: once per camera sample when on.
+    pub vertex_connections: f64,
+    /// Merging at every x_i: η ρ_i each, η = M π r².
+    pub merges: f64,
+}
+
+impl Mixture {
+    /// Σ_u n_u p_u.
+    pub fn total(&self) -> f64 {
+        self.fixed + self.light_tracing + self.vertex_connections + self.merges
+    }
+}
+
+/// A technique's weight and the effective densities it was computed from.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Weighed {
+    pub weight: f64,
+    pub mixture: Mixture,
+}
+
+/// The weight of `technique` under `h` over every technique of `set` from the full path's
+/// per-vertex densities in `chain`, merging at x_i counted η ρ_i times with `corr`
+/// (correlation-aware) and η times without: O(k) through prefix products ∏_{j<s} l_j and suffix
+/// products ∏_{j≥s} c_j (what the integrators run; the oracle is `Densities::vcm_weight_with`).
 pub fn weight(
     chain: &Chain,
     set: TechniqueSet,
-    corr: &Correlation,
+    corr: Option<&Correlation>,
     technique: Technique,
     h: Heuristic,
 ) -> f64 {
+    weigh(chain, set, corr, technique, h).weight
+}
+
+/// [`weight`] with the effective densities grouped as [`Mixture`] (balance-heuristic sums,
+/// whatever `h`).
+pub fn weigh(
+    chain: &Chain,
+    set: TechniqueSet,
+    corr: Option<&Correlation>,
+    technique: Technique,
+    h: Heuristic,
+) -> Weighed {
     let k = chain.k();
     let (mut la, mut ca, mut pa) = ([0.0f64; STACK], [0.0f64; STACK], [0.0f64; STACK]);
     let (mut lv, mut cv, mut pv) = (Vec::new(), Vec::new(), Vec::new());
@@ -63,7 +108,11 @@ pub fn weight(
     }
     // Connection techniques s = 0 … k+1 at p[s], merges i = 0 … k at p[k + 2 + i].
     for s in 0..=k + 1 {
-        p[s] = if !chain.valid(s) || (s >= 1 && !set.connections) {
+        let vertex_connection = s >= 2 && s < k;
+        p[s] = if !chain.valid(s)
+            || (s >= 1 && !set.connections)
+            || (vertex_connection && !set.vertex_connections)
+        {
             0.0
         } else {
             let prefix = if s == 1 && chain.one_is_nee() {
@@ -78,7 +127,7 @@ pub fn weight(
     // P_c,i as a running suffix product from x_{k−1} down, P_l,i as a prefix product.
     let mut p_camera = 1.0;
     let mut p_light_below = 1.0;
-    let a = corr.footprint;
+    let a = corr.map_or(0.0, |c| c.footprint);
     let mut p_light = [0.0f64; STACK];
     let mut p_light_v = Vec::new();
     let pl: &mut [f64] = if k < STACK {
@@ -95,10 +144,9 @@ pub fn weight(
     p[2 * k + 2] = 0.0;
     for i in (1..k).rev() {
         p_camera *= (a * chain.camera[i]).min(1.0);
-        let rho = if i + 1 == k {
-            1.0
-        } else {
-            corr.ratio(p_camera, pl[i])
+        let rho = match corr {
+            Some(corr) if i + 1 < k => corr.ratio(p_camera, pl[i]),
+            _ => 1.0,
         };
         p[k + 2 + i] = if eta > 0.0 && chain.connectable[i] {
             eta * rho * lpre[i + 1] * csuf[i]
@@ -111,7 +159,7 @@ pub fn weight(
         Technique::Merge(i) => p[k + 2 + i],
     };
     if own.is_nan() || own <= 0.0 {
-        return 0.0;
+        return Weighed::default();
     }
     let all = &p[..2 * k + 3];
     let sum: f64 = match h {
@@ -120,9 +168,16 @@ pub fn weight(
         Heuristic::Uniform => all.iter().filter(|&&x| x > 0.0).count() as f64,
     };
     let w = 1.0 / sum;
-    if w.is_finite() {
-        w
-    } else {
-        0.0
+    let fixed = p[0] + if k >= 2 { p[1] } else { 0.0 } + p[k + 1];
+    let mixture = Mixture {
+        own,
+        fixed,
+        light_tracing: p[k],
+        vertex_connections: if k >= 3 { p[2..k].iter().sum() } else { 0.0 },
+        merges: p[k + 2..2 * k + 3].iter().sum(),
+    };
+    Weighed {
+        weight: if w.is_finite() { w } else { 0.0 },
+        mixture,
     }
 }

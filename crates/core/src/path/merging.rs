@@ -29,6 +29,22 @@ pub struct TechniqueSet {
     pub connections: bool,
     /// η = N_VM π r² of merging; 0 turns merging off.
     pub merging_eta: f64,
+    /// Vertex connections s ≥ 2, t ≥ 2 (a light subpath vertex joined to a camera subpath
+    /// vertex by a shadow ray), when `connections` is on. Off keeps next-event estimation and
+    /// light tracing: one of the choices efficiency-aware MIS makes. Only the full-path weights
+    /// (`path::camis`) and the oracle read it; `SubpathMis` assumes it equals `connections`.
+    pub vertex_connections: bool,
+}
+
+impl TechniqueSet {
+    /// Connections (every s, t) and merging counted η times; vertex connections with the others.
+    pub fn new(connections: bool, merging_eta: f64) -> TechniqueSet {
+        TechniqueSet {
+            connections,
+            merging_eta,
+            vertex_connections: connections,
+        }
+    }
 }
 
 /// One technique of a path of the full VCM family.
@@ -106,8 +122,12 @@ impl Densities {
     /// techniques s = 0 … k+1 (zero for s ≥ 1 without connections), then η·p_VM,i for i = 0 … k.
     pub fn effective_vcm(&self, set: TechniqueSet) -> (Vec<f64>, Vec<f64>) {
         let mut vc = self.effective_all();
+        let k = self.k();
         if !set.connections {
             vc.iter_mut().skip(1).for_each(|p| *p = 0.0);
+        } else if !set.vertex_connections {
+            // s = 2 … k−1: both subpaths have an inner vertex at the joint.
+            vc.iter_mut().take(k).skip(2).for_each(|p| *p = 0.0);
         }
         let vm = (0..=self.k())
             .map(|i| set.merging_eta * self.merging(i))

@@ -39,6 +39,7 @@
 pub mod camis;
 pub mod correlation;
 pub mod densities;
+pub mod efficiency;
 pub mod merging;
 pub mod mis;
 #[allow(clippy::module_inception)]

@@ -44,6 +44,12 @@ pub struct MisCheckArgs {
     /// densities and vertex positions (see the module docs of verify::mis_check::tolerance).
     #[arg(long, default_value_t = DEFAULT_SLACK)]
     pub slack: f64,
+    /// vcm: without vertex connections s ≥ 2, t ≥ 2 (one of eamis's choices).
+    #[arg(long)]
+    pub no_vertex_connections: bool,
+    /// vcm, bpm: merging only in a checkerboard of pixels (eamis's per-pixel choice).
+    #[arg(long)]
+    pub checkerboard_merging: bool,
 }
 
 /// `lt mis-check`: the report, or an error carrying it when any check fails.
@@ -53,6 +59,14 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
         Weights::Connections => Which::Bdpt,
         Weights::VertexCache => Which::Lvc,
         Weights::ConnectMerge { connections } => return run_vcm_bpm(args, connections),
+        Weights::EfficiencyAware => {
+            return Err(format!(
+                "mis-check: {}'s weights are vcm's full-path weights with the counts its pilot \
+                 chose; check those counts through vcm: `lt mis-check --integrator vcm \
+                 --no-vertex-connections --checkerboard-merging`",
+                args.integrator
+            ))
+        }
         Weights::None => {
             let checked: Vec<&str> = registry::with_weights(|w| w != Weights::None).collect();
             return Err(format!(
@@ -130,6 +144,8 @@ fn run_vcm_bpm(args: &MisCheckArgs, connections: bool) -> Result<String, String>
     opts.resolution = args.resolution;
     opts.max_passes = args.max_passes;
     opts.slack = args.slack;
+    opts.vertex_connections = !args.no_vertex_connections;
+    opts.checkerboard_merging = args.checkerboard_merging;
     let name = args.scene.display().to_string();
     let report = vcm_bpm::check_scene(&mut scene, &opts, &name);
     let mut out = String::new();

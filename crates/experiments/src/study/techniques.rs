@@ -45,14 +45,39 @@ pub const TALLIED: [Config; 3] = [
     ("vcm", "vcm", &[]),
 ];
 
-/// The configurations of the inefficiency table.
-pub const COMPARED: [Config; 5] = [
+/// The configurations of the inefficiency table: bdpt, the light-vertex cache at several N, vcm
+/// with and without correlation-aware MIS, efficiency-aware MIS (`eamis`) and every fixed
+/// configuration its choice ranges over (rendered by `eamis fixed=…`: the same code without the
+/// pilot, so a gap between the choice and the best fixed one is the pilot's cost or a wrong
+/// choice).
+pub const COMPARED: &[Config] = &[
     ("bdpt", "bdpt", &[]),
     ("lvc-bdpt N=1", "lvc-bdpt", &[("connections", "1")]),
     ("lvc-bdpt N=4", "lvc-bdpt", &[("connections", "4")]),
     ("lvc-bdpt N=16", "lvc-bdpt", &[("connections", "16")]),
     ("vcm", "vcm", &[]),
+    ("vcm correlation-aware", "vcm", &[("correlation_aware", "true")]),
+    ("eamis", "eamis", &[]),
+    ("eamis fixed m0.25_vc1_merge", "eamis", &[("fixed", "m0.25_vc1_merge")]),
+    ("eamis fixed m0.25_vc1_nomerge", "eamis", &[("fixed", "m0.25_vc1_nomerge")]),
+    ("eamis fixed m0.25_vc0_merge", "eamis", &[("fixed", "m0.25_vc0_merge")]),
+    ("eamis fixed m0.25_vc0_nomerge", "eamis", &[("fixed", "m0.25_vc0_nomerge")]),
+    ("eamis fixed m0.5_vc1_merge", "eamis", &[("fixed", "m0.5_vc1_merge")]),
+    ("eamis fixed m0.5_vc1_nomerge", "eamis", &[("fixed", "m0.5_vc1_nomerge")]),
+    ("eamis fixed m0.5_vc0_merge", "eamis", &[("fixed", "m0.5_vc0_merge")]),
+    ("eamis fixed m0.5_vc0_nomerge", "eamis", &[("fixed", "m0.5_vc0_nomerge")]),
+    ("eamis fixed m1_vc1_merge", "eamis", &[("fixed", "m1_vc1_merge")]),
+    ("eamis fixed m1_vc1_nomerge", "eamis", &[("fixed", "m1_vc1_nomerge")]),
+    ("eamis fixed m1_vc0_merge", "eamis", &[("fixed", "m1_vc0_merge")]),
+    ("eamis fixed m1_vc0_nomerge", "eamis", &[("fixed", "m1_vc0_nomerge")]),
+    ("eamis fixed m2_vc1_merge", "eamis", &[("fixed", "m2_vc1_merge")]),
+    ("eamis fixed m2_vc1_nomerge", "eamis", &[("fixed", "m2_vc1_nomerge")]),
+    ("eamis fixed m2_vc0_merge", "eamis", &[("fixed", "m2_vc0_merge")]),
+    ("eamis fixed m2_vc0_nomerge", "eamis", &[("fixed", "m2_vc0_nomerge")]),
 ];
+
+/// The prefix of the fixed configurations' labels in `COMPARED`.
+const FIXED_PREFIX: &str = "eamis fixed ";
 
 /// How big the study is at a scale (the scale's own fields are read, never changed).
 #[derive(Clone, Debug)]
@@ -619,22 +644,39 @@ fn inefficiency(
 ) -> Result<(), String> {
     let conf = ctx.scale.confidence;
     let mut rows = Vec::new();
+    let mut efficiency_aware_rows = Vec::new();
     for scene in &plan.scenes {
         let reference = ctx.reference_at(&plan.scale, scene, None)?;
-        for (lab, integ, params) in COMPARED {
+        let mut by_label: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
+        let mut choices = Vec::new();
+        for &(lab, integ, params) in COMPARED {
             let (mut rel, mut secs, mut ineff, mut over) =
                 (Vec::new(), Vec::new(), Vec::new(), Vec::new());
             for seed in 1..=plan.runs as u64 {
-                let e = tally_entry(ctx, &spec(plan, scene, integ, params, seed))?;
-                *tally_cpu += e.plain_cpu + e.tallied_cpu;
-                bit_equal.1 += 1;
-                bit_equal.0 += e.bit_equal as usize;
-                let r = rel_mse(&read_exr(&e.dir.join("plain.exr"))?, &reference);
+                let run_spec = spec(plan, scene, integ, params, seed);
+                // eamis has no tallied twin: its plain render alone.
+                let (dir, plain_cpu) = if lt_integrators::tally_run::TALLIED.contains(&integ) {
+                    let e = tally_entry(ctx, &run_spec)?;
+                    *tally_cpu += e.plain_cpu + e.tallied_cpu;
+                    bit_equal.1 += 1;
+                    bit_equal.0 += e.bit_equal as usize;
+                    over.push(100.0 * (e.tallied_cpu / e.plain_cpu - 1.0));
+                    (e.dir, e.plain_cpu)
+                } else {
+                    let e = plain_entry(ctx, &run_spec)?;
+                    *tally_cpu += e.1;
+                    if lab == "eamis" {
+                        choices.push(e.2);
+                    }
+                    over.push(f64::NAN);
+                    (e.0, e.1)
+                };
+                let r = rel_mse(&read_exr(&dir.join("plain.exr"))?, &reference);
                 rel.push(r);
-                secs.push(e.plain_cpu);
-                ineff.push(r * e.plain_cpu);
-                over.push(100.0 * (e.tallied_cpu / e.plain_cpu - 1.0));
+                secs.push(plain_cpu);
+                ineff.push(r * plain_cpu);
             }
+            by_label.insert(lab, ineff.clone());
             rows.push(vec![
                 stem(scene),
                 lab.to_string(),
@@ -645,6 +687,12 @@ fn inefficiency(
                 iv(&over, conf).1,
             ]);
         }
+        efficiency_aware_rows.push(efficiency_aware_row(
+            &stem(scene),
+            &by_label,
+            &choices,
+            conf,
+        ));
     }
     out.table(
         "inefficiency",
@@ -667,7 +715,117 @@ fn inefficiency(
         ],
         rows,
         true,
+    )?;
+    out.table(
+        "efficiency-aware",
+        "Efficiency-aware MIS against the fixed configurations it chooses from",
+        &format!(
+            "Per scene: the configuration `eamis` chose in each run (M per pixel, vertex \
+             connections, share of pixels that merge; the same in every run unless listed), the \
+             best of its {} fixed configurations by mean relMSE × seconds (each rendered without \
+             a pilot, `eamis fixed=…`), and the ratio eamis / best fixed with an interval from \
+             the two Student-t intervals' ends (conservative). A ratio above 1 is the pilot's \
+             cost (one pass of {} on one thread, with moments and counts) or a wrong choice.",
+            COMPARED
+                .iter()
+                .filter(|c| c.0.starts_with(FIXED_PREFIX))
+                .count(),
+            plan.passes
+        ),
+        &[
+            "scene",
+            "eamis chose",
+            "eamis relMSE × s",
+            "best fixed",
+            "its relMSE × s",
+            "eamis / best fixed",
+        ],
+        efficiency_aware_rows,
+        true,
     )
+}
+
+/// One row of the efficiency-aware table from each configuration's per-run inefficiencies.
+fn efficiency_aware_row(
+    scene: &str,
+    by_label: &BTreeMap<&str, Vec<f64>>,
+    choices: &[String],
+    conf: f64,
+) -> Vec<String> {
+    let interval = |v: &[f64]| mean_of_runs(v, conf);
+    let best = by_label
+        .iter()
+        .filter(|(l, v)| l.starts_with(FIXED_PREFIX) && v.iter().all(|x| x.is_finite()))
+        .map(|(l, v)| (*l, interval(v)))
+        .min_by(|a, b| a.1.estimate.total_cmp(&b.1.estimate));
+    let mut chosen: Vec<&String> = choices.iter().collect();
+    chosen.dedup();
+    let chose = chosen
+        .iter()
+        .map(|s| s.as_str())
+        .collect::<Vec<_>>()
+        .join("; ");
+    let Some(e) = by_label.get("eamis").map(|v| interval(v)) else {
+        return vec![scene.into(), chose, "—".into(), "—".into(), "—".into(), "—".into()];
+    };
+    let show = |i: &lt_estimators::bias_variance::Interval| {
+        format!("{} [{}, {}]", num(i.estimate), num(i.lo), num(i.hi))
+    };
+    match best {
+        None => vec![scene.into(), chose, show(&e), "—".into(), "—".into(), "—".into()],
+        Some((label, b)) => {
+            let ratio = e.estimate / b.estimate;
+            let lo = e.lo / b.hi;
+            let hi = if b.lo > 0.0 { e.hi / b.lo } else { f64::INFINITY };
+            vec![
+                scene.into(),
+                chose,
+                show(&e),
+                label.trim_start_matches(FIXED_PREFIX).to_string(),
+                show(&b),
+                format!("{} [{}, {}]", num(ratio), num(lo), num(hi)),
+            ]
+        }
+    }
+}
+
+/// A plain render on one thread (an integrator `tally_run` does not take): its cache entry, CPU
+/// seconds, and the choice its record states (eamis: `eamis_*` facts).
+fn plain_entry(ctx: &Ctx, spec: &RunSpec) -> Result<(PathBuf, f64, String), String> {
+    let scene = spec.load_scene()?;
+    let mut material = spec.key_material(&scene)?;
+    material["what"] = json!("techniques-plain");
+    ctx.say(&format!("techniques (plain): {}", spec.label()));
+    let dir = ctx.runs.cache.get_or_build(&material, |tmp| {
+        let p = spec.integrator_params();
+        let est = lt_integrators::make_integrator(&spec.integrator, &scene, &p)?;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .map_err(|e| e.to_string())?;
+        let (img, cpu, facts) = pool.install(|| timed_plain_logged(&scene, &est, spec.seed, spec.passes));
+        write_exr(&tmp.join("plain.exr"), &img)?;
+        let text = serde_json::to_string_pretty(&json!({
+            "plain_cpu_seconds": cpu,
+            "facts": facts.into_iter().collect::<BTreeMap<_, _>>(),
+        }))
+        .map_err(|e| e.to_string())?;
+        write_atomic(&tmp.join("plain.json"), text.as_bytes())
+    })?;
+    let path = dir.join("plain.json");
+    let v: Value = serde_json::from_str(
+        &std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?,
+    )
+    .map_err(|e| format!("{}: {e}", path.display()))?;
+    let fact = |k: &str| v["facts"][k].as_str().unwrap_or("?").to_string();
+    let merging: f64 = fact("eamis_merging_pixels").parse().unwrap_or(f64::NAN);
+    let choice = format!(
+        "M {}×, vc {}, merge {:.0} %",
+        fact("eamis_light_ratio"),
+        if fact("eamis_vertex_connections") == "true" { "on" } else { "off" },
+        100.0 * merging
+    );
+    Ok((dir, v["plain_cpu_seconds"].as_f64().unwrap_or(f64::NAN), choice))
 }
 
 /// The `Work` a table label names (for ordering rows).
@@ -792,6 +950,30 @@ fn overhead(ctx: &Ctx, plan: &Plan, out: &mut StudyOutput) -> Result<(), String>
 
 /// The plain render `render` makes (its passes accumulated the same way, so the same bits), on
 /// the current pool, with the pool's CPU seconds.
+/// `timed_plain` with the run's recorded facts (a progressive run's log; none for unbiased ones).
+fn timed_plain_logged(
+    scene: &lt_core::Scene,
+    est: &lt_integrators::Estimator,
+    seed: u64,
+    passes: u32,
+) -> (lt_estimators::Image, f64, Vec<(String, String)>) {
+    let c0 = pool_cpu_seconds();
+    match est {
+        lt_integrators::Estimator::Unbiased(_) => {
+            let (img, cpu) = timed_plain(scene, est, seed, passes);
+            (img, cpu, Vec::new())
+        }
+        lt_integrators::Estimator::Consistent(p) => {
+            let mut run = p.start(scene, seed);
+            for pass in 0..passes {
+                run.pass(pass);
+            }
+            let img = run.estimate();
+            (img, pool_cpu_seconds() - c0, run.log().facts)
+        }
+    }
+}
+
 fn timed_plain(
     scene: &lt_core::Scene,
     est: &lt_integrators::Estimator,

@@ -63,14 +63,14 @@ fn recursive_weights_equal_the_oracle_on_random_chains() {
     for trial in 0..20_000 {
         let k = 1 + trial % 8;
         let d = random_densities(&mut rng, k);
-        let set = TechniqueSet {
-            connections: rng.gen_bool(0.8),
-            merging_eta: if rng.gen_bool(0.7) {
+        let set = TechniqueSet::new(
+            rng.gen_bool(0.8),
+            if rng.gen_bool(0.7) {
                 10f64.powf(rng.gen_range(-4.0..4.0))
             } else {
                 0.0
             },
-        };
+        );
         for h in [Heuristic::Power, Heuristic::Balance, Heuristic::Uniform] {
             let mis = SubpathMis::new(h, set, d.light_tracing_ratio);
             for t in d.vcm_techniques(set) {
@@ -93,10 +93,7 @@ fn recursive_weights_equal_the_oracle_on_random_chains() {
 #[test]
 fn without_merging_the_recursion_is_bdpts_chain() {
     let mut rng = Pcg64::seed_from_u64(13);
-    let set = TechniqueSet {
-        connections: true,
-        merging_eta: 0.0,
-    };
+    let set = TechniqueSet::new(true, 0.0);
     for trial in 0..5_000 {
         let d = random_densities(&mut rng, 1 + trial % 8);
         let chain = d.chain();

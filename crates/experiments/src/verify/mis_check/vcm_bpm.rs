@@ -22,7 +22,9 @@ use lt_core::path::{
     camis, Correlation, Densities, Heuristic, Path, PathVertex, SubpathMis, Technique, TechniqueSet,
 };
 use lt_core::Scene;
-use lt_integrators::connect_merge::{initial_radius, Engine, PassInputs, VcmParams};
+use lt_integrators::connect_merge::{
+    initial_radius, pixel_of, Engine, MergeMask, PassInputs, VcmParams,
+};
 use lt_integrators::radius::InitialRadius;
 use lt_integrators::record::{Completed, Merged, Recorder};
 use lt_integrators::registry::{self, Weights};
@@ -51,6 +53,12 @@ pub struct VcmOptions {
     /// the oracle's weights with ρ_i; the sum and replay then run `camis::weight` (the
     /// integrator's full-path routine) on the oracle's densities.
     pub correlation_aware: bool,
+    /// Vertex connections s ≥ 2, t ≥ 2 (vcm's option; off is one of eamis's choices): off, the
+    /// oracle drops those techniques and the replay runs the full-path routine.
+    pub vertex_connections: bool,
+    /// Merging only in the pixels of a checkerboard (eamis's per-pixel choice, through
+    /// `Run::with_merge_mask`'s route): each record's η is its pixel's, 0 off the board.
+    pub checkerboard_merging: bool,
 }
 
 impl VcmOptions {
@@ -70,7 +78,14 @@ impl VcmOptions {
             // weights far from 0 and 1, where a wrong density shows.
             radius: InitialRadius::Pixels(2.0),
             correlation_aware: false,
+            vertex_connections: true,
+            checkerboard_merging: false,
         }
+    }
+
+    /// Whether the integrator weighs from the full path's densities (`camis::weigh`).
+    fn full_path(&self) -> bool {
+        self.correlation_aware || !self.vertex_connections || self.checkerboard_merging
     }
 
     /// The registered integrator whose weights these options check.
@@ -94,6 +109,7 @@ impl VcmOptions {
             connections: self.connections,
             merging: true,
             correlation_aware: self.correlation_aware,
+            vertex_connections: self.vertex_connections,
         }
     }
 }
@@ -143,9 +159,21 @@ pub struct VcmCollector {
     pub records: Vec<VcmRecord>,
     pub too_long: usize,
     eta: f64,
+    /// The pixels that merge (`VcmOptions::checkerboard_merging`).
+    mask: Option<MergeMask>,
+    width: u32,
+    height: u32,
 }
 
 impl VcmCollector {
+    /// η of a path landing at `raster`: the pass's, 0 in a pixel that does not merge.
+    fn eta_at(&self, raster: lt_core::math::Vec2) -> f64 {
+        match &self.mask {
+            Some(m) if !m[pixel_of(raster, self.width, self.height)] => 0.0,
+            _ => self.eta,
+        }
+    }
+
     fn keep(&mut self, k: usize, t: Technique) -> bool {
         if k > self.max_depth || k == 0 {
             self.too_long += 1;
@@ -182,7 +210,7 @@ impl Recorder for VcmCollector {
                 light: p.light.to_vec(),
                 camera: p.camera.to_vec(),
                 weight: p.weight,
-                eta: self.eta,
+                eta: self.eta_at(p.raster),
             });
         }
     }
@@ -195,7 +223,7 @@ impl Recorder for VcmCollector {
                 light: p.light.to_vec(),
                 camera: p.camera.to_vec(),
                 weight: p.weight,
-                eta: self.eta,
+                eta: self.eta_at(p.raster),
             });
         }
     }
@@ -212,7 +240,13 @@ pub fn prepare_scene(scene: &mut Scene, opts: &VcmOptions) {
 /// its paths or `max_passes` ran.
 pub fn collect(scene: &Scene, opts: &VcmOptions) -> (VcmCollector, u32) {
     let params = opts.params();
-    let engine = Engine::new(&params, scene);
+    let mut engine = Engine::new(&params, scene);
+    let cam = &scene.camera;
+    let board = |i: usize| (i % cam.width as usize + i / cam.width as usize) % 2 == 0;
+    let mask: Option<MergeMask> = opts
+        .checkerboard_merging
+        .then(|| (0..cam.pixel_count()).map(board).collect());
+    engine.merge_mask = mask.clone();
     let r0 = initial_radius(scene, params.radius);
     let mut c = VcmCollector {
         quota: opts.paths,
@@ -221,8 +255,10 @@ pub fn collect(scene: &Scene, opts: &VcmOptions) -> (VcmCollector, u32) {
         records: Vec::new(),
         too_long: 0,
         eta: 0.0,
+        mask,
+        width: cam.width,
+        height: cam.height,
     };
-    let cam = &scene.camera;
     let mut scratch = engine.scratch();
     let mut passes = 0;
     while passes < opts.max_passes && !c.full() {
@@ -292,8 +328,8 @@ pub fn check_record(
     (ratio, light_paths): (f64, f64),
 ) -> VcmCheck {
     let set = TechniqueSet {
-        connections: opts.connections,
-        merging_eta: r.eta,
+        vertex_connections: opts.connections && opts.vertex_connections,
+        ..TechniqueSet::new(opts.connections, r.eta)
     };
     let h = opts.heuristic;
     let path = r.path();
@@ -341,9 +377,10 @@ pub fn check_record(
     let mut sum = 0.0;
     let mut replay_error = 0.0f64;
     for &t in &techniques {
-        let w = match corr {
-            Some(corr) => camis::weight(&d.chain(), set, corr, t, h),
-            None => mis.replay(&d, t),
+        let w = if opts.full_path() {
+            camis::weight(&d.chain(), set, corr, t, h)
+        } else {
+            mis.replay(&d, t)
         };
         replay_error = replay_error.max((w - d.vcm_weight_with(set, corr, t, h)).abs());
         sum += w;

@@ -1,0 +1,171 @@
+//! Efficiency-aware MIS (Grittmann, Yazici, Georgiev & Slusallek, "Efficiency-aware multiple
+//! importance sampling for bidirectional rendering algorithms", SIGGRAPH 2022): predict, from
+//! the samples of a pilot configuration, the second moment every other configuration of the
+//! same techniques would have, so that sample counts can be chosen by predicted efficiency.
+//!
+//! **The prediction.** A multi-sample MIS estimator with counts n_u and the balance heuristic
+//! has the per-camera-sample second moment (cross terms of independent samples dropped)
+//!
+//!   M(c) = ∫ f(x̄)² / q_c(x̄) dx̄,   q_c = Σ_u n_u^c p_u   (Veach 1997, §9.2.2).
+//!
+//! Any MIS estimator of the pilot estimates an integral ∫ g as Σ w_u g / (n_u p_u) over its
+//! samples. With g = f²/q_c and a sample's unweighted value V = f/(n_u p_u), one sample of
+//! technique u adds
+//!
+//!   w_u · V² · n_u p_u / q_c                                  ([`Counts::second_moment_term`])
+//!
+//! whatever heuristic gave w_u: an unbiased estimate of M(c) for every c whose techniques the
+//! pilot runs. q_c follows from the pilot's effective densities grouped by how their counts scale
+//! ([`Mixture`]): light tracing and merging (η = M π r²) with the light subpath count M, vertex
+//! connections on or off, the rest fixed per camera sample.
+//!
+//! The paper's own derivation and its cost model could not be read from this machine; this is
+//! the second-moment identity above, which the paper builds on, not its text.
+
+use super::camis::Mixture;
+
+/// The sample counts of one configuration of the VCM family, per camera sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Counts {
+    /// M/N: light subpaths per camera sample.
+    pub light_ratio: f64,
+    /// Vertex connections s ≥ 2, t ≥ 2 (one light subpath per camera vertex).
+    pub vertex_connections: bool,
+    /// Merging, counted η = M π r² (so it scales with M at a fixed radius).
+    pub merging: bool,
+}
+
+impl Counts {
+    /// Σ_u n_u p_u of a path under `self`, from its `mixture` as `pilot` weighed it. The pilot
+    /// must run every technique `self` does (vertex connections, merging).
+    pub fn total(&self, mixture: &Mixture, pilot: &Counts) -> f64 {
+        let r = self.light_ratio / pilot.light_ratio;
+        let vc = if self.vertex_connections {
+            mixture.vertex_connections
+        } else {
+            0.0
+        };
+        let vm = if self.merging {
+            r * mixture.merges
+        } else {
+            0.0
+        };
+        mixture.fixed + r * mixture.light_tracing + vc + vm
+    }
+
+    /// One pilot sample's share of the second moment M(`self`): w · v² · n_u p_u / q_c, for a
+    /// sample of weight `weight` and unweighted value `value` whose effective densities under
+    /// `pilot` are `mixture` (0 where no technique of `self` makes the path and f² = 0 there).
+    pub fn second_moment_term(
+        &self,
+        weight: f64,
+        value: f64,
+        mixture: &Mixture,
+        pilot: &Counts,
+    ) -> f64 {
+        let q = self.total(mixture, pilot);
+        if q > 0.0 && mixture.own > 0.0 {
+            weight * value * value * mixture.own / q
+        } else {
+            0.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::path::camis::weigh;
+    use crate::path::{Densities, Heuristic, Technique, TechniqueSet};
+    use rand_pcg::rand_core::Rng as _;
+    use rand_pcg::Pcg32;
+
+    struct Pcg64(Pcg32);
+
+    impl Pcg64 {
+        fn seed_from_u64(seed: u64) -> Pcg64 {
+            Pcg64(Pcg32::new(seed, 0x5bd1_e995_2022_0001))
+        }
+
+        fn gen_range(&mut self, r: std::ops::Range<f64>) -> f64 {
+            let u = (self.0.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
+            r.start + (r.end - r.start) * u
+        }
+
+        fn gen_bool(&mut self, p: f64) -> bool {
+            self.gen_range(0.0..1.0) < p
+        }
+    }
+
+    fn random_path(rng: &mut Pcg64, k: usize) -> Densities {
+        let mut pick = || 10f64.powf(rng.gen_range(-3.0..3.0));
+        let light: Vec<f64> = (0..=k).map(|_| pick()).collect();
+        let camera: Vec<f64> = (0..=k).map(|_| pick()).collect();
+        let nee = pick();
+        let connectable = (0..=k).map(|_| rng.gen_bool(0.85)).collect();
+        let mut d = Densities {
+            light,
+            camera,
+            nee,
+            connectable,
+            light_tracing_ratio: 10f64.powf(rng.gen_range(-1.0..1.0)),
+        };
+        d.light[k] = 0.0;
+        d.camera[k] = 1.0;
+        d
+    }
+
+    /// q_c predicted from the pilot's grouped densities equals the oracle's Σ n_u p_u of `c`
+    /// built from scratch (`Densities::effective_vcm`) — for every technique a pilot sample may
+    /// come from, every path length and every configuration.
+    #[test]
+    fn predicted_mixture_totals_match_the_oracle_for_every_configuration() {
+        let mut rng = Pcg64::seed_from_u64(2022);
+        let mut checked = 0;
+        for trial in 0..4000 {
+            let k = 1 + trial % 7;
+            let d = random_path(&mut rng, k);
+            let eta = 10f64.powf(rng.gen_range(-3.0..3.0));
+            let pilot = Counts {
+                light_ratio: d.light_tracing_ratio,
+                vertex_connections: true,
+                merging: true,
+            };
+            let set = TechniqueSet::new(true, eta);
+            for own in d.vcm_techniques(set) {
+                let w = weigh(&d.chain(), set, None, own, Heuristic::Balance);
+                for (r, vc, vm) in [(0.25, true, true), (2.0, false, true), (1.0, true, false)]
+                    .into_iter()
+                    .chain([(0.5, false, false)])
+                {
+                    let c = Counts {
+                        light_ratio: pilot.light_ratio * r,
+                        vertex_connections: vc,
+                        merging: vm,
+                    };
+                    let mut dc = d.clone();
+                    dc.light_tracing_ratio = c.light_ratio;
+                    let set_c = TechniqueSet {
+                        vertex_connections: vc,
+                        ..TechniqueSet::new(true, if vm { eta * r } else { 0.0 })
+                    };
+                    let (vcs, vms) = dc.effective_vcm(set_c);
+                    let want: f64 = vcs.iter().chain(&vms).sum();
+                    let got = c.total(&w.mixture, &pilot);
+                    assert!(
+                        (got - want).abs() <= 1e-12 * want.max(1e-300),
+                        "k {k}, {own:?}, ratio ×{r}, vc {vc}, vm {vm}: predicted {got}, oracle {want}"
+                    );
+                    checked += 1;
+                }
+                // The pilot's own total is its balance weight's denominator.
+                let own_p = w.mixture.own;
+                assert!((own_p / w.mixture.total() - w.weight).abs() <= 1e-12);
+                if let Technique::Merge(_) = own {
+                    assert!(w.mixture.merges >= own_p);
+                }
+            }
+        }
+        assert!(checked > 10_000, "{checked}");
+    }
+}

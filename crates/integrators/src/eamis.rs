@@ -1,0 +1,498 @@
+//! `eamis` — efficiency-aware MIS over VCM's techniques (Grittmann, Yazici, Georgiev & Slusallek,
+//! SIGGRAPH 2022): a pilot of `pilot_passes` VCM passes (one light subpath per pixel, every
+//! technique) predicts, per pixel, the second moment every candidate configuration would have
+//! (`lt_core::path::efficiency`), and counts what each would cost; the rest of the run renders
+//! with the configuration of least predicted inefficiency (second moment × cost):
+//!
+//! - the light subpath count M ∈ {¼, ½, 1, 2} × the pixel count (global),
+//! - vertex connections s ≥ 2, t ≥ 2 on or off (global; next-event estimation and light tracing
+//!   always run),
+//! - merging on or off **per pixel**: η counts in the pixel a path lands in, 0 where it is off.
+//!
+//! Every weight comes from the full path's densities (`connect_merge`'s full-path route), so the
+//! per-pixel η is exact. The pilot passes belong to the image (each pass is a VCM estimate); the
+//! choice is a function of the pilot's samples alone, so the estimator stays consistent, and
+//! unbiased wherever merging is off. The pilot runs on one thread (its moment sums then do not
+//! depend on the thread count) and the cost is counted, not timed, so the same seed gives the same
+//! choice and the same image bit for bit.
+//!
+//! **Cost model**: the pilot counts camera samples, next-event shadow rays (one per connectable
+//! camera vertex), vertex connections, light vertices, light-tracing joins, merge queries and
+//! light vertices found per pixel, and weighs them with unit costs measured once on this machine
+//! (`COST_*`, results/eamis.md): a count, not a clock, so the choice is deterministic. Light
+//! vertices, light tracing and merges found scale with M.
+//!
+//! **Which pixels matter.** The image's inefficiency is Σ_p M_p / (μ_p + 0.01)² × cost, the relative
+//! second moment (pbrt's relMSE guard; μ_p the pilot's estimate) summed over pixels: the merge
+//! mask is the prefix, by moment saved per cost added, that minimises it; the global choice the
+//! candidate whose best mask minimises it. The choice and the predicted inefficiency of every
+//! candidate (per pixel mean, per pass) go to the JSON record.
+//!
+//! | key | type | default | meaning |
+//! |---|---|---|---|
+//! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
+//! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
+//! | `mis` | power/balance/none | balance | heuristic (the prediction is the balance heuristic's) |
+//! | `pilot_passes` | u32 | 1 | passes of the pilot (all techniques) before the choice |
+//! | `fixed` | text | — | no pilot: render every pass with one candidate, `m<ratio>_vc<0/1>_<merge/nomerge>` (e.g. `m2_vc0_merge`): the fixed configurations the choice is measured against |
+//! | `light_paths` | u64 | — | refused: eamis chooses it |
+//! | `radius_px` | f32 | 2 | initial radius in pixel footprints at the mean primary-hit distance |
+//! | `radius_scene` | f32 | — | initial radius as a fraction of the scene's bounding-sphere diameter |
+//! | `radius` | f32 | — | initial radius in scene units |
+//! | `alpha` | f64 | 0.75 | radius reduction α: rᵢ = r₀ i^((α−1)/2) |
+//! | `correlation_aware` | true/false | false | refused when true (the prediction assumes η counts) |
+//! | `vertex_connections` | true/false | — | refused: eamis chooses it |
+
+use crate::connect_merge::{pixel_of, MergeMask, Run, Techniques, VcmParams};
+use crate::params::ParamReader;
+use crate::record::{Completed, Merged, Recorder, Work};
+use crate::{Progressive, ProgressiveRun, ProgressLog};
+use lt_core::math::Color;
+use lt_core::path::camis::Mixture;
+use lt_core::path::efficiency::Counts;
+use lt_core::path::Heuristic;
+use lt_core::Scene;
+use lt_estimators::metrics::REL_MSE_GUARD;
+use lt_estimators::Image;
+use std::sync::Arc;
+
+/// Light subpaths per pixel the choice ranges over.
+pub const LIGHT_RATIOS: [f64; 4] = [0.25, 0.5, 1.0, 2.0];
+/// The cost model's unit costs, in units of 200 ns of one core of this machine, from one-thread
+/// renders of `cornell-box` at 128 px with each `fixed` candidate (results/eamis.md): a camera
+/// sample, and per connectable camera vertex its extension and its next-event shadow ray.
+pub const COST_CAMERA: f64 = 1.25;
+/// A vertex connection (shadow ray and two BSDF evaluations, full-path weight).
+pub const COST_VERTEX_CONNECTION: f64 = 0.7;
+/// A light vertex traced and stored, or one joined to the lens (light tracing).
+pub const COST_LIGHT: f64 = 1.1;
+/// A merge query (the grid lookup).
+pub const COST_QUERY: f64 = 0.5;
+/// A light vertex found in range (BSDF evaluation and full-path weight).
+pub const COST_MERGE: f64 = 1.3;
+
+pub struct Eamis {
+    pub params: VcmParams,
+    pub pilot_passes: u32,
+    /// A candidate rendered without pilot or choice.
+    pub fixed: Option<Counts>,
+}
+
+/// The label of a candidate with merging everywhere or nowhere, as the record and `fixed` name it.
+pub fn label(c: &Counts) -> String {
+    format!(
+        "m{}_vc{}_{}",
+        c.light_ratio,
+        u8::from(c.vertex_connections),
+        if c.merging { "merge" } else { "nomerge" }
+    )
+}
+
+/// Every candidate with merging everywhere or nowhere.
+pub fn fixed_candidates() -> Vec<Counts> {
+    globals()
+        .into_iter()
+        .flat_map(|(light_ratio, vertex_connections)| {
+            [true, false].map(|merging| Counts {
+                light_ratio,
+                vertex_connections,
+                merging,
+            })
+        })
+        .collect()
+}
+
+impl Eamis {
+    pub fn read(scene: &Scene, r: &ParamReader) -> Result<Eamis, String> {
+        let mut params = VcmParams::read(scene, r, "eamis", Techniques::VCM)?;
+        if r.get_with("mis", Heuristic::parse)?.is_none() {
+            params.mis = Heuristic::Balance;
+        }
+        if params.light_paths.is_some() {
+            return Err("eamis chooses light_paths itself; leave it out".into());
+        }
+        if params.correlation_aware {
+            return Err("eamis predicts moments with merging counted η times: correlation_aware \
+                        must stay false"
+                .into());
+        }
+        if r.get::<bool>("vertex_connections")?.is_some() {
+            return Err("eamis chooses vertex_connections itself; leave it out".into());
+        }
+        let pilot_passes = r.get::<u32>("pilot_passes")?.unwrap_or(1);
+        if pilot_passes == 0 {
+            return Err("eamis: pilot_passes must be at least 1".into());
+        }
+        let fixed = match r.get::<String>("fixed")? {
+            None => None,
+            Some(name) => Some(
+                fixed_candidates()
+                    .into_iter()
+                    .find(|c| label(c) == name)
+                    .ok_or_else(|| {
+                        let known: Vec<String> = fixed_candidates().iter().map(label).collect();
+                        format!("eamis: unknown fixed = '{name}' (known: {})", known.join(", "))
+                    })?,
+            ),
+        };
+        Ok(Eamis {
+            params,
+            pilot_passes,
+            fixed,
+        })
+    }
+}
+
+impl Progressive for Eamis {
+    fn name(&self) -> &'static str {
+        "eamis"
+    }
+
+    fn start<'a>(&'a self, scene: &'a Scene, seed: u64) -> Box<dyn ProgressiveRun + 'a> {
+        let n = scene.camera.pixel_count();
+        let all: MergeMask = vec![true; n].into();
+        let mut run = EamisRun {
+            eamis: self,
+            scene,
+            seed,
+            pilot: Run::new(&self.params, scene, seed).with_merge_mask(all.clone()),
+            probe: Probe::new(scene),
+            render: None,
+            choice: None,
+        };
+        if let Some(counts) = self.fixed {
+            let mask = if counts.merging {
+                all
+            } else {
+                vec![false; n].into()
+            };
+            run.start_render(Choice {
+                counts,
+                merge_mask: mask,
+                predicted: f64::NAN,
+                fixed: Vec::new(),
+            });
+        }
+        Box::new(run)
+    }
+}
+
+/// One configuration the choice ranges over, and what it predicts.
+#[derive(Clone, Debug)]
+pub struct Choice {
+    pub counts: Counts,
+    /// Pixels that merge.
+    pub merge_mask: MergeMask,
+    /// Σ_p relative second moment per pass × cost per pass (traced-ray units), per pixel.
+    pub predicted: f64,
+    /// Every global candidate with merging everywhere and nowhere: (label, predicted).
+    pub fixed: Vec<(String, f64)>,
+}
+
+struct EamisRun<'a> {
+    eamis: &'a Eamis,
+    scene: &'a Scene,
+    seed: u64,
+    pilot: Run<'a>,
+    probe: Probe,
+    render: Option<Run<'a>>,
+    choice: Option<Choice>,
+}
+
+impl EamisRun<'_> {
+    /// Every further pass renders with `choice`.
+    fn start_render(&mut self, choice: Choice) {
+        let mut params = self.eamis.params;
+        let n = self.scene.camera.pixel_count() as f64;
+        params.light_paths = Some(((choice.counts.light_ratio * n).round() as u64).max(1));
+        params.vertex_connections = choice.counts.vertex_connections;
+        params.merging = choice.merge_mask.iter().any(|&m| m);
+        let run = Run::new(&params, self.scene, self.seed);
+        self.render = Some(if params.merging {
+            run.with_merge_mask(choice.merge_mask.clone())
+        } else {
+            run
+        });
+        self.choice = Some(choice);
+    }
+}
+
+impl ProgressiveRun for EamisRun<'_> {
+    fn pass(&mut self, pass: u32) -> u64 {
+        if let Some(render) = &mut self.render {
+            return render.pass(pass);
+        }
+        let invalid = self.pilot.recorded_pass(pass, &mut self.probe);
+        self.probe.light_vertices += self.pilot.stored_light_vertices() as u64;
+        if self.pilot.sum().1 >= self.eamis.pilot_passes {
+            let choice = choose(&self.probe, &self.pilot.estimate());
+            self.start_render(choice);
+        }
+        invalid
+    }
+
+    fn estimate(&self) -> Image {
+        let (sum, passes) = self.pilot.sum();
+        let mut img = sum.clone();
+        let mut total = passes;
+        if let Some(render) = &self.render {
+            let (s, p) = render.sum();
+            for (a, b) in img.data.iter_mut().zip(&s.data) {
+                for c in 0..3 {
+                    a[c] += b[c];
+                }
+            }
+            total += p;
+        }
+        let k = 1.0 / total.max(1) as f64;
+        img.data
+            .iter_mut()
+            .for_each(|p| p.iter_mut().for_each(|c| *c *= k));
+        img
+    }
+
+    fn log(&self) -> ProgressLog {
+        let mut log = self.pilot.log();
+        if let Some(render) = &self.render {
+            let r = render.log();
+            log.photon_paths.extend(r.photon_paths);
+            log.radius_scale.extend(r.radius_scale);
+            log.mean_radius.extend(r.mean_radius);
+        }
+        if let Some(c) = &self.choice {
+            let merging = c.merge_mask.iter().filter(|&&m| m).count();
+            let facts = [
+                ("eamis_light_ratio", format!("{}", c.counts.light_ratio)),
+                (
+                    "eamis_vertex_connections",
+                    format!("{}", c.counts.vertex_connections),
+                ),
+                (
+                    "eamis_merging_pixels",
+                    format!("{:.4}", merging as f64 / c.merge_mask.len().max(1) as f64),
+                ),
+                ("eamis_predicted", format!("{:.6e}", c.predicted)),
+                (
+                    "eamis_pilot_passes",
+                    format!("{}", self.pilot.sum().1),
+                ),
+            ];
+            log.facts
+                .extend(facts.into_iter().map(|(k, v)| (k.to_string(), v)));
+            let p = &self.probe;
+            let counted = [
+                ("camera_samples", p.camera_samples),
+                ("nee_rays", p.shadow_rays_fixed),
+                ("vertex_connections", p.vertex_connections),
+                ("light_tracing_joins", p.light_tracing),
+                ("light_vertices", p.light_vertices),
+                ("merge_queries", p.merge_queries.iter().sum()),
+                ("merges_found", p.merges_found.iter().sum()),
+            ];
+            for (k, v) in counted {
+                log.facts.push((format!("eamis_pilot_{k}"), v.to_string()));
+            }
+            for (label, p) in &c.fixed {
+                log.facts
+                    .push((format!("eamis_predicted_{label}"), format!("{p:.6e}")));
+            }
+        }
+        log
+    }
+}
+
+/// The pilot's pilot configuration: one light subpath per pixel, every technique.
+const PILOT: Counts = Counts {
+    light_ratio: 1.0,
+    vertex_connections: true,
+    merging: true,
+};
+
+/// The global candidates (M, vertex connections), each rendered with merging on (`2g`) or off
+/// (`2g + 1`) in a pixel.
+fn globals() -> Vec<(f64, bool)> {
+    LIGHT_RATIOS
+        .iter()
+        .flat_map(|&r| [(r, true), (r, false)])
+        .collect()
+}
+
+/// What the pilot gathers: per pixel and candidate the second-moment sums, per pixel the merge
+/// work, and the counts of the rest of the work.
+struct Probe {
+    width: u32,
+    height: u32,
+    candidates: Vec<Counts>,
+    /// moments[pixel × candidates + c].
+    moments: Vec<f64>,
+    merge_queries: Vec<u64>,
+    merges_found: Vec<u64>,
+    camera_samples: u64,
+    shadow_rays_fixed: u64,
+    vertex_connections: u64,
+    light_tracing: u64,
+    light_vertices: u64,
+    /// The mixture of the path about to be reported.
+    pending: Option<Mixture>,
+    pixel: usize,
+    film_weight: f64,
+}
+
+impl Probe {
+    fn new(scene: &Scene) -> Probe {
+        let n = scene.camera.pixel_count();
+        let candidates = fixed_candidates();
+        Probe {
+            width: scene.camera.width,
+            height: scene.camera.height,
+            moments: vec![0.0; n * candidates.len()],
+            candidates,
+            merge_queries: vec![0; n],
+            merges_found: vec![0; n],
+            camera_samples: 0,
+            shadow_rays_fixed: 0,
+            vertex_connections: 0,
+            light_tracing: 0,
+            light_vertices: 0,
+            pending: None,
+            pixel: 0,
+            film_weight: 1.0,
+        }
+    }
+
+    fn add(&mut self, pixel: usize, weight: f64, value: f64, mixture: &Mixture) {
+        let c = self.candidates.len();
+        let row = &mut self.moments[pixel * c..(pixel + 1) * c];
+        for (m, counts) in row.iter_mut().zip(&self.candidates) {
+            *m += counts.second_moment_term(weight, value, mixture, &PILOT);
+        }
+    }
+}
+
+fn channel_mean(c: Color) -> f64 {
+    (c.x as f64 + c.y as f64 + c.z as f64) / 3.0
+}
+
+impl Recorder for Probe {
+    const ACTIVE: bool = true;
+
+    fn mixture(&mut self, m: Mixture) {
+        self.pending = Some(m);
+    }
+
+    fn begin_sample(&mut self, pixel: u64, film_weight: f32) {
+        self.pixel = pixel as usize;
+        self.film_weight = film_weight as f64;
+    }
+
+    fn completed(&mut self, p: Completed) {
+        let Some(m) = self.pending.take() else {
+            return;
+        };
+        let light_tracing = p.s >= 1 && p.camera.len() == 1;
+        let value = channel_mean(p.value)
+            * if light_tracing {
+                1.0
+            } else {
+                self.film_weight
+            };
+        let pixel = pixel_of(p.raster, self.width, self.height);
+        self.add(pixel, p.weight, value, &m);
+    }
+
+    fn merged(&mut self, p: Merged) {
+        let Some(m) = self.pending.take() else {
+            return;
+        };
+        let value = channel_mean(p.value) * self.film_weight;
+        let pixel = pixel_of(p.raster, self.width, self.height);
+        self.merges_found[pixel] += 1;
+        self.add(pixel, p.weight, value, &m);
+    }
+
+    fn lap(&mut self, work: Work) {
+        match work {
+            Work::CameraWalk => self.camera_samples += 1,
+            Work::Connection { t: 1, .. } => self.light_tracing += 1,
+            Work::Connection { s: 0, .. } => {}
+            Work::Connection { s: 1, .. } => self.shadow_rays_fixed += 1,
+            Work::Connection { .. } => self.vertex_connections += 1,
+            Work::Merge { .. } => self.merge_queries[self.pixel] += 1,
+            Work::LightWalk => {}
+        }
+    }
+}
+
+/// The configuration of least predicted inefficiency from the pilot's `probe` and estimate.
+fn choose(probe: &Probe, estimate: &Image) -> Choice {
+    let n = estimate.data.len();
+    let nc = probe.candidates.len();
+    // 1/(μ + 0.01)²: each pixel's second moment relative to its value.
+    let rel: Vec<f64> = estimate
+        .data
+        .iter()
+        .map(|p| {
+            let mu = (p[0] + p[1] + p[2]) / 3.0;
+            1.0 / (mu.max(0.0) + REL_MSE_GUARD).powi(2)
+        })
+        .collect();
+    let fixed_work = COST_CAMERA * (probe.camera_samples + 2 * probe.shadow_rays_fixed) as f64;
+    let mut best: Option<Choice> = None;
+    let mut fixed = Vec::new();
+    for (g, (ratio, vc)) in globals().into_iter().enumerate() {
+        let cost0 = fixed_work
+            + COST_LIGHT * ratio * (probe.light_vertices + probe.light_tracing) as f64
+            + if vc {
+                COST_VERTEX_CONNECTION * probe.vertex_connections as f64
+            } else {
+                0.0
+            };
+        let on = |p: usize| probe.moments[p * nc + 2 * g] * rel[p];
+        let off = |p: usize| probe.moments[p * nc + 2 * g + 1] * rel[p];
+        let merge_cost = |p: usize| {
+            COST_QUERY * probe.merge_queries[p] as f64
+                + COST_MERGE * ratio * probe.merges_found[p] as f64
+        };
+        let all_on: f64 =
+            (0..n).map(on).sum::<f64>() * (cost0 + (0..n).map(merge_cost).sum::<f64>());
+        let all_off: f64 = (0..n).map(off).sum::<f64>() * cost0;
+        fixed.push((label(&probe.candidates[2 * g]), all_on / n as f64));
+        fixed.push((label(&probe.candidates[2 * g + 1]), all_off / n as f64));
+        // Pixels where merging lowers the moment, by moment saved per cost added.
+        let mut gain: Vec<(f64, usize)> = (0..n)
+            .filter(|&p| on(p) < off(p))
+            .map(|p| ((off(p) - on(p)) / merge_cost(p).max(1e-9), p))
+            .collect();
+        gain.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let (mut v, mut c) = ((0..n).map(off).sum::<f64>(), cost0);
+        let (mut best_j, mut best_len) = (v * c, 0);
+        for (i, &(_, p)) in gain.iter().enumerate() {
+            v -= off(p) - on(p);
+            c += merge_cost(p);
+            if v * c < best_j {
+                best_j = v * c;
+                best_len = i + 1;
+            }
+        }
+        let predicted = best_j / n as f64;
+        if best.as_ref().is_none_or(|b| predicted < b.predicted) {
+            let mut mask = vec![false; n];
+            for &(_, p) in &gain[..best_len] {
+                mask[p] = true;
+            }
+            best = Some(Choice {
+                counts: Counts {
+                    light_ratio: ratio,
+                    vertex_connections: vc,
+                    merging: best_len > 0,
+                },
+                merge_mask: Arc::from(mask),
+                predicted,
+                fixed: Vec::new(),
+            });
+        }
+    }
+    let mut choice = best.expect("at least one candidate");
+    choice.fixed = fixed;
+    choice
+}
