@@ -297,14 +297,13 @@ impl FullPathSetup {
     /// The weight of `technique` on `chain`, whose primary hit lies `distance` from the camera
     /// and which lands at `raster`.
     fn weigh(&self, chain: &Chain, technique: Technique, distance: f32, raster: Vec2) -> Weighed {
-        let corr = self
-            .correlation
-            .then(|| Correlation::new(self.light_paths, distance as f64));
+        // ρ always, for `Mixture::merges_correlated`; in the weights only when correlation-aware.
+        let corr = Correlation::new(self.light_paths, distance as f64);
         let mut set = self.set;
         if !self.merges_at(raster) {
             set.merging_eta = 0.0;
         }
-        camis::weigh(chain, set, corr.as_ref(), technique, self.heuristic)
+        camis::weigh_full(chain, set, Some(&corr), self.correlation, technique, self.heuristic)
     }
 
     /// The weight of connection technique (s, t) formed by `split` (`strategy_weight`).

@@ -45,8 +45,13 @@ pub struct Mixture {
     pub light_tracing: f64,
     /// s = 2 … k−1, vertex connections: once per camera sample when on.
     pub vertex_connections: f64,
-    /// Merging at every x_i: η ρ_i each, η = M π r².
+    /// Merging at every x_i as the weights counted it: η each, or η ρ_i with correlation-aware
+    /// weights; η = M π r².
     pub merges: f64,
+    /// Merging at every x_i counted η ρ_i (correlation-aware MIS's effective count) whenever a
+    /// `Correlation` was given, whatever the weights counted: what efficiency-aware MIS predicts
+    /// merging's second moment with, since the merges of one camera vertex share its prefix.
+    pub merges_correlated: f64,
 }
 
 impl Mixture {
@@ -83,6 +88,19 @@ pub fn weigh(
     chain: &Chain,
     set: TechniqueSet,
     corr: Option<&Correlation>,
+    technique: Technique,
+    h: Heuristic,
+) -> Weighed {
+    weigh_full(chain, set, corr, corr.is_some(), technique, h)
+}
+
+/// [`weigh`] with ρ_i computed from `corr` for `Mixture::merges_correlated` and applied to the
+/// weights only when `correlated_weights`.
+pub fn weigh_full(
+    chain: &Chain,
+    set: TechniqueSet,
+    corr: Option<&Correlation>,
+    correlated_weights: bool,
     technique: Technique,
     h: Heuristic,
 ) -> Weighed {
@@ -142,16 +160,23 @@ pub fn weigh(
     }
     p[k + 2] = 0.0;
     p[2 * k + 2] = 0.0;
+    let mut merges_correlated = 0.0;
     for i in (1..k).rev() {
         p_camera *= (a * chain.camera[i]).min(1.0);
         let rho = match corr {
             Some(corr) if i + 1 < k => corr.ratio(p_camera, pl[i]),
             _ => 1.0,
         };
-        p[k + 2 + i] = if eta > 0.0 && chain.connectable[i] {
-            eta * rho * lpre[i + 1] * csuf[i]
+        let independent = if eta > 0.0 && chain.connectable[i] {
+            eta * lpre[i + 1] * csuf[i]
         } else {
             0.0
+        };
+        merges_correlated += independent * rho;
+        p[k + 2 + i] = if correlated_weights {
+            independent * rho
+        } else {
+            independent
         };
     }
     let own = match technique {
@@ -175,6 +200,7 @@ pub fn weigh(
         light_tracing: p[k],
         vertex_connections: if k >= 3 { p[2..k].iter().sum() } else { 0.0 },
         merges: p[k + 2..2 * k + 3].iter().sum(),
+        merges_correlated,
     };
     Weighed {
         weight: if w.is_finite() { w } else { 0.0 },
