@@ -494,12 +494,7 @@ impl<'a> Engine<'a> {
                     lights,
                     pass: Pass { seed, pass },
                 };
-                let mut worker = Worker {
-                    splats,
-                    scratch,
-                    rec: &mut NoRecord,
-                };
-                self.item(&inputs, i, &mut worker)
+                self.item_into(&inputs, i, (splats, scratch, &mut NoRecord))
             },
         )
     }
@@ -530,6 +525,21 @@ impl<'a> Engine<'a> {
             let l = self.camera_sample(inputs, light, i, worker);
             worker.splats.add_to_pixel(i as u32, l);
         }
+    }
+
+    /// `item` with its worker assembled from (splats, scratch, recorder).
+    pub fn item_into<R: Recorder>(
+        &self,
+        inputs: &PassInputs,
+        i: u64,
+        (splats, scratch, rec): (&mut Splats, &mut Scratch, &mut R),
+    ) {
+        let mut worker = Worker {
+            splats,
+            scratch,
+            rec,
+        };
+        self.item(inputs, i, &mut worker)
     }
 
     /// t = 1: every connectable vertex of one light subpath joined to the pinhole.
@@ -1230,6 +1240,17 @@ impl<'a> Run<'a> {
 }
 
 impl Run<'_> {
+    /// Adds one pass's image to the run and logs it.
+    fn add_pass(&mut self, img: &Image, setup: &PassSetup) {
+        for (a, b) in self.sum.data.iter_mut().zip(&img.data) {
+            for c in 0..3 {
+                a[c] += b[c];
+            }
+        }
+        self.passes += 1;
+        log_pass(&mut self.log, setup, self.r0);
+    }
+
     /// Merging only where `mask` is on (efficiency-aware MIS's per-pixel choice); every weight
     /// then comes from the full path's densities.
     pub fn with_merge_mask(mut self, mask: MergeMask) -> Self {
@@ -1262,21 +1283,10 @@ impl Run<'_> {
                     lights,
                     pass: Pass { seed, pass },
                 };
-                let mut worker = Worker {
-                    splats,
-                    scratch,
-                    rec: &mut **rec,
-                };
-                engine.item(&inputs, i, &mut worker)
+                engine.item_into(&inputs, i, (splats, scratch, &mut **rec))
             },
         );
-        for (a, b) in self.sum.data.iter_mut().zip(&img.data) {
-            for c in 0..3 {
-                a[c] += b[c];
-            }
-        }
-        self.passes += 1;
-        log_pass(&mut self.log, &setup, self.r0);
+        self.add_pass(&img, &setup);
         invalid
     }
 
@@ -1317,21 +1327,10 @@ impl Run<'_> {
                     lights,
                     pass: Pass { seed, pass },
                 };
-                let mut worker = Worker {
-                    splats,
-                    scratch,
-                    rec,
-                };
-                engine.item(&inputs, i, &mut worker)
+                engine.item_into(&inputs, i, (splats, scratch, rec))
             },
         );
-        for (a, b) in self.sum.data.iter_mut().zip(&img.data) {
-            for c in 0..3 {
-                a[c] += b[c];
-            }
-        }
-        self.passes += 1;
-        log_pass(&mut self.log, &setup, self.r0);
+        self.add_pass(&img, &setup);
         (invalid, tally.finish(clock, &[(Work::LightWalk, walk)]))
     }
 }
@@ -1344,13 +1343,7 @@ impl ProgressiveRun for Run<'_> {
         let (img, invalid) = self
             .engine
             .render_pass(&setup, &self.lights, self.seed, pass);
-        for (a, b) in self.sum.data.iter_mut().zip(&img.data) {
-            for c in 0..3 {
-                a[c] += b[c];
-            }
-        }
-        self.passes += 1;
-        log_pass(&mut self.log, &setup, self.r0);
+        self.add_pass(&img, &setup);
         invalid
     }
 

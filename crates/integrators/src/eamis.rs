@@ -164,6 +164,7 @@ impl Progressive for Eamis {
             probe: Probe::new(scene),
             render: None,
             choice: None,
+            pilot_cpu: 0.0,
         };
         if let Some(counts) = self.fixed {
             let mask = if counts.merging {
@@ -205,6 +206,8 @@ struct EamisRun<'a> {
     probe: Probe,
     render: Option<Run<'a>>,
     choice: Option<Choice>,
+    /// CPU seconds the pilot passes took (the record's; nothing rendered depends on it).
+    pilot_cpu: f64,
 }
 
 impl EamisRun<'_> {
@@ -230,8 +233,10 @@ impl ProgressiveRun for EamisRun<'_> {
         if let Some(render) = &mut self.render {
             return render.pass(pass);
         }
+        let cpu0 = crate::tally::pool_cpu_seconds();
         let invalid = self.pilot.recorded_pass(pass, &mut self.probe);
         self.probe.flush();
+        self.pilot_cpu += crate::tally::pool_cpu_seconds() - cpu0;
         self.probe.light_vertices += self.pilot.stored_light_vertices() as u64;
         if self.pilot.sum().1 >= self.eamis.pilot_passes {
             let choice = choose(&self.probe, &self.pilot.estimate());
@@ -282,6 +287,7 @@ impl ProgressiveRun for EamisRun<'_> {
                 ),
                 ("eamis_predicted", format!("{:.6e}", c.predicted)),
                 ("eamis_merge_correlation", format!("{:.4}", c.merge_correlation)),
+                ("eamis_pilot_cpu_seconds", format!("{:.6}", self.pilot_cpu)),
                 (
                     "eamis_pilot_passes",
                     format!("{}", self.pilot.sum().1),
@@ -478,6 +484,27 @@ fn merge_correlation(probe: &Probe, rel: &[f64]) -> f64 {
     }
 }
 
+/// Per-pixel rows of `nc` values averaged over each pixel's 3 × 3 neighbourhood (clamped at the
+/// film's edges).
+fn box_filter(values: &[f64], nc: usize, w: usize, h: usize) -> Vec<f64> {
+    let mut out = vec![0.0; values.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let row = &mut out[(y * w + x) * nc..(y * w + x + 1) * nc];
+            let mut count = 0.0;
+            for ny in y.saturating_sub(1)..(y + 2).min(h) {
+                for nx in x.saturating_sub(1)..(x + 2).min(w) {
+                    let src = &values[(ny * w + nx) * nc..(ny * w + nx + 1) * nc];
+                    row.iter_mut().zip(src).for_each(|(a, b)| *a += b);
+                    count += 1.0;
+                }
+            }
+            row.iter_mut().for_each(|a| *a /= count);
+        }
+    }
+    out
+}
+
 /// The configuration of least predicted inefficiency from the pilot's `probe` and estimate.
 fn choose(probe: &Probe, estimate: &Image) -> Choice {
     let n = estimate.data.len();
@@ -493,6 +520,11 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
         .collect();
     let fixed_work = COST_CAMERA * (probe.camera_samples + 2 * probe.shadow_rays_fixed) as f64;
     let kappa = merge_correlation(probe, &rel);
+    // One pilot pass is one sample per pixel: each pixel's moments are averaged over its 3 × 3
+    // neighbourhood (an infinite one — light only merging finds — spreads to the neighbours,
+    // which then merge too, since a rare path the pilot saw once is likely near).
+    let (w, h) = (probe.width as usize, probe.height as usize);
+    let moments = box_filter(&probe.moments, nc, w, h);
     let mut best: Option<Choice> = None;
     let mut fixed = Vec::new();
     for (g, (ratio, vc)) in globals().into_iter().enumerate() {
@@ -503,8 +535,8 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
             } else {
                 0.0
             };
-        let on = |p: usize| kappa * probe.moments[p * nc + 2 * g] * rel[p];
-        let off = |p: usize| probe.moments[p * nc + 2 * g + 1] * rel[p];
+        let on = |p: usize| kappa * moments[p * nc + 2 * g] * rel[p];
+        let off = |p: usize| moments[p * nc + 2 * g + 1] * rel[p];
         let merge_cost = |p: usize| {
             COST_QUERY * probe.merge_queries[p] as f64
                 + COST_MERGE * ratio * probe.merges_found[p] as f64
@@ -514,13 +546,23 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
         let all_off: f64 = (0..n).map(off).sum::<f64>() * cost0;
         fixed.push((label(&probe.candidates[2 * g]), all_on / n as f64));
         fixed.push((label(&probe.candidates[2 * g + 1]), all_off / n as f64));
+        // A pixel whose light only merging samples (a caustic seen in a mirror) must merge: its
+        // moment without merging is infinite. A candidate that misses light in some pixel
+        // whatever it merges is out.
+        if (0..n).any(|p| on(p).is_infinite() && off(p).is_infinite()) {
+            continue;
+        }
+        let must: Vec<usize> = (0..n).filter(|&p| off(p).is_infinite()).collect();
+        let free = |p: &usize| !off(*p).is_infinite() && !on(*p).is_infinite();
+        let mut v: f64 = must.iter().map(|&p| on(p)).sum::<f64>()
+            + (0..n).filter(free).map(off).sum::<f64>();
+        let mut c = cost0 + must.iter().map(|&p| merge_cost(p)).sum::<f64>();
         // Pixels where merging lowers the moment, by moment saved per cost added.
         let mut gain: Vec<(f64, usize)> = (0..n)
-            .filter(|&p| on(p) < off(p))
+            .filter(|p| free(p) && on(*p) < off(*p))
             .map(|p| ((off(p) - on(p)) / merge_cost(p).max(1e-9), p))
             .collect();
         gain.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        let (mut v, mut c) = ((0..n).map(off).sum::<f64>(), cost0);
         let (mut best_j, mut best_len) = (v * c, 0);
         for (i, &(_, p)) in gain.iter().enumerate() {
             v -= off(p) - on(p);
@@ -533,7 +575,7 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
         let predicted = best_j / n as f64;
         if best.as_ref().is_none_or(|b| predicted < b.predicted) {
             let mut mask = vec![false; n];
-            for &(_, p) in &gain[..best_len] {
+            for &p in must.iter().chain(gain[..best_len].iter().map(|(_, p)| p)) {
                 mask[p] = true;
             }
             best = Some(Choice {
@@ -549,7 +591,15 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
             });
         }
     }
-    let mut choice = best.expect("at least one candidate");
+    // Every global candidate ruled out (light no candidate samples, e.g. a path only vertex
+    // connections make): the pilot's own configuration, which runs every technique.
+    let mut choice = best.unwrap_or_else(|| Choice {
+        counts: PILOT,
+        merge_mask: Arc::from(vec![true; n]),
+        predicted: f64::INFINITY,
+        fixed: Vec::new(),
+        merge_correlation: kappa,
+    });
     choice.fixed = fixed;
     choice
 }

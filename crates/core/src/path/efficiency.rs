@@ -63,7 +63,9 @@ impl Counts {
 
     /// One pilot sample's share of the second moment M(`self`): w · v² · n_u p_u / q_c, for a
     /// sample of weight `weight` and unweighted value `value` whose effective densities under
-    /// `pilot` are `mixture` (0 where no technique of `self` makes the path and f² = 0 there).
+    /// `pilot` are `mixture`. Infinite where the sample carries light but no technique of `self`
+    /// makes its path (q_c = 0): `self` would miss that light, an error no number of samples
+    /// removes.
     pub fn second_moment_term(
         &self,
         weight: f64,
@@ -72,10 +74,13 @@ impl Counts {
         pilot: &Counts,
     ) -> f64 {
         let q = self.total(mixture, pilot);
-        if q > 0.0 && mixture.own > 0.0 {
-            weight * value * value * mixture.own / q
-        } else {
+        let term = weight * value * value;
+        if !(mixture.own > 0.0) || term == 0.0 {
             0.0
+        } else if q > 0.0 {
+            term * mixture.own / q
+        } else {
+            f64::INFINITY
         }
     }
 }

@@ -246,11 +246,7 @@ fn tally_entry(ctx: &Ctx, spec: &RunSpec) -> Result<TallyEntry, String> {
         .map_err(|e| e.to_string())?;
         write_atomic(&tmp.join("tally.json"), text.as_bytes())
     })?;
-    let path = dir.join("tally.json");
-    let v: Value = serde_json::from_str(
-        &std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?,
-    )
-    .map_err(|e| format!("{}: {e}", path.display()))?;
+    let v = read_json(&dir.join("tally.json"))?;
     let f = |v: &Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
     let mut e = TallyEntry {
         seconds: f(&v, "seconds_per_pass"),
@@ -268,6 +264,12 @@ fn tally_entry(ctx: &Ctx, spec: &RunSpec) -> Result<TallyEntry, String> {
             .insert(name, (f(t, "mean"), f(t, "second_moment"), f(t, "seconds")));
     }
     Ok(e)
+}
+
+/// A cache entry's JSON file, parsed.
+fn read_json(path: &Path) -> Result<Value, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// A technique's family, for the summary's condensed tables.
@@ -648,7 +650,7 @@ fn inefficiency(
     for scene in &plan.scenes {
         let reference = ctx.reference_at(&plan.scale, scene, None)?;
         let mut by_label: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
-        let mut choices = Vec::new();
+        let (mut choices, mut pilot_share, mut without_pilot) = (Vec::new(), Vec::new(), Vec::new());
         for &(lab, integ, params) in COMPARED {
             let (mut rel, mut secs, mut ineff, mut over) =
                 (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -665,13 +667,16 @@ fn inefficiency(
                 } else {
                     let e = plain_entry(ctx, &run_spec)?;
                     *tally_cpu += e.1;
-                    if lab == "eamis" {
-                        choices.push(e.2);
-                    }
                     over.push(f64::NAN);
                     (e.0, e.1)
                 };
                 let r = rel_mse(&read_exr(&dir.join("plain.exr"))?, &reference);
+                if lab == "eamis" {
+                    let (choice, pilot) = eamis_choice(&dir)?;
+                    choices.push(choice);
+                    pilot_share.push(pilot / plain_cpu);
+                    without_pilot.push(r * (plain_cpu - pilot));
+                }
                 rel.push(r);
                 secs.push(plain_cpu);
                 ineff.push(r * plain_cpu);
@@ -687,12 +692,10 @@ fn inefficiency(
                 iv(&over, conf).1,
             ]);
         }
-        efficiency_aware_rows.push(efficiency_aware_row(
-            &stem(scene),
-            &by_label,
-            &choices,
-            conf,
-        ));
+        by_label.insert("eamis without its pilot", without_pilot);
+        let mut row = efficiency_aware_row(&stem(scene), &by_label, &choices, conf);
+        row.push(iv(&pilot_share, conf).1);
+        efficiency_aware_rows.push(row);
     }
     out.table(
         "inefficiency",
@@ -725,7 +728,10 @@ fn inefficiency(
              best of its {} fixed configurations by mean relMSE × seconds (each rendered without \
              a pilot, `eamis fixed=…`), and the ratio eamis / best fixed with an interval from \
              the two Student-t intervals' ends (conservative). A ratio above 1 is the pilot's \
-             cost (one pass of {} on one thread, with moments and counts) or a wrong choice.",
+             cost (one pass of {} on one thread, merging everywhere, with moments and counts) \
+             or a wrong choice: the last two columns separate them — the ratio with the pilot's \
+             CPU seconds taken out of eamis's (its image keeps the pilot pass), and the \
+             pilot's share of eamis's CPU time.",
             COMPARED
                 .iter()
                 .filter(|c| c.0.starts_with(FIXED_PREFIX))
@@ -739,6 +745,8 @@ fn inefficiency(
             "best fixed",
             "its relMSE × s",
             "eamis / best fixed",
+            "without the pilot's CPU",
+            "pilot share of CPU",
         ],
         efficiency_aware_rows,
         true,
@@ -766,32 +774,41 @@ fn efficiency_aware_row(
         .collect::<Vec<_>>()
         .join("; ");
     let Some(e) = by_label.get("eamis").map(|v| interval(v)) else {
-        return vec![scene.into(), chose, "—".into(), "—".into(), "—".into(), "—".into()];
+        let dash = || "—".to_string();
+        return vec![scene.into(), chose, dash(), dash(), dash(), dash(), dash()];
     };
+    let bare = by_label
+        .get("eamis without its pilot")
+        .filter(|v| !v.is_empty())
+        .map(|v| interval(v));
     let show = |i: &lt_estimators::bias_variance::Interval| {
         format!("{} [{}, {}]", num(i.estimate), num(i.lo), num(i.hi))
     };
+    let ratio = |a: &lt_estimators::bias_variance::Interval,
+                 b: &lt_estimators::bias_variance::Interval| {
+        let hi = if b.lo > 0.0 { a.hi / b.lo } else { f64::INFINITY };
+        format!("{} [{}, {}]", num(a.estimate / b.estimate), num(a.lo / b.hi), num(hi))
+    };
     match best {
-        None => vec![scene.into(), chose, show(&e), "—".into(), "—".into(), "—".into()],
-        Some((label, b)) => {
-            let ratio = e.estimate / b.estimate;
-            let lo = e.lo / b.hi;
-            let hi = if b.lo > 0.0 { e.hi / b.lo } else { f64::INFINITY };
-            vec![
-                scene.into(),
-                chose,
-                show(&e),
-                label.trim_start_matches(FIXED_PREFIX).to_string(),
-                show(&b),
-                format!("{} [{}, {}]", num(ratio), num(lo), num(hi)),
-            ]
+        None => {
+            let dash = || "—".to_string();
+            vec![scene.into(), chose, show(&e), dash(), dash(), dash(), dash()]
         }
+        Some((label, b)) => vec![
+            scene.into(),
+            chose,
+            show(&e),
+            label.trim_start_matches(FIXED_PREFIX).to_string(),
+            show(&b),
+            ratio(&e, &b),
+            bare.map_or("—".into(), |x| ratio(&x, &b)),
+        ],
     }
 }
 
-/// A plain render on one thread (an integrator `tally_run` does not take): its cache entry, CPU
-/// seconds, and the choice its record states (eamis: `eamis_*` facts).
-fn plain_entry(ctx: &Ctx, spec: &RunSpec) -> Result<(PathBuf, f64, String), String> {
+/// A plain render on one thread (an integrator `tally_run` does not take): its cache entry (the
+/// image and the record's facts) and CPU seconds.
+fn plain_entry(ctx: &Ctx, spec: &RunSpec) -> Result<(PathBuf, f64), String> {
     let scene = spec.load_scene()?;
     let mut material = spec.key_material(&scene)?;
     material["what"] = json!("techniques-plain");
@@ -812,20 +829,28 @@ fn plain_entry(ctx: &Ctx, spec: &RunSpec) -> Result<(PathBuf, f64, String), Stri
         .map_err(|e| e.to_string())?;
         write_atomic(&tmp.join("plain.json"), text.as_bytes())
     })?;
-    let path = dir.join("plain.json");
-    let v: Value = serde_json::from_str(
-        &std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?,
-    )
-    .map_err(|e| format!("{}: {e}", path.display()))?;
+    let v = read_json(&dir.join("plain.json"))?;
+    Ok((dir, v["plain_cpu_seconds"].as_f64().unwrap_or(f64::NAN)))
+}
+
+/// What eamis chose in the run cached in `dir` (from its record's `eamis_*` facts), and the CPU
+/// seconds its pilot took.
+fn eamis_choice(dir: &Path) -> Result<(String, f64), String> {
+    let v = read_json(&dir.join("plain.json"))?;
     let fact = |k: &str| v["facts"][k].as_str().unwrap_or("?").to_string();
     let merging: f64 = fact("eamis_merging_pixels").parse().unwrap_or(f64::NAN);
     let choice = format!(
         "M {}×, vc {}, merge {:.0} %",
         fact("eamis_light_ratio"),
-        if fact("eamis_vertex_connections") == "true" { "on" } else { "off" },
+        if fact("eamis_vertex_connections") == "true" {
+            "on"
+        } else {
+            "off"
+        },
         100.0 * merging
     );
-    Ok((dir, v["plain_cpu_seconds"].as_f64().unwrap_or(f64::NAN), choice))
+    let pilot = fact("eamis_pilot_cpu_seconds").parse().unwrap_or(f64::NAN);
+    Ok((choice, pilot))
 }
 
 /// The `Work` a table label names (for ordering rows).
