@@ -39,16 +39,17 @@
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `mis` | power/balance/none | balance | heuristic (the prediction is the balance heuristic's) |
 //! | `pilot_passes` | u32 | 1 | passes of the pilot (all techniques) before the choice |
-//! | `fixed` | text | — | no pilot: render every pass with one candidate, `m<ratio>_vc<0/1>_<merge/nomerge>` (e.g. `m2_vc0_merge`): the fixed configurations the choice is measured against |
-//! | `light_paths` | u64 | — | refused: eamis chooses it |
+//! | `fixed` | m0.25_vc1_merge/m0.25_vc1_nomerge/m0.25_vc0_merge/m0.25_vc0_nomerge/m0.5_vc1_merge/m0.5_vc1_nomerge/m0.5_vc0_merge/m0.5_vc0_nomerge/m1_vc1_merge/m1_vc1_nomerge/m1_vc0_merge/m1_vc0_nomerge/m2_vc1_merge/m2_vc1_nomerge/m2_vc0_merge/m2_vc0_nomerge | — | no pilot: render every pass with one candidate, m(M per pixel)_vc(vertex connections)_(merge or not everywhere): the fixed configurations the choice is measured against |
 //! | `radius_px` | f32 | 2 | initial radius in pixel footprints at the mean primary-hit distance |
 //! | `radius_scene` | f32 | — | initial radius as a fraction of the scene's bounding-sphere diameter |
 //! | `radius` | f32 | — | initial radius in scene units |
 //! | `alpha` | f64 | 0.75 | radius reduction α: rᵢ = r₀ i^((α−1)/2) |
-//! | `correlation_aware` | true/false | false | refused when true (the prediction assumes η counts) |
-//! | `vertex_connections` | true/false | — | refused: eamis chooses it |
+//!
+//! The light subpath count and vertex connections are the choice's, so they are not keys;
+//! correlation-aware weights are not offered (the prediction counts merges from η weights).
 
-use crate::connect_merge::{pixel_of, MergeMask, Run, Techniques, VcmParams};
+use crate::connect_merge::{pixel_of, MergeMask, Run, VcmParams, DEFAULT_ALPHA};
+use crate::radius::InitialRadius;
 use crate::params::ParamReader;
 use crate::record::{Completed, Merged, Recorder, Work};
 use crate::{Progressive, ProgressiveRun, ProgressLog};
@@ -109,21 +110,29 @@ pub fn fixed_candidates() -> Vec<Counts> {
 
 impl Eamis {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<Eamis, String> {
-        let mut params = VcmParams::read(scene, r, "eamis", Techniques::VCM)?;
-        if r.get_with("mis", Heuristic::parse)?.is_none() {
-            params.mis = Heuristic::Balance;
-        }
-        if params.light_paths.is_some() {
-            return Err("eamis chooses light_paths itself; leave it out".into());
-        }
-        if params.correlation_aware {
-            return Err("eamis predicts moments with merging counted η times: correlation_aware \
-                        must stay false"
+        if scene.camera.is_delta_direction() {
+            return Err("eamis cannot render through an orthographic camera (a delta in \
+                        direction: no light-tracing connection reaches it); use pt or bdpt"
                 .into());
         }
-        if r.get::<bool>("vertex_connections")?.is_some() {
-            return Err("eamis chooses vertex_connections itself; leave it out".into());
+        let alpha = r.get::<f64>("alpha")?.unwrap_or(DEFAULT_ALPHA);
+        if !(alpha > 0.0 && alpha <= 1.0) {
+            return Err(format!("eamis: alpha must be in (0, 1], got {alpha}"));
         }
+        let params = VcmParams {
+            max_depth: r.max_depth(scene)?,
+            rr_depth: r.rr_depth(scene)?,
+            mis: r
+                .get_with("mis", Heuristic::parse)?
+                .unwrap_or(Heuristic::Balance),
+            light_paths: None,
+            radius: InitialRadius::read(r, "eamis")?,
+            alpha,
+            connections: true,
+            merging: true,
+            correlation_aware: false,
+            vertex_connections: true,
+        };
         let pilot_passes = r.get::<u32>("pilot_passes")?.unwrap_or(1);
         if pilot_passes == 0 {
             return Err("eamis: pilot_passes must be at least 1".into());
@@ -484,6 +493,34 @@ fn merge_correlation(probe: &Probe, rel: &[f64]) -> f64 {
     }
 }
 
+/// How much lower than merging everywhere or nowhere a per-pixel mask's predicted inefficiency
+/// must be for eamis to use it.
+pub const MASK_MARGIN: f64 = 1.25;
+
+/// The moments' box filter reaches this many pixels each way.
+pub const FILTER_REACH: usize = 3;
+
+/// Pixels within this many of one where the pilot found light only merging makes merge too.
+pub const MUST_MERGE_REACH: usize = 4;
+
+/// `mask` grown by `reach` pixels in x and y.
+fn dilate(mask: &[bool], w: usize, h: usize, reach: usize) -> Vec<bool> {
+    let mut out = vec![false; mask.len()];
+    for y in 0..h {
+        for x in 0..w {
+            if !mask[y * w + x] {
+                continue;
+            }
+            for ny in y.saturating_sub(reach)..(y + reach + 1).min(h) {
+                for nx in x.saturating_sub(reach)..(x + reach + 1).min(w) {
+                    out[ny * w + nx] = true;
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Per-pixel rows of `nc` values averaged over each pixel's 3 × 3 neighbourhood (clamped at the
 /// film's edges).
 fn box_filter(values: &[f64], nc: usize, w: usize, h: usize) -> Vec<f64> {
@@ -492,8 +529,8 @@ fn box_filter(values: &[f64], nc: usize, w: usize, h: usize) -> Vec<f64> {
         for x in 0..w {
             let row = &mut out[(y * w + x) * nc..(y * w + x + 1) * nc];
             let mut count = 0.0;
-            for ny in y.saturating_sub(1)..(y + 2).min(h) {
-                for nx in x.saturating_sub(1)..(x + 2).min(w) {
+            for ny in y.saturating_sub(FILTER_REACH)..(y + FILTER_REACH + 1).min(h) {
+                for nx in x.saturating_sub(FILTER_REACH)..(x + FILTER_REACH + 1).min(w) {
                     let src = &values[(ny * w + nx) * nc..(ny * w + nx + 1) * nc];
                     row.iter_mut().zip(src).for_each(|(a, b)| *a += b);
                     count += 1.0;
@@ -525,6 +562,14 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
     // which then merge too, since a rare path the pilot saw once is likely near).
     let (w, h) = (probe.width as usize, probe.height as usize);
     let moments = box_filter(&probe.moments, nc, w, h);
+    // Light only merging reaches, seen by the pilot in one pixel, is likely in the pixels around
+    // it that one pass did not sample: every pixel within `MUST_MERGE_REACH` of one merges.
+    let only_merging: Vec<bool> = (0..n)
+        .map(|p| {
+            (0..globals().len()).any(|g| probe.moments[p * nc + 2 * g + 1].is_infinite())
+        })
+        .collect();
+    let must_merge = dilate(&only_merging, w, h, MUST_MERGE_REACH);
     let mut best: Option<Choice> = None;
     let mut fixed = Vec::new();
     for (g, (ratio, vc)) in globals().into_iter().enumerate() {
@@ -552,8 +597,10 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
         if (0..n).any(|p| on(p).is_infinite() && off(p).is_infinite()) {
             continue;
         }
-        let must: Vec<usize> = (0..n).filter(|&p| off(p).is_infinite()).collect();
-        let free = |p: &usize| !off(*p).is_infinite() && !on(*p).is_infinite();
+        let must: Vec<usize> = (0..n)
+            .filter(|&p| off(p).is_infinite() || (must_merge[p] && !on(p).is_infinite()))
+            .collect();
+        let free = |p: &usize| !must_merge[*p] && !off(*p).is_infinite() && !on(*p).is_infinite();
         let mut v: f64 = must.iter().map(|&p| on(p)).sum::<f64>()
             + (0..n).filter(free).map(off).sum::<f64>();
         let mut c = cost0 + must.iter().map(|&p| merge_cost(p)).sum::<f64>();
@@ -572,12 +619,23 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
                 best_len = i + 1;
             }
         }
-        let predicted = best_j / n as f64;
-        if best.as_ref().is_none_or(|b| predicted < b.predicted) {
-            let mut mask = vec![false; n];
-            for &p in must.iter().chain(gain[..best_len].iter().map(|(_, p)| p)) {
-                mask[p] = true;
+        // The per-pixel mask must beat merging everywhere and nowhere by `MASK_MARGIN`: one pilot
+        // pass under-predicts rare, heavy-tailed light in the pixels it turns merging off in.
+        let uniform = all_on.min(all_off);
+        let use_mask = best_j * MASK_MARGIN < uniform;
+        let (predicted, everywhere) = if use_mask {
+            (best_j / n as f64, false)
+        } else {
+            (uniform / n as f64, all_on <= all_off)
+        };
+        if predicted.is_finite() && best.as_ref().is_none_or(|b| predicted < b.predicted) {
+            let mut mask = vec![everywhere; n];
+            if use_mask {
+                for &p in must.iter().chain(gain[..best_len].iter().map(|(_, p)| p)) {
+                    mask[p] = true;
+                }
             }
+            let best_len = mask.iter().filter(|&&m| m).count();
             best = Some(Choice {
                 counts: Counts {
                     light_ratio: ratio,

@@ -14,7 +14,8 @@ use std::path::PathBuf;
 pub struct MisCheckArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    /// Integrator whose weights are checked: pt, bdpt, lvc-bdpt, vcm or bpm.
+    /// Integrator whose weights are checked: pt, bdpt, lvc-bdpt, vcm or bpm (for eamis, its counts are
+    /// checked through vcm with `--no-vertex-connections --checkerboard-merging`).
     #[arg(long, default_value = "bdpt")]
     pub integrator: String,
     /// MIS heuristic: power (the integrators' default), balance, or none (bdpt only).
