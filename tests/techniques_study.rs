@@ -50,8 +50,12 @@ fn the_techniques_study_writes_its_files_and_its_techniques_add_up() {
         .and_then(|head| {
             let words: Vec<&str> = head.split_whitespace().collect();
             let n = words.len();
-            (n >= 3 && words[n - 2] == "of")
-                .then(|| (words[n - 3].parse::<u32>().ok(), words[n - 1].parse::<u32>().ok()))
+            (n >= 3 && words[n - 2] == "of").then(|| {
+                (
+                    words[n - 3].parse::<u32>().ok(),
+                    words[n - 1].parse::<u32>().ok(),
+                )
+            })
         })
         .and_then(|(a, b)| Some((a?, b?)))
         .expect("the summary counts the bit-equal images");

@@ -29,19 +29,19 @@ use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkL
 use crate::{ProgressLog, ProgressiveRun};
 use lt_core::bsdf::TransportMode;
 use lt_core::math::{Color, Vec2, Vec3, PI};
+use lt_core::path::camis::{Mixture, Weighed};
 use lt_core::path::scatter::{connectable, connectable_inside};
 use lt_core::path::subpath_mis::{ConnectionDensities, NextEventDensities, VertexTechniques};
 use lt_core::path::{
     camis, CameraMis, Chain, Correlation, Heuristic, LightMis, PathVertex, SubpathMis, Technique,
     TechniqueSet, VertexKind,
 };
-use lt_core::path::camis::{Mixture, Weighed};
-use std::sync::Arc;
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::spatial::PointGrid;
 use lt_core::Scene;
 use lt_estimators::Image;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// The techniques and schedule of a VCM-family estimator.
 #[derive(Clone, Copy, Debug)]
@@ -303,7 +303,14 @@ impl FullPathSetup {
         if !self.merges_at(raster) {
             set.merging_eta = 0.0;
         }
-        camis::weigh_full(chain, set, Some(&corr), self.correlation, technique, self.heuristic)
+        camis::weigh_full(
+            chain,
+            set,
+            Some(&corr),
+            self.correlation,
+            technique,
+            self.heuristic,
+        )
     }
 
     /// The weight of connection technique (s, t) formed by `split` (`strategy_weight`).
@@ -765,7 +772,10 @@ impl<'a> Engine<'a> {
         }
         if camera.len() == 1 {
             let (l0, _) = emission_densities(scene, x0, None);
-            return (mis.emitter_seen(c0 as f64, l0, joinable(scene, x0, x1)), None);
+            return (
+                mis.emitter_seen(c0 as f64, l0, joinable(scene, x0, x1)),
+                None,
+            );
         }
         // VC(1) is next-event estimation from x1 (`Chain::valid`); x1 is inside this path.
         let vc1 = connectable_inside(scene, x1);
@@ -893,7 +903,10 @@ impl<'a> Engine<'a> {
                 let wd = camis.connection(scene, split, evals, ctx.primary, ctx.raster);
                 (wd.weight, Some(wd.mixture))
             }
-            None => (ctx.mis.connection(&ly[s - 1], (&zr[t - 1], &zr[t - 2]), d), None),
+            None => (
+                ctx.mis.connection(&ly[s - 1], (&zr[t - 1], &zr[t - 2]), d),
+                None,
+            ),
         };
         if R::ACTIVE {
             if let Some(m) = mixture {

@@ -49,10 +49,10 @@
 //! correlation-aware weights are not offered (the prediction counts merges from η weights).
 
 use crate::connect_merge::{pixel_of, MergeMask, Run, VcmParams, DEFAULT_ALPHA};
-use crate::radius::InitialRadius;
 use crate::params::ParamReader;
+use crate::radius::InitialRadius;
 use crate::record::{Completed, Merged, Recorder, Work};
-use crate::{Progressive, ProgressiveRun, ProgressLog};
+use crate::{ProgressLog, Progressive, ProgressiveRun};
 use lt_core::math::Color;
 use lt_core::path::camis::Mixture;
 use lt_core::path::efficiency::Counts;
@@ -111,9 +111,11 @@ pub fn fixed_candidates() -> Vec<Counts> {
 impl Eamis {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<Eamis, String> {
         if scene.camera.is_delta_direction() {
-            return Err("eamis cannot render through an orthographic camera (a delta in \
+            return Err(
+                "eamis cannot render through an orthographic camera (a delta in \
                         direction: no light-tracing connection reaches it); use pt or bdpt"
-                .into());
+                    .into(),
+            );
         }
         let alpha = r.get::<f64>("alpha")?.unwrap_or(DEFAULT_ALPHA);
         if !(alpha > 0.0 && alpha <= 1.0) {
@@ -145,7 +147,10 @@ impl Eamis {
                     .find(|c| label(c) == name)
                     .ok_or_else(|| {
                         let known: Vec<String> = fixed_candidates().iter().map(label).collect();
-                        format!("eamis: unknown fixed = '{name}' (known: {})", known.join(", "))
+                        format!(
+                            "eamis: unknown fixed = '{name}' (known: {})",
+                            known.join(", ")
+                        )
                     })?,
             ),
         };
@@ -295,12 +300,12 @@ impl ProgressiveRun for EamisRun<'_> {
                     format!("{:.4}", merging as f64 / c.merge_mask.len().max(1) as f64),
                 ),
                 ("eamis_predicted", format!("{:.6e}", c.predicted)),
-                ("eamis_merge_correlation", format!("{:.4}", c.merge_correlation)),
-                ("eamis_pilot_cpu_seconds", format!("{:.6}", self.pilot_cpu)),
                 (
-                    "eamis_pilot_passes",
-                    format!("{}", self.pilot.sum().1),
+                    "eamis_merge_correlation",
+                    format!("{:.4}", c.merge_correlation),
                 ),
+                ("eamis_pilot_cpu_seconds", format!("{:.6}", self.pilot_cpu)),
+                ("eamis_pilot_passes", format!("{}", self.pilot.sum().1)),
             ];
             log.facts
                 .extend(facts.into_iter().map(|(k, v)| (k.to_string(), v)));
@@ -430,12 +435,7 @@ impl Recorder for Probe {
             return;
         };
         let light_tracing = p.s >= 1 && p.camera.len() == 1;
-        let value = channel_mean(p.value)
-            * if light_tracing {
-                1.0
-            } else {
-                self.film_weight
-            };
+        let value = channel_mean(p.value) * if light_tracing { 1.0 } else { self.film_weight };
         let pixel = pixel_of(p.raster, self.width, self.height);
         self.add(pixel, p.weight, value, &m);
         if light_tracing {
@@ -565,9 +565,7 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
     // Light only merging reaches, seen by the pilot in one pixel, is likely in the pixels around
     // it that one pass did not sample: every pixel within `MUST_MERGE_REACH` of one merges.
     let only_merging: Vec<bool> = (0..n)
-        .map(|p| {
-            (0..globals().len()).any(|g| probe.moments[p * nc + 2 * g + 1].is_infinite())
-        })
+        .map(|p| (0..globals().len()).any(|g| probe.moments[p * nc + 2 * g + 1].is_infinite()))
         .collect();
     let must_merge = dilate(&only_merging, w, h, MUST_MERGE_REACH);
     let mut best: Option<Choice> = None;
@@ -601,8 +599,8 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
             .filter(|&p| off(p).is_infinite() || (must_merge[p] && !on(p).is_infinite()))
             .collect();
         let free = |p: &usize| !must_merge[*p] && !off(*p).is_infinite() && !on(*p).is_infinite();
-        let mut v: f64 = must.iter().map(|&p| on(p)).sum::<f64>()
-            + (0..n).filter(free).map(off).sum::<f64>();
+        let mut v: f64 =
+            must.iter().map(|&p| on(p)).sum::<f64>() + (0..n).filter(free).map(off).sum::<f64>();
         let mut c = cost0 + must.iter().map(|&p| merge_cost(p)).sum::<f64>();
         // Pixels where merging lowers the moment, by moment saved per cost added.
         let mut gain: Vec<(f64, usize)> = (0..n)

@@ -3,6 +3,7 @@
 
 use crate::bdpt::{Bdpt, BdptParams};
 use crate::bpm::Bpm;
+use crate::eamis::Eamis;
 use crate::light::{LightParams, LightTracer};
 use crate::lvc_bdpt::{LvcBdpt, LvcParams};
 use crate::params::{IntegratorParams, ParamReader};
@@ -11,7 +12,6 @@ use crate::ppm::Ppm;
 use crate::pt::{Pt, PtParams};
 use crate::pt_bsdf::{PtBsdf, PtBsdfParams};
 use crate::sppm::Sppm;
-use crate::eamis::Eamis;
 use crate::vcm::Vcm;
 use crate::{Estimator, Kind};
 use lt_core::Scene;

@@ -59,7 +59,6 @@ pub struct Scale {
     pub folder_suffix: &'static str,
 }
 
-
 pub const ALL_ALPHAS: [f64; 6] = [0.3, 0.5, 2.0 / 3.0, 0.75, 0.9, 1.0];
 
 /// The shipped scenes (every `.toml` in the folder), sorted by name.

@@ -56,24 +56,92 @@ pub const COMPARED: &[Config] = &[
     ("lvc-bdpt N=4", "lvc-bdpt", &[("connections", "4")]),
     ("lvc-bdpt N=16", "lvc-bdpt", &[("connections", "16")]),
     ("vcm", "vcm", &[]),
-    ("vcm correlation-aware", "vcm", &[("correlation_aware", "true")]),
+    (
+        "vcm correlation-aware",
+        "vcm",
+        &[("correlation_aware", "true")],
+    ),
     ("eamis", "eamis", &[]),
-    ("eamis fixed m0.25_vc1_merge", "eamis", &[("fixed", "m0.25_vc1_merge")]),
-    ("eamis fixed m0.25_vc1_nomerge", "eamis", &[("fixed", "m0.25_vc1_nomerge")]),
-    ("eamis fixed m0.25_vc0_merge", "eamis", &[("fixed", "m0.25_vc0_merge")]),
-    ("eamis fixed m0.25_vc0_nomerge", "eamis", &[("fixed", "m0.25_vc0_nomerge")]),
-    ("eamis fixed m0.5_vc1_merge", "eamis", &[("fixed", "m0.5_vc1_merge")]),
-    ("eamis fixed m0.5_vc1_nomerge", "eamis", &[("fixed", "m0.5_vc1_nomerge")]),
-    ("eamis fixed m0.5_vc0_merge", "eamis", &[("fixed", "m0.5_vc0_merge")]),
-    ("eamis fixed m0.5_vc0_nomerge", "eamis", &[("fixed", "m0.5_vc0_nomerge")]),
-    ("eamis fixed m1_vc1_merge", "eamis", &[("fixed", "m1_vc1_merge")]),
-    ("eamis fixed m1_vc1_nomerge", "eamis", &[("fixed", "m1_vc1_nomerge")]),
-    ("eamis fixed m1_vc0_merge", "eamis", &[("fixed", "m1_vc0_merge")]),
-    ("eamis fixed m1_vc0_nomerge", "eamis", &[("fixed", "m1_vc0_nomerge")]),
-    ("eamis fixed m2_vc1_merge", "eamis", &[("fixed", "m2_vc1_merge")]),
-    ("eamis fixed m2_vc1_nomerge", "eamis", &[("fixed", "m2_vc1_nomerge")]),
-    ("eamis fixed m2_vc0_merge", "eamis", &[("fixed", "m2_vc0_merge")]),
-    ("eamis fixed m2_vc0_nomerge", "eamis", &[("fixed", "m2_vc0_nomerge")]),
+    (
+        "eamis fixed m0.25_vc1_merge",
+        "eamis",
+        &[("fixed", "m0.25_vc1_merge")],
+    ),
+    (
+        "eamis fixed m0.25_vc1_nomerge",
+        "eamis",
+        &[("fixed", "m0.25_vc1_nomerge")],
+    ),
+    (
+        "eamis fixed m0.25_vc0_merge",
+        "eamis",
+        &[("fixed", "m0.25_vc0_merge")],
+    ),
+    (
+        "eamis fixed m0.25_vc0_nomerge",
+        "eamis",
+        &[("fixed", "m0.25_vc0_nomerge")],
+    ),
+    (
+        "eamis fixed m0.5_vc1_merge",
+        "eamis",
+        &[("fixed", "m0.5_vc1_merge")],
+    ),
+    (
+        "eamis fixed m0.5_vc1_nomerge",
+        "eamis",
+        &[("fixed", "m0.5_vc1_nomerge")],
+    ),
+    (
+        "eamis fixed m0.5_vc0_merge",
+        "eamis",
+        &[("fixed", "m0.5_vc0_merge")],
+    ),
+    (
+        "eamis fixed m0.5_vc0_nomerge",
+        "eamis",
+        &[("fixed", "m0.5_vc0_nomerge")],
+    ),
+    (
+        "eamis fixed m1_vc1_merge",
+        "eamis",
+        &[("fixed", "m1_vc1_merge")],
+    ),
+    (
+        "eamis fixed m1_vc1_nomerge",
+        "eamis",
+        &[("fixed", "m1_vc1_nomerge")],
+    ),
+    (
+        "eamis fixed m1_vc0_merge",
+        "eamis",
+        &[("fixed", "m1_vc0_merge")],
+    ),
+    (
+        "eamis fixed m1_vc0_nomerge",
+        "eamis",
+        &[("fixed", "m1_vc0_nomerge")],
+    ),
+    (
+        "eamis fixed m2_vc1_merge",
+        "eamis",
+        &[("fixed", "m2_vc1_merge")],
+    ),
+    (
+        "eamis fixed m2_vc1_nomerge",
+        "eamis",
+        &[("fixed", "m2_vc1_nomerge")],
+    ),
+    (
+        "eamis fixed m2_vc0_merge",
+        "eamis",
+        &[("fixed", "m2_vc0_merge")],
+    ),
+    (
+        "eamis fixed m2_vc0_nomerge",
+        "eamis",
+        &[("fixed", "m2_vc0_nomerge")],
+    ),
 ];
 
 /// The prefix of the fixed configurations' labels in `COMPARED`.
@@ -650,7 +718,8 @@ fn inefficiency(
     for scene in &plan.scenes {
         let reference = ctx.reference_at(&plan.scale, scene, None)?;
         let mut by_label: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
-        let (mut choices, mut pilot_share, mut without_pilot) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut choices, mut pilot_share, mut without_pilot) =
+            (Vec::new(), Vec::new(), Vec::new());
         for &(lab, integ, params) in COMPARED {
             let (mut rel, mut secs, mut ineff, mut over) =
                 (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -786,13 +855,30 @@ fn efficiency_aware_row(
     };
     let ratio = |a: &lt_estimators::bias_variance::Interval,
                  b: &lt_estimators::bias_variance::Interval| {
-        let hi = if b.lo > 0.0 { a.hi / b.lo } else { f64::INFINITY };
-        format!("{} [{}, {}]", num(a.estimate / b.estimate), num(a.lo / b.hi), num(hi))
+        let hi = if b.lo > 0.0 {
+            a.hi / b.lo
+        } else {
+            f64::INFINITY
+        };
+        format!(
+            "{} [{}, {}]",
+            num(a.estimate / b.estimate),
+            num(a.lo / b.hi),
+            num(hi)
+        )
     };
     match best {
         None => {
             let dash = || "—".to_string();
-            vec![scene.into(), chose, show(&e), dash(), dash(), dash(), dash()]
+            vec![
+                scene.into(),
+                chose,
+                show(&e),
+                dash(),
+                dash(),
+                dash(),
+                dash(),
+            ]
         }
         Some((label, b)) => vec![
             scene.into(),
@@ -820,7 +906,8 @@ fn plain_entry(ctx: &Ctx, spec: &RunSpec) -> Result<(PathBuf, f64), String> {
             .num_threads(1)
             .build()
             .map_err(|e| e.to_string())?;
-        let (img, cpu, facts) = pool.install(|| timed_plain_logged(&scene, &est, spec.seed, spec.passes));
+        let (img, cpu, facts) =
+            pool.install(|| timed_plain_logged(&scene, &est, spec.seed, spec.passes));
         write_exr(&tmp.join("plain.exr"), &img)?;
         let text = serde_json::to_string_pretty(&json!({
             "plain_cpu_seconds": cpu,

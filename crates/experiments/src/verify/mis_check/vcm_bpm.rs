@@ -242,7 +242,7 @@ pub fn collect(scene: &Scene, opts: &VcmOptions) -> (VcmCollector, u32) {
     let params = opts.params();
     let mut engine = Engine::new(&params, scene);
     let cam = &scene.camera;
-    let board = |i: usize| (i % cam.width as usize + i / cam.width as usize) % 2 == 0;
+    let board = |i: usize| (i % cam.width as usize + i / cam.width as usize).is_multiple_of(2);
     let mask: Option<MergeMask> = opts
         .checkerboard_merging
         .then(|| (0..cam.pixel_count()).map(board).collect());
