@@ -22,6 +22,7 @@ use crate::params::ParamReader;
 use crate::pixel::{pixel_sample, weighted};
 use crate::radius::InitialRadius;
 use crate::record::{Completed, Merged, NoRecord, Reached, Recorder, Work};
+pub use crate::splat::pixel_of;
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::strategy_weight::{with_chain, EndEvals, Split};
 use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
@@ -103,6 +104,31 @@ impl VcmParams {
         who: &str,
         techniques: Techniques,
     ) -> Result<VcmParams, String> {
+        let base = VcmParams::read_base(scene, r, who, Heuristic::Power)?;
+        Ok(VcmParams {
+            light_paths: r.light_paths()?,
+            connections: techniques.connections,
+            merging: techniques.merging,
+            correlation_aware: r.get::<bool>("correlation_aware")?.unwrap_or(false),
+            // bpm has no connections to turn off.
+            vertex_connections: if techniques.connections {
+                r.get::<bool>("vertex_connections")?.unwrap_or(true)
+            } else {
+                true
+            },
+            ..base
+        })
+    }
+
+    /// The keys every VCM-family estimator reads — `max_depth`, `rr_depth`, `mis` (default
+    /// `mis`), the initial radius and `alpha` — with one light subpath per pixel, every technique
+    /// and recursive weights; refuses an orthographic camera.
+    pub fn read_base(
+        scene: &Scene,
+        r: &ParamReader,
+        who: &str,
+        mis: Heuristic,
+    ) -> Result<VcmParams, String> {
         if scene.camera.is_delta_direction() {
             // Its MIS records count light tracing as a technique; with a camera that no
             // connection reaches, that share would be lost.
@@ -118,21 +144,14 @@ impl VcmParams {
         Ok(VcmParams {
             max_depth: r.max_depth(scene)?,
             rr_depth: r.rr_depth(scene)?,
-            mis: r
-                .get_with("mis", Heuristic::parse)?
-                .unwrap_or(Heuristic::Power),
-            light_paths: r.light_paths()?,
+            mis: r.get_with("mis", Heuristic::parse)?.unwrap_or(mis),
+            light_paths: None,
             radius: InitialRadius::read(r, who)?,
             alpha,
-            connections: techniques.connections,
-            merging: techniques.merging,
-            correlation_aware: r.get::<bool>("correlation_aware")?.unwrap_or(false),
-            // bpm has no connections to turn off.
-            vertex_connections: if techniques.connections {
-                r.get::<bool>("vertex_connections")?.unwrap_or(true)
-            } else {
-                true
-            },
+            connections: true,
+            merging: true,
+            correlation_aware: false,
+            vertex_connections: true,
         })
     }
 
@@ -326,13 +345,6 @@ impl FullPathSetup {
             self.weigh(chain, Technique::Connect(s), distance, raster)
         })
     }
-}
-
-/// The pixel (row-major) holding raster point `raster`, clamped to the film.
-pub fn pixel_of(raster: Vec2, width: u32, height: u32) -> usize {
-    let x = (raster.x.max(0.0) as u32).min(width - 1);
-    let y = (raster.y.max(0.0) as u32).min(height - 1);
-    (y * width + x) as usize
 }
 
 pub struct Engine<'a> {
@@ -641,6 +653,11 @@ impl<'a> Engine<'a> {
             } else {
                 0.0
             },
+            light_nee: if setup.camis.is_some() {
+                light_nee(scene, light.0)
+            } else {
+                0.0
+            },
             raster,
             rec: &mut *worker.rec,
         };
@@ -894,7 +911,7 @@ impl<'a> Engine<'a> {
                 let split = Split {
                     light: &y[..s],
                     camera: &z[..t],
-                    light_nee: light_nee(scene, y),
+                    light_nee: ctx.light_nee,
                 };
                 let evals = EndEvals {
                     light_end: Some(ev_y),
@@ -1067,6 +1084,9 @@ struct CameraSample<'a, R> {
     camis: Option<&'a FullPathSetup>,
     /// |z_1 − z_0|: the primary hit's distance (the footprint of correlation-aware MIS).
     primary: f32,
+    /// With full-path weights: next-event estimation's density of y_0 of the light subpath this
+    /// sample connects to (`light_nee`), read by each of its connections.
+    light_nee: f64,
     raster: Vec2,
     rec: &'a mut R,
 }

@@ -48,9 +48,8 @@
 //! The light subpath count and vertex connections are the choice's, so they are not keys;
 //! correlation-aware weights are not offered (the prediction counts merges from η weights).
 
-use crate::connect_merge::{pixel_of, MergeMask, Run, VcmParams, DEFAULT_ALPHA};
+use crate::connect_merge::{pixel_of, MergeMask, Run, VcmParams};
 use crate::params::ParamReader;
-use crate::radius::InitialRadius;
 use crate::record::{Completed, Merged, Recorder, Work};
 use crate::{ProgressLog, Progressive, ProgressiveRun};
 use lt_core::math::Color;
@@ -110,31 +109,8 @@ pub fn fixed_candidates() -> Vec<Counts> {
 
 impl Eamis {
     pub fn read(scene: &Scene, r: &ParamReader) -> Result<Eamis, String> {
-        if scene.camera.is_delta_direction() {
-            return Err(
-                "eamis cannot render through an orthographic camera (a delta in \
-                        direction: no light-tracing connection reaches it); use pt or bdpt"
-                    .into(),
-            );
-        }
-        let alpha = r.get::<f64>("alpha")?.unwrap_or(DEFAULT_ALPHA);
-        if !(alpha > 0.0 && alpha <= 1.0) {
-            return Err(format!("eamis: alpha must be in (0, 1], got {alpha}"));
-        }
-        let params = VcmParams {
-            max_depth: r.max_depth(scene)?,
-            rr_depth: r.rr_depth(scene)?,
-            mis: r
-                .get_with("mis", Heuristic::parse)?
-                .unwrap_or(Heuristic::Balance),
-            light_paths: None,
-            radius: InitialRadius::read(r, "eamis")?,
-            alpha,
-            connections: true,
-            merging: true,
-            correlation_aware: false,
-            vertex_connections: true,
-        };
+        // The pilot's configuration; the choice sets light paths, connections and merging.
+        let params = VcmParams::read_base(scene, r, "eamis", Heuristic::Balance)?;
         let pilot_passes = r.get::<u32>("pilot_passes")?.unwrap_or(1);
         if pilot_passes == 0 {
             return Err("eamis: pilot_passes must be at least 1".into());
@@ -565,7 +541,7 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
     // Light only merging reaches, seen by the pilot in one pixel, is likely in the pixels around
     // it that one pass did not sample: every pixel within `MUST_MERGE_REACH` of one merges.
     let only_merging: Vec<bool> = (0..n)
-        .map(|p| (0..globals().len()).any(|g| probe.moments[p * nc + 2 * g + 1].is_infinite()))
+        .map(|p| (0..nc / 2).any(|g| probe.moments[p * nc + 2 * g + 1].is_infinite()))
         .collect();
     let must_merge = dilate(&only_merging, w, h, MUST_MERGE_REACH);
     let mut best: Option<Choice> = None;

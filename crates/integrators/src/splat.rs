@@ -60,10 +60,17 @@ impl Splats {
             self.invalid += 1;
             return;
         }
-        let x = (raster.x as u32).min(self.width - 1);
-        let y = (raster.y as u32).min(self.height - 1);
-        self.entries.push((y * self.width + x, value));
+        let i = pixel_of(raster, self.width, self.height) as u32;
+        self.entries.push((i, value));
     }
+}
+
+/// The pixel (row-major) holding raster point `raster`, clamped to the film (a negative or NaN
+/// coordinate to 0, as `as u32` does).
+pub fn pixel_of(raster: Vec2, width: u32, height: u32) -> usize {
+    let x = (raster.x as u32).min(width - 1);
+    let y = (raster.y as u32).min(height - 1);
+    (y * width + x) as usize
 }
 
 /// Runs `work(item, splats, state)` for items 0..count in chunks of `chunk` and returns the summed
