@@ -125,6 +125,7 @@ pub fn integrator_rate(
         // A progressive run's first pass includes its set-up (a photon map, visible points).
         Estimator::Consistent(p) => {
             let mut run = pool.install(|| p.start(scene, 1));
+            run.plan(passes);
             for pass in 0..passes {
                 std::hint::black_box(pool.install(|| run.pass(pass)));
             }

@@ -10,9 +10,11 @@
 //! - merging on or off **per pixel**: η counts in the pixel a path lands in, 0 where it is off.
 //!
 //! Every weight comes from the full path's densities (`connect_merge`'s full-path route), so the
-//! per-pixel η is exact. The pilot passes belong to the image (each pass is a VCM estimate); the
-//! choice is a function of the pilot's samples alone, so the estimator stays consistent, and
-//! unbiased wherever merging is off. The pilot runs on one thread (its moment sums then do not
+//! per-pixel η is exact. The pilot passes are left out of the image once a pass has rendered
+//! with the choice (`keep_pilot` keeps them): they are full VCM passes, and on veach-bidir their
+//! merging's fireflies and bias made most of eamis's error (results/eamis.md). The choice is a
+//! function of the pilot's samples alone and the later passes are independent of them, so the
+//! estimator stays consistent, and unbiased wherever merging is off. The pilot runs on one thread (its moment sums then do not
 //! depend on the thread count) and the cost is counted, not timed, so the same seed gives the same
 //! choice and the same image bit for bit.
 //!
@@ -27,6 +29,34 @@
 //! contributions summed before squaring), and every merging candidate's prediction is scaled by
 //! measured / predicted of the pilot's own configuration (κ, `merge_correlation`).
 //!
+//! **Merging's bias.** Second moments alone favour merging where it is biased (Bitterli's
+//! veach-bidir: 16× the best fixed configuration's inefficiency). The pilot therefore also
+//! estimates each pixel's merging bias at the initial radius r₀ from its own merges: with a disk
+//! kernel, the estimate at r/√2 keeps the merges within r/√2 at twice their value, and where the
+//! blurred density is smooth the bias grows as r² (Knaus & Zwicker 2011, §4.2), so
+//! b(r) = 2 (F(r) − F(r/√2)), each merge adding w_c · v · (1 − 2·[d < r/√2]) under candidate c's
+//! own merge weight w_c (`Counts::merge_weight`). Per pixel, b² is estimated as the square of
+//! that sum less the sum of its terms' squares (the terms' signs have mean 0 where the photon
+//! density is smooth — half the disk's area lies within r/√2 — so their cross terms drop out),
+//! then averaged over the pixel's 7 × 7 neighbourhood like the moments and clamped at 0. The
+//! average keeps a small cluster's total: where merging leaks light through a thin wall
+//! (veach-bidir's lamp shade, 1 % of the pixels and 90 % of vcm's relMSE) the window's mean of
+//! differences would shrink it by the window's area. Over a render of
+//! P passes (`ProgressiveRun::plan`, else `DEFAULT_HORIZON`) whose radius shrinks as
+//! r_i² = r₀² i^(α−1), the image's bias is b₀ s(P), s(P) = (1/P) Σ_{i≤P} i^(α−1), so a merging
+//! pixel's per-pass moment becomes κ M + P s(P)² b₀²: the inefficiency of the whole render,
+//! relMSE × time, divided by P.
+//!
+//! **Light a configuration misses, and heavy tails.** A pilot sample whose path no technique of
+//! a candidate makes (q_c = 0: a caustic seen in a mirror, without merging) is light that
+//! candidate misses in every pass, a bias: it adds P b² to the pixel's moment. Such light seen
+//! in one pixel is likely in the pixels around it that one pass did not sample, so every pixel
+//! within `MUST_MERGE_REACH` of one merges. Without merging, a pixel's moment comes from every
+//! pilot sample (`Counts::second_moment_term`: merges are the better witnesses of light the
+//! other techniques find rarely, caustic-sds) except where merging's bias is predicted to
+//! outweigh its moment: there a merge witnesses a blurred integrand, and the moment comes from
+//! the other samples alone (`Counts::second_moment_term_without_merges`).
+//!
 //! **Which pixels matter.** The image's inefficiency is Σ_p M_p / (μ_p + 0.01)² × cost, the relative
 //! second moment (pbrt's relMSE guard; μ_p the pilot's estimate) summed over pixels: the merge
 //! mask is the prefix, by moment saved per cost added, that minimises it; the global choice the
@@ -39,6 +69,7 @@
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `mis` | power/balance/none | balance | heuristic (the prediction is the balance heuristic's) |
 //! | `pilot_passes` | u32 | 1 | passes of the pilot (all techniques) before the choice |
+//! | `keep_pilot` | bool | false | the pilot passes' image joins the estimate (else only the passes after the choice count, once there is one) |
 //! | `fixed` | m0.25_vc1_merge/m0.25_vc1_nomerge/m0.25_vc0_merge/m0.25_vc0_nomerge/m0.5_vc1_merge/m0.5_vc1_nomerge/m0.5_vc0_merge/m0.5_vc0_nomerge/m1_vc1_merge/m1_vc1_nomerge/m1_vc0_merge/m1_vc0_nomerge/m2_vc1_merge/m2_vc1_nomerge/m2_vc0_merge/m2_vc0_nomerge | — | no pilot: render every pass with one candidate, m(M per pixel)_vc(vertex connections)_(merge or not everywhere): the fixed configurations the choice is measured against |
 //! | `radius_px` | f32 | 2 | initial radius in pixel footprints at the mean primary-hit distance |
 //! | `radius_scene` | f32 | — | initial radius as a fraction of the scene's bounding-sphere diameter |
@@ -61,6 +92,10 @@ use lt_estimators::metrics::REL_MSE_GUARD;
 use lt_estimators::Image;
 use std::sync::Arc;
 
+/// The render length the bias is weighed over when the caller does not say
+/// (`ProgressiveRun::plan`).
+pub const DEFAULT_HORIZON: u32 = 16;
+
 /// Light subpaths per pixel the choice ranges over.
 pub const LIGHT_RATIOS: [f64; 4] = [0.25, 0.5, 1.0, 2.0];
 /// The cost model's unit costs, in units of 200 ns of one core of this machine, from one-thread
@@ -79,6 +114,8 @@ pub const COST_MERGE: f64 = 1.3;
 pub struct Eamis {
     pub params: VcmParams,
     pub pilot_passes: u32,
+    /// Whether the pilot passes' own image joins the estimate.
+    pub keep_pilot: bool,
     /// A candidate rendered without pilot or choice.
     pub fixed: Option<Counts>,
 }
@@ -130,9 +167,11 @@ impl Eamis {
                     })?,
             ),
         };
+        let keep_pilot = r.get::<bool>("keep_pilot")?.unwrap_or(false);
         Ok(Eamis {
             params,
             pilot_passes,
+            keep_pilot,
             fixed,
         })
     }
@@ -155,6 +194,7 @@ impl Progressive for Eamis {
             render: None,
             choice: None,
             pilot_cpu: 0.0,
+            horizon: DEFAULT_HORIZON,
         };
         if let Some(counts) = self.fixed {
             let mask = if counts.merging {
@@ -168,6 +208,8 @@ impl Progressive for Eamis {
                 predicted: f64::NAN,
                 fixed: Vec::new(),
                 merge_correlation: f64::NAN,
+                bias_share: f64::NAN,
+                must_merge: f64::NAN,
             });
         }
         Box::new(run)
@@ -186,6 +228,12 @@ pub struct Choice {
     pub fixed: Vec<(String, f64)>,
     /// κ, the pilot's measured second moment over its predicted one (`merge_correlation`).
     pub merge_correlation: f64,
+    /// The share of merging's bias in the pilot configuration's predicted inefficiency over the
+    /// horizon (0 … 1).
+    pub bias_share: f64,
+    /// The share of pixels that must merge (within `MUST_MERGE_REACH` of light only merging
+    /// found).
+    pub must_merge: f64,
 }
 
 struct EamisRun<'a> {
@@ -198,6 +246,8 @@ struct EamisRun<'a> {
     choice: Option<Choice>,
     /// CPU seconds the pilot passes took (the record's; nothing rendered depends on it).
     pilot_cpu: f64,
+    /// The passes the caller means to run, over which merging's bias is weighed.
+    horizon: u32,
 }
 
 impl EamisRun<'_> {
@@ -224,18 +274,32 @@ impl ProgressiveRun for EamisRun<'_> {
             return render.pass(pass);
         }
         let cpu0 = crate::tally::pool_cpu_seconds();
+        self.probe.bias_scale = 1.0 / self.eamis.params.radius_scale(pass).powi(2);
         let invalid = self.pilot.recorded_pass(pass, &mut self.probe);
         self.probe.flush();
         self.pilot_cpu += crate::tally::pool_cpu_seconds() - cpu0;
         self.probe.light_vertices += self.pilot.stored_light_vertices() as u64;
         if self.pilot.sum().1 >= self.eamis.pilot_passes {
-            let choice = choose(&self.probe, &self.pilot.estimate());
+            let horizon = Horizon {
+                passes: self.horizon.max(self.eamis.pilot_passes),
+                alpha: self.eamis.params.alpha,
+                pilot_passes: self.eamis.pilot_passes,
+            };
+            let choice = choose(&self.probe, &self.pilot.estimate(), &horizon);
             self.start_render(choice);
         }
         invalid
     }
 
+    fn plan(&mut self, passes: u32) {
+        self.horizon = passes;
+    }
+
     fn estimate(&self) -> Image {
+        let rendered = self.render.as_ref().is_some_and(|r| r.sum().1 > 0);
+        if rendered && !self.eamis.keep_pilot {
+            return self.render.as_ref().expect("rendered").estimate();
+        }
         let (sum, passes) = self.pilot.sum();
         let mut img = sum.clone();
         let mut total = passes;
@@ -280,6 +344,9 @@ impl ProgressiveRun for EamisRun<'_> {
                     "eamis_merge_correlation",
                     format!("{:.4}", c.merge_correlation),
                 ),
+                ("eamis_merge_bias_share", format!("{:.4}", c.bias_share)),
+                ("eamis_must_merge_pixels", format!("{:.4}", c.must_merge)),
+                ("eamis_horizon_passes", format!("{}", self.horizon)),
                 ("eamis_pilot_cpu_seconds", format!("{:.6}", self.pilot_cpu)),
                 ("eamis_pilot_passes", format!("{}", self.pilot.sum().1)),
             ];
@@ -314,6 +381,11 @@ const PILOT: Counts = Counts {
     merging: true,
 };
 
+/// The number of global candidates.
+fn candidates_len_half() -> usize {
+    globals().len()
+}
+
 /// The global candidates (M, vertex connections), each rendered with merging on (`2g`) or off
 /// (`2g + 1`) in a pixel.
 fn globals() -> Vec<(f64, bool)> {
@@ -331,6 +403,12 @@ struct Probe {
     candidates: Vec<Counts>,
     /// moments[pixel × candidates + c].
     moments: Vec<f64>,
+    /// moments_unmerged[pixel × globals + g]: the moment of global g without merging from the
+    /// pilot's samples that are not merges (`Counts::second_moment_term_without_merges`).
+    moments_unmerged: Vec<f64>,
+    /// The same layout: the pilot's weighted light that candidate c makes no path for (q_c = 0:
+    /// a caustic seen in a mirror, without merging), summed over the pilot passes.
+    missed: Vec<f64>,
     merge_queries: Vec<u64>,
     merges_found: Vec<u64>,
     camera_samples: u64,
@@ -348,6 +426,14 @@ struct Probe {
     measured: Vec<f64>,
     /// The weighted contributions of the camera sample under way.
     sample_sum: f64,
+    /// bias_diff[pixel × globals + g]: Σ over the pilot's merges of w_c v (1 − 2·[d < r/√2]) ×
+    /// `bias_scale`, c the merging candidate of global g: half of merging's bias at r₀, summed
+    /// over the pilot passes.
+    bias_diff: Vec<f64>,
+    /// The same layout: Σ of the terms' squares (the differences' sampling variance).
+    bias_terms_sq: Vec<f64>,
+    /// (r₀ / r_pass)² of the pass under way: brings each pass's difference to r₀.
+    bias_scale: f64,
 }
 
 impl Probe {
@@ -358,6 +444,8 @@ impl Probe {
             width: scene.camera.width,
             height: scene.camera.height,
             moments: vec![0.0; n * candidates.len()],
+            moments_unmerged: vec![0.0; n * candidates.len() / 2],
+            missed: vec![0.0; n * candidates.len()],
             candidates,
             merge_queries: vec![0; n],
             merges_found: vec![0; n],
@@ -371,6 +459,9 @@ impl Probe {
             film_weight: 1.0,
             measured: vec![0.0; n],
             sample_sum: 0.0,
+            bias_diff: vec![0.0; n * candidates_len_half()],
+            bias_terms_sq: vec![0.0; n * candidates_len_half()],
+            bias_scale: 1.0,
         }
     }
 
@@ -380,11 +471,22 @@ impl Probe {
         self.sample_sum = 0.0;
     }
 
-    fn add(&mut self, pixel: usize, weight: f64, value: f64, mixture: &Mixture) {
+    fn add(&mut self, pixel: usize, weight: f64, value: f64, mixture: &Mixture, merge: bool) {
         let c = self.candidates.len();
-        let row = &mut self.moments[pixel * c..(pixel + 1) * c];
-        for (m, counts) in row.iter_mut().zip(&self.candidates) {
-            *m += counts.second_moment_term(weight, value, mixture, &PILOT);
+        for (i, counts) in self.candidates.iter().enumerate() {
+            let term = counts.second_moment_term(weight, value, mixture, &PILOT);
+            if term.is_infinite() {
+                self.missed[pixel * c + i] += weight * value;
+            } else {
+                self.moments[pixel * c + i] += term;
+            }
+            if !counts.merging {
+                // Missed light is counted above, from every sample.
+                let term = counts.second_moment_term_without_merges(value, mixture, &PILOT, merge);
+                if term.is_finite() {
+                    self.moments_unmerged[pixel * (c / 2) + i / 2] += term;
+                }
+            }
         }
     }
 }
@@ -413,7 +515,7 @@ impl Recorder for Probe {
         let light_tracing = p.s >= 1 && p.camera.len() == 1;
         let value = channel_mean(p.value) * if light_tracing { 1.0 } else { self.film_weight };
         let pixel = pixel_of(p.raster, self.width, self.height);
-        self.add(pixel, p.weight, value, &m);
+        self.add(pixel, p.weight, value, &m, false);
         if light_tracing {
             self.measured[pixel] += (p.weight * value).powi(2);
         } else {
@@ -428,8 +530,22 @@ impl Recorder for Probe {
         let value = channel_mean(p.value) * self.film_weight;
         let pixel = pixel_of(p.raster, self.width, self.height);
         self.merges_found[pixel] += 1;
-        self.add(pixel, p.weight, value, &m);
+        self.add(pixel, p.weight, value, &m, true);
         self.sample_sum += p.weight * value;
+        // Merging's bias: + outside r/√2, − inside (kept there twice), per merging candidate.
+        let (Some(y), Some(x)) = (p.light.last(), p.camera.last()) else {
+            return;
+        };
+        let radius = p.radius as f64;
+        let inner = (y.p - x.p).length_squared() as f64 * 2.0 < radius * radius;
+        let sign = if inner { -1.0 } else { 1.0 };
+        let g_count = self.candidates.len() / 2;
+        for g in 0..g_count {
+            let w = self.candidates[2 * g].merge_weight(&m, &PILOT);
+            let term = sign * w * value * self.bias_scale;
+            self.bias_diff[pixel * g_count + g] += term;
+            self.bias_terms_sq[pixel * g_count + g] += term * term;
+        }
     }
 
     fn lap(&mut self, work: Work) {
@@ -470,8 +586,11 @@ fn merge_correlation(probe: &Probe, rel: &[f64]) -> f64 {
 }
 
 /// How much lower than merging everywhere or nowhere a per-pixel mask's predicted inefficiency
-/// must be for eamis to use it.
-pub const MASK_MARGIN: f64 = 1.25;
+/// must be for eamis to use it. A one-pass pilot misjudges the pixels at a mask's edge both ways:
+/// on caustic-sds it under-predicted heavy-tailed light where it turned merging off (relMSE 317
+/// at a margin of 1), on veach-bidir merging's rare fireflies where it turned it on (a mask
+/// predicted 1.3× better than merging nowhere measured 5× worse; results/eamis.md).
+pub const MASK_MARGIN: f64 = 2.0;
 
 /// The moments' box filter reaches this many pixels each way.
 pub const FILTER_REACH: usize = 3;
@@ -497,7 +616,7 @@ fn dilate(mask: &[bool], w: usize, h: usize, reach: usize) -> Vec<bool> {
     out
 }
 
-/// Per-pixel rows of `nc` values averaged over each pixel's 3 × 3 neighbourhood (clamped at the
+/// Per-pixel rows of `nc` values averaged over each pixel's (2 `FILTER_REACH` + 1)² neighbourhood (clamped at the
 /// film's edges).
 fn box_filter(values: &[f64], nc: usize, w: usize, h: usize) -> Vec<f64> {
     let mut out = vec![0.0; values.len()];
@@ -518,8 +637,46 @@ fn box_filter(values: &[f64], nc: usize, w: usize, h: usize) -> Vec<f64> {
     out
 }
 
+/// The render the choice is made for: merging's bias weighs in over `passes`.
+struct Horizon {
+    passes: u32,
+    alpha: f64,
+    pilot_passes: u32,
+}
+
+impl Horizon {
+    /// P s(P)², s(P) = (1/P) Σ_{i=1}^{P} i^(α−1): what b₀² adds to a merging pixel's per-pass
+    /// moment when relMSE × time is divided by P (the module's doc).
+    fn bias_factor(&self) -> f64 {
+        let p = self.passes.max(1);
+        let s = (1..=p)
+            .map(|i| (i as f64).powf(self.alpha - 1.0))
+            .sum::<f64>()
+            / p as f64;
+        p as f64 * s * s
+    }
+}
+
+/// Per pixel and global candidate g, b₀² of merging at r₀: 4 × (the pilot's mean difference
+/// squared less its sampling variance), averaged over the pixel's (2 `FILTER_REACH` + 1)²
+/// neighbourhood and clamped at 0. Laid out as `Probe::bias_diff`.
+fn merge_bias_squared(probe: &Probe, pilot_passes: u32) -> Vec<f64> {
+    let g_count = probe.candidates.len() / 2;
+    let (w, h) = (probe.width as usize, probe.height as usize);
+    let k = 1.0 / pilot_passes.max(1) as f64;
+    let raw: Vec<f64> = probe
+        .bias_diff
+        .iter()
+        .zip(&probe.bias_terms_sq)
+        .map(|(d, sq)| 4.0 * ((d * k).powi(2) - sq * k * k))
+        .collect();
+    let mut out = box_filter(&raw, g_count, w, h);
+    out.iter_mut().for_each(|b| *b = b.max(0.0));
+    out
+}
+
 /// The configuration of least predicted inefficiency from the pilot's `probe` and estimate.
-fn choose(probe: &Probe, estimate: &Image) -> Choice {
+fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
     let n = estimate.data.len();
     let nc = probe.candidates.len();
     // 1/(μ + 0.01)²: each pixel's second moment relative to its value.
@@ -533,17 +690,65 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
         .collect();
     let fixed_work = COST_CAMERA * (probe.camera_samples + 2 * probe.shadow_rays_fixed) as f64;
     let kappa = merge_correlation(probe, &rel);
-    // One pilot pass is one sample per pixel: each pixel's moments are averaged over its 3 × 3
-    // neighbourhood (an infinite one — light only merging finds — spreads to the neighbours,
-    // which then merge too, since a rare path the pilot saw once is likely near).
+    // Light a candidate makes no path for is a bias no pass removes: over the horizon's P passes
+    // it adds P b² to the per-pass moment (b the light missed per pass). One pilot pass is one
+    // sample per pixel: each pixel's moments are averaged over its 7 × 7 neighbourhood, which
+    // keeps the total a rare path the pilot saw once adds and spreads it to the pixels around.
     let (w, h) = (probe.width as usize, probe.height as usize);
-    let moments = box_filter(&probe.moments, nc, w, h);
+    let per_pass = 1.0 / horizon.pilot_passes.max(1) as f64;
+    let with_missed: Vec<f64> = probe
+        .moments
+        .iter()
+        .zip(&probe.missed)
+        .map(|(m, b)| m + horizon.passes as f64 * (b * per_pass).powi(2))
+        .collect();
+    let moments = box_filter(&with_missed, nc, w, h);
+    let unmerged_with_missed: Vec<f64> = probe
+        .moments_unmerged
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let (p, g) = (i / (nc / 2), i % (nc / 2));
+            m + horizon.passes as f64 * (probe.missed[p * nc + 2 * g + 1] * per_pass).powi(2)
+        })
+        .collect();
+    let moments_unmerged = box_filter(&unmerged_with_missed, nc / 2, w, h);
     // Light only merging reaches, seen by the pilot in one pixel, is likely in the pixels around
-    // it that one pass did not sample: every pixel within `MUST_MERGE_REACH` of one merges.
+    // it that one pass did not sample (caustic-sds: a mask of the pixels the pilot saw it in
+    // merged 7–10 % of the image and was 97× the best fixed configuration's inefficiency): every
+    // pixel within `MUST_MERGE_REACH` of one merges, and merging nowhere is not an option.
     let only_merging: Vec<bool> = (0..n)
-        .map(|p| (0..nc / 2).any(|g| probe.moments[p * nc + 2 * g + 1].is_infinite()))
+        .map(|p| (0..nc / 2).any(|g| probe.missed[p * nc + 2 * g + 1] != 0.0))
         .collect();
     let must_merge = dilate(&only_merging, w, h, MUST_MERGE_REACH);
+    let any_must = must_merge.iter().any(|&m| m);
+    let must_share = must_merge.iter().filter(|&&m| m).count() as f64 / n.max(1) as f64;
+    let g_count = nc / 2;
+    let bias2 = merge_bias_squared(probe, horizon.pilot_passes);
+    let bias_factor = horizon.bias_factor();
+    let pilot_g = globals()
+        .iter()
+        .position(|&(r, vc)| r == PILOT.light_ratio && vc == PILOT.vertex_connections)
+        .unwrap_or(0);
+    // Pixels where merging's predicted bias outweighs its moment: their merges witness a blurred
+    // integrand, so the moment without merging comes from the other samples alone there.
+    let bias_dominated: Vec<bool> = (0..n)
+        .map(|p| bias_factor * bias2[p * g_count + pilot_g] > kappa * moments[p * nc + 2 * pilot_g])
+        .collect();
+    let bias_share = {
+        let g = pilot_g;
+        let bias: f64 = (0..n)
+            .map(|p| bias_factor * bias2[p * g_count + g] * rel[p])
+            .sum();
+        let var: f64 = (0..n)
+            .map(|p| kappa * moments[p * nc + 2 * g] * rel[p])
+            .sum();
+        if bias + var > 0.0 {
+            bias / (bias + var)
+        } else {
+            0.0
+        }
+    };
     let mut best: Option<Choice> = None;
     let mut fixed = Vec::new();
     for (g, (ratio, vc)) in globals().into_iter().enumerate() {
@@ -554,8 +759,17 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
             } else {
                 0.0
             };
-        let on = |p: usize| kappa * moments[p * nc + 2 * g] * rel[p];
-        let off = |p: usize| moments[p * nc + 2 * g + 1] * rel[p];
+        let on = |p: usize| {
+            (kappa * moments[p * nc + 2 * g] + bias_factor * bias2[p * g_count + g]) * rel[p]
+        };
+        let off = |p: usize| {
+            rel[p]
+                * if bias_dominated[p] {
+                    moments_unmerged[p * g_count + g]
+                } else {
+                    moments[p * nc + 2 * g + 1]
+                }
+        };
         let merge_cost = |p: usize| {
             COST_QUERY * probe.merge_queries[p] as f64
                 + COST_MERGE * ratio * probe.merges_found[p] as f64
@@ -565,22 +779,17 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
         let all_off: f64 = (0..n).map(off).sum::<f64>() * cost0;
         fixed.push((label(&probe.candidates[2 * g]), all_on / n as f64));
         fixed.push((label(&probe.candidates[2 * g + 1]), all_off / n as f64));
-        // A pixel whose light only merging samples (a caustic seen in a mirror) must merge: its
-        // moment without merging is infinite. A candidate that misses light in some pixel
-        // whatever it merges is out.
-        if (0..n).any(|p| on(p).is_infinite() && off(p).is_infinite()) {
-            continue;
-        }
-        let must: Vec<usize> = (0..n)
-            .filter(|&p| off(p).is_infinite() || (must_merge[p] && !on(p).is_infinite()))
-            .collect();
-        let free = |p: &usize| !must_merge[*p] && !off(*p).is_infinite() && !on(*p).is_infinite();
-        let mut v: f64 =
-            must.iter().map(|&p| on(p)).sum::<f64>() + (0..n).filter(free).map(off).sum::<f64>();
-        let mut c = cost0 + must.iter().map(|&p| merge_cost(p)).sum::<f64>();
+        let mut v: f64 = (0..n)
+            .map(|p| if must_merge[p] { on(p) } else { off(p) })
+            .sum();
+        let mut c = cost0
+            + (0..n)
+                .filter(|&p| must_merge[p])
+                .map(merge_cost)
+                .sum::<f64>();
         // Pixels where merging lowers the moment, by moment saved per cost added.
         let mut gain: Vec<(f64, usize)> = (0..n)
-            .filter(|p| free(p) && on(*p) < off(*p))
+            .filter(|&p| !must_merge[p] && on(p) < off(p))
             .map(|p| ((off(p) - on(p)) / merge_cost(p).max(1e-9), p))
             .collect();
         gain.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
@@ -594,19 +803,26 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
             }
         }
         // The per-pixel mask must beat merging everywhere and nowhere by `MASK_MARGIN`: one pilot
-        // pass under-predicts rare, heavy-tailed light in the pixels it turns merging off in.
-        let uniform = all_on.min(all_off);
+        // pass misses rare, heavy-tailed light on either side of the mask's edge.
+        let uniform = if any_must {
+            all_on
+        } else {
+            all_on.min(all_off)
+        };
         let use_mask = best_j * MASK_MARGIN < uniform;
         let (predicted, everywhere) = if use_mask {
             (best_j / n as f64, false)
         } else {
-            (uniform / n as f64, all_on <= all_off)
+            (uniform / n as f64, any_must || all_on <= all_off)
         };
         if predicted.is_finite() && best.as_ref().is_none_or(|b| predicted < b.predicted) {
             let mut mask = vec![everywhere; n];
             if use_mask {
-                for &p in must.iter().chain(gain[..best_len].iter().map(|(_, p)| p)) {
+                for &(_, p) in &gain[..best_len] {
                     mask[p] = true;
+                }
+                for (m, &must) in mask.iter_mut().zip(&must_merge) {
+                    *m |= must;
                 }
             }
             let best_len = mask.iter().filter(|&&m| m).count();
@@ -620,6 +836,8 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
                 predicted,
                 fixed: Vec::new(),
                 merge_correlation: kappa,
+                bias_share,
+                must_merge: must_share,
             });
         }
     }
@@ -631,6 +849,8 @@ fn choose(probe: &Probe, estimate: &Image) -> Choice {
         predicted: f64::INFINITY,
         fixed: Vec::new(),
         merge_correlation: kappa,
+        bias_share,
+        must_merge: must_share,
     });
     choice.fixed = fixed;
     choice

@@ -90,6 +90,10 @@ pub trait ProgressiveRun: Send + Sync {
     /// of samples discarded as invalid.
     fn pass(&mut self, pass: u32) -> u64;
 
+    /// Told before pass 0 how many passes the caller means to run (it may stop sooner): a run
+    /// whose choices weigh bias against variance (`eamis`) needs the horizon; others ignore it.
+    fn plan(&mut self, _passes: u32) {}
+
     /// The run's estimate of the image after the passes done so far.
     fn estimate(&self) -> Image;
 

@@ -193,6 +193,7 @@ fn render_in(
         }
         EstimatorRef::Consistent(progressive) => {
             let mut run = pool.install(|| progressive.start(scene, seed));
+            run.plan(opts.passes);
             while pass < opts.passes {
                 invalid += pool.install(|| run.pass(pass));
                 pass += 1;

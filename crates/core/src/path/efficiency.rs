@@ -61,6 +61,27 @@ impl Counts {
         mixture.fixed + r * mixture.light_tracing + vc + vm
     }
 
+    /// The balance weight `self` would give a merge the pilot weighed with `mixture`:
+    /// n_u p_u / Σ_v n_v p_v with merging counted η (as the weights count it, not η ρ), the
+    /// merge's own count scaling with M. 0 where `self` does not merge.
+    pub fn merge_weight(&self, mixture: &Mixture, pilot: &Counts) -> f64 {
+        if !self.merging {
+            return 0.0;
+        }
+        let r = self.light_ratio / pilot.light_ratio;
+        let vc = if self.vertex_connections {
+            mixture.vertex_connections
+        } else {
+            0.0
+        };
+        let total = mixture.fixed + r * (mixture.light_tracing + mixture.merges) + vc;
+        if total > 0.0 {
+            r * mixture.own / total
+        } else {
+            0.0
+        }
+    }
+
     /// One pilot sample's share of the second moment M(`self`): w · v² · n_u p_u / q_c, for a
     /// sample of weight `weight` and unweighted value `value` whose effective densities under
     /// `pilot` are `mixture`. Infinite where the sample carries light but no technique of `self`
@@ -82,6 +103,40 @@ impl Counts {
         } else {
             f64::INFINITY
         }
+    }
+
+    /// The same for a configuration without merging, from the pilot's samples that are not
+    /// merges (`merge` false) alone, each reweighted by the balance heuristic over the
+    /// techniques that are not merges: weights summing to one over techniques that cover the
+    /// integrand keep the estimate unbiased. A merge's value is the blurred integrand; where
+    /// merging is biased it is not the f² a configuration without merging would see, and on
+    /// veach-bidir [`second_moment_term`](Self::second_moment_term) inflated such a
+    /// configuration's predicted moment 25× past merging everywhere, whose measured
+    /// inefficiency was 50× worse (results/eamis.md). Where merging is unbiased the merges are
+    /// the better witnesses of light the other techniques find rarely (caustic-sds), so eamis
+    /// uses this estimate only where it predicts merging's bias to dominate.
+    pub fn second_moment_term_without_merges(
+        &self,
+        value: f64,
+        mixture: &Mixture,
+        pilot: &Counts,
+        merge: bool,
+    ) -> f64 {
+        debug_assert!(!self.merging);
+        let q = self.total(mixture, pilot);
+        let own = mixture.own;
+        if merge || !(own > 0.0) || value == 0.0 {
+            return 0.0;
+        }
+        if !(q > 0.0) {
+            return f64::INFINITY;
+        }
+        let without_merges = Counts {
+            merging: false,
+            ..*pilot
+        }
+        .total(mixture, pilot);
+        (own / without_merges) * value * value * own / q
     }
 }
 
@@ -145,11 +200,16 @@ mod tests {
                 merging: true,
             };
             let set = TechniqueSet::new(true, eta);
+            // Per configuration: Σ over techniques of n_u p_u × share, and q_c; then the same
+            // for the configurations without merging, from the samples that are not merges.
+            let mut integrand = [(0.0, 0.0); 8];
             for own in d.vcm_techniques(set) {
                 let w = weigh(&d.chain(), set, None, own, Heuristic::Balance);
-                for (r, vc, vm) in [(0.25, true, true), (2.0, false, true), (1.0, true, false)]
-                    .into_iter()
-                    .chain([(0.5, false, false)])
+                for (ci, (r, vc, vm)) in
+                    [(0.25, true, true), (2.0, false, true), (1.0, true, false)]
+                        .into_iter()
+                        .chain([(0.5, false, false)])
+                        .enumerate()
                 {
                     let c = Counts {
                         light_ratio: pilot.light_ratio * r,
@@ -169,6 +229,38 @@ mod tests {
                         (got - want).abs() <= 1e-12 * want.max(1e-300),
                         "k {k}, {own:?}, ratio ×{r}, vc {vc}, vm {vm}: predicted {got}, oracle {want}"
                     );
+                    // Σ_u n_u p_u × (one sample of u's share of M(c)) = f²/q_c, the integrand of
+                    // M(c), whatever u (value f/(n_u p_u) with f = 1); merges add nothing
+                    // without merging.
+                    {
+                        let total_c = c.total(&w.mixture, &pilot);
+                        let is_merge = matches!(own, Technique::Merge(_));
+                        let v = 1.0 / w.mixture.own;
+                        let share =
+                            c.second_moment_term(w.weight, v, &w.mixture, &pilot) * w.mixture.own;
+                        integrand[ci].0 += share;
+                        integrand[ci].1 = total_c;
+                        if !vm {
+                            let share = c
+                                .second_moment_term_without_merges(v, &w.mixture, &pilot, is_merge)
+                                * w.mixture.own;
+                            integrand[4 + ci].0 += share;
+                            integrand[4 + ci].1 = total_c;
+                        }
+                    }
+                    // A merge's balance weight under `c`, against the oracle's weights of `c`.
+                    if let Technique::Merge(_) = own {
+                        let got = c.merge_weight(&w.mixture, &pilot);
+                        let want = if vm {
+                            weigh(&dc.chain(), set_c, None, own, Heuristic::Balance).weight
+                        } else {
+                            0.0
+                        };
+                        assert!(
+                            (got - want).abs() <= 1e-12,
+                            "k {k}, {own:?}, ratio ×{r}, vc {vc}: merge weight {got}, oracle {want}"
+                        );
+                    }
                     checked += 1;
                 }
                 // The pilot's own total is its balance weight's denominator.
@@ -177,6 +269,30 @@ mod tests {
                 if let Technique::Merge(_) = own {
                     assert!(w.mixture.merges >= own_p);
                 }
+            }
+            for (ci, (sum, q)) in integrand.iter().enumerate() {
+                if ci >= 4 && [2, 3].binary_search(&(ci - 4)).is_err() {
+                    continue; // merging configurations have no estimate without merges
+                }
+                if *q == 0.0 {
+                    // No technique of the configuration makes the path: infinite where the
+                    // pilot's do.
+                    let pilot_makes_it = d
+                        .vcm_techniques(set)
+                        .iter()
+                        .any(|t| ci < 4 || !matches!(t, Technique::Merge(_)));
+                    assert_eq!(
+                        sum.is_infinite(),
+                        pilot_makes_it,
+                        "k {k}, configuration {ci}"
+                    );
+                    continue;
+                }
+                let want = 1.0 / q;
+                assert!(
+                    (sum - want).abs() <= 1e-9 * want,
+                    "k {k}, configuration {ci}: Σ_u n_u p_u × share {sum}, f²/q_c {want}"
+                );
             }
         }
         assert!(checked > 10_000, "{checked}");

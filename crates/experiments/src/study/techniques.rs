@@ -1077,6 +1077,7 @@ fn timed_plain_logged(
         }
         lt_integrators::Estimator::Consistent(p) => {
             let mut run = p.start(scene, seed);
+            run.plan(passes);
             for pass in 0..passes {
                 run.pass(pass);
             }
@@ -1104,6 +1105,7 @@ fn timed_plain(
         }
         lt_integrators::Estimator::Consistent(p) => {
             let mut run = p.start(scene, seed);
+            run.plan(passes);
             for pass in 0..passes {
                 run.pass(pass);
             }
