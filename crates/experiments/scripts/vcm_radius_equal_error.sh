@@ -13,7 +13,7 @@
 # WIDTH (128), PASSES (32),
 # SEEDS (4), RADII ("0.5 1 2 4"), SCENES (cornell-box veach-door caustic-sds
 # smallvcm-mirror-ball), INTEGRATORS ("vcm bpm"). References come from `lt reference` (cached
-# under results/cache, so a second run reuses them).
+# under results/references, so a second run reuses them), or REF_<scene with - as _>=FILE.exr.
 set -euo pipefail
 REPO=$(cd "$(dirname "$0")/../../.." && pwd)
 OUT=""
@@ -47,10 +47,16 @@ echo "scene,integrator,radius_px,passes,runs,cpu_seconds_mean,relmse_mean,ineffi
 for scene in $SCENES; do
   # The scene at WIDTH pixels wide, aspect kept.
   src="$REPO/scenes/$scene.toml"
+  # REF_<scene, - as _>=FILE.exr takes another reference (e.g. `lt study`'s for that scene).
+  override="REF_${scene//-/_}"
+  if [ -n "${!override:-}" ]; then
+    ref="${!override}"
+  else
   ref_json=$("$LT" reference "$src" --width "$WIDTH" --threads "$THREADS" --results "$REPO/results" 2>&1 | tee "$WORK/ref.log" |
     grep -o '[^ ]*\.exr' | tail -1)
   [ -f "$ref_json" ] || { echo "no reference for $scene:"; cat "$WORK/ref.log"; exit 1; } >&2
   ref="$ref_json"
+  fi
   awk -v w="$WIDTH" '/^resolution *=/ { gsub(/[^0-9,]/, "", $0); split($0, a, ",");
     printf "resolution = [%d, %d]\n", w, int(a[2] * w / a[1] + 0.5); next } { print }' "$src" \
     >"$WORK/$scene.toml"
