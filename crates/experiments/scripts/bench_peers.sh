@@ -13,9 +13,11 @@
 #     g++ -o smallvcm ./src/smallvcm.cxx -O3 -std=c++0x -fopenmp
 #   and SMALLVCM=/path/to/smallvcm (default /work/peers/smallvcm/smallvcm): its vcm, bpt and bpm
 #   against our vcm, bdpt and bpm at its settings, time per iteration (vcm_vs_smallvcm.sh).
-# - Tungsten: its equal-error comparison (results/bench.md, "light and bdpt, side by side with
-#   Tungsten") needs its own scene conversion and is not part of this script yet; TUNGSTEN is
-#   reported as not run.
+# - Tungsten, built from its public source outside the repository (tungsten_vs_lt.sh's header
+#   says how), at TUNGSTEN (default /work/peers/tungsten/build/release/tungsten): `pt`, `light`
+#   and `bdpt` against its path, light and bidirectional path tracers at equal error (efficiency
+#   1/(MSE·time)), `sppm` against its progressive photon map (time to an MSE), on the Cornell box
+#   converted by tungsten_scene.py, through tungsten_vs_lt.sh.
 #
 # Ratios: lt throughput / peer throughput (> 1: lt is faster); for SmallVCM the time ratio
 # lt / SmallVCM (< 1: lt is faster), as the issue states its target.
@@ -85,13 +87,30 @@ else
   echo "| SmallVCM | not run: no executable at \$SMALLVCM ($SMALLVCM) | ≤ 0.7 (vcm) |" >>"$REPORT"
 fi
 
-echo "| Tungsten (equal error) | not run by this script (see results/bench.md) | pt ≥ 1, bdpt ≥ 2, sppm ≤ 0.67 |" >>"$REPORT"
+# Tungsten: the summary rows of tungsten_vs_lt.sh, with the issue's targets.
+TUNGSTEN=${TUNGSTEN:-/work/peers/tungsten/build/release/tungsten}
+if [ -x "$TUNGSTEN" ]; then
+  tu_args=(--out "$WORK/tungsten.md")
+  if [ "$QUICK" = 1 ]; then tu_args+=(--quick); fi
+  LT="$LT" TUNGSTEN="$TUNGSTEN" "$SCRIPTS/tungsten_vs_lt.sh" "${tu_args[@]}" >"$WORK/tungsten.log" 2>&1 || {
+    echo "bench_peers.sh: tungsten_vs_lt.sh failed; its log:" >&2
+    tail -20 "$WORK/tungsten.log" >&2
+    exit 1
+  }
+  awk -F'|' '/^\| lt `/ {
+      t = "—"; if ($2 ~ /bdpt/) t = "≥ 2"; if ($2 ~ /sppm/) t = "≤ 0.67"; if ($2 ~ /`pt`/) t = "(≥ 1 vs Mitsuba)"
+      printf "|%s|%s| %s |\n", $2, $3, t }' "$WORK/tungsten.md" >>"$REPORT"
+else
+  echo "| Tungsten (equal error) | not run: no executable at \$TUNGSTEN ($TUNGSTEN) | bdpt ≥ 2, sppm ≤ 0.67 |" >>"$REPORT"
+fi
 {
   echo
   echo "Mitsuba ratios are spp/s of lt over spp/s of Mitsuba (> 1: lt faster); SmallVCM ratios are"
-  echo "seconds of lt over seconds of SmallVCM (< 1: lt faster). Full tables of every round follow."
+  echo "seconds of lt over seconds of SmallVCM (< 1: lt faster); Tungsten's are efficiency at equal"
+  echo "error (> 1: lt faster) and, for sppm, time to an MSE (< 1: lt faster). Full tables follow."
   if [ -f "$WORK/mitsuba.md" ]; then echo; echo "## Mitsuba 3, every round"; echo; cat "$WORK/mitsuba.md"; fi
   if [ -f "$WORK/smallvcm.log" ]; then echo; echo "## SmallVCM, every round"; echo; echo '```'; cat "$WORK/smallvcm.log"; echo '```'; fi
+  if [ -f "$WORK/tungsten.md" ]; then echo; echo "## Tungsten, every render"; echo; cat "$WORK/tungsten.md"; fi
 } >>"$REPORT"
 
 if [ -n "$OUT" ]; then
