@@ -3,7 +3,11 @@
 # ratios beside the issue's targets. Run it on an otherwise idle machine (ratios are what carry
 # over: the absolute figures vary by ±20 % on a shared one).
 #
-#   crates/experiments/scripts/bench_peers.sh [--quick] [--out FILE.md]
+#   [LT=/path/to/lt] crates/experiments/scripts/bench_peers.sh [--quick] [--out FILE.md]
+#
+# lt: built with cargo (release) unless LT names a binary to run instead; a private copy is run by
+# every peer's comparison. Full run ≈ 15–20 min on 2 busy cores (the first one also renders
+# Tungsten's reference, ≈ 4 min, then cached); --quick ≈ 3 min.
 #
 # Peers, each skipped with a line saying so when absent (nothing of them is committed):
 # - Mitsuba 3 (`pip install mitsuba numpy`; `llvm_ad_rgb` needs Debian's libllvm): `path` against
@@ -13,14 +17,20 @@
 #     g++ -o smallvcm ./src/smallvcm.cxx -O3 -std=c++0x -fopenmp
 #   and SMALLVCM=/path/to/smallvcm (default /work/peers/smallvcm/smallvcm): its vcm, bpt and bpm
 #   against our vcm, bdpt and bpm at its settings, time per iteration (vcm_vs_smallvcm.sh).
-# - Tungsten, built from its public source outside the repository (tungsten_vs_lt.sh's header
-#   says how), at TUNGSTEN (default /work/peers/tungsten/build/release/tungsten): `pt`, `light`
-#   and `bdpt` against its path, light and bidirectional path tracers at equal error (efficiency
-#   1/(MSE·time)), `sppm` against its progressive photon map (time to an MSE), on the Cornell box
-#   converted by tungsten_scene.py, through tungsten_vs_lt.sh.
+# - Tungsten, built from its public source outside the repository:
+#     git clone https://github.com/tunabrain/tungsten && cd tungsten && mkdir -p build/release &&
+#     cd build/release && CC=gcc-12 CXX=g++-12 cmake -DCMAKE_BUILD_TYPE=Release \
+#       -DTARGET_ARCHITECTURE=haswell ../.. && nice -n 10 make -j2 tungsten
+#   (CMake < 4 for its bundled Embree: `pip install cmake==3.27.9`), at TUNGSTEN (default
+#   /work/peers/tungsten/build/release/tungsten): `pt`, `light` and `bdpt` against its
+#   path_tracer, light_tracer and bidirectional_path_tracer at equal error (efficiency
+#   1/(MSE·time) against an lt `pt` reference, bdpt also time to target MSEs), `sppm` against its
+#   progressive_photon_map at our sppm's settings (time to target MSEs), on the Cornell box
+#   converted by tungsten_scene.py, through tungsten_vs_lt.sh (its header has the details).
 #
 # Ratios: lt throughput / peer throughput (> 1: lt is faster); for SmallVCM the time ratio
-# lt / SmallVCM (< 1: lt is faster), as the issue states its target.
+# lt / SmallVCM (< 1: lt is faster), as the issue states its target; for Tungsten efficiency
+# lt / Tungsten (> 1: lt better) and time to an MSE lt / Tungsten (< 1: lt faster).
 set -euo pipefail
 REPO=$(cd "$(dirname "$0")/../../.." && pwd)
 SCRIPTS="$REPO/crates/experiments/scripts"
@@ -36,9 +46,17 @@ while [ $# -gt 0 ]; do
 done
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
-cargo build --release -q -p lt-experiments --bin lt --manifest-path "$REPO/Cargo.toml"
+t_start=$(date +%s)
+# lt: LT=/path/to/lt runs that binary (no build); otherwise cargo builds it. Either way a private
+# copy is run, so a rebuild in the tree cannot change it mid-run.
+if [ -n "${LT:-}" ]; then
+  [ -x "$LT" ] || { echo "bench_peers.sh: LT=$LT is not an executable" >&2; exit 2; }
+  cp "$LT" "$WORK/lt"
+else
+  cargo build --release -q -p lt-experiments --bin lt --manifest-path "$REPO/Cargo.toml"
+  cp "$REPO/target/release/lt" "$WORK/lt"
+fi
 LT="$WORK/lt"
-cp "$REPO/target/release/lt" "$LT"
 
 REPORT="$WORK/report.md"
 {
@@ -74,7 +92,14 @@ fi
 SMALLVCM=${SMALLVCM:-/work/peers/smallvcm/smallvcm}
 if [ -x "$SMALLVCM" ]; then
   if [ "$QUICK" = 1 ]; then rounds=1; iters=1; else rounds=3; iters=8; fi
-  SMALLVCM="$SMALLVCM" "$SCRIPTS/vcm_vs_smallvcm.sh" "$rounds" "$iters" >"$WORK/smallvcm.txt"
+  # vcm_vs_smallvcm.sh runs $REPO/target/release/lt; a copy of it with REPO and LT pointed at
+  # this run's binary keeps every peer on the same lt.
+  mkdir -p "$WORK/svcm"
+  sed -e "s|^REPO=.*|REPO=\"$REPO\"|" -e "s|^LT=.*|LT=\"$LT\"|" "$SCRIPTS/vcm_vs_smallvcm.sh" \
+    >"$WORK/svcm/vcm_vs_smallvcm.sh"
+  grep -q "^LT=\"$LT\"" "$WORK/svcm/vcm_vs_smallvcm.sh" ||
+    { echo "bench_peers.sh: could not point vcm_vs_smallvcm.sh at $LT" >&2; exit 1; }
+  SMALLVCM="$SMALLVCM" bash "$WORK/svcm/vcm_vs_smallvcm.sh" "$rounds" "$iters" >"$WORK/smallvcm.txt"
   cp "$WORK/smallvcm.txt" "$WORK/smallvcm.log"
   for algo in vcm bdpt bpm; do
     awk -v a="$algo" '$2 == a { print $5 }' "$WORK/smallvcm.txt" | sort -g | awk -v a="$algo" '
@@ -97,13 +122,19 @@ if [ -x "$TUNGSTEN" ]; then
     tail -20 "$WORK/tungsten.log" >&2
     exit 1
   }
+  # Its summary rows ("| lt `ours` / Tungsten `theirs`, what | ratio |"), with the issue's targets.
   awk -F'|' '/^\| lt `/ {
-      t = "—"; if ($2 ~ /bdpt/) t = "≥ 2"; if ($2 ~ /sppm/) t = "≤ 0.67"; if ($2 ~ /`pt`/) t = "(≥ 1 vs Mitsuba)"
+      t = "—"
+      if ($2 ~ /`bdpt`/) t = ($2 ~ /time to/) ? "≤ 0.5 (2× faster)" : "≥ 2"
+      if ($2 ~ /`sppm`/) t = "≤ 0.67"
+      if ($2 ~ /`pt`/) t = "— (≥ 1 is against Mitsuba)"
       printf "|%s|%s| %s |\n", $2, $3, t }' "$WORK/tungsten.md" >>"$REPORT"
 else
   echo "| Tungsten (equal error) | not run: no executable at \$TUNGSTEN ($TUNGSTEN) | bdpt ≥ 2, sppm ≤ 0.67 |" >>"$REPORT"
 fi
 {
+  echo
+  echo "Whole run: $(($(date +%s) - t_start)) s; load at end: $(cut -d' ' -f1-3 /proc/loadavg)"
   echo
   echo "Mitsuba ratios are spp/s of lt over spp/s of Mitsuba (> 1: lt faster); SmallVCM ratios are"
   echo "seconds of lt over seconds of SmallVCM (< 1: lt faster); Tungsten's are efficiency at equal"

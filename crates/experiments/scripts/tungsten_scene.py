@@ -129,7 +129,10 @@ def main():
             "stratified_sampler": False,
             "scene_bvh": True,
             "spp": a.spp,
-            "spp_step": a.spp,
+            # Tungsten renders spp in segments of spp_step; its progressive photon map traces one
+            # photon pass per segment (with spp_step camera samples), so 1 there: one spp = one
+            # pass of photon_count photon paths and one camera sample per pixel, as our sppm.
+            "spp_step": 1 if a.integrator == "progressive_photon_map" else a.spp,
             "checkpoint_interval": "0",
             "timeout": "0",
         },
