@@ -52,9 +52,11 @@ t_start=$(date +%s)
 if [ -n "${LT:-}" ]; then
   [ -x "$LT" ] || { echo "bench_peers.sh: LT=$LT is not an executable" >&2; exit 2; }
   cp "$LT" "$WORK/lt"
+  LT_FROM="the binary LT=$LT (sha256 $(sha256sum "$LT" | cut -c1-12)), not built from this tree"
 else
   cargo build --release -q -p lt-experiments --bin lt --manifest-path "$REPO/Cargo.toml"
   cp "$REPO/target/release/lt" "$WORK/lt"
+  LT_FROM="built from this tree (cargo build --release)"
 fi
 LT="$WORK/lt"
 
@@ -64,6 +66,8 @@ REPORT="$WORK/report.md"
   echo
   echo "Date: $(date -u '+%Y-%m-%d %H:%M UTC'); repo $(git -C "$REPO" rev-parse --short HEAD)" \
     "; machine: $(nproc) hardware threads; load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
+  echo
+  echo "lt: $LT_FROM"
   echo
   echo "| pair | ratio (median [min, max] over rounds) | target (issue 28) |"
   echo "|---|---|---|"
