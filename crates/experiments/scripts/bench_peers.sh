@@ -34,16 +34,9 @@
 set -euo pipefail
 REPO=$(cd "$(dirname "$0")/../../.." && pwd)
 SCRIPTS="$REPO/crates/experiments/scripts"
-QUICK=0
-OUT=""
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --quick) QUICK=1 ;;
-    --out) OUT="$2"; shift ;;
-    *) echo "bench_peers.sh: unknown argument '$1' (expected --quick or --out FILE)" >&2; exit 2 ;;
-  esac
-  shift
-done
+# shellcheck source=quick_out_args.sh
+. "$SCRIPTS/quick_out_args.sh"
+parse_quick_out bench_peers.sh "$@"
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 t_start=$(date +%s)

@@ -55,16 +55,9 @@ TUNGSTEN=${TUNGSTEN:-/work/peers/tungsten/build/release/tungsten}
 LT=${LT:-$REPO/target/release/lt}
 THREADS=${THREADS:-2}
 CACHE=${CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/lt-bench-peers}
-QUICK=0
-OUT=""
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --quick) QUICK=1 ;;
-    --out) OUT="$2"; shift ;;
-    *) echo "tungsten_vs_lt.sh: unknown argument '$1' (expected --quick or --out FILE)" >&2; exit 2 ;;
-  esac
-  shift
-done
+# shellcheck source=quick_out_args.sh
+. "$SCRIPTS/quick_out_args.sh"
+parse_quick_out tungsten_vs_lt.sh "$@"
 [ -x "$TUNGSTEN" ] || { echo "tungsten_vs_lt.sh: no Tungsten executable at \$TUNGSTEN ($TUNGSTEN)" >&2; exit 3; }
 command -v oiiotool >/dev/null || { echo "tungsten_vs_lt.sh: needs oiiotool (apt-get install openimageio-tools)" >&2; exit 3; }
 [ -x "$LT" ] || cargo build --release -q -p lt-experiments --bin lt --manifest-path "$REPO/Cargo.toml"

@@ -16,7 +16,6 @@
 # under results/references, so a second run reuses them), or REF_<scene with - as _>=FILE.exr.
 set -euo pipefail
 REPO=$(cd "$(dirname "$0")/../../.." && pwd)
-OUT=""
 WIDTH=${WIDTH:-128}
 THREADS=${THREADS:-1}
 PASSES=${PASSES:-32}
@@ -24,14 +23,10 @@ SEEDS=${SEEDS:-4}
 RADII=${RADII:-"0.5 1 2 4"}
 SCENES=${SCENES:-"cornell-box veach-door caustic-sds smallvcm-mirror-ball"}
 INTEGRATORS=${INTEGRATORS:-"vcm bpm"}
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --quick) PASSES=4; SEEDS=2; RADII="1 2"; SCENES="cornell-box"; INTEGRATORS="vcm" ;;
-    --out) OUT="$2"; shift ;;
-    *) echo "vcm_radius_equal_error.sh: unknown argument '$1' (expected --quick or --out FILE)" >&2; exit 2 ;;
-  esac
-  shift
-done
+# shellcheck source=quick_out_args.sh
+. "$REPO/crates/experiments/scripts/quick_out_args.sh"
+parse_quick_out vcm_radius_equal_error.sh "$@"
+if [ "$QUICK" = 1 ]; then PASSES=4; SEEDS=2; RADII="1 2"; SCENES="cornell-box"; INTEGRATORS="vcm"; fi
 LT=${LT:-$REPO/target/release/lt}
 [ -x "$LT" ] || cargo build --release -q -p lt-experiments --bin lt --manifest-path "$REPO/Cargo.toml"
 WORK=$(mktemp -d)
