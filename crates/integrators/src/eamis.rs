@@ -69,7 +69,7 @@
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `mis` | power/balance/none | balance | heuristic (the prediction is the balance heuristic's) |
 //! | `pilot_passes` | u32 | 1 | passes of the pilot (all techniques) before the choice |
-//! | `keep_pilot` | bool | false | the pilot passes' image joins the estimate (else only the passes after the choice count, once there is one) |
+//! | `keep_pilot` | true/false | false | the pilot passes' image joins the estimate (else only the passes after the choice count, once there is one) |
 //! | `fixed` | m0.25_vc1_merge/m0.25_vc1_nomerge/m0.25_vc0_merge/m0.25_vc0_nomerge/m0.5_vc1_merge/m0.5_vc1_nomerge/m0.5_vc0_merge/m0.5_vc0_nomerge/m1_vc1_merge/m1_vc1_nomerge/m1_vc0_merge/m1_vc0_nomerge/m2_vc1_merge/m2_vc1_nomerge/m2_vc0_merge/m2_vc0_nomerge | — | no pilot: render every pass with one candidate, m(M per pixel)_vc(vertex connections)_(merge or not everywhere): the fixed configurations the choice is measured against |
 //! | `radius_px` | f32 | 2 | initial radius in pixel footprints at the mean primary-hit distance |
 //! | `radius_scene` | f32 | — | initial radius as a fraction of the scene's bounding-sphere diameter |
