@@ -381,11 +381,6 @@ const PILOT: Counts = Counts {
     merging: true,
 };
 
-/// The number of global candidates.
-fn candidates_len_half() -> usize {
-    globals().len()
-}
-
 /// The global candidates (M, vertex connections), each rendered with merging on (`2g`) or off
 /// (`2g + 1`) in a pixel.
 fn globals() -> Vec<(f64, bool)> {
@@ -440,11 +435,12 @@ impl Probe {
     fn new(scene: &Scene) -> Probe {
         let n = scene.camera.pixel_count();
         let candidates = fixed_candidates();
+        let globals = candidates.len() / 2;
         Probe {
             width: scene.camera.width,
             height: scene.camera.height,
             moments: vec![0.0; n * candidates.len()],
-            moments_unmerged: vec![0.0; n * candidates.len() / 2],
+            moments_unmerged: vec![0.0; n * globals],
             missed: vec![0.0; n * candidates.len()],
             candidates,
             merge_queries: vec![0; n],
@@ -459,8 +455,8 @@ impl Probe {
             film_weight: 1.0,
             measured: vec![0.0; n],
             sample_sum: 0.0,
-            bias_diff: vec![0.0; n * candidates_len_half()],
-            bias_terms_sq: vec![0.0; n * candidates_len_half()],
+            bias_diff: vec![0.0; n * globals],
+            bias_terms_sq: vec![0.0; n * globals],
             bias_scale: 1.0,
         }
     }
@@ -696,20 +692,18 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
     // keeps the total a rare path the pilot saw once adds and spreads it to the pixels around.
     let (w, h) = (probe.width as usize, probe.height as usize);
     let per_pass = 1.0 / horizon.pilot_passes.max(1) as f64;
-    let with_missed: Vec<f64> = probe
-        .moments
-        .iter()
-        .zip(&probe.missed)
-        .map(|(m, b)| m + horizon.passes as f64 * (b * per_pass).powi(2))
+    // P b² of candidate c in pixel p.
+    let missed_bias =
+        |p: usize, c: usize| horizon.passes as f64 * (probe.missed[p * nc + c] * per_pass).powi(2);
+    let with_missed: Vec<f64> = (0..n * nc)
+        .map(|i| probe.moments[i] + missed_bias(i / nc, i % nc))
         .collect();
     let moments = box_filter(&with_missed, nc, w, h);
-    let unmerged_with_missed: Vec<f64> = probe
-        .moments_unmerged
-        .iter()
-        .enumerate()
-        .map(|(i, m)| {
+    // Without merging: global g's candidate is 2g + 1.
+    let unmerged_with_missed: Vec<f64> = (0..n * nc / 2)
+        .map(|i| {
             let (p, g) = (i / (nc / 2), i % (nc / 2));
-            m + horizon.passes as f64 * (probe.missed[p * nc + 2 * g + 1] * per_pass).powi(2)
+            probe.moments_unmerged[i] + missed_bias(p, 2 * g + 1)
         })
         .collect();
     let moments_unmerged = box_filter(&unmerged_with_missed, nc / 2, w, h);

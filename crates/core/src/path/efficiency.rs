@@ -47,17 +47,19 @@ impl Counts {
     /// Σ_u n_u p_u of a path under `self`, from its `mixture` as `pilot` weighed it. The pilot
     /// must run every technique `self` does (vertex connections, merging).
     pub fn total(&self, mixture: &Mixture, pilot: &Counts) -> f64 {
+        self.total_with_merges(mixture, pilot, mixture.merges_correlated)
+    }
+
+    /// `total` with merging at the pilot's light-path count counted `merges` (η ρ for the
+    /// second-moment model, η as the weights count it).
+    fn total_with_merges(&self, mixture: &Mixture, pilot: &Counts, merges: f64) -> f64 {
         let r = self.light_ratio / pilot.light_ratio;
         let vc = if self.vertex_connections {
             mixture.vertex_connections
         } else {
             0.0
         };
-        let vm = if self.merging {
-            r * mixture.merges_correlated
-        } else {
-            0.0
-        };
+        let vm = if self.merging { r * merges } else { 0.0 };
         mixture.fixed + r * mixture.light_tracing + vc + vm
     }
 
@@ -69,12 +71,7 @@ impl Counts {
             return 0.0;
         }
         let r = self.light_ratio / pilot.light_ratio;
-        let vc = if self.vertex_connections {
-            mixture.vertex_connections
-        } else {
-            0.0
-        };
-        let total = mixture.fixed + r * (mixture.light_tracing + mixture.merges) + vc;
+        let total = self.total_with_merges(mixture, pilot, mixture.merges);
         if total > 0.0 {
             r * mixture.own / total
         } else {
