@@ -27,7 +27,8 @@
 //! **Correlated merges.** The prediction treats every sample as independent; the merges around
 //! one camera vertex are not. The pilot also measures its own second moment (each camera sample's
 //! contributions summed before squaring), and every merging candidate's prediction is scaled by
-//! measured / predicted of the pilot's own configuration (κ, `merge_correlation`).
+//! measured / predicted of the pilot's own configuration (κ, `merge_correlation`), taken per
+//! pixel over a 15 × 15 window and never below the image's ratio (`local_merge_correlation`).
 //!
 //! **Merging's bias.** Second moments alone favour merging where it is biased (Bitterli's
 //! veach-bidir: 16× the best fixed configuration's inefficiency). The pilot therefore also
@@ -61,7 +62,8 @@
 //! second moment (pbrt's relMSE guard; μ_p the pilot's estimate) summed over pixels: the merge
 //! mask is the prefix, by moment saved per cost added, that minimises it; the global choice the
 //! candidate whose best mask minimises it. The choice and the predicted inefficiency of every
-//! candidate (per pixel mean, per pass) go to the JSON record.
+//! candidate (per pixel mean, per pass) go to the JSON record, and the merge mask to
+//! `OUT.merge-mask.exr` beside `lt render`'s output (1 where the pixel merges).
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
@@ -208,6 +210,7 @@ impl Progressive for Eamis {
                 predicted: f64::NAN,
                 fixed: Vec::new(),
                 merge_correlation: f64::NAN,
+                merge_correlation_median: f64::NAN,
                 bias_share: f64::NAN,
                 must_merge: f64::NAN,
             });
@@ -228,6 +231,8 @@ pub struct Choice {
     pub fixed: Vec<(String, f64)>,
     /// κ, the pilot's measured second moment over its predicted one (`merge_correlation`).
     pub merge_correlation: f64,
+    /// The median over pixels of κ per pixel (`local_merge_correlation`).
+    pub merge_correlation_median: f64,
     /// The share of merging's bias in the pilot configuration's predicted inefficiency over the
     /// horizon (0 … 1).
     pub bias_share: f64,
@@ -344,6 +349,10 @@ impl ProgressiveRun for EamisRun<'_> {
                     "eamis_merge_correlation",
                     format!("{:.4}", c.merge_correlation),
                 ),
+                (
+                    "eamis_merge_correlation_median",
+                    format!("{:.4}", c.merge_correlation_median),
+                ),
                 ("eamis_merge_bias_share", format!("{:.4}", c.bias_share)),
                 ("eamis_must_merge_pixels", format!("{:.4}", c.must_merge)),
                 ("eamis_horizon_passes", format!("{}", self.horizon)),
@@ -369,6 +378,12 @@ impl ProgressiveRun for EamisRun<'_> {
                 log.facts
                     .push((format!("eamis_predicted_{label}"), format!("{p:.6e}")));
             }
+            let (w, h) = (self.probe.width, self.probe.height);
+            let mut mask = Image::new(w as usize, h as usize);
+            for (px, &m) in mask.data.iter_mut().zip(c.merge_mask.iter()) {
+                *px = [if m { 1.0 } else { 0.0 }; 3];
+            }
+            log.images.push(("merge-mask".to_string(), mask));
         }
         log
     }
@@ -581,6 +596,36 @@ fn merge_correlation(probe: &Probe, rel: &[f64]) -> f64 {
     }
 }
 
+/// κ per pixel: the pilot's measured over predicted second moment of its own configuration
+/// (candidate `own`), both averaged over the pixel's (2 `KAPPA_REACH` + 1)² neighbourhood, and
+/// never below the image's κ (`kappa`). The image's κ is a ratio of sums over pixels, so the
+/// few pixels whose predicted moment a rare pilot sample inflated set it: on veach-bidir it was
+/// 1.4 where the pixels' own ratios have median 8.8 and reach 100 around the glass egg, where
+/// merging's caustic is heavy-tailed. There the image's κ under-predicted merging's moment and
+/// eamis merged where a fixed configuration without merging was 2–8× better (results/eamis.md).
+fn local_merge_correlation(probe: &Probe, kappa: f64, per_pass: f64, own: usize) -> Vec<f64> {
+    let (w, h) = (probe.width as usize, probe.height as usize);
+    let nc = probe.candidates.len();
+    let n = w * h;
+    let measured: Vec<f64> = probe.measured.iter().map(|m| m * per_pass).collect();
+    let predicted: Vec<f64> = (0..n)
+        .map(|p| probe.moments[p * nc + own] * per_pass)
+        .collect();
+    let measured = box_filter(&measured, 1, w, h, KAPPA_REACH);
+    let predicted = box_filter(&predicted, 1, w, h, KAPPA_REACH);
+    measured
+        .iter()
+        .zip(&predicted)
+        .map(|(&m, &q)| if q > 0.0 { (m / q).max(kappa) } else { kappa })
+        .collect()
+}
+
+/// The window of the per-pixel κ reaches this many pixels each way: wider than the moments'
+/// (`FILTER_REACH`), since κ is a ratio that changes slowly across the image and one pilot pass
+/// gives one sample per pixel (veach-bidir, 4 seeds: reach 3 left one seed at 3.5× the best
+/// fixed configuration's relMSE, reach 7 at 1.8×).
+pub const KAPPA_REACH: usize = 7;
+
 /// How much lower than merging everywhere or nowhere a per-pixel mask's predicted inefficiency
 /// must be for eamis to use it. A one-pass pilot misjudges the pixels at a mask's edge both ways:
 /// on caustic-sds it under-predicted heavy-tailed light where it turned merging off (relMSE 317
@@ -612,16 +657,16 @@ fn dilate(mask: &[bool], w: usize, h: usize, reach: usize) -> Vec<bool> {
     out
 }
 
-/// Per-pixel rows of `nc` values averaged over each pixel's (2 `FILTER_REACH` + 1)² neighbourhood (clamped at the
-/// film's edges).
-fn box_filter(values: &[f64], nc: usize, w: usize, h: usize) -> Vec<f64> {
+/// Per-pixel rows of `nc` values averaged over each pixel's (2 `reach` + 1)² neighbourhood
+/// (clamped at the film's edges).
+fn box_filter(values: &[f64], nc: usize, w: usize, h: usize, reach: usize) -> Vec<f64> {
     let mut out = vec![0.0; values.len()];
     for y in 0..h {
         for x in 0..w {
             let row = &mut out[(y * w + x) * nc..(y * w + x + 1) * nc];
             let mut count = 0.0;
-            for ny in y.saturating_sub(FILTER_REACH)..(y + FILTER_REACH + 1).min(h) {
-                for nx in x.saturating_sub(FILTER_REACH)..(x + FILTER_REACH + 1).min(w) {
+            for ny in y.saturating_sub(reach)..(y + reach + 1).min(h) {
+                for nx in x.saturating_sub(reach)..(x + reach + 1).min(w) {
                     let src = &values[(ny * w + nx) * nc..(ny * w + nx + 1) * nc];
                     row.iter_mut().zip(src).for_each(|(a, b)| *a += b);
                     count += 1.0;
@@ -666,7 +711,7 @@ fn merge_bias_squared(probe: &Probe, pilot_passes: u32) -> Vec<f64> {
         .zip(&probe.bias_terms_sq)
         .map(|(d, sq)| 4.0 * ((d * k).powi(2) - sq * k * k))
         .collect();
-    let mut out = box_filter(&raw, g_count, w, h);
+    let mut out = box_filter(&raw, g_count, w, h, FILTER_REACH);
     out.iter_mut().for_each(|b| *b = b.max(0.0));
     out
 }
@@ -691,22 +736,24 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
     // sample per pixel: each pixel's moments are averaged over its 7 × 7 neighbourhood, which
     // keeps the total a rare path the pilot saw once adds and spreads it to the pixels around.
     let (w, h) = (probe.width as usize, probe.height as usize);
+    // The probe's sums run over every pilot pass; the bias terms below are per pass, so the
+    // moments are too.
     let per_pass = 1.0 / horizon.pilot_passes.max(1) as f64;
     // P b² of candidate c in pixel p.
     let missed_bias =
         |p: usize, c: usize| horizon.passes as f64 * (probe.missed[p * nc + c] * per_pass).powi(2);
     let with_missed: Vec<f64> = (0..n * nc)
-        .map(|i| probe.moments[i] + missed_bias(i / nc, i % nc))
+        .map(|i| probe.moments[i] * per_pass + missed_bias(i / nc, i % nc))
         .collect();
-    let moments = box_filter(&with_missed, nc, w, h);
+    let moments = box_filter(&with_missed, nc, w, h, FILTER_REACH);
     // Without merging: global g's candidate is 2g + 1.
     let unmerged_with_missed: Vec<f64> = (0..n * nc / 2)
         .map(|i| {
             let (p, g) = (i / (nc / 2), i % (nc / 2));
-            probe.moments_unmerged[i] + missed_bias(p, 2 * g + 1)
+            probe.moments_unmerged[i] * per_pass + missed_bias(p, 2 * g + 1)
         })
         .collect();
-    let moments_unmerged = box_filter(&unmerged_with_missed, nc / 2, w, h);
+    let moments_unmerged = box_filter(&unmerged_with_missed, nc / 2, w, h, FILTER_REACH);
     // Light only merging reaches, seen by the pilot in one pixel, is likely in the pixels around
     // it that one pass did not sample (caustic-sds: a mask of the pixels the pilot saw it in
     // merged 7–10 % of the image and was 97× the best fixed configuration's inefficiency): every
@@ -726,8 +773,16 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
         .unwrap_or(0);
     // Pixels where merging's predicted bias outweighs its moment: their merges witness a blurred
     // integrand, so the moment without merging comes from the other samples alone there.
+    let kappa_at = local_merge_correlation(probe, kappa, per_pass, 2 * pilot_g);
+    let kappa_median = {
+        let mut sorted = kappa_at.clone();
+        sorted.sort_by(f64::total_cmp);
+        sorted.get(sorted.len() / 2).copied().unwrap_or(kappa)
+    };
     let bias_dominated: Vec<bool> = (0..n)
-        .map(|p| bias_factor * bias2[p * g_count + pilot_g] > kappa * moments[p * nc + 2 * pilot_g])
+        .map(|p| {
+            bias_factor * bias2[p * g_count + pilot_g] > kappa_at[p] * moments[p * nc + 2 * pilot_g]
+        })
         .collect();
     let bias_share = {
         let g = pilot_g;
@@ -735,7 +790,7 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
             .map(|p| bias_factor * bias2[p * g_count + g] * rel[p])
             .sum();
         let var: f64 = (0..n)
-            .map(|p| kappa * moments[p * nc + 2 * g] * rel[p])
+            .map(|p| kappa_at[p] * moments[p * nc + 2 * g] * rel[p])
             .sum();
         if bias + var > 0.0 {
             bias / (bias + var)
@@ -754,7 +809,7 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
                 0.0
             };
         let on = |p: usize| {
-            (kappa * moments[p * nc + 2 * g] + bias_factor * bias2[p * g_count + g]) * rel[p]
+            (kappa_at[p] * moments[p * nc + 2 * g] + bias_factor * bias2[p * g_count + g]) * rel[p]
         };
         let off = |p: usize| {
             rel[p]
@@ -830,6 +885,7 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
                 predicted,
                 fixed: Vec::new(),
                 merge_correlation: kappa,
+                merge_correlation_median: kappa_median,
                 bias_share,
                 must_merge: must_share,
             });
@@ -843,6 +899,7 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
         predicted: f64::INFINITY,
         fixed: Vec::new(),
         merge_correlation: kappa,
+        merge_correlation_median: kappa_median,
         bias_share,
         must_merge: must_share,
     });

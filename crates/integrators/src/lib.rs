@@ -113,6 +113,9 @@ pub struct ProgressLog {
     pub mean_radius: Vec<f64>,
     /// Everything else worth recording, as (key, value) text.
     pub facts: Vec<(String, String)>,
+    /// Images worth keeping beside the render, as (name, image): `lt render -o OUT.exr` writes
+    /// each as `OUT.<name>.exr` (eamis: the merge mask it chose).
+    pub images: Vec<(String, Image)>,
 }
 
 /// An integrator as the registry builds it: one of the two kinds.

@@ -73,6 +73,7 @@ fn log_json(log: &ProgressLog) -> serde_json::Value {
         "radius_scale_per_pass": log.radius_scale,
         "mean_radius_per_pass": log.mean_radius,
         "facts": log.facts.iter().map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone()))).collect::<serde_json::Map<_, _>>(),
+        "images": log.images.iter().map(|(name, _)| format!(".{name}.exr")).collect::<Vec<_>>(),
     })
 }
 
@@ -234,6 +235,10 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         ),
     };
     write_all(&mean, se)?;
+    // The first run's side images (one run's choice; `--runs K` repeats it with other seeds).
+    for (name, img) in result.runs[0].log.iter().flat_map(|l| &l.images) {
+        crate::image_io::write_exr(&sibling(output, &format!(".{name}.exr")), img)?;
+    }
     let secs = result.elapsed.as_secs_f64();
     let total_passes: u64 = result.runs.iter().map(|r| r.passes as u64).sum();
     let first = &result.runs[0];
