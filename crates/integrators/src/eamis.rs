@@ -602,7 +602,8 @@ fn merge_correlation(probe: &Probe, rel: &[f64]) -> f64 {
 /// few pixels whose predicted moment a rare pilot sample inflated set it: on veach-bidir it was
 /// 1.4 where the pixels' own ratios have median 8.8 and reach 100 around the glass egg, where
 /// merging's caustic is heavy-tailed. There the image's κ under-predicted merging's moment and
-/// eamis merged where a fixed configuration without merging was 2–8× better (results/eamis.md).
+/// eamis merged where a fixed configuration without merging was 2.5–10× better
+/// (results/eamis.md).
 fn local_merge_correlation(probe: &Probe, kappa: f64, per_pass: f64, own: usize) -> Vec<f64> {
     let (w, h) = (probe.width as usize, probe.height as usize);
     let nc = probe.candidates.len();
@@ -622,8 +623,8 @@ fn local_merge_correlation(probe: &Probe, kappa: f64, per_pass: f64, own: usize)
 
 /// The window of the per-pixel κ reaches this many pixels each way: wider than the moments'
 /// (`FILTER_REACH`), since κ is a ratio that changes slowly across the image and one pilot pass
-/// gives one sample per pixel (veach-bidir, 4 seeds: reach 3 left one seed at 3.5× the best
-/// fixed configuration's relMSE, reach 7 at 1.8×).
+/// gives one sample per pixel (veach-bidir, 4 seeds: reach 3 left one seed at 3.9× the relMSE of
+/// m2_vc1_nomerge, reach 7 at 1.8×).
 pub const KAPPA_REACH: usize = 7;
 
 /// How much lower than merging everywhere or nowhere a per-pixel mask's predicted inefficiency
