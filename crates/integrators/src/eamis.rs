@@ -65,10 +65,10 @@
 //! moments, which the pixel's own 1/(μ + 0.01)² then weighs, so a bright pixel's moment is
 //! spread over dark neighbours (on cornell-box the lamp's edge dominates the sum). Averaging
 //! relative moments instead fixed that, and lost caustic-sds 3.45× to its best fixed
-//! configuration: the relative prediction of merging's variance there is flat in M where the
-//! measurement falls as M^−0.6 (results/eamis.md). The choice and the predicted inefficiency
-//! of every candidate (per pixel mean, per pass) go to the JSON record, and the merge mask to
-//! `OUT.merge-mask.exr` beside `lt render`'s output (1 where the pixel merges).
+//! configuration: its relative second moments are μ² and a sliver, so second moment × cost
+//! ranked by cost (results/eamis.md; the cure is a variance). The choice and the predicted
+//! inefficiency of every candidate (per pixel mean, per pass) go to the JSON record, and the
+//! merge mask to `OUT.merge-mask.exr` beside `lt render`'s output (1 where the pixel merges).
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
