@@ -19,6 +19,7 @@ mod photon_estimates;
 mod pt_agreement;
 mod robustness;
 mod runs;
+mod side_images;
 mod studies;
 mod techniques_study;
 mod translation;

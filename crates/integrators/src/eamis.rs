@@ -609,15 +609,12 @@ fn merge_correlation(probe: &Probe, rel: &[f64]) -> f64 {
 /// merging's caustic is heavy-tailed. There the image's κ under-predicted merging's moment and
 /// eamis merged where a fixed configuration without merging was 2.5–10× better
 /// (results/eamis.md).
-fn local_merge_correlation(probe: &Probe, kappa: f64, per_pass: f64, own: usize) -> Vec<f64> {
+fn local_merge_correlation(probe: &Probe, kappa: f64, own: usize) -> Vec<f64> {
     let (w, h) = (probe.width as usize, probe.height as usize);
     let nc = probe.candidates.len();
-    let n = w * h;
-    let measured: Vec<f64> = probe.measured.iter().map(|m| m * per_pass).collect();
-    let predicted: Vec<f64> = (0..n)
-        .map(|p| probe.moments[p * nc + own] * per_pass)
-        .collect();
-    let measured = box_filter(&measured, 1, w, h, KAPPA_REACH);
+    // Sums over the pilot passes: the ratio needs no per-pass scale.
+    let predicted: Vec<f64> = (0..w * h).map(|p| probe.moments[p * nc + own]).collect();
+    let measured = box_filter(&probe.measured, 1, w, h, KAPPA_REACH);
     let predicted = box_filter(&predicted, 1, w, h, KAPPA_REACH);
     measured
         .iter()
@@ -777,14 +774,14 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
         .iter()
         .position(|&(r, vc)| r == PILOT.light_ratio && vc == PILOT.vertex_connections)
         .unwrap_or(0);
-    // Pixels where merging's predicted bias outweighs its moment: their merges witness a blurred
-    // integrand, so the moment without merging comes from the other samples alone there.
-    let kappa_at = local_merge_correlation(probe, kappa, per_pass, 2 * pilot_g);
+    let kappa_at = local_merge_correlation(probe, kappa, 2 * pilot_g);
     let kappa_median = {
         let mut sorted = kappa_at.clone();
         sorted.sort_by(f64::total_cmp);
         sorted.get(sorted.len() / 2).copied().unwrap_or(kappa)
     };
+    // Pixels where merging's predicted bias outweighs its moment: their merges witness a blurred
+    // integrand, so the moment without merging comes from the other samples alone there.
     let bias_dominated: Vec<bool> = (0..n)
         .map(|p| {
             bias_factor * bias2[p * g_count + pilot_g] > kappa_at[p] * moments[p * nc + 2 * pilot_g]
