@@ -1,8 +1,9 @@
 //! `eamis` — efficiency-aware MIS over VCM's techniques (Grittmann, Yazici, Georgiev & Slusallek,
 //! SIGGRAPH 2022): a pilot of `pilot_passes` VCM passes (one light subpath per pixel, every
-//! technique) predicts, per pixel, the second moment every candidate configuration would have
-//! (`lt_core::path::efficiency`), and counts what each would cost; the rest of the run renders
-//! with the configuration of least predicted inefficiency (second moment × cost):
+//! technique) predicts, per pixel, the variance every candidate configuration would have
+//! (`Counts::contribution` in `lt_core::path::efficiency`), and counts what each would cost; the
+//! rest of the run renders with the configuration of least predicted inefficiency (relative
+//! variance × cost):
 //!
 //! - the light subpath count M ∈ {¼, ½, 1, 2} × the pixel count (global),
 //! - vertex connections s ≥ 2, t ≥ 2 on or off (global; next-event estimation and light tracing
@@ -14,23 +15,31 @@
 //! with the choice (`keep_pilot` keeps them): they are full VCM passes, and on veach-bidir their
 //! merging's fireflies and bias made most of eamis's error (results/eamis.md). The choice is a
 //! function of the pilot's samples alone and the later passes are independent of them, so the
-//! estimator stays consistent, and unbiased wherever merging is off. The pilot runs on one thread (its moment sums then do not
-//! depend on the thread count) and the cost is counted, not timed, so the same seed gives the same
+//! estimator stays consistent, and unbiased wherever merging is off. The pilot runs on one
+//! thread (its sums then do not depend on the thread count) and the cost is counted, not timed, so the same seed gives the same
 //! choice and the same image bit for bit.
 //!
 //! **Cost model**: the pilot counts camera samples, next-event shadow rays (one per connectable
 //! camera vertex), vertex connections, light vertices, light-tracing joins, merge queries and
 //! light vertices found per pixel, and weighs them with unit costs measured once on this machine
 //! (`COST_*`, results/eamis.md): a count, not a clock, so the choice is deterministic. Light
-//! vertices, light tracing and merges found scale with M.
+//! vertices, light tracing and merges found scale with M. The unit costs are one scene's: over
+//! four scenes one set predicts each render's CPU time within 0.84–1.14× (after a per-scene
+//! scale), so configurations predicted within ~1.15× of each other are a toss-up.
 //!
-//! **Correlated merges.** The prediction treats every sample as independent; the merges around
-//! one camera vertex are not. The pilot also measures its own second moment (each camera sample's
-//! contributions summed before squaring), and every merging candidate's prediction is scaled by
-//! measured / predicted of the pilot's own configuration (κ, `merge_correlation`), taken per
-//! pixel over a 15 × 15 window and never below the image's ratio (`local_merge_correlation`).
+//! **The variance, from the pilot's own samples.** Each pilot sample's value under every
+//! candidate c is f/q_c (the balance heuristic's, merges counted with c's η); a camera sample's
+//! values are summed before squaring, so the correlation between the techniques of one camera
+//! path and between the merges around one camera vertex is in the square. Light tracing and
+//! merging draw on M_c light paths: their values are scaled to the pilot's light-path count and
+//! their part of the variance counted M_pilot/M_c times. μ² is taken out with the neighbours'
+//! samples (`direct_variance`). The paper's independent-sample second moment, ∫ f²/q_c, which
+//! this replaced, drops those cross terms (it is Var + Σ_u μ_u²/n_u, not Var + μ²) and made
+//! second moment × cost rank by cost where μ² dominates (caustic-sds; results/eamis.md). It is
+//! still computed: its ratio to the pilot's measured moment, κ, floors merging's variance
+//! (`local_merge_correlation`), where one pass sees too few clumps of merges to trust.
 //!
-//! **Merging's bias.** Second moments alone favour merging where it is biased (Bitterli's
+//! **Merging's bias.** Variances alone favour merging where it is biased (Bitterli's
 //! veach-bidir: 16× the best fixed configuration's inefficiency). The pilot therefore also
 //! estimates each pixel's merging bias at the initial radius r₀ from its own merges: with a disk
 //! kernel, the estimate at r/√2 keeps the merges within r/√2 at twice their value, and where the
@@ -45,30 +54,28 @@
 //! differences would shrink it by the window's area. Over a render of
 //! P passes (`ProgressiveRun::plan`, else `DEFAULT_HORIZON`) whose radius shrinks as
 //! r_i² = r₀² i^(α−1), the image's bias is b₀ s(P), s(P) = (1/P) Σ_{i≤P} i^(α−1), so a merging
-//! pixel's per-pass moment becomes κ M + P s(P)² b₀²: the inefficiency of the whole render,
+//! pixel's per-pass moment becomes κ V + P s(P)² b₀²: the inefficiency of the whole render,
 //! relMSE × time, divided by P.
 //!
 //! **Light a configuration misses, and heavy tails.** A pilot sample whose path no technique of
 //! a candidate makes (q_c = 0: a caustic seen in a mirror, without merging) is light that
 //! candidate misses in every pass, a bias: it adds P b² to the pixel's moment. Such light seen
 //! in one pixel is likely in the pixels around it that one pass did not sample, so every pixel
-//! within `MUST_MERGE_REACH` of one merges. Without merging, a pixel's moment comes from every
-//! pilot sample (`Counts::second_moment_term`: merges are the better witnesses of light the
-//! other techniques find rarely, caustic-sds) except where merging's bias is predicted to
-//! outweigh its moment: there a merge witnesses a blurred integrand, and the moment comes from
-//! the other samples alone (`Counts::second_moment_term_without_merges`).
+//! within `MUST_MERGE_REACH` of one merges. Without merging, a pixel's variance gains the
+//! independent-sample moment the merges add (`Counts::second_moment_term` less
+//! `Counts::second_moment_term_without_merges`): merges are the better witnesses of light the
+//! other techniques find rarely, a heavy tail one pass does not show in their own samples
+//! (caustic-sds). Not where merging's bias is predicted to outweigh its variance: there a merge
+//! witnesses a blurred integrand.
 //!
-//! **Which pixels matter.** The image's inefficiency is Σ_p M_p / (μ_p + 0.01)² × cost, the relative
-//! second moment (pbrt's relMSE guard; μ_p the pilot's estimate) summed over pixels: the merge
-//! mask is the prefix, by moment saved per cost added, that minimises it; the global choice the
-//! candidate whose best mask minimises it. A known flaw: the 7 × 7 window averages absolute
-//! moments, which the pixel's own 1/(μ + 0.01)² then weighs, so a bright pixel's moment is
-//! spread over dark neighbours (on cornell-box the lamp's edge dominates the sum). Averaging
-//! relative moments instead fixed that, and lost caustic-sds 3.45× to its best fixed
-//! configuration: its relative second moments are μ² and a sliver, so second moment × cost
-//! ranked by cost (results/eamis.md; the cure is a variance). The choice and the predicted
-//! inefficiency of every candidate (per pixel mean, per pass) go to the JSON record, and the
-//! merge mask to `OUT.merge-mask.exr` beside `lt render`'s output (1 where the pixel merges).
+//! **Which pixels matter.** The image's inefficiency is Σ_p V_p / (μ̃_p + 0.01)² × cost, the
+//! relative variance (pbrt's relMSE guard; μ̃_p the median of the pilot's estimate over the pixel
+//! and its 8 neighbours, `relative_weights`) summed over pixels, each pixel's relative terms
+//! averaged over its 7 × 7 window (`relative_window`): the merge mask is the prefix, by variance
+//! saved per cost added, that minimises it; the global choice the candidate whose best mask
+//! minimises it. The choice and the predicted inefficiency of every
+//! candidate (per pixel mean, per pass) go to the JSON record, and the merge mask to
+//! `OUT.merge-mask.exr` beside `lt render`'s output (1 where the pixel merges).
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
@@ -92,7 +99,7 @@ use crate::record::{Completed, Merged, Recorder, Work};
 use crate::{ProgressLog, Progressive, ProgressiveRun};
 use lt_core::math::Color;
 use lt_core::path::camis::Mixture;
-use lt_core::path::efficiency::Counts;
+use lt_core::path::efficiency::{Counts, Scaling};
 use lt_core::path::Heuristic;
 use lt_core::Scene;
 use lt_estimators::metrics::REL_MSE_GUARD;
@@ -108,15 +115,15 @@ pub const LIGHT_RATIOS: [f64; 4] = [0.25, 0.5, 1.0, 2.0];
 /// The cost model's unit costs, in units of 200 ns of one core of this machine, from one-thread
 /// renders of `cornell-box` at 128 px with each `fixed` candidate (results/eamis.md): a camera
 /// sample, and per connectable camera vertex its extension and its next-event shadow ray.
-pub const COST_CAMERA: f64 = 1.25;
+pub const COST_CAMERA: f64 = 0.97;
 /// A vertex connection (shadow ray and two BSDF evaluations, full-path weight).
-pub const COST_VERTEX_CONNECTION: f64 = 0.7;
+pub const COST_VERTEX_CONNECTION: f64 = 0.45;
 /// A light vertex traced and stored, or one joined to the lens (light tracing).
-pub const COST_LIGHT: f64 = 1.1;
+pub const COST_LIGHT: f64 = 1.25;
 /// A merge query (the grid lookup).
 pub const COST_QUERY: f64 = 0.5;
 /// A light vertex found in range (BSDF evaluation and full-path weight).
-pub const COST_MERGE: f64 = 1.3;
+pub const COST_MERGE: f64 = 1.2;
 
 pub struct Eamis {
     pub params: VcmParams,
@@ -214,6 +221,7 @@ impl Progressive for Eamis {
                 merge_mask: mask,
                 predicted: f64::NAN,
                 fixed: Vec::new(),
+                direct_over_independent: f64::NAN,
                 merge_correlation: f64::NAN,
                 merge_correlation_median: f64::NAN,
                 bias_share: f64::NAN,
@@ -230,11 +238,14 @@ pub struct Choice {
     pub counts: Counts,
     /// Pixels that merge.
     pub merge_mask: MergeMask,
-    /// Σ_p relative second moment per pass × cost per pass (traced-ray units), per pixel.
+    /// Σ_p relative variance per pass × cost per pass (units of `COST_*`), per pixel.
     pub predicted: f64,
     /// Every global candidate with merging everywhere and nowhere: (label, predicted).
     pub fixed: Vec<(String, f64)>,
-    /// κ, the pilot's measured second moment over its predicted one (`merge_correlation`).
+    /// The pilot configuration's direct variance over its independent-sample moment, relative
+    /// and summed over pixels: how much of that model's moment was variance.
+    pub direct_over_independent: f64,
+    /// κ, the pilot's measured second moment over its independent-sample one (`merge_correlation`).
     pub merge_correlation: f64,
     /// The median over pixels of κ per pixel (`local_merge_correlation`).
     pub merge_correlation_median: f64,
@@ -287,7 +298,6 @@ impl ProgressiveRun for EamisRun<'_> {
         self.probe.bias_scale = 1.0 / self.eamis.params.radius_scale(pass).powi(2);
         let invalid = self.pilot.recorded_pass(pass, &mut self.probe);
         self.probe.flush();
-        self.pilot_cpu += crate::tally::pool_cpu_seconds() - cpu0;
         self.probe.light_vertices += self.pilot.stored_light_vertices() as u64;
         if self.pilot.sum().1 >= self.eamis.pilot_passes {
             let horizon = Horizon {
@@ -298,6 +308,8 @@ impl ProgressiveRun for EamisRun<'_> {
             let choice = choose(&self.probe, &self.pilot.estimate(), &horizon);
             self.start_render(choice);
         }
+        // The choice is overhead too: it is counted with the pilot.
+        self.pilot_cpu += crate::tally::pool_cpu_seconds() - cpu0;
         invalid
     }
 
@@ -350,6 +362,10 @@ impl ProgressiveRun for EamisRun<'_> {
                     format!("{:.4}", merging as f64 / c.merge_mask.len().max(1) as f64),
                 ),
                 ("eamis_predicted", format!("{:.6e}", c.predicted)),
+                (
+                    "eamis_direct_over_independent",
+                    format!("{:.4}", c.direct_over_independent),
+                ),
                 (
                     "eamis_merge_correlation",
                     format!("{:.4}", c.merge_correlation),
@@ -435,12 +451,19 @@ struct Probe {
     pending: Option<Mixture>,
     pixel: usize,
     film_weight: f64,
-    /// Per pixel, the pilot's own second moment as measured: each camera sample's weighted
-    /// contributions summed before squaring (so the correlation between its merges is in it),
-    /// light-tracing splats squared one by one.
-    measured: Vec<f64>,
-    /// The weighted contributions of the camera sample under way.
-    sample_sum: f64,
+    /// direct[pixel × candidates + c]: Σ over the pilot's camera samples of the square of the
+    /// value c would have got from it (`Counts::contribution` summed over its samples, so the
+    /// correlation between its techniques and between its merges is in it), plus (r_c − 1) ×
+    /// the sum of its merges' squares; plus each light-tracing splat's square × r_c. The values
+    /// are c's own per sample, and c draws r_c = M_c/M_pilot times the pilot's light paths: the
+    /// part of the variance that comes from the light paths (the squares of independent
+    /// samples) counts r_c times.
+    direct: Vec<f64>,
+    /// The same layout: Σ over camera samples of that value (its mean's estimate).
+    direct_sum: Vec<f64>,
+    /// Per candidate, the value of the camera sample under way and its merges' squares.
+    sample_value: Vec<f64>,
+    sample_merge_sq: Vec<f64>,
     /// bias_diff[pixel × globals + g]: Σ over the pilot's merges of w_c v (1 − 2·[d < r/√2]) ×
     /// `bias_scale`, c the merging candidate of global g: half of merging's bias at r₀, summed
     /// over the pilot passes.
@@ -455,7 +478,8 @@ impl Probe {
     fn new(scene: &Scene) -> Probe {
         let n = scene.camera.pixel_count();
         let candidates = fixed_candidates();
-        let globals = candidates.len() / 2;
+        let nc = candidates.len();
+        let globals = nc / 2;
         Probe {
             width: scene.camera.width,
             height: scene.camera.height,
@@ -473,18 +497,48 @@ impl Probe {
             pending: None,
             pixel: 0,
             film_weight: 1.0,
-            measured: vec![0.0; n],
-            sample_sum: 0.0,
+            direct: vec![0.0; n * nc],
+            direct_sum: vec![0.0; n * nc],
+            sample_value: vec![0.0; nc],
+            sample_merge_sq: vec![0.0; nc],
             bias_diff: vec![0.0; n * globals],
             bias_terms_sq: vec![0.0; n * globals],
             bias_scale: 1.0,
         }
     }
 
-    /// Adds the camera sample under way to `measured`.
+    /// Adds the camera sample under way to `direct`.
     fn flush(&mut self) {
-        self.measured[self.pixel] += self.sample_sum * self.sample_sum;
-        self.sample_sum = 0.0;
+        let nc = self.candidates.len();
+        for (c, counts) in self.candidates.iter().enumerate() {
+            let (v, sq) = (self.sample_value[c], self.sample_merge_sq[c]);
+            let r = counts.light_ratio / PILOT.light_ratio;
+            self.direct[self.pixel * nc + c] += v * v + (1.0 / r - 1.0) * sq;
+            self.direct_sum[self.pixel * nc + c] += v;
+        }
+        self.sample_value.iter_mut().for_each(|v| *v = 0.0);
+        self.sample_merge_sq.iter_mut().for_each(|v| *v = 0.0);
+    }
+
+    /// The value every candidate gives one pilot sample, into the camera sample under way or,
+    /// for a light-tracing splat, straight into `direct` of the pixel it lands in.
+    fn add_direct(&mut self, pixel: usize, value: f64, mixture: &Mixture, scaling: Scaling) {
+        let nc = self.candidates.len();
+        for (c, counts) in self.candidates.iter().enumerate() {
+            let x = counts.contribution(value, mixture, &PILOT, scaling);
+            match scaling {
+                Scaling::LightTracing => {
+                    let r = counts.light_ratio / PILOT.light_ratio;
+                    self.direct[pixel * nc + c] += x * x * r;
+                }
+                Scaling::Merge => {
+                    let y = x * counts.light_ratio / PILOT.light_ratio;
+                    self.sample_value[c] += y;
+                    self.sample_merge_sq[c] += y * y;
+                }
+                _ => self.sample_value[c] += x,
+            }
+        }
     }
 
     fn add(&mut self, pixel: usize, weight: f64, value: f64, mixture: &Mixture, merge: bool) {
@@ -532,11 +586,7 @@ impl Recorder for Probe {
         let value = channel_mean(p.value) * if light_tracing { 1.0 } else { self.film_weight };
         let pixel = pixel_of(p.raster, self.width, self.height);
         self.add(pixel, p.weight, value, &m, false);
-        if light_tracing {
-            self.measured[pixel] += (p.weight * value).powi(2);
-        } else {
-            self.sample_sum += p.weight * value;
-        }
+        self.add_direct(pixel, value, &m, Scaling::of(p.s, p.camera.len(), false));
     }
 
     fn merged(&mut self, p: Merged) {
@@ -547,7 +597,7 @@ impl Recorder for Probe {
         let pixel = pixel_of(p.raster, self.width, self.height);
         self.merges_found[pixel] += 1;
         self.add(pixel, p.weight, value, &m, true);
-        self.sample_sum += p.weight * value;
+        self.add_direct(pixel, value, &m, Scaling::Merge);
         // Merging's bias: + outside r/√2, − inside (kept there twice), per merging candidate.
         let (Some(y), Some(x)) = (p.light.last(), p.camera.last()) else {
             return;
@@ -577,21 +627,59 @@ impl Recorder for Probe {
     }
 }
 
-/// κ = Σ_p rel_p · measured_p / Σ_p rel_p · predicted_p for the pilot's own configuration (which
-/// merges everywhere): how far the independent-sample prediction falls short of the pilot's
-/// measured second moment. Merges around one camera vertex share its prefix, which the
-/// prediction (even with ρ) does not see; the measured moment does, because each camera sample's
-/// contributions are summed before squaring. Every merging candidate's prediction is multiplied
-/// by κ (on cornell-box at 64 px κ = 8.2 and 7.8 for two seeds: without it eamis merged 30 % of
-/// the pixels and lost 1.6× to the best fixed configuration, which merges nowhere; results/eamis.md).
-fn merge_correlation(probe: &Probe, rel: &[f64]) -> f64 {
+/// Per pixel and candidate, the variance per pass of the value the candidate would get, from
+/// the pilot's own samples (`Probe::direct`): each pixel's square less its value times its 8
+/// neighbours' mean, averaged over the pixel's window as relative values (`relative_window`),
+/// clamped at 0.
+///
+/// The independent-sample model, M(c) = ∫ f²/q_c, drops the cross terms between techniques: it
+/// is Var + Σ_u μ_u²/n_u, not Var + μ², and on cornell-box it fell below μ² altogether. How the
+/// mean is split between techniques changes with the configuration, so second moment × cost
+/// ranked configurations by that split and by cost as much as by their variance (caustic-sds,
+/// where μ² is most of every candidate's second moment; results/eamis.md). Merges around one
+/// camera vertex share its prefix and the techniques of one camera path are correlated: summing
+/// a camera sample's values before squaring keeps both.
+fn direct_variance(probe: &Probe, per_pass: f64, rel: &[f64]) -> Vec<f64> {
+    let (w, h) = (probe.width as usize, probe.height as usize);
     let nc = probe.candidates.len();
-    let Some(own) = probe.candidates.iter().position(|c| *c == PILOT) else {
-        return 1.0;
-    };
+    let mean = |p: usize, c: usize| probe.direct_sum[p * nc + c] * per_pass;
+    // x_p² − x_p x̄_q, x̄_q the mean of the 8 neighbours' (independent) samples: an estimate of
+    // E[x²] − μ_p μ_q that a pixel's single sample cannot give of μ_p²; only the local gradient
+    // of μ is left in it, not the window's spread of μ (the lamp's edge on cornell-box).
+    let mut raw = vec![0.0; w * h * nc];
+    for y in 0..h {
+        for x in 0..w {
+            let p = y * w + x;
+            let mut neighbours = Vec::with_capacity(8);
+            for ny in y.saturating_sub(1)..(y + 2).min(h) {
+                for nx in x.saturating_sub(1)..(x + 2).min(w) {
+                    if (nx, ny) != (x, y) {
+                        neighbours.push(ny * w + nx);
+                    }
+                }
+            }
+            let k = 1.0 / neighbours.len().max(1) as f64;
+            for c in 0..nc {
+                let around: f64 = neighbours.iter().map(|&q| mean(q, c)).sum::<f64>() * k;
+                raw[p * nc + c] = probe.direct[p * nc + c] * per_pass - mean(p, c) * around;
+            }
+        }
+    }
+    let mut out = relative_window(&raw, nc, w, h, rel);
+    out.iter_mut().for_each(|v| *v = v.max(0.0));
+    out
+}
+
+/// κ = Σ_p rel_p · measured_p / Σ_p rel_p · predicted_p for the pilot's own configuration
+/// (candidate `own`, which merges everywhere): the pilot's second moment as measured (each camera
+/// sample's contributions summed before squaring, `Probe::direct`) over the independent-sample
+/// model's (`Probe::moments`). Merges around one camera vertex share its prefix, which the model
+/// does not see and the measurement does.
+fn merge_correlation(probe: &Probe, rel: &[f64], own: usize) -> f64 {
+    let nc = probe.candidates.len();
     let (mut measured, mut predicted) = (0.0, 0.0);
     for (p, r) in rel.iter().enumerate() {
-        measured += r * probe.measured[p];
+        measured += r * probe.direct[p * nc + own];
         predicted += r * probe.moments[p * nc + own];
     }
     if predicted > 0.0 && measured > 0.0 {
@@ -601,20 +689,22 @@ fn merge_correlation(probe: &Probe, rel: &[f64]) -> f64 {
     }
 }
 
-/// κ per pixel: the pilot's measured over predicted second moment of its own configuration
-/// (candidate `own`), both averaged over the pixel's (2 `KAPPA_REACH` + 1)² neighbourhood, and
-/// never below the image's κ (`kappa`). The image's κ is a ratio of sums over pixels, so the
-/// few pixels whose predicted moment a rare pilot sample inflated set it: on veach-bidir it was
-/// 1.4 where the pixels' own ratios have median 8.8 and reach 100 around the glass egg, where
-/// merging's caustic is heavy-tailed. There the image's κ under-predicted merging's moment and
-/// eamis merged where a fixed configuration without merging was 2.5–10× better
-/// (results/eamis.md).
+/// κ per pixel: `merge_correlation`'s ratio over the pixel's (2 `KAPPA_REACH` + 1)²
+/// neighbourhood, never below the image's κ (`kappa`). Every merging candidate's variance is
+/// multiplied by it. The direct variance already holds the correlation the pilot saw, so this
+/// is a guard, not a correction: where one camera sample's merges are strongly correlated, one
+/// pilot pass sees few of the clumps that make merging's tail, and its variance is unreliable.
+/// Without it, veach-bidir merged 8–17 % of its pixels again, on the glass egg where merging's
+/// caustic is heavy-tailed; with it, 1 % (results/eamis.md). The image's κ alone, a ratio of
+/// sums, is set by the few pixels a rare pilot sample inflated (veach-bidir: 1.4, where the
+/// pixels' own ratios have median 8.8).
 fn local_merge_correlation(probe: &Probe, kappa: f64, own: usize) -> Vec<f64> {
     let (w, h) = (probe.width as usize, probe.height as usize);
     let nc = probe.candidates.len();
     // Sums over the pilot passes: the ratio needs no per-pass scale.
+    let measured: Vec<f64> = (0..w * h).map(|p| probe.direct[p * nc + own]).collect();
     let predicted: Vec<f64> = (0..w * h).map(|p| probe.moments[p * nc + own]).collect();
-    let measured = box_filter(&probe.measured, 1, w, h, KAPPA_REACH);
+    let measured = box_filter(&measured, 1, w, h, KAPPA_REACH);
     let predicted = box_filter(&predicted, 1, w, h, KAPPA_REACH);
     measured
         .iter()
@@ -661,24 +751,73 @@ fn dilate(mask: &[bool], w: usize, h: usize, reach: usize) -> Vec<bool> {
 }
 
 /// Per-pixel rows of `nc` values averaged over each pixel's (2 `reach` + 1)² neighbourhood
-/// (clamped at the film's edges).
+/// (clamped at the film's edges), as two passes of 2 `reach` + 1 taps: along x, then along y.
 fn box_filter(values: &[f64], nc: usize, w: usize, h: usize, reach: usize) -> Vec<f64> {
+    let span = |i: usize, len: usize| i.saturating_sub(reach)..(i + reach + 1).min(len);
+    let mut along_x = vec![0.0; values.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let row = &mut along_x[(y * w + x) * nc..(y * w + x + 1) * nc];
+            for nx in span(x, w) {
+                let src = &values[(y * w + nx) * nc..(y * w + nx + 1) * nc];
+                row.iter_mut().zip(src).for_each(|(a, b)| *a += b);
+            }
+        }
+    }
     let mut out = vec![0.0; values.len()];
     for y in 0..h {
         for x in 0..w {
             let row = &mut out[(y * w + x) * nc..(y * w + x + 1) * nc];
-            let mut count = 0.0;
-            for ny in y.saturating_sub(reach)..(y + reach + 1).min(h) {
-                for nx in x.saturating_sub(reach)..(x + reach + 1).min(w) {
-                    let src = &values[(ny * w + nx) * nc..(ny * w + nx + 1) * nc];
-                    row.iter_mut().zip(src).for_each(|(a, b)| *a += b);
-                    count += 1.0;
-                }
+            for ny in span(y, h) {
+                let src = &along_x[(ny * w + x) * nc..(ny * w + x + 1) * nc];
+                row.iter_mut().zip(src).for_each(|(a, b)| *a += b);
             }
+            let count = (span(x, w).len() * span(y, h).len()) as f64;
             row.iter_mut().for_each(|a| *a /= count);
         }
     }
     out
+}
+
+/// Rows of `nc` per-pixel values averaged over each pixel's (2 `FILTER_REACH` + 1)² window as
+/// relative values (each weighed by its own pixel's `rel`), then divided by the pixel's `rel`:
+/// times `rel` again, a pixel gets its window's mean relative value. Averaging absolute values
+/// instead weighed a bright pixel's μ² as its dark neighbours' (cornell-box: the lamp's edge
+/// made the whole prediction; results/eamis.md).
+fn relative_window(values: &[f64], nc: usize, w: usize, h: usize, rel: &[f64]) -> Vec<f64> {
+    let scaled: Vec<f64> = values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v * rel[i / nc])
+        .collect();
+    let mut out = box_filter(&scaled, nc, w, h, FILTER_REACH);
+    out.iter_mut()
+        .enumerate()
+        .for_each(|(i, v)| *v /= rel[i / nc]);
+    out
+}
+
+/// 1/(μ̃ + 0.01)² per pixel (pbrt's relMSE guard), μ̃ the median of the pilot's estimate over
+/// the pixel and its 8 neighbours: one pilot sample per pixel is no estimate of the pixel's
+/// value where rare light lands (caustic-sds: a pixel whose one sample found the caustic would
+/// weigh its own moment by its firefly and call it small).
+fn relative_weights(estimate: &Image, w: usize, h: usize) -> Vec<f64> {
+    let mean = |p: usize| {
+        let c = estimate.data[p];
+        (c[0] + c[1] + c[2]) / 3.0
+    };
+    (0..w * h)
+        .map(|p| {
+            let (x, y) = (p % w, p / w);
+            let mut around: Vec<f64> = (y.saturating_sub(1)..(y + 2).min(h))
+                .flat_map(|ny| (x.saturating_sub(1)..(x + 2).min(w)).map(move |nx| ny * w + nx))
+                .map(mean)
+                .collect();
+            around.sort_by(f64::total_cmp);
+            let mu = around[around.len() / 2];
+            1.0 / (mu.max(0.0) + REL_MSE_GUARD).powi(2)
+        })
+        .collect()
 }
 
 /// The render the choice is made for: merging's bias weighs in over `passes`.
@@ -704,7 +843,7 @@ impl Horizon {
 /// Per pixel and global candidate g, b₀² of merging at r₀: 4 × (the pilot's mean difference
 /// squared less its sampling variance), averaged over the pixel's (2 `FILTER_REACH` + 1)²
 /// neighbourhood and clamped at 0. Laid out as `Probe::bias_diff`.
-fn merge_bias_squared(probe: &Probe, pilot_passes: u32) -> Vec<f64> {
+fn merge_bias_squared(probe: &Probe, pilot_passes: u32, rel: &[f64]) -> Vec<f64> {
     let g_count = probe.candidates.len() / 2;
     let (w, h) = (probe.width as usize, probe.height as usize);
     let k = 1.0 / pilot_passes.max(1) as f64;
@@ -714,7 +853,7 @@ fn merge_bias_squared(probe: &Probe, pilot_passes: u32) -> Vec<f64> {
         .zip(&probe.bias_terms_sq)
         .map(|(d, sq)| 4.0 * ((d * k).powi(2) - sq * k * k))
         .collect();
-    let mut out = box_filter(&raw, g_count, w, h, FILTER_REACH);
+    let mut out = relative_window(&raw, g_count, w, h, rel);
     out.iter_mut().for_each(|b| *b = b.max(0.0));
     out
 }
@@ -723,40 +862,33 @@ fn merge_bias_squared(probe: &Probe, pilot_passes: u32) -> Vec<f64> {
 fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
     let n = estimate.data.len();
     let nc = probe.candidates.len();
-    // 1/(μ + 0.01)²: each pixel's second moment relative to its value.
-    let rel: Vec<f64> = estimate
-        .data
-        .iter()
-        .map(|p| {
-            let mu = (p[0] + p[1] + p[2]) / 3.0;
-            1.0 / (mu.max(0.0) + REL_MSE_GUARD).powi(2)
-        })
-        .collect();
+    let (w, h) = (probe.width as usize, probe.height as usize);
+    let rel = relative_weights(estimate, w, h);
     let fixed_work = COST_CAMERA * (probe.camera_samples + 2 * probe.shadow_rays_fixed) as f64;
-    let kappa = merge_correlation(probe, &rel);
     // Light a candidate makes no path for is a bias no pass removes: over the horizon's P passes
     // it adds P b² to the per-pass moment (b the light missed per pass). One pilot pass is one
     // sample per pixel: each pixel's moments are averaged over its 7 × 7 neighbourhood, which
     // keeps the total a rare path the pilot saw once adds and spreads it to the pixels around.
-    let (w, h) = (probe.width as usize, probe.height as usize);
     // The probe's sums run over every pilot pass; the bias terms below are per pass, so the
     // moments are too.
     let per_pass = 1.0 / horizon.pilot_passes.max(1) as f64;
     // P b² of candidate c in pixel p.
     let missed_bias =
         |p: usize, c: usize| horizon.passes as f64 * (probe.missed[p * nc + c] * per_pass).powi(2);
-    let with_missed: Vec<f64> = (0..n * nc)
-        .map(|i| probe.moments[i] * per_pass + missed_bias(i / nc, i % nc))
-        .collect();
-    let moments = box_filter(&with_missed, nc, w, h, FILTER_REACH);
-    // Without merging: global g's candidate is 2g + 1.
-    let unmerged_with_missed: Vec<f64> = (0..n * nc / 2)
-        .map(|i| {
-            let (p, g) = (i / (nc / 2), i % (nc / 2));
-            probe.moments_unmerged[i] * per_pass + missed_bias(p, 2 * g + 1)
-        })
-        .collect();
-    let moments_unmerged = box_filter(&unmerged_with_missed, nc / 2, w, h, FILTER_REACH);
+    let missed: Vec<f64> = (0..n * nc).map(|i| missed_bias(i / nc, i % nc)).collect();
+    let missed = relative_window(&missed, nc, w, h, &rel);
+    let variance = direct_variance(probe, per_pass, &rel);
+    // The independent-sample model's moments, from every pilot sample and (without merging,
+    // global g's candidate 2g + 1) from the samples that are not merges: where merging is
+    // unbiased, their difference is light the merges witness that the other techniques find
+    // rarely — a heavy tail one pilot pass does not show in the techniques' own samples
+    // (caustic-sds).
+    let per_pass_sums = |v: &[f64], k: usize| {
+        let scaled: Vec<f64> = v.iter().map(|m| m * per_pass).collect();
+        relative_window(&scaled, k, w, h, &rel)
+    };
+    let independent = per_pass_sums(&probe.moments, nc);
+    let independent_unmerged = per_pass_sums(&probe.moments_unmerged, nc / 2);
     // Light only merging reaches, seen by the pilot in one pixel, is likely in the pixels around
     // it that one pass did not sample (caustic-sds: a mask of the pixels the pilot saw it in
     // merged 7–10 % of the image and was 97× the best fixed configuration's inefficiency): every
@@ -768,39 +900,52 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
     let any_must = must_merge.iter().any(|&m| m);
     let must_share = must_merge.iter().filter(|&&m| m).count() as f64 / n.max(1) as f64;
     let g_count = nc / 2;
-    let bias2 = merge_bias_squared(probe, horizon.pilot_passes);
+    let bias2 = merge_bias_squared(probe, horizon.pilot_passes, &rel);
     let bias_factor = horizon.bias_factor();
     let pilot_g = globals()
         .iter()
         .position(|&(r, vc)| r == PILOT.light_ratio && vc == PILOT.vertex_connections)
         .unwrap_or(0);
-    let kappa_at = local_merge_correlation(probe, kappa, 2 * pilot_g);
-    let kappa_median = {
-        let mut sorted = kappa_at.clone();
-        sorted.sort_by(f64::total_cmp);
-        sorted.get(sorted.len() / 2).copied().unwrap_or(kappa)
-    };
-    // Pixels where merging's predicted bias outweighs its moment: their merges witness a blurred
-    // integrand, so the moment without merging comes from the other samples alone there.
+    // Pixels where merging's predicted bias outweighs its variance: their merges witness a
+    // blurred integrand, so they witness nothing for the configurations without merging.
     let bias_dominated: Vec<bool> = (0..n)
-        .map(|p| {
-            bias_factor * bias2[p * g_count + pilot_g] > kappa_at[p] * moments[p * nc + 2 * pilot_g]
-        })
+        .map(|p| bias_factor * bias2[p * g_count + pilot_g] > variance[p * nc + 2 * pilot_g])
         .collect();
     let bias_share = {
         let g = pilot_g;
         let bias: f64 = (0..n)
             .map(|p| bias_factor * bias2[p * g_count + g] * rel[p])
             .sum();
-        let var: f64 = (0..n)
-            .map(|p| kappa_at[p] * moments[p * nc + 2 * g] * rel[p])
-            .sum();
+        let var: f64 = (0..n).map(|p| variance[p * nc + 2 * g] * rel[p]).sum();
         if bias + var > 0.0 {
             bias / (bias + var)
         } else {
             0.0
         }
     };
+    let direct_over_independent = {
+        let own = 2 * pilot_g;
+        let d: f64 = (0..n).map(|p| variance[p * nc + own] * rel[p]).sum();
+        let i: f64 = (0..n).map(|p| independent[p * nc + own] * rel[p]).sum();
+        d / i
+    };
+    // Merging's variance is floored by κ per pixel: see `local_merge_correlation`.
+    let own = 2 * pilot_g;
+    let kappa = merge_correlation(probe, &rel, own);
+    let kappa_at = local_merge_correlation(probe, kappa, own);
+    let kappa_median = {
+        let mut sorted = kappa_at.clone();
+        sorted.sort_by(f64::total_cmp);
+        sorted.get(sorted.len() / 2).copied().unwrap_or(kappa)
+    };
+    let mut variance = variance;
+    for (p, k) in kappa_at.iter().enumerate() {
+        for g in 0..g_count {
+            variance[p * nc + 2 * g] *= k;
+        }
+    }
+    // Index of candidate c in pixel p.
+    let p_c = |c: usize| move |p: usize| p * nc + c;
     let mut best: Option<Choice> = None;
     let mut fixed = Vec::new();
     for (g, (ratio, vc)) in globals().into_iter().enumerate() {
@@ -811,16 +956,17 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
             } else {
                 0.0
             };
+        let (on_c, off_c) = (p_c(2 * g), p_c(2 * g + 1));
         let on = |p: usize| {
-            (kappa_at[p] * moments[p * nc + 2 * g] + bias_factor * bias2[p * g_count + g]) * rel[p]
+            (variance[on_c(p)] + missed[on_c(p)] + bias_factor * bias2[p * g_count + g]) * rel[p]
         };
         let off = |p: usize| {
-            rel[p]
-                * if bias_dominated[p] {
-                    moments_unmerged[p * g_count + g]
-                } else {
-                    moments[p * nc + 2 * g + 1]
-                }
+            let witnessed = if bias_dominated[p] {
+                0.0
+            } else {
+                (independent[off_c(p)] - independent_unmerged[p * g_count + g]).max(0.0)
+            };
+            (variance[off_c(p)] + missed[off_c(p)] + witnessed) * rel[p]
         };
         let merge_cost = |p: usize| {
             COST_QUERY * probe.merge_queries[p] as f64
@@ -887,6 +1033,7 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
                 merge_mask: Arc::from(mask),
                 predicted,
                 fixed: Vec::new(),
+                direct_over_independent,
                 merge_correlation: kappa,
                 merge_correlation_median: kappa_median,
                 bias_share,
@@ -901,6 +1048,7 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
         merge_mask: Arc::from(vec![true; n]),
         predicted: f64::INFINITY,
         fixed: Vec::new(),
+        direct_over_independent,
         merge_correlation: kappa,
         merge_correlation_median: kappa_median,
         bias_share,
@@ -908,4 +1056,57 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
     });
     choice.fixed = fixed;
     choice
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The separable filter against the window's mean summed directly; the tolerance is f64
+    /// rounding of sums taken in another order, not a statistical one.
+    #[test]
+    fn box_filter_is_the_mean_over_the_clamped_window() {
+        let (w, h, nc, reach) = (9, 7, 3, 2);
+        let values: Vec<f64> = (0..w * h * nc)
+            .map(|i| ((i * 7919) % 101) as f64 - 50.0)
+            .collect();
+        let got = box_filter(&values, nc, w, h, reach);
+        for y in 0..h {
+            for x in 0..w {
+                for c in 0..nc {
+                    let (mut sum, mut count) = (0.0, 0.0);
+                    for ny in y.saturating_sub(reach)..(y + reach + 1).min(h) {
+                        for nx in x.saturating_sub(reach)..(x + reach + 1).min(w) {
+                            sum += values[(ny * w + nx) * nc + c];
+                            count += 1.0;
+                        }
+                    }
+                    let want = sum / count;
+                    let have = got[(y * w + x) * nc + c];
+                    assert!(
+                        (have - want).abs() <= 1e-12 * want.abs().max(1.0),
+                        "({x}, {y}) channel {c}: {have} against {want}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// A pixel whose one pilot sample found a firefly keeps the relative weight of the value
+    /// around it: the median of its 3 × 3 neighbourhood, not its own estimate.
+    #[test]
+    fn a_lone_firefly_does_not_set_its_pixels_relative_weight() {
+        let (w, h) = (5, 4);
+        let mut img = Image::new(w, h);
+        img.data.iter_mut().for_each(|p| *p = [0.1; 3]);
+        img.data[2 * w + 2] = [1000.0; 3];
+        let rel = relative_weights(&img, w, h);
+        let want = 1.0 / (0.1 + REL_MSE_GUARD).powi(2);
+        for (p, r) in rel.iter().enumerate() {
+            assert!(
+                (r - want).abs() <= 1e-9 * want,
+                "pixel {p}: {r} against {want}"
+            );
+        }
+    }
 }

@@ -32,6 +32,34 @@
 
 use super::camis::Mixture;
 
+/// How a technique's sample count scales between configurations of the VCM family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scaling {
+    /// s = 0 and s = 1 (next-event estimation): once per camera sample.
+    PerCameraSample,
+    /// t = 1: M/N per camera sample.
+    LightTracing,
+    /// s ≥ 2, t ≥ 2: once per camera sample when on.
+    VertexConnection,
+    /// η = M π r² per camera vertex when on.
+    Merge,
+}
+
+impl Scaling {
+    /// The scaling of technique (s, t) (s light vertices, t camera vertices), or of a merge.
+    pub fn of(s: usize, t: usize, merge: bool) -> Scaling {
+        if merge {
+            Scaling::Merge
+        } else if t == 1 {
+            Scaling::LightTracing
+        } else if s >= 2 {
+            Scaling::VertexConnection
+        } else {
+            Scaling::PerCameraSample
+        }
+    }
+}
+
 /// The sample counts of one configuration of the VCM family, per camera sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Counts {
@@ -77,6 +105,32 @@ impl Counts {
         } else {
             0.0
         }
+    }
+
+    /// The weighted value `self` gives the pilot's sample of a technique scaling as `scaling`,
+    /// with unweighted value `value` = f/(n_u p_u) under the pilot: the balance heuristic's
+    /// f/q_c = value · n_u p_u / q_c, merging counted η as the weights count it (the count of
+    /// light tracing and merging scales with M, so their n_u^c p_u/n_u^c cancels). The camera
+    /// walk, next-event estimation and the connections draw their paths alike in every
+    /// configuration, so summing these over one camera sample gives the value `self` would
+    /// have got from it. 0 where `self` does not run the technique or makes no path.
+    pub fn contribution(
+        &self,
+        value: f64,
+        mixture: &Mixture,
+        pilot: &Counts,
+        scaling: Scaling,
+    ) -> f64 {
+        let runs = match scaling {
+            Scaling::VertexConnection => self.vertex_connections,
+            Scaling::Merge => self.merging,
+            Scaling::PerCameraSample | Scaling::LightTracing => true,
+        };
+        let q = self.total_with_merges(mixture, pilot, mixture.merges);
+        if !runs || !(mixture.own > 0.0) || !(q > 0.0) {
+            return 0.0;
+        }
+        value * mixture.own / q
     }
 
     /// One pilot sample's share of the second moment M(`self`): w · v² · n_u p_u / q_c, for a
@@ -244,6 +298,33 @@ mod tests {
                             integrand[4 + ci].0 += share;
                             integrand[4 + ci].1 = total_c;
                         }
+                    }
+                    // The value `c` gives the sample (f = 1): its oracle balance weight over
+                    // n_u^c p_u, 0 where `c` does not run the technique.
+                    {
+                        let (scaling, n_c) = match own {
+                            Technique::Merge(_) => (Scaling::Merge, w.mixture.own * r),
+                            Technique::Connect(s) => {
+                                let sc = Scaling::of(s, k + 1 - s, false);
+                                let n = if sc == Scaling::LightTracing { r } else { 1.0 };
+                                (sc, w.mixture.own * n)
+                            }
+                        };
+                        let runs = match scaling {
+                            Scaling::VertexConnection => vc,
+                            Scaling::Merge => vm,
+                            _ => true,
+                        };
+                        let got = c.contribution(1.0 / w.mixture.own, &w.mixture, &pilot, scaling);
+                        let want = if runs {
+                            weigh(&dc.chain(), set_c, None, own, Heuristic::Balance).weight / n_c
+                        } else {
+                            0.0
+                        };
+                        assert!(
+                            (got - want).abs() <= 1e-9 * want.abs().max(1e-300),
+                            "k {k}, {own:?}, ratio ×{r}, vc {vc}, vm {vm}: value {got}, oracle {want}"
+                        );
                     }
                     // A merge's balance weight under `c`, against the oracle's weights of `c`.
                     if let Technique::Merge(_) = own {
