@@ -16,24 +16,25 @@
 //! merging's fireflies and bias made most of eamis's error (results/eamis.md). The choice is a
 //! function of the pilot's samples alone and the later passes are independent of them, so the
 //! estimator stays consistent, and unbiased wherever merging is off. The pilot runs on one
-//! thread (its sums then do not depend on the thread count) and the cost is counted, not timed, so the same seed gives the same
-//! choice and the same image bit for bit.
+//! thread (its sums then do not depend on the thread count) and the cost is counted, not timed,
+//! so the same seed gives the same choice and the same image bit for bit.
 //!
 //! **Cost model**: the pilot counts camera samples, next-event shadow rays (one per connectable
 //! camera vertex), vertex connections, light vertices, light-tracing joins, merge queries and
 //! light vertices found per pixel, and weighs them with unit costs measured once on this machine
 //! (`COST_*`, results/eamis.md): a count, not a clock, so the choice is deterministic. Light
-//! vertices, light tracing and merges found scale with M. The unit costs are one scene's: over
-//! four scenes one set predicts each render's CPU time within 0.84–1.14× (after a per-scene
-//! scale), so configurations predicted within ~1.15× of each other are a toss-up.
+//! vertices, light tracing and merges found scale with M. The unit costs are one scene's: even
+//! a set fitted to four scenes (with a free scale per scene) predicts their renders' CPU time
+//! only within 0.84–1.14×, so configurations predicted within ~1.15× of each other are a
+//! toss-up.
 //!
 //! **The variance, from the pilot's own samples.** Each pilot sample's value under every
 //! candidate c is f/q_c (the balance heuristic's, merges counted with c's η); a camera sample's
 //! values are summed before squaring, so the correlation between the techniques of one camera
 //! path and between the merges around one camera vertex is in the square. Light tracing and
-//! merging draw on M_c light paths: their values are scaled to the pilot's light-path count and
-//! their part of the variance counted M_pilot/M_c times. μ² is taken out with the neighbours'
-//! samples (`direct_variance`). The paper's independent-sample second moment, ∫ f²/q_c, which
+//! merging draw on M_c = r_c M_pilot light paths: light tracing's squares count r_c times; a
+//! camera sample's merges are scaled by r_c, and the squares of the scaled values count 1/r_c
+//! times (`Probe::direct`). μ² is taken out with the neighbours' samples (`direct_variance`). The paper's independent-sample second moment, ∫ f²/q_c, which
 //! this replaced, drops those cross terms (it is Var + Σ_u μ_u²/n_u, not Var + μ²) and made
 //! second moment × cost rank by cost where μ² dominates (caustic-sds; results/eamis.md). It is
 //! still computed: its ratio to the pilot's measured moment, κ, floors merging's variance
@@ -73,9 +74,9 @@
 //! and its 8 neighbours, `relative_weights`) summed over pixels, each pixel's relative terms
 //! averaged over its 7 × 7 window (`relative_window`): the merge mask is the prefix, by variance
 //! saved per cost added, that minimises it; the global choice the candidate whose best mask
-//! minimises it. The choice and the predicted inefficiency of every
-//! candidate (per pixel mean, per pass) go to the JSON record, and the merge mask to
-//! `OUT.merge-mask.exr` beside `lt render`'s output (1 where the pixel merges).
+//! minimises it. The choice and the predicted inefficiency of every candidate (per pixel mean,
+//! per pass) go to the JSON record, and the merge mask to `OUT.merge-mask.exr` beside
+//! `lt render`'s output (1 where the pixel merges).
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
@@ -453,11 +454,12 @@ struct Probe {
     film_weight: f64,
     /// direct[pixel × candidates + c]: Σ over the pilot's camera samples of the square of the
     /// value c would have got from it (`Counts::contribution` summed over its samples, so the
-    /// correlation between its techniques and between its merges is in it), plus (r_c − 1) ×
-    /// the sum of its merges' squares; plus each light-tracing splat's square × r_c. The values
-    /// are c's own per sample, and c draws r_c = M_c/M_pilot times the pilot's light paths: the
-    /// part of the variance that comes from the light paths (the squares of independent
-    /// samples) counts r_c times.
+    /// correlation between its techniques and between its merges is in it); plus each
+    /// light-tracing splat's square × r_c. c draws r_c = M_c/M_pilot times the pilot's light
+    /// paths: it makes r_c splats for each of the pilot's, and r_c merges of the same mean for
+    /// each, so a merge's value is scaled by r_c, and the squares of those scaled values, the
+    /// part of the variance from independent light paths, count 1/r_c times (r_c² from the
+    /// scaling, over r_c as many paths): (1/r_c − 1) × their sum is added.
     direct: Vec<f64>,
     /// The same layout: Σ over camera samples of that value (its mean's estimate).
     direct_sum: Vec<f64>,
