@@ -649,21 +649,27 @@ fn direct_variance(probe: &Probe, per_pass: f64, rel: &[f64]) -> Vec<f64> {
     // E[x²] − μ_p μ_q that a pixel's single sample cannot give of μ_p²; only the local gradient
     // of μ is left in it, not the window's spread of μ (the lamp's edge on cornell-box).
     let mut raw = vec![0.0; w * h * nc];
+    let mut around = vec![0.0; nc];
     for y in 0..h {
         for x in 0..w {
             let p = y * w + x;
-            let mut neighbours = Vec::with_capacity(8);
-            for ny in y.saturating_sub(1)..(y + 2).min(h) {
-                for nx in x.saturating_sub(1)..(x + 2).min(w) {
-                    if (nx, ny) != (x, y) {
-                        neighbours.push(ny * w + nx);
+            around.fill(0.0);
+            let mut count = 0usize;
+            for ny in span(y, h, 1) {
+                for nx in span(x, w, 1) {
+                    let q = ny * w + nx;
+                    if q != p {
+                        count += 1;
+                        around
+                            .iter_mut()
+                            .enumerate()
+                            .for_each(|(c, a)| *a += mean(q, c));
                     }
                 }
             }
-            let k = 1.0 / neighbours.len().max(1) as f64;
-            for c in 0..nc {
-                let around: f64 = neighbours.iter().map(|&q| mean(q, c)).sum::<f64>() * k;
-                raw[p * nc + c] = probe.direct[p * nc + c] * per_pass - mean(p, c) * around;
+            let k = 1.0 / count.max(1) as f64;
+            for (c, a) in around.iter().enumerate() {
+                raw[p * nc + c] = probe.direct[p * nc + c] * per_pass - mean(p, c) * (a * k);
             }
         }
     }
@@ -742,8 +748,8 @@ fn dilate(mask: &[bool], w: usize, h: usize, reach: usize) -> Vec<bool> {
             if !mask[y * w + x] {
                 continue;
             }
-            for ny in y.saturating_sub(reach)..(y + reach + 1).min(h) {
-                for nx in x.saturating_sub(reach)..(x + reach + 1).min(w) {
+            for ny in span(y, h, reach) {
+                for nx in span(x, w, reach) {
                     out[ny * w + nx] = true;
                 }
             }
@@ -752,30 +758,51 @@ fn dilate(mask: &[bool], w: usize, h: usize, reach: usize) -> Vec<bool> {
     out
 }
 
+/// Indices within `reach` of `i` on an axis of `len`, clamped at its ends.
+fn span(i: usize, len: usize, reach: usize) -> std::ops::Range<usize> {
+    i.saturating_sub(reach)..(i + reach + 1).min(len)
+}
+
 /// Per-pixel rows of `nc` values averaged over each pixel's (2 `reach` + 1)² neighbourhood
 /// (clamped at the film's edges), as two passes of 2 `reach` + 1 taps: along x, then along y.
 fn box_filter(values: &[f64], nc: usize, w: usize, h: usize, reach: usize) -> Vec<f64> {
-    let span = |i: usize, len: usize| i.saturating_sub(reach)..(i + reach + 1).min(len);
-    let mut along_x = vec![0.0; values.len()];
+    let along_x = window_sums(values, nc, w, h, reach, true);
+    let mut out = window_sums(&along_x, nc, w, h, reach, false);
     for y in 0..h {
         for x in 0..w {
-            let row = &mut along_x[(y * w + x) * nc..(y * w + x + 1) * nc];
-            for nx in span(x, w) {
-                let src = &values[(y * w + nx) * nc..(y * w + nx + 1) * nc];
-                row.iter_mut().zip(src).for_each(|(a, b)| *a += b);
-            }
+            let count = (span(x, w, reach).len() * span(y, h, reach).len()) as f64;
+            out[(y * w + x) * nc..(y * w + x + 1) * nc]
+                .iter_mut()
+                .for_each(|a| *a /= count);
         }
     }
+    out
+}
+
+/// Per-pixel rows of `nc` values summed over the 2 `reach` + 1 pixels around each along one
+/// axis (x when `along_x`, else y), clamped at the film's edges.
+fn window_sums(
+    values: &[f64],
+    nc: usize,
+    w: usize,
+    h: usize,
+    reach: usize,
+    along_x: bool,
+) -> Vec<f64> {
     let mut out = vec![0.0; values.len()];
     for y in 0..h {
         for x in 0..w {
             let row = &mut out[(y * w + x) * nc..(y * w + x + 1) * nc];
-            for ny in span(y, h) {
-                let src = &along_x[(ny * w + x) * nc..(ny * w + x + 1) * nc];
+            let taps = if along_x {
+                span(x, w, reach)
+            } else {
+                span(y, h, reach)
+            };
+            for t in taps {
+                let q = if along_x { y * w + t } else { t * w + x };
+                let src = &values[q * nc..(q + 1) * nc];
                 row.iter_mut().zip(src).for_each(|(a, b)| *a += b);
             }
-            let count = (span(x, w).len() * span(y, h).len()) as f64;
-            row.iter_mut().for_each(|a| *a /= count);
         }
     }
     out
@@ -811,12 +838,16 @@ fn relative_weights(estimate: &Image, w: usize, h: usize) -> Vec<f64> {
     (0..w * h)
         .map(|p| {
             let (x, y) = (p % w, p / w);
-            let mut around: Vec<f64> = (y.saturating_sub(1)..(y + 2).min(h))
-                .flat_map(|ny| (x.saturating_sub(1)..(x + 2).min(w)).map(move |nx| ny * w + nx))
-                .map(mean)
-                .collect();
+            let (mut around, mut len) = ([0.0; 9], 0);
+            for ny in span(y, h, 1) {
+                for nx in span(x, w, 1) {
+                    around[len] = mean(ny * w + nx);
+                    len += 1;
+                }
+            }
+            let around = &mut around[..len];
             around.sort_by(f64::total_cmp);
-            let mu = around[around.len() / 2];
+            let mu = around[len / 2];
             1.0 / (mu.max(0.0) + REL_MSE_GUARD).powi(2)
         })
         .collect()
@@ -908,17 +939,19 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
         .iter()
         .position(|&(r, vc)| r == PILOT.light_ratio && vc == PILOT.vertex_connections)
         .unwrap_or(0);
+    // The pilot's own candidate: global `pilot_g` with merging.
+    let own = 2 * pilot_g;
     // Pixels where merging's predicted bias outweighs its variance: their merges witness a
     // blurred integrand, so they witness nothing for the configurations without merging.
     let bias_dominated: Vec<bool> = (0..n)
-        .map(|p| bias_factor * bias2[p * g_count + pilot_g] > variance[p * nc + 2 * pilot_g])
+        .map(|p| bias_factor * bias2[p * g_count + pilot_g] > variance[p * nc + own])
         .collect();
     let bias_share = {
         let g = pilot_g;
         let bias: f64 = (0..n)
             .map(|p| bias_factor * bias2[p * g_count + g] * rel[p])
             .sum();
-        let var: f64 = (0..n).map(|p| variance[p * nc + 2 * g] * rel[p]).sum();
+        let var: f64 = (0..n).map(|p| variance[p * nc + own] * rel[p]).sum();
         if bias + var > 0.0 {
             bias / (bias + var)
         } else {
@@ -926,13 +959,12 @@ fn choose(probe: &Probe, estimate: &Image, horizon: &Horizon) -> Choice {
         }
     };
     let direct_over_independent = {
-        let own = 2 * pilot_g;
         let d: f64 = (0..n).map(|p| variance[p * nc + own] * rel[p]).sum();
         let i: f64 = (0..n).map(|p| independent[p * nc + own] * rel[p]).sum();
         d / i
     };
-    // Merging's variance is floored by κ per pixel: see `local_merge_correlation`.
-    let own = 2 * pilot_g;
+    // Merging's variance is floored by κ per pixel (`local_merge_correlation`), after the
+    // comparisons above, which weigh the bias against the variance as the pilot measured it.
     let kappa = merge_correlation(probe, &rel, own);
     let kappa_at = local_merge_correlation(probe, kappa, own);
     let kappa_median = {

@@ -32,10 +32,11 @@
 
 use super::camis::Mixture;
 
-/// How a technique's sample count scales between configurations of the VCM family.
+/// How a technique's sample count scales between configurations of the VCM family: the groups
+/// of `Mixture`'s fields.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scaling {
-    /// s = 0 and s = 1 (next-event estimation): once per camera sample.
+    /// s = 0, s = 1 (next-event estimation) and t = 0: once per camera sample (`Mixture::fixed`).
     PerCameraSample,
     /// t = 1: M/N per camera sample.
     LightTracing,
@@ -52,7 +53,7 @@ impl Scaling {
             Scaling::Merge
         } else if t == 1 {
             Scaling::LightTracing
-        } else if s >= 2 {
+        } else if s >= 2 && t >= 2 {
             Scaling::VertexConnection
         } else {
             Scaling::PerCameraSample
