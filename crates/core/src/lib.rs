@@ -7,6 +7,7 @@ pub mod geometry;
 pub mod light;
 pub mod math;
 pub mod measure;
+pub mod medium;
 pub mod path;
 pub mod sampling;
 pub mod scene;
