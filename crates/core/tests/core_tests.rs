@@ -6,3 +6,4 @@
 mod bsdf_sampling;
 mod light_sampling;
 mod path_space;
+mod phase_sampling;
