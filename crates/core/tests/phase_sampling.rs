@@ -79,8 +79,14 @@ fn sample_value_pdf_and_eval_agree_and_are_reciprocal() {
         for wo in wo_cases() {
             let mut s = Sampler::new(11, 0, 0);
             for _ in 0..10_000 {
-                let r = p.sample(wo, s.next_2d()).expect("these phase functions never reject");
-                assert!((r.wi.length() - 1.0).abs() < 1e-5, "{p:?}: |wi| = {}", r.wi.length());
+                let r = p
+                    .sample(wo, s.next_2d())
+                    .expect("these phase functions never reject");
+                assert!(
+                    (r.wi.length() - 1.0).abs() < 1e-5,
+                    "{p:?}: |wi| = {}",
+                    r.wi.length()
+                );
                 // The same f32 expression on the same inputs: equal bit for bit.
                 assert_eq!(r.value, r.pdf, "{p:?}");
                 assert_eq!(r.pdf, p.pdf(wo, r.wi), "{p:?}");
@@ -102,5 +108,8 @@ fn hg_follows_mitsubas_sign_forward_for_positive_g() {
     let g = 0.7f32;
     let expected = (1.0 + g) / (4.0 * std::f32::consts::PI * (1.0 - g) * (1.0 - g));
     let got = hg.eval(wo, forward);
-    assert!((got - expected).abs() <= 8.0 * f32::EPSILON * expected, "{got} vs {expected}");
+    assert!(
+        (got - expected).abs() <= 8.0 * f32::EPSILON * expected,
+        "{got} vs {expected}"
+    );
 }

@@ -28,6 +28,7 @@
 //!
 //! A scene without media holds none of this: `Scene::media` is empty and no walk asks.
 
+pub mod params;
 pub mod phase;
 
 pub use phase::PhaseFunction;
