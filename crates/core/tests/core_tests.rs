@@ -5,5 +5,6 @@
 
 mod bsdf_sampling;
 mod light_sampling;
+mod media;
 mod path_space;
 mod phase_sampling;

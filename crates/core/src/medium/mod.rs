@@ -28,10 +28,15 @@
 //!
 //! A scene without media holds none of this: `Scene::media` is empty and no walk asks.
 
+pub mod grid;
+pub mod majorant;
 pub mod params;
 pub mod phase;
+pub mod volume;
 
-pub use phase::PhaseFunction;
+pub use grid::{GridMedium, TransmittanceEstimator};
+pub use phase::{PhaseFunction, PhaseSample};
+pub use volume::{GridVolume, Volume, VolumeGrid, WrapMode};
 
 use crate::math::{Color, Vec3};
 use crate::sampling::Sampler;
@@ -51,6 +56,9 @@ pub struct Homogeneous {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Medium {
     Homogeneous(Homogeneous),
+    /// Mitsuba's `heterogeneous` (σt from a `gridvolume` or `constvolume`).
+    /// Boxed: a scene's media are few, and the homogeneous variant stays small.
+    Grid(Box<GridMedium>),
 }
 
 /// The outcome of free-flight sampling along a ray segment of length `t_max`.
@@ -66,25 +74,29 @@ impl Medium {
     pub fn phase(&self) -> PhaseFunction {
         match self {
             Medium::Homogeneous(h) => h.phase,
+            Medium::Grid(g) => g.phase,
         }
     }
 
-    pub fn sigma_t(&self, _p: Vec3) -> Color {
+    pub fn sigma_t(&self, p: Vec3) -> Color {
         match self {
             Medium::Homogeneous(h) => h.sigma_t,
+            Medium::Grid(g) => g.sigma_t(p),
         }
     }
 
-    pub fn sigma_s(&self, _p: Vec3) -> Color {
+    pub fn sigma_s(&self, p: Vec3) -> Color {
         match self {
-            Medium::Homogeneous(h) => h.sigma_t * h.albedo,
+            Medium::Homogeneous(h) => h.sigma_s(),
+            Medium::Grid(g) => g.sigma_s(p),
         }
     }
 
     /// T(a, b) = exp(−∫ σt) per channel, deterministic.
     pub fn transmittance(&self, a: Vec3, b: Vec3) -> Color {
         match self {
-            Medium::Homogeneous(h) => exp_neg(h.sigma_t * a.distance(b)),
+            Medium::Homogeneous(h) => h.transmittance(a.distance(b)),
+            Medium::Grid(g) => g.transmittance(a, b),
         }
     }
 
@@ -126,23 +138,60 @@ impl Medium {
                     let p = self.free_flight_density(o, x, true);
                     FreeFlight::Scattered {
                         t,
-                        weight: self.sigma_s(x) * self.transmittance(o, x) / p,
+                        weight: weigh(self.sigma_s(x) * self.transmittance(o, x), p),
                     }
                 } else {
                     let x = o + d * t_max;
                     let p = self.free_flight_density(o, x, false);
                     FreeFlight::Passed {
-                        weight: self.transmittance(o, x) / p,
+                        weight: weigh(self.transmittance(o, x), p),
                     }
                 }
             }
+            Medium::Grid(g) => g.sample_free_flight(o, d, t_max, sampler),
         }
     }
 
     /// An unbiased estimate of T(a, b) for shadow rays and connections (exact for homogeneous
-    /// media).
-    pub fn transmittance_estimate(&self, a: Vec3, b: Vec3, _sampler: &mut Sampler) -> Color {
-        self.transmittance(a, b)
+    /// media; the grid's estimator otherwise, ratio tracking by default).
+    pub fn transmittance_estimate(&self, a: Vec3, b: Vec3, sampler: &mut Sampler) -> Color {
+        match self {
+            Medium::Homogeneous(h) => h.transmittance(a.distance(b)),
+            Medium::Grid(g) => g.transmittance_estimate(a, b, sampler),
+        }
+    }
+
+    /// The homogeneous medium, for estimators that need σt, σs and T in closed form (photon
+    /// beams).
+    pub fn as_homogeneous(&self) -> Option<&Homogeneous> {
+        match self {
+            Medium::Homogeneous(h) => Some(h),
+            Medium::Grid(_) => None,
+        }
+    }
+}
+
+impl Homogeneous {
+    #[inline]
+    pub fn sigma_s(&self) -> Color {
+        self.sigma_t * self.albedo
+    }
+
+    /// T over a distance, per channel.
+    #[inline]
+    pub fn transmittance(&self, distance: f32) -> Color {
+        exp_neg(self.sigma_t * distance)
+    }
+}
+
+/// `value / density`, or zero where the density underflowed (an outcome of probability zero in
+/// f32, whose contribution is zero too).
+#[inline]
+fn weigh(value: Color, density: f32) -> Color {
+    if density > 0.0 {
+        value / density
+    } else {
+        Color::ZERO
     }
 }
 
