@@ -256,8 +256,8 @@ fn a_study_plan_is_collected_from_the_cache() {
         "{out}"
     );
     let (whole, split) = (
-        lt_experiments::cache::Cache::new(&cache),
-        lt_experiments::cache::Cache::new(&split_cache),
+        lt_experiments::cache::RenderCache::new(&cache),
+        lt_experiments::cache::RenderCache::new(&split_cache),
     );
     let mut worst = 0;
     for a in &planned.assemble {

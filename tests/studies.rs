@@ -7,8 +7,8 @@
 //! The test scale's intervals are at 99.9 %: about 50 intervals are checked here, so the chance
 //! that any one misses by luck is ≈ 5 % (Šidák), which the fixed seeds then pin either way.
 
-use lt_experiments::cache::Cache;
-use lt_experiments::study::{self, Ctx, Scale};
+use lt_experiments::cache::RenderCache;
+use lt_experiments::study::{self, Scale, StudyContext};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -17,12 +17,12 @@ fn scenes() -> PathBuf {
     lt_tests::scenes_dir()
 }
 
-fn ctx(results: &Path, stop_after: Option<u64>) -> Ctx {
+fn ctx(results: &Path, stop_after: Option<u64>) -> StudyContext {
     let scale = Scale::named("test", &scenes()).unwrap();
-    Ctx::with(
+    StudyContext::with(
         scale,
-        Cache::new(results.join("cache")),
-        Cache::new(results.join("references")),
+        RenderCache::new(results.join("cache")),
+        RenderCache::new(results.join("references")),
         results.to_path_buf(),
         0,
         true,

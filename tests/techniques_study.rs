@@ -3,19 +3,19 @@
 //! within their interval over runs, and within rounding run by run (a technique the tally
 //! missed, or counted twice, shows as its own share of the mean).
 
-use lt_experiments::cache::Cache;
+use lt_experiments::cache::RenderCache;
 use lt_experiments::manifest::Manifest;
-use lt_experiments::study::{self, Ctx, Scale};
+use lt_experiments::study::{self, Scale, StudyContext};
 
 #[test]
 fn the_techniques_study_writes_its_files_and_its_techniques_add_up() {
     let dir = std::env::temp_dir().join(format!("lt-techniques-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let scale = Scale::named("test", &lt_tests::scenes_dir()).unwrap();
-    let ctx = Ctx::with(
+    let ctx = StudyContext::with(
         scale,
-        Cache::new(dir.join("cache")),
-        Cache::new(dir.join("references")),
+        RenderCache::new(dir.join("cache")),
+        RenderCache::new(dir.join("references")),
         dir.clone(),
         0,
         true,

@@ -6,11 +6,11 @@ pub mod agreement;
 pub mod bias_variance;
 pub mod binomial;
 pub mod blocks;
-pub mod efficiency;
 pub mod fit;
 pub mod image;
 pub mod jackknife;
 pub mod metrics;
+pub mod mse_time;
 pub mod running;
 
 #[cfg(test)]
@@ -23,9 +23,9 @@ pub use agreement::{
 pub use bias_variance::{BiasVariance, ImageBiasVariance, Interval};
 pub use binomial::{binomial_test, BinomialTest};
 pub use blocks::{block_means, BlockEstimate, RunningBlocks};
-pub use efficiency::{efficiency, time_to_mse, time_to_mse_extrapolated};
 pub use fit::{fit_line, fit_log_log, LineFit};
 pub use image::Image;
 pub use jackknife::{jackknife, Jackknifed};
 pub use metrics::{image_metrics, psnr, ChannelMetrics, ImageMetrics};
+pub use mse_time::{efficiency, time_to_mse, time_to_mse_extrapolated};
 pub use running::{RunningImage, RunningStat};

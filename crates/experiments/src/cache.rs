@@ -61,15 +61,15 @@ pub fn scene_hash(files: &[PathBuf]) -> Result<String, String> {
 /// A cache folder, and how many entries this handle (and its clones) built and found finished:
 /// what a resumed run reports.
 #[derive(Clone, Debug)]
-pub struct Cache {
+pub struct RenderCache {
     pub root: PathBuf,
     built: Arc<AtomicU64>,
     reused: Arc<AtomicU64>,
 }
 
-impl Cache {
-    pub fn new(root: impl Into<PathBuf>) -> Cache {
-        Cache {
+impl RenderCache {
+    pub fn new(root: impl Into<PathBuf>) -> RenderCache {
+        RenderCache {
             root: root.into(),
             built: Arc::default(),
             reused: Arc::default(),
@@ -186,10 +186,10 @@ fn remove_stale(parent: &Path, key: &Key, host: &str) {
 mod tests {
     use super::*;
 
-    fn temp_cache(name: &str) -> Cache {
+    fn temp_cache(name: &str) -> RenderCache {
         let dir = std::env::temp_dir().join(format!("lt-cache-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        Cache::new(dir)
+        RenderCache::new(dir)
     }
 
     #[test]

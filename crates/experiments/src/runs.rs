@@ -7,7 +7,7 @@
 //! An entry holds `snapshot-<P>.exr` (the estimate after P passes, for each snapshot P),
 //! `stderr.exr` when the render has an honest standard error, and `record.json` (`RunRecord`).
 
-use crate::cache::{scene_hash, Cache};
+use crate::cache::{scene_hash, RenderCache};
 use crate::image_io::{read_exr, write_exr};
 use lt_core::Scene;
 use lt_estimators::Image;
@@ -254,7 +254,7 @@ impl RunEntry {
 /// How runs are executed: where the cache is and with how many threads (which changes no image).
 #[derive(Clone, Debug)]
 pub struct Executor {
-    pub cache: Cache,
+    pub cache: RenderCache,
     pub threads: usize,
 }
 

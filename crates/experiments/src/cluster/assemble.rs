@@ -7,14 +7,14 @@
 
 use super::partial::{merge, Partial, Span, ENTRY_FILE};
 use super::plan::{Assembly, Plan};
-use crate::cache::{key_of, Cache, Key, CODE_VERSION};
+use crate::cache::{key_of, Key, RenderCache, CODE_VERSION};
 use crate::image_io::{write_atomic, write_exr};
 use crate::runs::RunRecord;
 use lt_estimators::running::RunningImage;
 
 /// Builds the entry of `a` from its finished parts; `Ok(false)` if the entry already exists.
 pub fn assemble(plan: &Plan, a: &Assembly) -> Result<bool, String> {
-    let cache = Cache::new(&a.cache);
+    let cache = RenderCache::new(&a.cache);
     if cache.lookup(&Key(a.key.clone())).is_some() {
         return Ok(false);
     }

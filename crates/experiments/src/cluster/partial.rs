@@ -515,7 +515,7 @@ impl Partial {
 
 /// Parts merged into one accumulator.
 #[derive(Clone, Debug)]
-pub struct Merged {
+pub struct MergedParts {
     pub identity: Identity,
     /// Same mode and fixed fields as the parts; covering the lowest to the highest part.
     pub span: Span,
@@ -534,8 +534,8 @@ pub struct Merged {
 /// starts — so the result does not depend on the order they are given in. Parts of different
 /// scenes, parameters, seeds or code are refused, as are overlapping ranges; gaps (and, for pass
 /// ranges, a first part not starting at pass 0) are refused unless `allow_gaps`, and listed in
-/// `Merged::missing` either way.
-pub fn merge(parts: &[(PathBuf, Partial)], allow_gaps: bool) -> Result<Merged, String> {
+/// `MergedParts::missing` either way.
+pub fn merge(parts: &[(PathBuf, Partial)], allow_gaps: bool) -> Result<MergedParts, String> {
     let Some((first_path, first)) = parts.first() else {
         return Err("no parts to merge".into());
     };
@@ -652,7 +652,7 @@ pub fn merge(parts: &[(PathBuf, Partial)], allow_gaps: bool) -> Result<Merged, S
             passes,
         },
     };
-    Ok(Merged {
+    Ok(MergedParts {
         identity: id.clone(),
         span,
         acc,
@@ -665,7 +665,7 @@ pub fn merge(parts: &[(PathBuf, Partial)], allow_gaps: bool) -> Result<Merged, S
     })
 }
 
-impl Merged {
+impl MergedParts {
     /// The merged accumulation as one part (for merging hierarchically).
     pub fn to_partial(&self) -> Partial {
         Partial {

@@ -10,7 +10,7 @@
 
 use super::partial::{normalize_params, parse_resolution, PartialJob, Span};
 use super::study_link;
-use crate::cache::{key_of, Cache, CODE_VERSION};
+use crate::cache::{key_of, RenderCache, CODE_VERSION};
 use crate::runs::RunSpec;
 use clap::{Args, Subcommand};
 use serde::{Deserialize, Serialize};
@@ -23,7 +23,7 @@ pub const PLAN_VERSION: u32 = 1;
 /// What one shard does.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case")]
-pub enum Work {
+pub enum ShardWork {
     /// A partial render (a range of passes, or a set of runs) into `partial.ltp`.
     Partial(PartialJob),
     /// One of a study's cached renders (`runs::Executor::run`).
@@ -39,7 +39,7 @@ pub struct Shard {
     /// The cache it writes into.
     pub cache: PathBuf,
     pub label: String,
-    pub work: Work,
+    pub work: ShardWork,
 }
 
 /// What `lt collect` makes of the finished shards.
@@ -143,7 +143,7 @@ impl Plan {
     /// The finished entry of shard `i`, if there is one.
     pub fn finished(&self, i: usize) -> Option<PathBuf> {
         let s = &self.shards[i];
-        Cache::new(&s.cache).lookup(&crate::cache::Key(s.key.clone()))
+        RenderCache::new(&s.cache).lookup(&crate::cache::Key(s.key.clone()))
     }
 
     /// Indices of the shards not yet finished.
@@ -466,7 +466,7 @@ pub fn render_shards(args: &PlanRenderArgs, cache: &Path) -> Result<(Vec<Shard>,
             key,
             cache: cache.to_path_buf(),
             label: format!("{stem} {} {}", job.integrator, job.span.describe()),
-            work: Work::Partial(job),
+            work: ShardWork::Partial(job),
         });
     }
     Ok((shards, total))
@@ -593,7 +593,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), String> {
                         key,
                         cache: cache.clone(),
                         label: spec.label(),
-                        work: Work::Run(spec),
+                        work: ShardWork::Run(spec),
                     });
                     continue;
                 };
@@ -616,7 +616,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), String> {
                         key: key_of(&job.key_material(&scene)?).0,
                         cache: cache.clone(),
                         label: format!("{}: passes {start}..{end}", spec.label()),
-                        work: Work::Partial(job),
+                        work: ShardWork::Partial(job),
                     });
                 }
                 assemble.push(Assembly {

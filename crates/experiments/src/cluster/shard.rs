@@ -4,8 +4,8 @@
 //! a failed shard from a killed one and names its log.
 
 use super::partial::ENTRY_FILE;
-use super::plan::{state_dir, state_path, Plan, Shard, Work};
-use crate::cache::{key_of, Cache, Key};
+use super::plan::{state_dir, state_path, Plan, Shard, ShardWork};
+use crate::cache::{key_of, Key, RenderCache};
 use crate::runs::Executor;
 use clap::Args;
 use serde::{Deserialize, Serialize};
@@ -111,7 +111,7 @@ fn threads(plan: &Plan, given: Option<usize>) -> usize {
 
 /// Runs `shard`'s work into its cache entry; returns (entry, reused).
 fn execute(shard: &Shard, threads: usize, total: usize) -> Result<(PathBuf, bool), String> {
-    let cache = Cache::new(&shard.cache);
+    let cache = RenderCache::new(&shard.cache);
     let key = Key(shard.key.clone());
     if let Some(dir) = cache.lookup(&key) {
         return Ok((dir, true));
@@ -124,7 +124,7 @@ fn execute(shard: &Shard, threads: usize, total: usize) -> Result<(PathBuf, bool
     };
     let i = shard.index;
     match &shard.work {
-        Work::Partial(job) => {
+        ShardWork::Partial(job) => {
             let scene = job.load_scene()?;
             let material = job.key_material(&scene)?;
             let now = key_of(&material);
@@ -147,7 +147,7 @@ fn execute(shard: &Shard, threads: usize, total: usize) -> Result<(PathBuf, bool
             })?;
             Ok((dir, false))
         }
-        Work::Run(spec) => {
+        ShardWork::Run(spec) => {
             let scene = spec.load_scene()?;
             let now = key_of(&spec.key_material(&scene)?);
             if now != key {

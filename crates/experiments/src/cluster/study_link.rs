@@ -4,7 +4,7 @@
 //! study of `study::registry` can be planned, the hidden `smoke` one included.
 
 use crate::runs::RunSpec;
-use crate::study::{Ctx, Role, StudySetup};
+use crate::study::{Role, StudyContext, StudySetup};
 use std::path::{Path, PathBuf};
 
 /// The cache folder of `role`.
@@ -32,7 +32,7 @@ pub fn plan(
     scenes: &Path,
     cache: &Path,
 ) -> Result<Vec<(RunSpec, Role)>, String> {
-    let ctx = Ctx::new(&setup(scale, results, scenes, cache, 0))?;
+    let ctx = StudyContext::new(&setup(scale, results, scenes, cache, 0))?;
     crate::study::plan(name, &ctx.scale, Some(&ctx))
 }
 
@@ -46,7 +46,7 @@ pub fn collect(
     cache: &Path,
     threads: usize,
 ) -> Result<(usize, usize), String> {
-    let ctx = Ctx::new(&setup(scale, results, scenes, cache, threads))?;
+    let ctx = StudyContext::new(&setup(scale, results, scenes, cache, threads))?;
     crate::study::run_named(name, &ctx)?;
     let (made, found) = ctx.counts();
     Ok((found as usize, made as usize))

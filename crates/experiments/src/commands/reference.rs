@@ -3,7 +3,7 @@
 //! (integrator, passes, seeds, seconds, mean standard error, code version, scene content hash)
 //! and reused for as long as the scene and the rendering code are unchanged.
 
-use crate::cache::Cache;
+use crate::cache::RenderCache;
 use crate::runs::{Executor, RunSpec};
 use crate::study::reference::{integrator_for, CONSISTENT_REFERENCE_RUNS, REFERENCE_SEED};
 use clap::Args;
@@ -65,7 +65,7 @@ pub fn run(args: &ReferenceArgs) -> Result<(), String> {
         }
     };
     let exec = Executor {
-        cache: Cache::new(args.results.join("references")),
+        cache: RenderCache::new(args.results.join("references")),
         threads: args.threads,
     };
     let passes = match (args.spp, args.time) {
@@ -78,7 +78,7 @@ pub fn run(args: &ReferenceArgs) -> Result<(), String> {
             // The probe goes to a throw-away cache: only its timing is wanted.
             let probe_dir = std::env::temp_dir().join(format!("lt-probe-{}", std::process::id()));
             let probe = Executor {
-                cache: Cache::new(&probe_dir),
+                cache: RenderCache::new(&probe_dir),
                 threads: args.threads,
             };
             let e = probe.run(&build(2).runs(1))?;

@@ -1,7 +1,7 @@
 //! `lt study NAME`: runs a study (or all of them, then the report) into RESULTS/<study>/.
 
 use crate::report;
-use crate::study::{registry, run_named, Ctx, StudySetup};
+use crate::study::{registry, run_named, StudyContext, StudySetup};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -80,7 +80,7 @@ pub fn run(args: &StudyArgs) -> Result<(), String> {
     let started = Instant::now();
     let setup = args.setup();
     let results = setup.results.clone();
-    let ctx = Ctx::new(&setup)?;
+    let ctx = StudyContext::new(&setup)?;
     run_named(&args.name, &ctx)?;
     let (built, reused) = ctx.counts();
     ctx.finish();

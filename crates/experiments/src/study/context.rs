@@ -3,7 +3,7 @@
 
 use super::reference::Reference;
 use super::scale::Scale;
-use crate::cache::Cache;
+use crate::cache::RenderCache;
 use crate::runs::{Executor, RunEntry, RunSpec};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -27,7 +27,7 @@ pub struct StudySetup {
     pub stop_after: Option<u64>,
 }
 
-pub struct Ctx {
+pub struct StudyContext {
     pub scale: Scale,
     pub runs: Executor,
     pub references: Executor,
@@ -42,17 +42,17 @@ pub struct Ctx {
     loaded: Mutex<Vec<(String, std::sync::Arc<Reference>)>>,
 }
 
-impl Ctx {
-    pub fn new(args: &StudySetup) -> Result<Ctx, String> {
+impl StudyContext {
+    pub fn new(args: &StudySetup) -> Result<StudyContext, String> {
         let scale = Scale::named(&args.scale, &args.scenes)?;
         let cache = args
             .cache
             .clone()
             .unwrap_or_else(|| args.results.join("cache"));
-        Ok(Ctx::with(
+        Ok(StudyContext::with(
             scale,
-            Cache::new(cache),
-            Cache::new(args.results.join("references")),
+            RenderCache::new(cache),
+            RenderCache::new(args.results.join("references")),
             args.results.clone(),
             args.threads,
             args.quiet,
@@ -62,13 +62,13 @@ impl Ctx {
 
     pub fn with(
         scale: Scale,
-        runs: Cache,
-        references: Cache,
+        runs: RenderCache,
+        references: RenderCache,
         results: PathBuf,
         threads: usize,
         quiet: bool,
         stop_after: Option<u64>,
-    ) -> Ctx {
+    ) -> StudyContext {
         let bar = if quiet {
             ProgressBar::hidden()
         } else {
@@ -81,7 +81,7 @@ impl Ctx {
             );
             b
         };
-        Ctx {
+        StudyContext {
             scale,
             runs: Executor {
                 cache: runs,

@@ -11,7 +11,7 @@
 
 use super::metrics::{log_log_slope, mean_of_runs, mean_over, mse, rel_mse};
 use super::output::{film, num, pct, stem, StudyOutput};
-use super::{Ctx, Scale};
+use super::{Scale, StudyContext};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
 use lt_estimators::{jackknife, time_to_mse, Interval};
@@ -239,7 +239,7 @@ impl Curves {
 }
 
 /// Renders (or finds) and measures every run of `integrator` on `scene`.
-pub fn curves(ctx: &Ctx, scene: &PathBuf, integrator: &str) -> Result<Curves, String> {
+pub fn curves(ctx: &StudyContext, scene: &PathBuf, integrator: &str) -> Result<Curves, String> {
     let reference = ctx.reference(scene, None)?;
     let specs: Vec<RunSpec> = (0..ctx.scale.runs)
         .map(|r| spec(&ctx.scale, scene, integrator, r))
@@ -288,7 +288,7 @@ fn series(c: &Curves, against_time: bool, conf: f64) -> Series {
     }
 }
 
-pub fn run(ctx: &Ctx) -> Result<(), String> {
+pub fn run(ctx: &StudyContext) -> Result<(), String> {
     let scale = &ctx.scale;
     let conf = scale.confidence;
     let mut out = StudyOutput::new(

@@ -12,7 +12,7 @@
 use super::convergence::{self, integrators};
 use super::metrics::mse;
 use super::output::{film, num, stem, StudyOutput};
-use super::{Ctx, Scale};
+use super::{Scale, StudyContext};
 use crate::gallery::{write_gallery, Entry};
 use crate::runs::RunSpec;
 use std::path::{Path, PathBuf};
@@ -61,7 +61,10 @@ pub fn fixed_specs(scale: &Scale) -> Vec<RunSpec> {
 
 /// Pass counts at equal time on `scene`, from the equal-samples runs' timings (rendered if
 /// absent).
-fn equal_time_passes(ctx: &Ctx, scene: &PathBuf) -> Result<Vec<(&'static str, u32, f64)>, String> {
+fn equal_time_passes(
+    ctx: &StudyContext,
+    scene: &PathBuf,
+) -> Result<Vec<(&'static str, u32, f64)>, String> {
     passes_from_timings(ctx, scene, true).map(|v| v.unwrap_or_default())
 }
 
@@ -70,7 +73,7 @@ type EqualPasses = Vec<(&'static str, u32, f64)>;
 
 /// The same from the cache alone: None when a convergence run is not there yet (`render` false).
 fn passes_from_timings(
-    ctx: &Ctx,
+    ctx: &StudyContext,
     scene: &PathBuf,
     render: bool,
 ) -> Result<Option<EqualPasses>, String> {
@@ -111,7 +114,7 @@ fn passes_from_timings(
 
 /// Every render of the study whose pass counts the cache's timings fix (see `fixed_specs`);
 /// renders nothing itself: a scene whose convergence runs are not finished is left out.
-pub fn specs(ctx: &Ctx) -> Result<Vec<RunSpec>, String> {
+pub fn specs(ctx: &StudyContext) -> Result<Vec<RunSpec>, String> {
     let mut v = fixed_specs(&ctx.scale);
     let gallery = ctx.scale.gallery();
     for scene in &gallery.scenes {
@@ -125,7 +128,7 @@ pub fn specs(ctx: &Ctx) -> Result<Vec<RunSpec>, String> {
     Ok(v)
 }
 
-pub fn run(ctx: &Ctx) -> Result<(), String> {
+pub fn run(ctx: &StudyContext) -> Result<(), String> {
     let scale = &ctx.scale.gallery();
     let mut out = StudyOutput::new(
         ctx.study_dir(NAME),
@@ -346,7 +349,7 @@ const TUNGSTEN_NOTE_MIS: &str = "same highlights on every plate; differences are
 /// each channel of our reference over Tungsten's (the image means, so the films' sizes do not
 /// matter). Not a z-test: Tungsten's depth and sample count are not stated, and the originals
 /// may bounce more often than these files' `max_depth`.
-fn tungsten_table(ctx: &Ctx, scale: &Scale, out: &mut StudyOutput) -> Result<(), String> {
+fn tungsten_table(ctx: &StudyContext, scale: &Scale, out: &mut StudyOutput) -> Result<(), String> {
     let mut rows = Vec::new();
     for scene in &scale.scenes {
         let Some(t) = tungsten_render(scene) else {

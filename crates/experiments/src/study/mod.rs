@@ -24,7 +24,7 @@ pub mod techniques;
 pub mod unbiased_consistent;
 
 use crate::runs::RunSpec;
-pub use context::{Ctx, StudySetup};
+pub use context::{StudyContext, StudySetup};
 pub use registry::{StudyInfo, STUDIES};
 pub use scale::Scale;
 use std::path::{Path, PathBuf};
@@ -53,7 +53,11 @@ impl Role {
 /// in, for `lt plan study`. The equal-time study's pass counts come from the convergence study's
 /// measured timings, so its equal-time renders are planned only with a context whose cache holds
 /// those (`ctx` = None plans the rest of it).
-pub fn plan(name: &str, scale: &Scale, ctx: Option<&Ctx>) -> Result<Vec<(RunSpec, Role)>, String> {
+pub fn plan(
+    name: &str,
+    scale: &Scale,
+    ctx: Option<&StudyContext>,
+) -> Result<Vec<(RunSpec, Role)>, String> {
     let mut specs = Vec::new();
     for study in registry::resolve(name)? {
         specs.extend((study.specs)(scale, ctx)?);
@@ -81,7 +85,7 @@ pub fn plan(name: &str, scale: &Scale, ctx: Option<&Ctx>) -> Result<Vec<(RunSpec
 }
 
 /// Runs study `name` (or all of them, then the report) with the context's cache.
-pub fn run_named(name: &str, ctx: &Ctx) -> Result<(), String> {
+pub fn run_named(name: &str, ctx: &StudyContext) -> Result<(), String> {
     for study in registry::resolve(name)? {
         let (n, t) = (study.name, Instant::now());
         ctx.say(&format!("study {n} ({} scale)", ctx.scale.name));

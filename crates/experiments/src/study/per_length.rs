@@ -10,7 +10,7 @@
 use super::convergence::integrators;
 use super::metrics::{mean_of_runs, mse};
 use super::output::{film, num, pct, stem, StudyOutput};
-use super::{Ctx, Scale};
+use super::{Scale, StudyContext};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
 use std::path::Path;
@@ -38,7 +38,7 @@ pub fn specs(scale: &Scale) -> Vec<RunSpec> {
     v
 }
 
-pub fn run(ctx: &Ctx) -> Result<(), String> {
+pub fn run(ctx: &StudyContext) -> Result<(), String> {
     let scale = &ctx.scale;
     let mut out = StudyOutput::new(
         ctx.study_dir(NAME),

@@ -20,7 +20,7 @@
 //! in their photon seeds only (independent streams, never correlated passes).
 
 use super::output::{num, pct, StudyOutput};
-use super::{Ctx, Scale};
+use super::{Scale, StudyContext};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
 use lt_core::sampling::{Domain, Sampler};
@@ -46,42 +46,42 @@ pub const ALPHAS: [f64; 5] = [0.3, 0.5, 2.0 / 3.0, 0.75, 0.9];
 ///   η = M π rᵢ² itself shrinks with i, plus camera jitter's 1/N. The estimator and schedule are
 ///   vcm's; the code path is `progressive`'s.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Estimator {
+pub enum RadiusSchedule {
     Ppm,
     SppmPhotons,
     VcmMerging,
 }
 
-pub const ESTIMATORS: [Estimator; 3] = [
-    Estimator::Ppm,
-    Estimator::SppmPhotons,
-    Estimator::VcmMerging,
+pub const SCHEDULES: [RadiusSchedule; 3] = [
+    RadiusSchedule::Ppm,
+    RadiusSchedule::SppmPhotons,
+    RadiusSchedule::VcmMerging,
 ];
 
-impl Estimator {
+impl RadiusSchedule {
     pub fn label(self) -> &'static str {
         match self {
-            Estimator::Ppm => "ppm",
-            Estimator::SppmPhotons => "sppm (photon part)",
-            Estimator::VcmMerging => "vcm (merging)",
+            RadiusSchedule::Ppm => "ppm",
+            RadiusSchedule::SppmPhotons => "sppm (photon part)",
+            RadiusSchedule::VcmMerging => "vcm (merging)",
         }
     }
 
-    /// ppm's `radius_update` that gives this estimator's schedule.
+    /// ppm's `radius_update` that gives this schedule.
     pub fn update(self) -> &'static str {
         match self {
-            Estimator::Ppm => "global",
-            Estimator::SppmPhotons => "local",
-            Estimator::VcmMerging => "power",
+            RadiusSchedule::Ppm => "global",
+            RadiusSchedule::SppmPhotons => "local",
+            RadiusSchedule::VcmMerging => "power",
         }
     }
 
     /// r²ᵢ / r²₁ of a deterministic schedule (None: the per-point update, random).
     pub fn scale2(self, i: u32, alpha: f64) -> Option<f64> {
         match self {
-            Estimator::Ppm => Some(global_scale2(i, alpha)),
-            Estimator::SppmPhotons => None,
-            Estimator::VcmMerging => Some(lt_integrators::radius::power_scale2(i, alpha)),
+            RadiusSchedule::Ppm => Some(global_scale2(i, alpha)),
+            RadiusSchedule::SppmPhotons => None,
+            RadiusSchedule::VcmMerging => Some(lt_integrators::radius::power_scale2(i, alpha)),
         }
     }
 }
@@ -117,13 +117,13 @@ pub fn plane_scale(scale: &Scale) -> (usize, u32, u64) {
 use super::metrics::alpha_text;
 
 /// The K runs of one estimator and α: photon seeds 1..=K, one shared camera pass.
-pub fn config_specs(scale: &Scale, est: Estimator, alpha: f64) -> Vec<RunSpec> {
+pub fn config_specs(scale: &Scale, est: RadiusSchedule, alpha: f64) -> Vec<RunSpec> {
     let (runs, n, photons) = plane_scale(scale);
     (0..runs)
         .map(|r| {
             let spec = RunSpec::new(scene(scale), "ppm", 1 + r as u64, n);
             let spec = match est {
-                Estimator::Ppm => spec,
+                RadiusSchedule::Ppm => spec,
                 _ => spec.param("radius_update", est.update()),
             };
             spec.snapshots(Scale::doublings(n))
@@ -138,7 +138,7 @@ pub fn config_specs(scale: &Scale, est: Estimator, alpha: f64) -> Vec<RunSpec> {
 }
 
 pub fn specs(scale: &Scale) -> Vec<RunSpec> {
-    ESTIMATORS
+    SCHEDULES
         .iter()
         .flat_map(|&e| ALPHAS.iter().flat_map(move |&a| config_specs(scale, e, a)))
         .collect()
@@ -239,7 +239,13 @@ pub struct Exact {
     pub variance: Vec<Vec<f64>>,
 }
 
-pub fn exact(points: &[Point], est: Estimator, alpha: f64, photons: u64, snaps: &[u32]) -> Exact {
+pub fn exact(
+    points: &[Point],
+    est: RadiusSchedule,
+    alpha: f64,
+    photons: u64,
+    snaps: &[u32],
+) -> Exact {
     let q = DiscAverage::new(24, 48);
     let last = *snaps.last().unwrap_or(&1);
     // β (ρ/π) Φ with Φ = 4πI: one photon path's contribution before the kernel 1/(π r²).
@@ -325,7 +331,7 @@ fn slope(xs: &[f64], ys: &[f64]) -> Result<f64, String> {
 
 /// One α's measurement.
 pub struct Measured {
-    pub estimator: Estimator,
+    pub schedule: RadiusSchedule,
     pub alpha: f64,
     pub snaps: Vec<u32>,
     /// Per snapshot: measured (bias², variance, MSE) with jackknife intervals.
@@ -340,7 +346,7 @@ pub struct Measured {
     pub seconds: f64,
 }
 
-pub fn measure(ctx: &Ctx, est: Estimator, alpha: f64) -> Result<Measured, String> {
+pub fn measure(ctx: &StudyContext, est: RadiusSchedule, alpha: f64) -> Result<Measured, String> {
     let scale = &ctx.scale;
     let specs = config_specs(scale, est, alpha);
     let entries = ctx.run_all(&specs)?;
@@ -405,7 +411,7 @@ pub fn measure(ctx: &Ctx, est: Estimator, alpha: f64) -> Result<Measured, String
             .iter()
             .filter_map(|e| e.record.seconds.last().copied())
             .sum(),
-        estimator: est,
+        schedule: est,
         alpha,
         tail: tail_idx.iter().map(|&k| snaps[k]).collect(),
         snaps,
@@ -443,16 +449,16 @@ pub fn camera_variance(width: usize) -> f64 {
     total / (width * width) as f64
 }
 
-pub fn run(ctx: &Ctx) -> Result<(), String> {
+pub fn run(ctx: &StudyContext) -> Result<(), String> {
     let scale = &ctx.scale;
     let t0 = std::time::Instant::now();
     let mut ms: Vec<Measured> = Vec::new();
-    for est in ESTIMATORS {
+    for est in SCHEDULES {
         for a in ALPHAS {
             ms.push(measure(ctx, est, a)?);
         }
     }
-    let first_spec = &config_specs(scale, Estimator::Ppm, ALPHAS[0])[0];
+    let first_spec = &config_specs(scale, RadiusSchedule::Ppm, ALPHAS[0])[0];
     let points = visible_points(first_spec)?.len();
     let width = first_spec.load_scene()?.camera.width as usize;
     let mut out = StudyOutput::new(
@@ -524,7 +530,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                 Err(_) => "—".into(),
             };
             rows.push(vec![
-                m.estimator.label().into(),
+                m.schedule.label().into(),
                 alpha_text(m.alpha),
                 QUANTITIES[q].into(),
                 meas,
@@ -567,7 +573,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
     let last = *ms[0].snaps.last().unwrap_or(&1);
     let photon_var: Vec<(f64, f64)> = ms
         .iter()
-        .filter(|m| m.estimator == Estimator::SppmPhotons)
+        .filter(|m| m.schedule == RadiusSchedule::SppmPhotons)
         .map(|m| (m.alpha, m.at_n.last().map_or(f64::NAN, |j| j[1].estimate)))
         .collect();
     out.para(&format!(
@@ -607,7 +613,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
                 let inside = lo <= e && e <= hi;
                 misses += usize::from(!inside);
                 exact_rows.push(vec![
-                    m.estimator.label().into(),
+                    m.schedule.label().into(),
                     alpha_text(m.alpha),
                     n.to_string(),
                     quantity.into(),
@@ -655,7 +661,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
     for (q, file) in [(0, "bias2"), (1, "variance"), (2, "mse")] {
         let mut series = Vec::new();
         for m in &ms {
-            let tag = format!("{}, α = {}", m.estimator.label(), alpha_text(m.alpha));
+            let tag = format!("{}, α = {}", m.schedule.label(), alpha_text(m.alpha));
             series.push(Series {
                 name: tag.clone(),
                 points: m
@@ -714,10 +720,10 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
         })
         .collect();
     let mut series = Vec::new();
-    for (e, shift) in ESTIMATORS.iter().zip([-0.01, 0.0, 0.01]) {
+    for (e, shift) in SCHEDULES.iter().zip([-0.01, 0.0, 0.01]) {
         let measured: Vec<(f64, f64, (f64, f64))> = ms
             .iter()
-            .filter(|m| m.estimator == *e)
+            .filter(|m| m.schedule == *e)
             .filter_map(|m| {
                 m.slopes[2].as_ref().ok().map(|j| {
                     (
@@ -745,7 +751,7 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
         name: "K&Z's model at these N, ppm's schedule (exact)".into(),
         points: ms
             .iter()
-            .filter(|m| m.estimator == Estimator::Ppm)
+            .filter(|m| m.schedule == RadiusSchedule::Ppm)
             .map(|m| (m.alpha, -m.exact_slopes[2]))
             .collect(),
         y_interval: Vec::new(),

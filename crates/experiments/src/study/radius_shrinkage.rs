@@ -12,7 +12,7 @@
 use super::metrics::subset_bias_variance;
 use super::output::{num, pct, stem, StudyOutput};
 use super::unbiased_consistent::{config_specs, decompose, runs};
-use super::{Ctx, Scale};
+use super::{Scale, StudyContext};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
 use lt_estimators::jackknife;
@@ -135,7 +135,7 @@ pub struct Rates {
 }
 
 pub fn rates(
-    ctx: &Ctx,
+    ctx: &StudyContext,
     integrator: &str,
     alpha: f64,
     fixed_points: bool,
@@ -235,7 +235,7 @@ pub fn rates(
     ))
 }
 
-pub fn run(ctx: &Ctx) -> Result<(), String> {
+pub fn run(ctx: &StudyContext) -> Result<(), String> {
     let scale = &ctx.scale;
     let scene = stem(&scale.focus_scene);
     let mut out = StudyOutput::new(

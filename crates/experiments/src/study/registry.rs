@@ -1,7 +1,7 @@
 //! The one table of studies: `lt study NAME`, `lt plan study NAME`, `lt collect` and the report's
 //! order all read it. Adding a study is one entry here (and its module).
 
-use super::context::Ctx;
+use super::context::StudyContext;
 use super::scale::Scale;
 use super::{
     convergence, equal_time, per_length, radius_plane, radius_shrinkage, smoke, techniques,
@@ -19,9 +19,9 @@ pub struct StudyInfo {
     /// Every render the study asks for at a scale. The context, when given, holds the caches
     /// (the equal-time study plans its pass counts from the convergence study's timings there;
     /// without it, it plans the renders that need none).
-    pub specs: fn(&Scale, Option<&Ctx>) -> Result<Vec<RunSpec>, String>,
+    pub specs: fn(&Scale, Option<&StudyContext>) -> Result<Vec<RunSpec>, String>,
     /// Renders what the cache lacks and writes the study's outputs under `RESULTS/<name>/`.
-    pub run: fn(&Ctx) -> Result<(), String>,
+    pub run: fn(&StudyContext) -> Result<(), String>,
 }
 
 /// The studies in the order `lt study all` runs them and the report shows them.

@@ -2,7 +2,7 @@
 //! focus scene (the Cornell box) whose collection writes `RESULTS/smoke/summary.json`. It
 //! exercises plans, submission and collection in the tests without a real study's cost.
 
-use super::context::Ctx;
+use super::context::StudyContext;
 use super::scale::Scale;
 use crate::runs::RunSpec;
 
@@ -23,7 +23,7 @@ pub fn specs(scale: &Scale) -> Result<Vec<RunSpec>, String> {
 }
 
 /// Each render's mean, one line per render, in `summary.json`.
-pub fn run(ctx: &Ctx) -> Result<(), String> {
+pub fn run(ctx: &StudyContext) -> Result<(), String> {
     let mut rows = Vec::new();
     for spec in specs(&ctx.scale)? {
         let entry = ctx.run(&spec)?;

@@ -14,7 +14,7 @@
 
 use super::metrics::{mean_of_runs, rel_mse};
 use super::output::{film, num, pct, stem, StudyOutput};
-use super::{Ctx, Scale};
+use super::{Scale, StudyContext};
 use crate::image_io::{read_exr, write_atomic, write_exr};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
@@ -149,7 +149,7 @@ const FIXED_PREFIX: &str = "eamis fixed ";
 
 /// How big the study is at a scale (the scale's own fields are read, never changed).
 #[derive(Clone, Debug)]
-pub struct Plan {
+pub struct StudySize {
     pub width: u32,
     pub runs: u32,
     pub passes: u32,
@@ -158,7 +158,7 @@ pub struct Plan {
     pub scale: Scale,
 }
 
-pub fn plan(scale: &Scale) -> Plan {
+pub fn size(scale: &Scale) -> StudySize {
     let dir = scale
         .focus_scene
         .parent()
@@ -194,7 +194,7 @@ pub fn plan(scale: &Scale) -> Plan {
             named(&["cornell-box", "veach-door", "caustic-sds"]),
         ),
     };
-    Plan {
+    StudySize {
         width,
         runs,
         passes,
@@ -207,14 +207,14 @@ pub fn plan(scale: &Scale) -> Plan {
 }
 
 fn spec(
-    plan: &Plan,
+    size: &StudySize,
     scene: &Path,
     integrator: &str,
     params: &[(&str, &str)],
     seed: u64,
 ) -> RunSpec {
-    let mut s = RunSpec::new(scene, integrator, seed, plan.passes)
-        .resolution(film(&plan.scale, scene).ok());
+    let mut s = RunSpec::new(scene, integrator, seed, size.passes)
+        .resolution(film(&size.scale, scene).ok());
     for (k, v) in params {
         s = s.param(k, v);
     }
@@ -224,10 +224,10 @@ fn spec(
 /// The references the study asks for; its runs (plain and tallied, on one thread, in one
 /// entry per seed) are entries of their own, which `lt plan` does not list.
 pub fn specs(scale: &Scale) -> Vec<RunSpec> {
-    let plan = plan(scale);
-    plan.scenes
+    let size = size(scale);
+    size.scenes
         .iter()
-        .filter_map(|scene| super::reference::spec(&plan.scale, scene, None).ok())
+        .filter_map(|scene| super::reference::spec(&size.scale, scene, None).ok())
         .collect()
 }
 
@@ -257,7 +257,7 @@ fn order(w: Work) -> (u8, u16, u16) {
 }
 
 /// The tallied run of `spec`, from the cache or rendered now on one thread.
-fn tally_entry(ctx: &Ctx, spec: &RunSpec) -> Result<TallyEntry, String> {
+fn tally_entry(ctx: &StudyContext, spec: &RunSpec) -> Result<TallyEntry, String> {
     let scene = spec.load_scene()?;
     let mut material = spec.key_material(&scene)?;
     material["what"] = json!("techniques");
@@ -498,14 +498,14 @@ pub struct SumCheck {
     pub paired_rel: f64,
 }
 
-pub fn run(ctx: &Ctx) -> Result<(), String> {
-    let plan = plan(&ctx.scale);
+pub fn run(ctx: &StudyContext) -> Result<(), String> {
+    let size = size(&ctx.scale);
     let conf = ctx.scale.confidence;
     let mut out = StudyOutput::new(
         ctx.study_dir(NAME),
         NAME,
         "Per technique: where the time goes and what it buys",
-        &plan.scale,
+        &size.scale,
     )?;
     let before = ctx.spent();
     let t_start = Instant::now();
@@ -522,15 +522,15 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
          says why, and what `other` is); **efficiency** = 1/(second moment × seconds per pass). \
          Second moments of techniques do not add up to the image's (their cross terms are not \
          measured); means do, and the check table shows it.",
-        plan.scenes
+        size.scenes
             .iter()
             .map(|s| format!("`{}`", stem(s)))
             .collect::<Vec<_>>()
             .join(", "),
-        plan.width,
-        plan.runs,
-        plan.runs,
-        plan.passes,
+        size.width,
+        size.runs,
+        size.runs,
+        size.passes,
         pct(conf),
     ));
     let mut checks = Vec::new();
@@ -550,13 +550,13 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
     };
     let mut bit_equal = (0usize, 0usize);
     let mut family_rows = Vec::new();
-    for scene in &plan.scenes {
+    for scene in &size.scenes {
         let sname = stem(scene);
         let mut full_rows = Vec::new();
         for (lab, integ, params) in TALLIED {
             let mut entries = Vec::new();
-            for seed in 1..=plan.runs as u64 {
-                let e = tally_entry(ctx, &spec(&plan, scene, integ, params, seed))?;
+            for seed in 1..=size.runs as u64 {
+                let e = tally_entry(ctx, &spec(&size, scene, integ, params, seed))?;
                 entries.push(e);
             }
             let by_tech = rows(&entries, false);
@@ -672,8 +672,8 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
          little time and carry most of the second moment (worth more samples); the flat end: \
          time that adds no second moment (walks, other, techniques that rarely contribute).",
     )?;
-    inefficiency(ctx, &plan, &mut out, &mut tally_seconds, &mut bit_equal)?;
-    overhead(ctx, &plan, &mut out)?;
+    inefficiency(ctx, &size, &mut out, &mut tally_seconds, &mut bit_equal)?;
+    overhead(ctx, &size, &mut out)?;
     out.para(&format!(
         "Tallied images against the plain renders of the same seeds: {} of {} bit for bit equal \
          (each cache entry keeps both, `image.exr` and `plain.exr`).",
@@ -706,8 +706,8 @@ pub fn run(ctx: &Ctx) -> Result<(), String> {
 
 /// relMSE × seconds of each configuration, from independent plain runs.
 fn inefficiency(
-    ctx: &Ctx,
-    plan: &Plan,
+    ctx: &StudyContext,
+    size: &StudySize,
     out: &mut StudyOutput,
     tally_cpu: &mut f64,
     bit_equal: &mut (usize, usize),
@@ -715,16 +715,16 @@ fn inefficiency(
     let conf = ctx.scale.confidence;
     let mut rows = Vec::new();
     let mut efficiency_aware_rows = Vec::new();
-    for scene in &plan.scenes {
-        let reference = ctx.reference_at(&plan.scale, scene, None)?;
+    for scene in &size.scenes {
+        let reference = ctx.reference_at(&size.scale, scene, None)?;
         let mut by_label: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
         let (mut choices, mut pilot_share, mut without_pilot) =
             (Vec::new(), Vec::new(), Vec::new());
         for &(lab, integ, params) in COMPARED {
             let (mut rel, mut secs, mut ineff, mut over) =
                 (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-            for seed in 1..=plan.runs as u64 {
-                let run_spec = spec(plan, scene, integ, params, seed);
+            for seed in 1..=size.runs as u64 {
+                let run_spec = spec(size, scene, integ, params, seed);
                 // eamis has no tallied twin: its plain render alone.
                 let (dir, plain_cpu) = if lt_integrators::tally_run::TALLIED.contains(&integ) {
                     let e = tally_entry(ctx, &run_spec)?;
@@ -754,7 +754,7 @@ fn inefficiency(
             rows.push(vec![
                 stem(scene),
                 lab.to_string(),
-                plan.passes.to_string(),
+                size.passes.to_string(),
                 iv(&secs, conf).1,
                 iv(&rel, conf).1,
                 iv(&ineff, conf).1,
@@ -774,7 +774,7 @@ fn inefficiency(
              scene's reference (`lt study`'s, at this film); seconds = CPU seconds of the plain \
              render on one thread; intervals Student-t over the runs. Lower is better. The last \
              column: the same run tallied (timing 1 item in {EVERY}) against plain, in CPU time.",
-            plan.runs, plan.passes
+            size.runs, size.passes
         ),
         &[
             "scene",
@@ -805,7 +805,7 @@ fn inefficiency(
                 .iter()
                 .filter(|c| c.0.starts_with(FIXED_PREFIX))
                 .count(),
-            plan.passes
+            size.passes
         ),
         &[
             "scene",
@@ -894,7 +894,7 @@ fn efficiency_aware_row(
 
 /// A plain render on one thread (an integrator `tally_run` does not take): its cache entry (the
 /// image and the record's facts) and CPU seconds.
-fn plain_entry(ctx: &Ctx, spec: &RunSpec) -> Result<(PathBuf, f64), String> {
+fn plain_entry(ctx: &StudyContext, spec: &RunSpec) -> Result<(PathBuf, f64), String> {
     let scene = spec.load_scene()?;
     let mut material = spec.key_material(&scene)?;
     material["what"] = json!("techniques-plain");
@@ -967,14 +967,14 @@ fn parse_label(s: &str) -> Work {
 /// Seconds per pass of one integrator on the focus scene: plain, tallied without timing, timed
 /// on one item in `EVERY`, and timed on every item — interleaved rounds on one thread, so a
 /// change of machine load falls on all four alike.
-fn overhead(ctx: &Ctx, plan: &Plan, out: &mut StudyOutput) -> Result<(), String> {
+fn overhead(ctx: &StudyContext, size: &StudySize, out: &mut StudyOutput) -> Result<(), String> {
     const ROUNDS: usize = 3;
-    let Some(scene_path) = plan.scenes.first() else {
+    let Some(scene_path) = size.scenes.first() else {
         return Ok(());
     };
     let mut rows = Vec::new();
     for (lab, integ, params) in TALLIED {
-        let s = spec(plan, scene_path, integ, params, 1);
+        let s = spec(size, scene_path, integ, params, 1);
         let scene = s.load_scene()?;
         let mut material = s.key_material(&scene)?;
         material["what"] = json!("technique-overhead");
@@ -1045,8 +1045,8 @@ fn overhead(ctx: &Ctx, plan: &Plan, out: &mut StudyOutput) -> Result<(), String>
              change against the plain render, and every round. Moments alone (no clock), with \
              one item in {EVERY} timed (what the tables above use), and with every item timed.",
             stem(scene_path),
-            plan.width,
-            plan.passes
+            size.width,
+            size.passes
         ),
         &[
             "integrator",

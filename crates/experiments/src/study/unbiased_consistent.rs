@@ -19,7 +19,7 @@
 
 use super::output::{film, num, pct, StudyOutput};
 use super::radius_plane::{bias2_variance, radiance, DiscAverage};
-use super::{Ctx, Scale};
+use super::{Scale, StudyContext};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
 use lt_estimators::{jackknife, ImageBiasVariance, Interval, Jackknifed};
@@ -150,7 +150,7 @@ pub struct Decomposition {
 }
 
 pub fn decompose(
-    ctx: &Ctx,
+    ctx: &StudyContext,
     scene: &Path,
     label: &str,
     integrator: &str,
@@ -274,7 +274,7 @@ pub struct Measured {
 
 #[allow(clippy::too_many_arguments)]
 fn measure(
-    ctx: &Ctx,
+    ctx: &StudyContext,
     label: &'static str,
     integrator: &'static str,
     params: &[(&str, &str)],
@@ -403,7 +403,7 @@ fn iv(j: &Jackknifed) -> String {
     )
 }
 
-pub fn run(ctx: &Ctx) -> Result<(), String> {
+pub fn run(ctx: &StudyContext) -> Result<(), String> {
     let scale = &ctx.scale;
     let (k, passes, photons) = uc_scale(scale);
     let scene_path = scene(scale);

@@ -1,4 +1,5 @@
-//! Efficiency (1 / (MSE × time)) and the time an estimator needs to reach a target MSE.
+//! MSE against time: efficiency (1 / (MSE × time)) and the time an estimator needs to reach a
+//! target MSE. (Not efficiency-aware MIS, `lt_core::path::efficiency`.)
 
 use crate::fit::LineFit;
 
