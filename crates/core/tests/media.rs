@@ -7,9 +7,12 @@
 
 use lt_core::math::{gamma, Color, Mat4, Vec3};
 use lt_core::medium::{
-    GridMedium, GridVolume, Medium, PhaseFunction, Volume, VolumeGrid, WrapMode,
+    FreeFlight, GridMedium, GridVolume, Homogeneous, Medium, PhaseFunction, TransmittanceEstimator,
+    Volume, VolumeGrid, WrapMode,
 };
 use lt_core::sampling::Sampler;
+use lt_core::testing::{sidak, MeanEstimate};
+use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 use std::sync::Arc;
 
 /// Per channel c: scale_c · (1 + 2x)(0.5 + y)(2 − 1.5z) in local coordinates: positive on the
@@ -244,4 +247,232 @@ fn majorants_bound_the_field_along_every_segment() {
             }
         }
     }
+}
+
+/// Two-sided z threshold at the Šidák per-test level of `tests` tests at family-wise `ALPHA`.
+fn z_threshold(tests: usize) -> f64 {
+    let level = sidak(ALPHA, tests);
+    Normal::standard().inverse_cdf(1.0 - 0.5 * level)
+}
+
+/// Family-wise false-alarm rate of each statistical test below.
+const ALPHA: f64 = 0.01;
+
+/// z-tests of estimates against references; failures listed, with the threshold for `tests`.
+fn z_failures(cases: &[(String, MeanEstimate, f64)], tests: usize) -> Vec<String> {
+    let z_max = z_threshold(tests);
+    let mut failures = Vec::new();
+    let mut worst = 0.0f64;
+    for (name, est, exact) in cases {
+        let z = (est.mean() - exact) / est.std_error().max(f64::MIN_POSITIVE);
+        // An estimator with zero variance (a homogeneous pass) must be exact to f32 rounding.
+        let ok = if est.std_error() == 0.0 {
+            (est.mean() - exact).abs() <= 16.0 * f32::EPSILON as f64 * exact.abs()
+        } else {
+            z.abs() <= z_max
+        };
+        worst = worst.max(if est.std_error() == 0.0 { 0.0 } else { z.abs() });
+        if !ok {
+            failures.push(format!(
+                "{name}: {:.6} ± {:.2e} vs {exact:.6} (z = {z:.2})",
+                est.mean(),
+                est.std_error()
+            ));
+        }
+    }
+    eprintln!(
+        "{} z-tests, threshold |z| ≤ {z_max:.2}, largest |z| = {worst:.2}",
+        cases.len()
+    );
+    failures
+}
+
+#[test]
+fn transmittance_estimators_are_unbiased_against_the_closed_form() {
+    const N: usize = 20_000;
+    let mut cases = Vec::new();
+    for channels in [1, 3] {
+        let (m, vol) = product_medium(channels, 1);
+        let Medium::Grid(g) = &m else { unreachable!() };
+        for estimator in [TransmittanceEstimator::Ratio, TransmittanceEstimator::Delta] {
+            for (k, (a, b)) in segments(&vol, 5, 21).into_iter().enumerate() {
+                let mut s = Sampler::new(31, k as u64, channels as u64);
+                let mut est = [MeanEstimate::default(); 3];
+                for _ in 0..N {
+                    let t = g.transmittance_estimate_with(estimator, a, b, &mut s);
+                    for c in 0..3 {
+                        est[c].add(t[c] as f64);
+                    }
+                }
+                for (c, e) in est.into_iter().enumerate() {
+                    let exact = (-analytic_depth(&vol, a, b, channels, c)).exp();
+                    let name = format!("{estimator:?} {channels} ch segment {k} channel {c}");
+                    cases.push((name, e, exact));
+                }
+            }
+        }
+    }
+    let failures = z_failures(&cases, cases.len());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The media of the free-flight tests: chromatic homogeneous, and the grid with 1 and 3 channels.
+/// A named medium with the segments it is tested on.
+type MediumCase = (String, Medium, Vec<(Vec3, Vec3)>);
+
+fn free_flight_media() -> Vec<MediumCase> {
+    let homogeneous = Medium::Homogeneous(
+        Homogeneous::new(
+            Color::new(0.5, 1.5, 3.0),
+            Color::new(0.9, 0.6, 0.3),
+            1.0,
+            PhaseFunction::Isotropic,
+        )
+        .unwrap(),
+    );
+    let line = |o: Vec3, t: f32| (o, o + Vec3::new(0.6, 0.0, 0.8) * t);
+    let mut v = vec![(
+        "homogeneous".to_string(),
+        homogeneous,
+        vec![line(Vec3::ZERO, 0.3), line(Vec3::ONE, 1.5)],
+    )];
+    for channels in [1, 3] {
+        let (m, vol) = product_medium(channels, 1);
+        v.push((format!("grid {channels} ch"), m, segments(&vol, 2, 41)));
+    }
+    v
+}
+
+/// ∫_t0^t1 f by 3-point Gauss–Legendre on `pieces` equal pieces, in f64.
+fn integrate(f: impl Fn(f64) -> [f64; 3], t0: f64, t1: f64, pieces: usize) -> [f64; 3] {
+    const X: [f64; 3] = [-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4];
+    const W: [f64; 3] = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
+    let h = (t1 - t0) / pieces as f64;
+    let mut sum = [0.0; 3];
+    for i in 0..pieces {
+        let mid = t0 + (i as f64 + 0.5) * h;
+        for (x, w) in X.iter().zip(W) {
+            let v = f(mid + 0.5 * h * x);
+            for c in 0..3 {
+                sum[c] += 0.5 * h * w * v[c];
+            }
+        }
+    }
+    sum
+}
+
+fn c3(c: Color) -> [f64; 3] {
+    [c.x as f64, c.y as f64, c.z as f64]
+}
+
+/// Pearson's χ² over cells (observed, expected), pooling cells expecting < 5; returns (χ², dof).
+fn chi2(mut cells: Vec<(f64, f64)>) -> (f64, usize) {
+    cells.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let (mut chi2, mut n, mut po, mut pe) = (0.0, 0usize, 0.0, 0.0);
+    for (o, e) in cells {
+        po += o;
+        pe += e;
+        if pe >= 5.0 {
+            chi2 += (po - pe) * (po - pe) / pe;
+            n += 1;
+            (po, pe) = (0.0, 0.0);
+        }
+    }
+    if pe > 0.0 {
+        chi2 += (po - pe) * (po - pe) / pe;
+        n += 1;
+    }
+    (chi2, n.saturating_sub(1))
+}
+
+#[test]
+fn free_flight_distances_and_pass_mass_follow_the_claimed_density_chi2() {
+    const N: usize = 200_000;
+    const BINS: usize = 40;
+    let mut outcomes = Vec::new();
+    for (name, m, segs) in free_flight_media() {
+        for (k, (a, b)) in segs.into_iter().enumerate() {
+            let t_max = a.distance(b);
+            let d = (b - a) / t_max;
+            let mut s = Sampler::new(51, k as u64, 0);
+            let mut observed = vec![0.0f64; BINS + 1];
+            for _ in 0..N {
+                match m.sample_free_flight(a, d, t_max, &mut s) {
+                    FreeFlight::Scattered { t, .. } => {
+                        observed[((t / t_max * BINS as f32) as usize).min(BINS - 1)] += 1.0;
+                    }
+                    FreeFlight::Passed { .. } => observed[BINS] += 1.0,
+                }
+            }
+            let density = |t: f64| {
+                let p = m.free_flight_density(a, a + d * t as f32, true) as f64;
+                [p; 3]
+            };
+            let h = t_max as f64 / BINS as f64;
+            let mut cells: Vec<(f64, f64)> = (0..BINS)
+                .map(|i| {
+                    let e = integrate(density, i as f64 * h, (i + 1) as f64 * h, 16)[0];
+                    (observed[i], N as f64 * e)
+                })
+                .collect();
+            let pass = m.free_flight_density(a, b, false) as f64;
+            cells.push((observed[BINS], N as f64 * pass));
+            let total: f64 = cells.iter().map(|c| c.1).sum::<f64>() / N as f64;
+            let (chi2, dof) = chi2(cells);
+            let p = ChiSquared::new(dof as f64).unwrap().sf(chi2);
+            let label = format!("{name} segment {k} (Σ expected = {total:.6})");
+            eprintln!("{label:<48} χ² = {chi2:.1}, dof {dof}, p = {p:.4}");
+            outcomes.push((label, p));
+        }
+    }
+    let level = sidak(ALPHA, outcomes.len());
+    let failures: Vec<_> = outcomes.iter().filter(|o| !(o.1 >= level)).collect();
+    assert!(failures.is_empty(), "level {level:.2e}: {failures:?}");
+}
+
+#[test]
+fn free_flight_weights_are_unbiased() {
+    const N: usize = 100_000;
+    let mut cases = Vec::new();
+    for (name, m, segs) in free_flight_media() {
+        for (k, (a, b)) in segs.into_iter().enumerate() {
+            let t_max = a.distance(b);
+            let d = (b - a) / t_max;
+            let mut s = Sampler::new(61, k as u64, 0);
+            let (mut scattered, mut passed) =
+                ([MeanEstimate::default(); 3], [MeanEstimate::default(); 3]);
+            for _ in 0..N {
+                let (ws, wp) = match m.sample_free_flight(a, d, t_max, &mut s) {
+                    FreeFlight::Scattered { weight, .. } => (weight, Color::ZERO),
+                    FreeFlight::Passed { weight } => (Color::ZERO, weight),
+                };
+                for c in 0..3 {
+                    scattered[c].add(ws[c] as f64);
+                    passed[c].add(wp[c] as f64);
+                }
+            }
+            // E[w·1_scattered] = ∫ σs T dt, E[w·1_passed] = T(t_max), per channel.
+            let x = |t: f64| a + d * t as f32;
+            let sigma_s_tr = |t: f64| {
+                let p = x(t);
+                c3(m.sigma_s(p) * m.transmittance(a, p))
+            };
+            let ref_s = integrate(sigma_s_tr, 0.0, t_max as f64, 200);
+            let ref_p = c3(m.transmittance(a, b));
+            for c in 0..3 {
+                cases.push((
+                    format!("{name} segment {k} scattered, channel {c}"),
+                    scattered[c],
+                    ref_s[c],
+                ));
+                cases.push((
+                    format!("{name} segment {k} passed, channel {c}"),
+                    passed[c],
+                    ref_p[c],
+                ));
+            }
+        }
+    }
+    let failures = z_failures(&cases, cases.len());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

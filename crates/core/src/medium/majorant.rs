@@ -21,9 +21,9 @@ pub struct MajorantGrid {
 
 impl MajorantGrid {
     /// Majorants of `scale` × the trilinear field of `vol`. A supervoxel spanning sample-space
-    /// [u_lo, u_hi] per axis is bounded by the samples ⌊u_lo⌋ − 1 … ⌊u_hi⌋ + 2 (wrapped): the
-    /// interpolant there is a convex combination of samples ⌊u_lo⌋ … ⌊u_hi⌋ + 1, and the one extra
-    /// sample each side covers a DDA that rounds a crossing into the neighbouring supervoxel.
+    /// [u_lo, u_hi] per axis is bounded by the samples ⌈u_lo⌉ − 1 … ⌊u_hi⌋ + 1 (wrapped): the
+    /// interpolant on the closed interval is a convex combination of exactly those (a face on a
+    /// sample plane takes the sample beyond it too, for a point the DDA rounds across the face).
     pub fn new(vol: &GridVolume, scale: f32, samples_per_supervoxel: usize) -> MajorantGrid {
         let res = vol.grid.res;
         let n = res.map(|r| r.div_ceil(samples_per_supervoxel.max(1)));
@@ -104,8 +104,8 @@ impl MajorantGrid {
 /// Integer sample indices bounding supervoxel `i` of `n` on an axis of `res` samples.
 fn sample_range(i: usize, n: usize, res: usize) -> std::ops::RangeInclusive<i64> {
     let to_u = |x: f64| x * res as f64 - 0.5;
-    let lo = to_u(i as f64 / n as f64).floor() as i64 - 1;
-    let hi = to_u((i + 1) as f64 / n as f64).floor() as i64 + 2;
+    let lo = to_u(i as f64 / n as f64).ceil() as i64 - 1;
+    let hi = to_u((i + 1) as f64 / n as f64).floor() as i64 + 1;
     lo..=hi
 }
 
