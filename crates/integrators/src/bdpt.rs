@@ -20,17 +20,17 @@
 //! | `mis` | power/balance/none | power | heuristic over the strategies (none: uniform weights) |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
 
-use crate::connect::{join, nee_density, next_event, splat_light_subpath, Joined, NextEvent};
+use crate::camera_loop::{camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight};
+use crate::connect::{nee_density, splat_light_subpath};
 use crate::params::ParamReader;
-use crate::pixel::{pixel_sample, weighted};
-use crate::record::{Completed, NoRecord, Reached, Recorder, Work};
+use crate::record::{NoRecord, Recorder, Work};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 pub use crate::strategy_weight::{mis_weight, with_chain, EndEvals, Split};
 use crate::tally::{tallied_pass, ItemTally, PassClock, PassTally, Tally};
-use crate::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
+use crate::walk::{light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
+use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
-use lt_core::path::scatter::connectable;
 use lt_core::path::{Heuristic, PathVertex};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
@@ -64,10 +64,8 @@ pub struct Bdpt {
 
 /// Per-thread buffers of one sample.
 pub struct Scratch {
-    camera: Subpath,
+    camera: CameraScratch,
     light: Subpath,
-    /// Prefix copies for strategies whose end vertex differs from the stored one (s = 0, 1).
-    prefix: Vec<PathVertex>,
 }
 
 /// What one camera sample pairs: the pixel it samples (none for items past the pixel count), the
@@ -80,12 +78,41 @@ struct Pairing {
     splat_light: bool,
 }
 
-/// What every strategy of one camera sample shares: its film position, the light-paths-per-pixel
-/// ratio MIS needs, and the recorder.
-struct CameraSample<'a, R> {
-    raster: Vec2,
+/// bdpt's policy in the camera loop: every camera vertex joins every vertex of the one light
+/// subpath `y` it is paired with; weights from the stored densities (`strategy_weight`).
+struct Policy<'a> {
+    y: &'a [PathVertex],
+    /// Next-event estimation's density of y_0 from y_1.
+    light_nee: f64,
+    h: Heuristic,
+    /// M/N.
     ratio: f64,
-    rec: &'a mut R,
+}
+
+impl CameraPolicy for Policy<'_> {
+    fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], _: Vec2) -> Weight {
+        let (split, evals) = Split::reached(path);
+        (mis_weight(scene, split, evals, self.h, self.ratio), None)
+    }
+
+    fn next_event_weight(
+        &self,
+        scene: &Scene,
+        z: &[PathVertex],
+        x0: &PathVertex,
+        camera_end: BsdfEval,
+        _: Vec2,
+    ) -> Weight {
+        let (split, evals) = Split::next_event(z, x0, camera_end);
+        (mis_weight(scene, split, evals, self.h, self.ratio), None)
+    }
+
+    fn connect<R: Recorder>(&mut self, scene: &Scene, joins: &mut Joins<'_, R>, _: &mut Sampler) {
+        joins.join_subpath(scene, self.y, |c| {
+            let (split, evals) = Split::connection(c, self.light_nee);
+            (mis_weight(scene, split, evals, self.h, self.ratio), None)
+        });
+    }
 }
 
 impl Bdpt {
@@ -159,203 +186,24 @@ impl Bdpt {
         let Some(pixel) = pixel else {
             return Color::ZERO;
         };
-
-        // The camera subpath through a filtered position of the pixel (weighted at the end).
-        let mut cs = Sampler::for_item(Domain::Camera, seed, pixel, pass as u64);
-        let Some(film) = pixel_sample(scene, pixel, &mut cs) else {
-            return Color::ZERO;
-        };
-        let raster = film.raster;
-        camera_subpath(
-            scene,
-            raster,
-            &mut cs,
-            WalkLimits::camera(self.params.max_depth, self.params.rr_depth),
-            &mut scratch.camera,
-        );
-        rec.begin_sample(pixel, film.weight);
-        rec.lap(Work::CameraWalk);
-        let z = &scratch.camera.vertices;
-        let prefix = &mut scratch.prefix;
-        let mut ctx = CameraSample {
-            raster,
+        let mut policy = Policy {
+            y,
+            light_nee,
+            h,
             ratio,
-            rec: &mut **rec,
         };
-        let mut l = Color::ZERO;
-        for t in 2..=z.len() {
-            let zv = &z[t - 1];
-            // s = 0: the walk hit an emitter at z_{t−1}.
-            if t - 1 <= max_k {
-                if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter()) {
-                    let le = scene.lights[li as usize].emitted(x0.ng, x0.wo, x0.uv);
-                    if le != Color::ZERO {
-                        let reached = Reached {
-                            camera: &z[..t - 1],
-                            x0,
-                            value: zv.beta * le,
-                        };
-                        l += self.emitter_reached(scene, reached, prefix, &mut ctx);
-                    }
-                    ctx.rec.lap(Work::Connection { s: 0, t: t as u16 });
-                }
-            }
-            if !connectable(scene, zv) {
-                continue;
-            }
-            // s = 1: next-event estimation from z_{t−1}.
-            if t <= max_k {
-                l += self.next_event_weighted(scene, &z[..t], &mut cs, &mut ctx);
-                ctx.rec.lap(Work::Connection { s: 1, t: t as u16 });
-            }
-            // s ≥ 2: shadow rays to the light subpath's vertices.
-            for s in 2..=y.len().min(max_k + 1 - t) {
-                'attempt: {
-                    let yv = &y[s - 1];
-                    if !connectable(scene, yv) {
-                        break 'attempt;
-                    }
-                    let Some(Joined {
-                        light_end: ev_y,
-                        camera_end: ev_z,
-                        value: c,
-                    }) = join(scene, yv, zv)
-                    else {
-                        break 'attempt;
-                    };
-                    let split = Split {
-                        light: &y[..s],
-                        camera: &z[..t],
-                        light_nee,
-                    };
-                    let evals = EndEvals {
-                        light_end: Some(ev_y),
-                        camera_end: Some(ev_z),
-                    };
-                    let wgt = mis_weight(scene, split, evals, h, ratio);
-                    if R::ACTIVE {
-                        ctx.rec.completed(Completed {
-                            s,
-                            light: &y[..s],
-                            camera: &z[..t],
-                            weight: wgt,
-                            value: c,
-                            raster,
-                            alternatives: &[],
-                        });
-                    }
-                    l += c * wgt as f32;
-                }
-                ctx.rec.lap(Work::Connection {
-                    s: s as u16,
-                    t: t as u16,
-                });
-            }
-        }
-        // s = 0 at infinity: the walk left the scene after its last vertex.
-        if let Some(esc) = scratch.camera.escape {
-            if z.len() <= max_k {
-                for &li in &scene.infinite_lights {
-                    let le = scene.lights[li as usize].escaped(esc.dir);
-                    if le == Color::ZERO {
-                        continue;
-                    }
-                    let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
-                    let reached = Reached {
-                        camera: z,
-                        x0,
-                        value: esc.beta * le,
-                    };
-                    l += self.emitter_reached(scene, reached, prefix, &mut ctx);
-                }
-                ctx.rec.lap(Work::Connection {
-                    s: 0,
-                    t: z.len() as u16 + 1,
-                });
-            }
-        }
-        weighted(l, film.weight)
-    }
-
-    /// Strategy s = 0: the weighted contribution of the walk that `reached` a light.
-    fn emitter_reached<R: Recorder>(
-        &self,
-        scene: &Scene,
-        reached: Reached,
-        prefix: &mut Vec<PathVertex>,
-        ctx: &mut CameraSample<'_, R>,
-    ) -> Color {
-        let Reached { camera, x0, value } = reached;
-        prefix.clear();
-        prefix.extend_from_slice(camera);
-        prefix.push(x0);
-        let split = Split {
-            light: &[],
-            camera: prefix,
-            light_nee: 0.0,
+        let depths = Depths {
+            max_depth: self.params.max_depth,
+            rr_depth: self.params.rr_depth,
         };
-        let w = mis_weight(
+        camera_sample(
             scene,
-            split,
-            EndEvals::default(),
-            self.params.mis,
-            ctx.ratio,
-        );
-        if R::ACTIVE {
-            let n = prefix.len();
-            ctx.rec.completed(Completed {
-                s: 0,
-                light: &prefix[n - 1..],
-                camera: &prefix[..n - 1],
-                weight: w,
-                value,
-                raster: ctx.raster,
-                alternatives: &[],
-            });
-        }
-        value * w as f32
-    }
-
-    /// Strategy s = 1 at the camera subpath's last vertex z_{t−1} (`z` = z_0 … z_{t−1}): one
-    /// light chosen by power and sampled towards it.
-    fn next_event_weighted<R: Recorder>(
-        &self,
-        scene: &Scene,
-        z: &[PathVertex],
-        sampler: &mut Sampler,
-        ctx: &mut CameraSample<'_, R>,
-    ) -> Color {
-        let t = z.len();
-        let Some(NextEvent {
-            x0,
-            camera_end: ev_z,
-            value,
-        }) = next_event(scene, &z[t - 1], sampler)
-        else {
-            return Color::ZERO;
-        };
-        let split = Split {
-            light: std::slice::from_ref(&x0),
-            camera: &z[..t],
-            light_nee: 0.0,
-        };
-        let evals = EndEvals {
-            light_end: None,
-            camera_end: Some(ev_z),
-        };
-        let w = mis_weight(scene, split, evals, self.params.mis, ctx.ratio);
-        if R::ACTIVE {
-            ctx.rec.completed(Completed {
-                s: 1,
-                light: std::slice::from_ref(&x0),
-                camera: &z[..t],
-                weight: w,
-                value,
-                raster: ctx.raster,
-                alternatives: &[],
-            });
-        }
-        value * w as f32
+            (Pass { seed, pass }, pixel),
+            depths,
+            &mut policy,
+            &mut scratch.camera,
+            &mut **rec,
+        )
     }
 
     /// One pass with every path reported to `rec` (for `lt mis-check`), pixel by pixel on one
@@ -376,11 +224,9 @@ impl Bdpt {
     }
 
     pub fn scratch(&self) -> Scratch {
-        let d = self.params.max_depth as usize;
         Scratch {
-            camera: Subpath::with_capacity(d + 1),
-            light: Subpath::with_capacity(d),
-            prefix: Vec::with_capacity(d + 2),
+            camera: CameraScratch::new(self.params.max_depth),
+            light: Subpath::with_capacity(self.params.max_depth as usize),
         }
     }
 

@@ -15,22 +15,22 @@
 //! rate, as in SmallVCM, α = 0.75); r₀ is pixel-footprint relative by default (at the mean
 //! primary-hit distance: one radius for the whole pass, which η needs) or scene relative.
 
-use crate::connect::{
-    emission_densities, join, nee_density, next_event, splat_light_subpath, Joined, NextEvent,
+use crate::camera_loop::{
+    camera_sample, CameraPolicy, CameraScratch, Connection, Depths, Joins, SampleCtx, Weight,
 };
+use crate::connect::{emission_densities, nee_density, splat_light_subpath, Joined};
 use crate::params::ParamReader;
-use crate::pixel::{pixel_sample, weighted};
 use crate::radius::InitialRadius;
-use crate::record::{Completed, Merged, NoRecord, Reached, Recorder, Work};
+use crate::record::{Merged, NoRecord, Recorder, Work};
 pub use crate::splat::pixel_of;
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::strategy_weight::{with_chain, EndEvals, Split};
 use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
-use crate::walk::{camera_subpath, light_subpath, reverse_density, Subpath, WalkLimits};
+use crate::walk::{light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::{ProgressLog, ProgressiveRun};
-use lt_core::bsdf::TransportMode;
+use lt_core::bsdf::{BsdfEval, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3, PI};
-use lt_core::path::camis::{Mixture, Weighed};
+use lt_core::path::camis::Weighed;
 use lt_core::path::scatter::{connectable, connectable_inside};
 use lt_core::path::subpath_mis::{ConnectionDensities, NextEventDensities, VertexTechniques};
 use lt_core::path::{
@@ -356,9 +356,8 @@ pub struct Engine<'a> {
 
 /// Per-thread buffers of one camera sample.
 pub struct Scratch {
-    camera: Subpath,
+    walk: CameraScratch,
     records: Vec<CameraMis>,
-    prefix: Vec<PathVertex>,
 }
 
 impl<'a> Engine<'a> {
@@ -482,11 +481,9 @@ impl<'a> Engine<'a> {
     }
 
     pub fn scratch(&self) -> Scratch {
-        let d = self.params.max_depth as usize;
         Scratch {
-            camera: Subpath::with_capacity(d + 1),
-            records: Vec::with_capacity(d + 1),
-            prefix: Vec::with_capacity(d + 2),
+            walk: CameraScratch::new(self.params.max_depth),
+            records: Vec::with_capacity(self.params.max_depth as usize + 1),
         }
     }
 
@@ -609,7 +606,8 @@ impl<'a> Engine<'a> {
         });
     }
 
-    /// The camera sample of `pixel`: every technique with t ≥ 2 (merges included).
+    /// The camera sample of `pixel`: every technique with t ≥ 2 (merges included), through the
+    /// camera loop under the VCM policy.
     fn camera_sample<R: Recorder>(
         &self,
         inputs: &PassInputs,
@@ -620,173 +618,89 @@ impl<'a> Engine<'a> {
         let PassInputs {
             setup,
             lights,
-            pass: Pass { seed, pass },
+            pass,
         } = *inputs;
-        let scratch = &mut *worker.scratch;
-        let scene = self.scene;
-        let max_k = self.params.max_depth as usize;
-        let mis = &setup.mis;
-        let mut cs = Sampler::for_item(Domain::Camera, seed, pixel, pass as u64);
-        let Some(film) = pixel_sample(scene, pixel, &mut cs) else {
-            return Color::ZERO;
+        let Scratch { walk, records } = &mut *worker.scratch;
+        let mut policy = VcmCamera {
+            engine: self,
+            setup,
+            lights,
+            light,
+            records,
+            primary: 0.0,
+            light_nee: 0.0,
+            merges_here: true,
         };
-        let raster = film.raster;
-        camera_subpath(
-            scene,
-            raster,
-            &mut cs,
-            WalkLimits::camera(self.params.max_depth, self.params.rr_depth),
-            &mut scratch.camera,
-        );
-        let z = &scratch.camera.vertices;
-        camera_records(scene, mis, z, &mut scratch.records);
-        worker.rec.begin_sample(pixel, film.weight);
-        worker.rec.lap(Work::CameraWalk);
-        let zr = &scratch.records;
-        let cam = CameraWalk { z, zr };
-        let merges_here = setup.camis.as_ref().is_none_or(|c| c.merges_at(raster));
-        let mut ctx = CameraSample {
-            mis,
-            camis: setup.camis.as_ref(),
-            primary: if z.len() >= 2 {
-                (z[1].p - z[0].p).length()
-            } else {
-                0.0
-            },
-            light_nee: if setup.camis.is_some() {
-                light_nee(scene, light.0)
-            } else {
-                0.0
-            },
-            raster,
-            rec: &mut *worker.rec,
+        let depths = Depths {
+            max_depth: self.params.max_depth,
+            rr_depth: self.params.rr_depth,
         };
-        let mut l = Color::ZERO;
-        for t in 2..=z.len() {
-            let zv = &z[t - 1];
-            // s = 0: the walk hit an emitter at z_{t−1}.
-            if t - 1 <= max_k {
-                if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter()) {
-                    let le = scene.lights[li as usize].emitted(x0.ng, x0.wo, x0.uv);
-                    if le != Color::ZERO {
-                        let (wgt, mixture) = self.emitter_weight(
-                            (mis, &ctx),
-                            &z[..t - 1],
-                            zr,
-                            &x0,
-                            zv.pdf_fwd,
-                            &mut scratch.prefix,
-                        );
-                        let value = zv.beta * le;
-                        if R::ACTIVE {
-                            let reached = Reached {
-                                camera: &z[..t - 1],
-                                x0,
-                                value,
-                            };
-                            record_emitter(reached, (wgt, mixture), &mut scratch.prefix, &mut ctx);
-                        }
-                        l += value * wgt as f32;
-                    }
-                    ctx.rec.lap(Work::Connection { s: 0, t: t as u16 });
-                }
-            }
-            if !connectable(scene, zv) {
-                continue;
-            }
-            if self.params.connections {
-                if t <= max_k {
-                    l += self.next_event_weighted(cam, t, &mut cs, &mut ctx);
-                    ctx.rec.lap(Work::Connection { s: 1, t: t as u16 });
-                }
-                let joins = if self.params.vertex_connections {
-                    light.0.len().min(max_k + 1 - t)
-                } else {
-                    1
-                };
-                for s in 2..=joins {
-                    l += self.connect(light, cam, (s, t), &mut ctx);
-                    ctx.rec.lap(Work::Connection {
-                        s: s as u16,
-                        t: t as u16,
-                    });
-                }
-            }
-            if self.params.merging && t <= max_k && merges_here {
-                l += self.merge(setup, lights, cam, t, &mut ctx);
-                ctx.rec.lap(Work::Merge { t: t as u16 });
-            }
-        }
-        // s = 0 at infinity: the walk left the scene after its last vertex.
-        if let Some(esc) = scratch.camera.escape {
-            if z.len() <= max_k {
-                for &li in &scene.infinite_lights {
-                    let le = scene.lights[li as usize].escaped(esc.dir);
-                    if le == Color::ZERO {
-                        continue;
-                    }
-                    let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
-                    let (wgt, mixture) = self.emitter_weight(
-                        (mis, &ctx),
-                        z,
-                        zr,
-                        &x0,
-                        esc.pdf_w,
-                        &mut scratch.prefix,
-                    );
-                    let value = esc.beta * le;
-                    if R::ACTIVE {
-                        let reached = Reached {
-                            camera: z,
-                            x0,
-                            value,
-                        };
-                        record_emitter(reached, (wgt, mixture), &mut scratch.prefix, &mut ctx);
-                    }
-                    l += value * wgt as f32;
-                }
-                ctx.rec.lap(Work::Connection {
-                    s: 0,
-                    t: z.len() as u16 + 1,
-                });
-            }
-        }
-        weighted(l, film.weight)
+        camera_sample(
+            self.scene,
+            (pass, pixel),
+            depths,
+            &mut policy,
+            walk,
+            &mut *worker.rec,
+        )
+    }
+}
+
+/// The VCM engine's policy in the camera loop, for one camera sample: its connections are
+/// bdpt's (light subpath j mod M), every weight comes from the per-vertex recursion
+/// (`SubpathMis`) or, when on, from the full path (`FullPathSetup`), and every non-delta camera
+/// vertex merges with the stored light vertices within the pass's radius.
+struct VcmCamera<'a, 'e> {
+    engine: &'a Engine<'e>,
+    setup: &'a PassSetup,
+    lights: &'a LightPaths,
+    /// The light subpath this sample connects to, and its MIS records.
+    light: (&'a [PathVertex], &'a [LightMis]),
+    /// The camera walk's MIS records, one per vertex (`walked`).
+    records: &'a mut Vec<CameraMis>,
+    /// |z_1 − z_0|: the primary hit's distance (the footprint of correlation-aware MIS).
+    primary: f32,
+    /// With full-path weights: next-event estimation's density of y_0 of `light`, read by each
+    /// of its connections.
+    light_nee: f64,
+    /// Whether the sample's pixel merges (efficiency-aware MIS's mask).
+    merges_here: bool,
+}
+
+impl CameraPolicy for VcmCamera<'_, '_> {
+    fn walked(&mut self, scene: &Scene, z: &[PathVertex], raster: Vec2) {
+        let setup = self.setup;
+        camera_records(scene, &setup.mis, z, self.records);
+        self.merges_here = setup.camis.as_ref().is_none_or(|c| c.merges_at(raster));
+        self.primary = if z.len() >= 2 {
+            (z[1].p - z[0].p).length()
+        } else {
+            0.0
+        };
+        self.light_nee = if setup.camis.is_some() {
+            light_nee(scene, self.light.0)
+        } else {
+            0.0
+        };
     }
 
-    /// Weight of s = 0: the camera walk `camera` (camera first, ending at x1) reached light
-    /// endpoint `x0` with density `c0`.
-    fn emitter_weight<R>(
-        &self,
-        (mis, ctx): (&SubpathMis, &CameraSample<'_, R>),
-        camera: &[PathVertex],
-        records: &[CameraMis],
-        x0: &PathVertex,
-        c0: f32,
-        prefix: &mut Vec<PathVertex>,
-    ) -> (f64, Option<Mixture>) {
-        let scene = self.scene;
+    /// The camera walk (camera first, ending at x1) reached light endpoint x0 with density c0
+    /// (its `pdf_fwd`).
+    fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], raster: Vec2) -> Weight {
+        let (camera, x0) = path.split_at(path.len() - 1);
+        let (x0, c0) = (&x0[0], x0[0].pdf_fwd);
         let x1 = camera.last().expect("the pinhole");
-        if let Some(camis) = ctx.camis {
-            // x0 as the walk reached it, with its density c0 (`strategy_weight::Split`).
-            prefix.clear();
-            prefix.extend_from_slice(camera);
-            let mut x0 = *x0;
-            x0.pdf_fwd = c0;
-            prefix.push(x0);
+        if let Some(camis) = &self.setup.camis {
             let primary = if camera.len() == 1 {
                 (x0.p - x1.p).length()
             } else {
-                ctx.primary
+                self.primary
             };
-            let split = Split {
-                light: &[],
-                camera: prefix,
-                light_nee: 0.0,
-            };
-            let wd = camis.connection(scene, split, EndEvals::default(), primary, ctx.raster);
+            let (split, evals) = Split::reached(path);
+            let wd = camis.connection(scene, split, evals, primary, raster);
             return (wd.weight, Some(wd.mixture));
         }
+        let mis = &self.setup.mis;
         if camera.len() == 1 {
             let (l0, _) = emission_densities(scene, x0, None);
             return (
@@ -798,161 +712,112 @@ impl<'a> Engine<'a> {
         let vc1 = connectable_inside(scene, x1);
         let (l0, l1) = emission_densities(scene, x0, Some(x1));
         let nee = nee_density(scene, x0, x1);
-        let w = mis.emitter_hit(&records[camera.len() - 1], c0 as f64, l0, l1, nee, vc1);
+        let records = &self.records[camera.len() - 1];
+        (mis.emitter_hit(records, c0 as f64, l0, l1, nee, vc1), None)
+    }
+
+    fn connects(&self) -> bool {
+        self.engine.params.connections
+    }
+
+    fn next_event_weight(
+        &self,
+        scene: &Scene,
+        z: &[PathVertex],
+        x0: &PathVertex,
+        ev_z: BsdfEval,
+        raster: Vec2,
+    ) -> Weight {
+        let t = z.len();
+        let zv = &z[t - 1];
+        if let Some(camis) = &self.setup.camis {
+            let (split, evals) = Split::next_event(z, x0, ev_z);
+            let wd = camis.connection(scene, split, evals, self.primary, raster);
+            return (wd.weight, Some(wd.mixture));
+        }
+        let (l0, l1) = emission_densities(scene, x0, Some(zv));
+        let d = NextEventDensities {
+            nee: x0.pdf_fwd as f64,
+            c0: reverse_density(x0, zv, ev_z.pdf_w) as f64,
+            l0,
+            l1,
+            l_z_prev: if t >= 3 {
+                reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64
+            } else {
+                0.0
+            },
+        };
+        let zr = &self.records;
+        (self.setup.mis.next_event((&zr[t - 1], &zr[t - 2]), d), None)
+    }
+
+    /// bdpt's connections to light subpath j mod M; with vertex connections off, none.
+    fn connect<R: Recorder>(&mut self, scene: &Scene, joins: &mut Joins<'_, R>, _: &mut Sampler) {
+        if self.engine.params.vertex_connections {
+            joins.join_subpath(scene, self.light.0, |c| self.connection_weight(scene, c));
+        }
+    }
+
+    fn at_vertex<R: Recorder>(
+        &mut self,
+        scene: &Scene,
+        z: &[PathVertex],
+        sample: &mut SampleCtx<'_, R>,
+        l: &mut Color,
+    ) {
+        let params = &self.engine.params;
+        let t = z.len();
+        if params.merging && t <= params.max_depth as usize && self.merges_here {
+            *l += self.merge(scene, z, sample);
+            sample.rec.lap(Work::Merge { t: t as u16 });
+        }
+    }
+}
+
+impl VcmCamera<'_, '_> {
+    /// The weight of strategy (s, t), s ≥ 2, t ≥ 2: a shadow ray from z_{t−1} to y_{s−1}.
+    fn connection_weight(&self, scene: &Scene, c: Connection) -> Weight {
+        let (y, z) = (c.light, c.camera);
+        let (s, t) = (y.len(), z.len());
+        let (yv, zv) = (&y[s - 1], &z[t - 1]);
+        if let Some(camis) = &self.setup.camis {
+            let (split, evals) = Split::connection(c, self.light_nee);
+            let wd = camis.connection(scene, split, evals, self.primary, c.raster);
+            return (wd.weight, Some(wd.mixture));
+        }
+        let Joined {
+            light_end: ev_y,
+            camera_end: ev_z,
+            ..
+        } = *c.joined;
+        let d = ConnectionDensities {
+            c_y: reverse_density(yv, zv, ev_z.pdf_w) as f64,
+            c_y_prev: reverse_density(&y[s - 2], yv, ev_y.pdf_rev_w) as f64,
+            l_z: yv.convert_density(ev_y.pdf_w, zv) as f64,
+            l_z_prev: if t >= 3 {
+                reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64
+            } else {
+                0.0
+            },
+        };
+        let (ly, zr) = (self.light.1, &self.records);
+        let w = self
+            .setup
+            .mis
+            .connection(&ly[s - 1], (&zr[t - 1], &zr[t - 2]), d);
         (w, None)
     }
 
-    /// s = 1 at camera vertex z_{t−1}: one light chosen by power and sampled towards it (the
-    /// random numbers `bdpt` draws, in its order).
-    fn next_event_weighted<R: Recorder>(
-        &self,
-        cam: CameraWalk,
-        t: usize,
-        sampler: &mut Sampler,
-        ctx: &mut CameraSample<'_, R>,
-    ) -> Color {
-        let CameraWalk { z, zr } = cam;
-        let scene = self.scene;
-        let zv = &z[t - 1];
-        let Some(NextEvent {
-            x0,
-            camera_end: ev_z,
-            value,
-        }) = next_event(scene, zv, sampler)
-        else {
-            return Color::ZERO;
-        };
-        let c0 = reverse_density(&x0, zv, ev_z.pdf_w) as f64;
-        let (l0, l1) = emission_densities(scene, &x0, Some(zv));
-        let l2 = if t >= 3 {
-            reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64
-        } else {
-            0.0
-        };
-        let nee = x0.pdf_fwd as f64;
-        let d = NextEventDensities {
-            nee,
-            c0,
-            l0,
-            l1,
-            l_z_prev: l2,
-        };
-        let (w, mixture) = match ctx.camis {
-            Some(camis) => {
-                let split = Split {
-                    light: std::slice::from_ref(&x0),
-                    camera: &z[..t],
-                    light_nee: 0.0,
-                };
-                let evals = EndEvals {
-                    light_end: None,
-                    camera_end: Some(ev_z),
-                };
-                let wd = camis.connection(scene, split, evals, ctx.primary, ctx.raster);
-                (wd.weight, Some(wd.mixture))
-            }
-            None => (ctx.mis.next_event((&zr[t - 1], &zr[t - 2]), d), None),
-        };
-        if R::ACTIVE {
-            if let Some(m) = mixture {
-                ctx.rec.mixture(m);
-            }
-            ctx.rec.completed(Completed {
-                s: 1,
-                light: std::slice::from_ref(&x0),
-                camera: &z[..t],
-                weight: w,
-                value,
-                raster: ctx.raster,
-                alternatives: &[],
-            });
-        }
-        value * w as f32
-    }
-
-    /// Strategy (s, t), s ≥ 2, t ≥ 2: a shadow ray from z_{t−1} to y_{s−1}.
-    fn connect<R: Recorder>(
-        &self,
-        (y, ly): (&[PathVertex], &[LightMis]),
-        cam: CameraWalk,
-        (s, t): (usize, usize),
-        ctx: &mut CameraSample<'_, R>,
-    ) -> Color {
-        let CameraWalk { z, zr } = cam;
-        let scene = self.scene;
-        let (yv, zv) = (&y[s - 1], &z[t - 1]);
-        if !connectable(scene, yv) {
-            return Color::ZERO;
-        }
-        let Some(Joined {
-            light_end: ev_y,
-            camera_end: ev_z,
-            value: c,
-        }) = join(scene, yv, zv)
-        else {
-            return Color::ZERO;
-        };
-        let c_y = reverse_density(yv, zv, ev_z.pdf_w) as f64;
-        let c_y_prev = reverse_density(&y[s - 2], yv, ev_y.pdf_rev_w) as f64;
-        let l_z = yv.convert_density(ev_y.pdf_w, zv) as f64;
-        let l_z_prev = if t >= 3 {
-            reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64
-        } else {
-            0.0
-        };
-        let d = ConnectionDensities {
-            c_y,
-            c_y_prev,
-            l_z,
-            l_z_prev,
-        };
-        let (w, mixture) = match ctx.camis {
-            Some(camis) => {
-                let split = Split {
-                    light: &y[..s],
-                    camera: &z[..t],
-                    light_nee: ctx.light_nee,
-                };
-                let evals = EndEvals {
-                    light_end: Some(ev_y),
-                    camera_end: Some(ev_z),
-                };
-                let wd = camis.connection(scene, split, evals, ctx.primary, ctx.raster);
-                (wd.weight, Some(wd.mixture))
-            }
-            None => (
-                ctx.mis.connection(&ly[s - 1], (&zr[t - 1], &zr[t - 2]), d),
-                None,
-            ),
-        };
-        if R::ACTIVE {
-            if let Some(m) = mixture {
-                ctx.rec.mixture(m);
-            }
-            ctx.rec.completed(Completed {
-                s,
-                light: &y[..s],
-                camera: &z[..t],
-                weight: w,
-                value: c,
-                raster: ctx.raster,
-                alternatives: &[],
-            });
-        }
-        c * w as f32
-    }
-
-    /// Merges at z_{t−1} with every stored light vertex within the pass's radius (disk kernel).
+    /// Merges at z_{t−1} (`z` = z_0 … z_{t−1}) with every stored light vertex within the pass's
+    /// radius (disk kernel).
     fn merge<R: Recorder>(
         &self,
-        setup: &PassSetup,
-        lights: &LightPaths,
-        cam: CameraWalk,
-        t: usize,
-        ctx: &mut CameraSample<'_, R>,
+        scene: &Scene,
+        z: &[PathVertex],
+        sample: &mut SampleCtx<'_, R>,
     ) -> Color {
-        let CameraWalk { z, zr } = cam;
-        let scene = self.scene;
+        let (setup, lights, zr) = (self.setup, self.lights, &self.records);
+        let t = z.len();
         let zv = &z[t - 1];
         let Some(grid) = &lights.grid else {
             return Color::ZERO;
@@ -960,7 +825,7 @@ impl<'a> Engine<'a> {
         let VertexKind::Surface { material } = zv.kind else {
             return Color::ZERO;
         };
-        let max_k = self.params.max_depth;
+        let max_k = self.engine.params.max_depth;
         let camera_segments = (t - 1) as u32;
         let sf = zv.shading_frame();
         let bsdf = scene.material(material);
@@ -997,12 +862,13 @@ impl<'a> Engine<'a> {
             } else {
                 0.0
             };
+            let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
+            let ys = &lights.chunks[y.chunk as usize].vertices[first..=vi];
             let (w, mixture) = match &setup.camis {
                 Some(camis) => {
-                    let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
-                    let ys = &lights.chunks[y.chunk as usize].vertices[first..=vi];
                     let merge = MergeDensities { c_y_prev, l_z_prev };
-                    let wd = merge_weight(scene, camis, (ys, &z[..t]), merge, ctx);
+                    let wd =
+                        merge_weight(scene, camis, (ys, z), merge, (self.primary, sample.raster));
                     (wd.weight, Some(wd.mixture))
                 }
                 None => (
@@ -1014,16 +880,15 @@ impl<'a> Engine<'a> {
             };
             if R::ACTIVE {
                 if let Some(m) = mixture {
-                    ctx.rec.mixture(m);
+                    sample.rec.mixture(m);
                 }
-                let (vi, first) = (y.index as usize, (y.index - y.segments) as usize);
-                ctx.rec.merged(Merged {
+                sample.rec.merged(Merged {
                     i: y.segments as usize,
-                    light: &lights.chunks[y.chunk as usize].vertices[first..=vi],
-                    camera: &z[..t],
+                    light: ys,
+                    camera: z,
                     weight: w,
                     value: value * setup.merge_norm,
-                    raster: ctx.raster,
+                    raster: sample.raster,
                     radius: setup.radius,
                 });
             }
@@ -1033,33 +898,6 @@ impl<'a> Engine<'a> {
     }
 }
 
-/// Reports an s = 0 path (a walk that `reached` a light) with its weight, copying the walk and the
-/// light endpoint into `prefix`.
-fn record_emitter<R: Recorder>(
-    reached: Reached,
-    (weight, mixture): (f64, Option<Mixture>),
-    prefix: &mut Vec<PathVertex>,
-    ctx: &mut CameraSample<'_, R>,
-) {
-    let Reached { camera, x0, value } = reached;
-    if let Some(m) = mixture {
-        ctx.rec.mixture(m);
-    }
-    prefix.clear();
-    prefix.extend_from_slice(camera);
-    prefix.push(x0);
-    let n = prefix.len();
-    ctx.rec.completed(Completed {
-        s: 0,
-        light: &prefix[n - 1..],
-        camera: &prefix[..n - 1],
-        weight,
-        value,
-        raster: ctx.raster,
-        alternatives: &[],
-    });
-}
-
 /// One pass's inputs to its work items: the setup (MIS, radius), the pass's light subpaths, and
 /// the seed and pass that key every random stream.
 #[derive(Clone, Copy)]
@@ -1067,28 +905,6 @@ pub struct PassInputs<'a> {
     pub setup: &'a PassSetup,
     pub lights: &'a LightPaths,
     pub pass: Pass,
-}
-
-/// A camera subpath z_0 … and its MIS records, one per vertex.
-#[derive(Clone, Copy)]
-struct CameraWalk<'a> {
-    z: &'a [PathVertex],
-    zr: &'a [CameraMis],
-}
-
-/// What every technique of one camera sample shares: the pass's MIS, the sample's film position,
-/// and the recorder.
-struct CameraSample<'a, R> {
-    mis: &'a SubpathMis,
-    /// Full-path weights, when on.
-    camis: Option<&'a FullPathSetup>,
-    /// |z_1 − z_0|: the primary hit's distance (the footprint of correlation-aware MIS).
-    primary: f32,
-    /// With full-path weights: next-event estimation's density of y_0 of the light subpath this
-    /// sample connects to (`light_nee`), read by each of its connections.
-    light_nee: f64,
-    raster: Vec2,
-    rec: &'a mut R,
 }
 
 /// Next-event estimation's density of y_0 from y_1 (0 for a one-vertex subpath): the density of
@@ -1117,12 +933,12 @@ const MERGE_STACK: usize = 24;
 /// z_0 … z_{t−1}): the full path's densities from the walks' stored ones, as
 /// `Densities::merged` defines them from scratch — the light side l_0 … l_i, c_0 … c_{i−2} from
 /// the light walk, c_i … c_k and l_{i+2} … from the camera walk, c_{i−1} and l_{i+1} the merge's.
-fn merge_weight<R>(
+fn merge_weight(
     scene: &Scene,
     camis: &FullPathSetup,
     (y, z): (&[PathVertex], &[PathVertex]),
     m: MergeDensities,
-    ctx: &CameraSample<'_, R>,
+    (primary, raster): (f32, Vec2),
 ) -> Weighed {
     let i = y.len() - 1;
     let t = z.len();
@@ -1177,7 +993,7 @@ fn merge_weight<R>(
         connectable: conn,
         light_tracing_ratio: camis.ratio,
     };
-    camis.weigh(&chain, Technique::Merge(i), ctx.primary, ctx.raster)
+    camis.weigh(&chain, Technique::Merge(i), primary, raster)
 }
 
 /// The MIS records of a light subpath y_0 … (see `SubpathMis`), appended to `out`.

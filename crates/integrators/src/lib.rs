@@ -3,6 +3,7 @@
 
 pub mod bdpt;
 pub mod bpm;
+pub mod camera_loop;
 pub mod connect;
 pub mod connect_merge;
 pub mod cpu_clock;

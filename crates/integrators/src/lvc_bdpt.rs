@@ -34,15 +34,16 @@
 //! | `light_paths` | u64 | the pixel count | light subpaths traced into the cache per pass |
 //! | `connections` | u32 | 1 | cache vertices each camera vertex connects to (N) |
 
-use crate::connect::{join, nee_density, next_event, splat_light_subpath, Joined, NextEvent};
+use crate::camera_loop::{camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight};
+use crate::connect::{nee_density, splat_light_subpath};
 use crate::params::ParamReader;
-use crate::pixel::{pixel_sample, weighted};
-use crate::record::{Completed, NoRecord, Reached, Recorder, Work};
+use crate::record::{NoRecord, Recorder, Work};
 use crate::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::strategy_weight::{with_chain, EndEvals, Split};
 use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
-use crate::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
+use crate::walk::{light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
+use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
 use lt_core::path::scatter::connectable;
 use lt_core::path::{Chain, Heuristic, PathVertex};
@@ -173,8 +174,7 @@ impl Mis {
 
 /// Per-thread buffers of one camera sample.
 pub struct Scratch {
-    camera: Subpath,
-    prefix: Vec<PathVertex>,
+    camera: CameraScratch,
 }
 
 impl LvcBdpt {
@@ -269,10 +269,8 @@ impl LvcBdpt {
     }
 
     pub fn scratch(&self) -> Scratch {
-        let d = self.params.max_depth as usize;
         Scratch {
-            camera: Subpath::with_capacity(d + 1),
-            prefix: Vec::with_capacity(d + 2),
+            camera: CameraScratch::new(self.params.max_depth),
         }
     }
 
@@ -316,126 +314,26 @@ impl LvcBdpt {
         scratch: &mut Scratch,
         rec: &mut R,
     ) -> Color {
-        let mis = self.mis(scene);
-        let max_k = self.params.max_depth as usize;
-        let mut cs = Sampler::for_item(Domain::Camera, pass.seed, pixel, pass.pass as u64);
-        let Some(film) = pixel_sample(scene, pixel, &mut cs) else {
-            return Color::ZERO;
-        };
-        let raster = film.raster;
-        camera_subpath(
-            scene,
-            raster,
-            &mut cs,
-            WalkLimits::camera(self.params.max_depth, self.params.rr_depth),
-            &mut scratch.camera,
-        );
-        rec.begin_sample(pixel, film.weight);
-        rec.lap(Work::CameraWalk);
-        let z = &scratch.camera.vertices;
-        let prefix = &mut scratch.prefix;
         let n = self.params.connections;
-        // |C| / (N·L): one pick's share of the mean over the cache (module docs).
-        let pick_scale = cache.len() as f32 / (n as f32 * self.light_paths(scene) as f32);
-        let mut l = Color::ZERO;
-        for t in 2..=z.len() {
-            let zv = &z[t - 1];
-            if t - 1 <= max_k {
-                if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter()) {
-                    let le = scene.lights[li as usize].emitted(x0.ng, x0.wo, x0.uv);
-                    if le != Color::ZERO {
-                        let reached = Reached {
-                            camera: &z[..t - 1],
-                            x0,
-                            value: zv.beta * le,
-                        };
-                        l += emitter_reached(scene, &mis, reached, prefix, raster, rec);
-                    }
-                    rec.lap(Work::Connection { s: 0, t: t as u16 });
-                }
-            }
-            if !connectable(scene, zv) {
-                continue;
-            }
-            if t <= max_k {
-                if let Some(NextEvent {
-                    x0,
-                    camera_end,
-                    value,
-                }) = next_event(scene, zv, &mut cs)
-                {
-                    let split = Split {
-                        light: std::slice::from_ref(&x0),
-                        camera: &z[..t],
-                        light_nee: 0.0,
-                    };
-                    let evals = EndEvals {
-                        light_end: None,
-                        camera_end: Some(camera_end),
-                    };
-                    l += weighted_join(scene, &mis, split, evals, value, raster, rec);
-                }
-                rec.lap(Work::Connection { s: 1, t: t as u16 });
-            }
-            if cache.is_empty() || t + 1 > max_k {
-                continue;
-            }
-            for _ in 0..n {
-                let (p, s) = cache.entries[uniform_index(&mut cs, cache.len())];
-                let (y, light_nee) = cache.path(p as usize);
-                let s = s as usize;
-                if s + t - 1 > max_k {
-                    continue;
-                }
-                'attempt: {
-                    let Some(Joined {
-                        light_end,
-                        camera_end,
-                        value,
-                    }) = join(scene, &y[s - 1], zv)
-                    else {
-                        break 'attempt;
-                    };
-                    let value = value * pick_scale;
-                    let split = Split {
-                        light: &y[..s],
-                        camera: &z[..t],
-                        light_nee,
-                    };
-                    let evals = EndEvals {
-                        light_end: Some(light_end),
-                        camera_end: Some(camera_end),
-                    };
-                    l += weighted_join(scene, &mis, split, evals, value, raster, rec);
-                }
-                rec.lap(Work::Connection {
-                    s: s as u16,
-                    t: t as u16,
-                });
-            }
-        }
-        if let Some(esc) = scratch.camera.escape {
-            if z.len() <= max_k {
-                for &li in &scene.infinite_lights {
-                    let le = scene.lights[li as usize].escaped(esc.dir);
-                    if le == Color::ZERO {
-                        continue;
-                    }
-                    let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
-                    let reached = Reached {
-                        camera: z,
-                        x0,
-                        value: esc.beta * le,
-                    };
-                    l += emitter_reached(scene, &mis, reached, prefix, raster, rec);
-                }
-                rec.lap(Work::Connection {
-                    s: 0,
-                    t: z.len() as u16 + 1,
-                });
-            }
-        }
-        weighted(l, film.weight)
+        let mut policy = Policy {
+            cache,
+            mis: self.mis(scene),
+            picks: n,
+            // |C| / (N·L): one pick's share of the mean over the cache (module docs).
+            pick_scale: cache.len() as f32 / (n as f32 * self.light_paths(scene) as f32),
+        };
+        let depths = Depths {
+            max_depth: self.params.max_depth,
+            rr_depth: self.params.rr_depth,
+        };
+        camera_sample(
+            scene,
+            (pass, pixel),
+            depths,
+            &mut policy,
+            &mut scratch.camera,
+            rec,
+        )
     }
 
     /// Work item i of a pass over `cache`: light subpath i splatted (i < L), pixel i (i < N).
@@ -485,64 +383,58 @@ fn uniform_index(s: &mut Sampler, n: usize) -> usize {
     (((x as u128) * (n as u128)) >> 48) as usize
 }
 
-/// Strategy s = 0: the weighted contribution of a camera walk that `reached` a light.
-/// A strategy with s ≥ 1 (NEE or a cache connection): its weighted contribution, reported to
-/// `rec` with the split's own light and camera vertices.
-fn weighted_join<R: Recorder>(
-    scene: &Scene,
-    mis: &Mis,
-    split: Split,
-    evals: EndEvals,
-    value: Color,
-    raster: Vec2,
-    rec: &mut R,
-) -> Color {
-    let w = mis.weight(scene, split, evals);
-    if R::ACTIVE {
-        rec.completed(Completed {
-            s: split.light.len(),
-            light: split.light,
-            camera: split.camera,
-            weight: w,
-            value,
-            raster,
-            alternatives: &[],
-        });
-    }
-    value * w as f32
+/// lvc-bdpt's policy in the camera loop: every camera vertex joins `picks` vertices drawn
+/// uniformly from the cache; weights from the stored densities with n_conn connections.
+struct Policy<'a> {
+    cache: &'a Cache,
+    mis: Mis,
+    /// N.
+    picks: u32,
+    /// |C| / (N·L).
+    pick_scale: f32,
 }
 
-fn emitter_reached<R: Recorder>(
-    scene: &Scene,
-    mis: &Mis,
-    reached: Reached,
-    prefix: &mut Vec<PathVertex>,
-    raster: Vec2,
-    rec: &mut R,
-) -> Color {
-    let Reached { camera, x0, value } = reached;
-    prefix.clear();
-    prefix.extend_from_slice(camera);
-    prefix.push(x0);
-    let split = Split {
-        light: &[],
-        camera: prefix,
-        light_nee: 0.0,
-    };
-    let w = mis.weight(scene, split, EndEvals::default());
-    if R::ACTIVE {
-        let n = prefix.len();
-        rec.completed(Completed {
-            s: 0,
-            light: &prefix[n - 1..],
-            camera: &prefix[..n - 1],
-            weight: w,
-            value,
-            raster,
-            alternatives: &[],
-        });
+impl CameraPolicy for Policy<'_> {
+    fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], _: Vec2) -> Weight {
+        let (split, evals) = Split::reached(path);
+        (self.mis.weight(scene, split, evals), None)
     }
-    value * w as f32
+
+    fn next_event_weight(
+        &self,
+        scene: &Scene,
+        z: &[PathVertex],
+        x0: &PathVertex,
+        camera_end: BsdfEval,
+        _: Vec2,
+    ) -> Weight {
+        let (split, evals) = Split::next_event(z, x0, camera_end);
+        (self.mis.weight(scene, split, evals), None)
+    }
+
+    fn connect<R: Recorder>(
+        &mut self,
+        scene: &Scene,
+        joins: &mut Joins<'_, R>,
+        sampler: &mut Sampler,
+    ) {
+        let (cache, t, max_k) = (self.cache, joins.t(), joins.max_k());
+        if cache.is_empty() || t + 1 > max_k {
+            return;
+        }
+        for _ in 0..self.picks {
+            let (p, s) = cache.entries[uniform_index(sampler, cache.len())];
+            let (y, light_nee) = cache.path(p as usize);
+            let s = s as usize;
+            if s + t - 1 > max_k {
+                continue;
+            }
+            joins.join(scene, &y[..s], self.pick_scale, |c| {
+                let (split, evals) = Split::connection(c, light_nee);
+                (self.mis.weight(scene, split, evals), None)
+            });
+        }
+    }
 }
 
 /// Work items per splat chunk (fixed, so the image does not depend on the thread count).

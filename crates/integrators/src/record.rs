@@ -6,14 +6,6 @@ use lt_core::math::{Color, Vec2};
 use lt_core::path::camis::Mixture;
 use lt_core::path::PathVertex;
 
-/// A camera walk (camera first) that reached light endpoint `x0` — an emitter it hit, or a light
-/// at infinity it escaped to — with unweighted contribution `value` (strategy s = 0).
-pub struct Reached<'a> {
-    pub camera: &'a [PathVertex],
-    pub x0: PathVertex,
-    pub value: Color,
-}
-
 /// One completed path: x0 (light end) first, xk (camera) last, as `lt_core::path::Path` wants.
 pub struct Completed<'a> {
     /// Technique s (vertices taken from the light side) that produced it.

@@ -4,6 +4,7 @@
 //! two integrators read it — `bdpt` and `lvc_bdpt`, whose connection counts differ — and
 //! integrator files import no other integrator file.
 
+use crate::camera_loop::Connection;
 use crate::connect::{emission_densities, nee_density};
 use crate::walk::reverse_density;
 use lt_core::bsdf::BsdfEval;
@@ -30,6 +31,52 @@ pub struct Split<'a> {
 pub struct EndEvals {
     pub light_end: Option<BsdfEval>,
     pub camera_end: Option<BsdfEval>,
+}
+
+impl<'a> Split<'a> {
+    /// s = 0: `path` = a camera walk and the light endpoint it reached.
+    pub fn reached(path: &'a [PathVertex]) -> (Split<'a>, EndEvals) {
+        let split = Split {
+            light: &[],
+            camera: path,
+            light_nee: 0.0,
+        };
+        (split, EndEvals::default())
+    }
+
+    /// s = 1: next-event estimation's `x0` joined to z_{t−1} (`z` = z_0 … z_{t−1}), whose BSDF
+    /// towards it is `camera_end`.
+    pub fn next_event(
+        z: &'a [PathVertex],
+        x0: &'a PathVertex,
+        camera_end: BsdfEval,
+    ) -> (Split<'a>, EndEvals) {
+        let split = Split {
+            light: std::slice::from_ref(x0),
+            camera: z,
+            light_nee: 0.0,
+        };
+        let evals = EndEvals {
+            light_end: None,
+            camera_end: Some(camera_end),
+        };
+        (split, evals)
+    }
+
+    /// s, t ≥ 2: the connection `c`, whose light subpath's x0 next-event estimation from x1
+    /// would choose with density `light_nee`.
+    pub fn connection(c: Connection<'a>, light_nee: f64) -> (Split<'a>, EndEvals) {
+        let split = Split {
+            light: c.light,
+            camera: c.camera,
+            light_nee,
+        };
+        let evals = EndEvals {
+            light_end: Some(c.joined.light_end),
+            camera_end: Some(c.joined.camera_end),
+        };
+        (split, evals)
+    }
 }
 
 /// Longest path weighed without allocating (segments); longer ones use the heap.

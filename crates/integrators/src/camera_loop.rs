@@ -1,0 +1,383 @@
+//! The bidirectional camera loop, written once for every estimator that joins a camera subpath
+//! to light vertices (`bdpt`, `lvc-bdpt`, and the VCM engine behind `vcm`, `bpm` and `eamis`).
+//! Per camera sample it walks the camera subpath z_0 z_1 … through a filtered position of the
+//! pixel and, at every vertex z_{t−1} (t ≥ 2), runs
+//!
+//! - s = 0: the walk reached an emitter at z_{t−1} (after the walk: a light at infinity it
+//!   escaped to);
+//! - s = 1: next-event estimation from z_{t−1};
+//! - s ≥ 2: shadow rays to the light vertices the estimator chooses (`Joins`);
+//! - the estimator's own techniques at the vertex (VCM's merges) and along the segment that
+//!   reached it (none yet: the hook UPBP's beams and medium points need),
+//!
+//! each completed path reported to the recorder and each technique's time lapped. What differs
+//! between estimators is a [`CameraPolicy`]: which light vertices a camera vertex joins, the MIS
+//! weight of s = 0, of s = 1 and of each connection, and techniques of their own. The loop is
+//! generic over the policy and the recorder, so each estimator gets its own monomorphised copy
+//! and the hot loop calls no trait object. Light tracing (t = 1) is per light subpath, not per
+//! camera sample: `connect::splat_light_subpath`.
+//!
+//! The random numbers are drawn from the pixel's camera stream in this order: film position,
+//! camera walk, then per vertex next-event estimation's three numbers and whatever the policy's
+//! `connect` draws (lvc-bdpt's cache picks). Contributions are summed in technique order, so an
+//! estimator's image does not depend on which code path formed it.
+
+use crate::connect::{join, next_event, Joined, NextEvent};
+use crate::pixel::{pixel_sample, weighted};
+use crate::record::{Completed, Recorder, Work};
+use crate::splat::Pass;
+use crate::walk::{camera_subpath, Subpath, WalkLimits};
+use lt_core::bsdf::BsdfEval;
+use lt_core::math::{Color, Vec2};
+use lt_core::path::camis::Mixture;
+use lt_core::path::scatter::connectable;
+use lt_core::path::PathVertex;
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::Scene;
+
+/// The MIS weight a policy gives one path, with the effective densities of every technique when
+/// it was computed from the full path (`lt_core::path::camis`; reported to the recorder first).
+pub type Weight = (f64, Option<Mixture>);
+
+/// What a bidirectional estimator does at the camera vertices the loop visits. `z` is always the
+/// camera prefix z_0 … z_{t−1}, camera first, its last vertex the one being visited.
+pub trait CameraPolicy {
+    /// The camera walk `z` is done, before any technique runs: per-sample state (the VCM
+    /// engine's MIS records of the walk, whether the pixel at `raster` merges).
+    #[inline]
+    fn walked(&mut self, _scene: &Scene, _z: &[PathVertex], _raster: Vec2) {}
+
+    /// s = 0: the weight of the path `path` = z_0 … z_m, x0 — a camera walk and the light
+    /// endpoint it reached (its `pdf_fwd` the walk's density of x0).
+    fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], raster: Vec2) -> Weight;
+
+    /// Whether the techniques with s ≥ 1 run (`bpm` has merges only).
+    #[inline]
+    fn connects(&self) -> bool {
+        true
+    }
+
+    /// s = 1: the weight of next-event estimation's light sample `x0` joined to z_{t−1}, whose
+    /// BSDF towards it is `camera_end`.
+    fn next_event_weight(
+        &self,
+        scene: &Scene,
+        z: &[PathVertex],
+        x0: &PathVertex,
+        camera_end: BsdfEval,
+        raster: Vec2,
+    ) -> Weight;
+
+    /// s ≥ 2: joins z_{t−1} (`joins.camera()`) to each light vertex it connects to, through
+    /// `Joins::join` (one light subpath: `Joins::join_subpath`). `sampler` is the pixel's camera
+    /// stream, for estimators that draw the light vertices.
+    fn connect<R: Recorder>(
+        &mut self,
+        scene: &Scene,
+        joins: &mut Joins<'_, R>,
+        sampler: &mut Sampler,
+    );
+
+    /// The estimator's own techniques at z_{t−1}, after its connections (VCM's merges), each
+    /// adding its weighted contribution to `l`.
+    #[inline]
+    fn at_vertex<R: Recorder>(
+        &mut self,
+        _scene: &Scene,
+        _z: &[PathVertex],
+        _sample: &mut SampleCtx<'_, R>,
+        _l: &mut Color,
+    ) {
+    }
+
+    /// The estimator's own techniques along the segment z_{t−2} → z_{t−1}, before any at
+    /// z_{t−1} (volumetric estimators' camera beams; none yet).
+    #[inline]
+    fn along_segment<R: Recorder>(
+        &mut self,
+        _scene: &Scene,
+        _z: &[PathVertex],
+        _sample: &mut SampleCtx<'_, R>,
+        _l: &mut Color,
+    ) {
+    }
+}
+
+/// What every technique of one camera sample shares: its film position and the recorder.
+pub struct SampleCtx<'a, R> {
+    pub raster: Vec2,
+    pub rec: &'a mut R,
+}
+
+/// Per-thread buffers of the loop.
+pub struct CameraScratch {
+    camera: Subpath,
+    /// A camera walk and the light endpoint it reached (s = 0), as one path.
+    reached: Vec<PathVertex>,
+}
+
+impl CameraScratch {
+    /// Buffers for paths of at most `max_depth` segments.
+    pub fn new(max_depth: u32) -> CameraScratch {
+        let d = max_depth as usize;
+        CameraScratch {
+            camera: Subpath::with_capacity(d + 1),
+            reached: Vec::with_capacity(d + 2),
+        }
+    }
+}
+
+/// One connection (s ≥ 2, t ≥ 2) as the loop formed it, for the policy to weigh.
+#[derive(Clone, Copy)]
+pub struct Connection<'a> {
+    /// y_0 … y_{s−1}.
+    pub light: &'a [PathVertex],
+    /// z_0 … z_{t−1}, camera first.
+    pub camera: &'a [PathVertex],
+    pub joined: &'a Joined,
+    /// Where on the film the path lands.
+    pub raster: Vec2,
+}
+
+/// The connections of camera vertex z_{t−1}: joins, records and sums them.
+pub struct Joins<'a, R> {
+    z: &'a [PathVertex],
+    max_k: usize,
+    raster: Vec2,
+    rec: &'a mut R,
+    l: &'a mut Color,
+}
+
+impl<R: Recorder> Joins<'_, R> {
+    /// z_0 … z_{t−1}.
+    pub fn camera(&self) -> &[PathVertex] {
+        self.z
+    }
+
+    /// t: the camera vertices of every path joined here.
+    pub fn t(&self) -> usize {
+        self.z.len()
+    }
+
+    /// Longest path in segments.
+    pub fn max_k(&self) -> usize {
+        self.max_k
+    }
+
+    /// Strategy (s, t), s = |y|: a shadow ray from z_{t−1} to y_{s−1} (`y` = y_0 … y_{s−1}),
+    /// its value scaled by `scale` and weighed by `weight`; reported, added, and its time lapped
+    /// whether or not it joined.
+    #[inline]
+    pub fn join(
+        &mut self,
+        scene: &Scene,
+        y: &[PathVertex],
+        scale: f32,
+        weight: impl FnOnce(Connection) -> Weight,
+    ) {
+        let (s, t) = (y.len(), self.z.len());
+        'attempt: {
+            let yv = &y[s - 1];
+            if !connectable(scene, yv) {
+                break 'attempt;
+            }
+            let Some(joined) = join(scene, yv, &self.z[t - 1]) else {
+                break 'attempt;
+            };
+            let value = joined.value * scale;
+            let (w, mixture) = weight(Connection {
+                light: y,
+                camera: self.z,
+                joined: &joined,
+                raster: self.raster,
+            });
+            if R::ACTIVE {
+                if let Some(m) = mixture {
+                    self.rec.mixture(m);
+                }
+                self.rec.completed(Completed {
+                    s,
+                    light: y,
+                    camera: self.z,
+                    weight: w,
+                    value,
+                    raster: self.raster,
+                    alternatives: &[],
+                });
+            }
+            *self.l += value * w as f32;
+        }
+        self.rec.lap(Work::Connection {
+            s: s as u16,
+            t: t as u16,
+        });
+    }
+
+    /// Every strategy (s, t), 2 ≤ s ≤ min(|y|, k_max + 1 − t), joining z_{t−1} to the vertices
+    /// of one light subpath `y` (bdpt's pairing), weighed by `weight`.
+    #[inline]
+    pub fn join_subpath(
+        &mut self,
+        scene: &Scene,
+        y: &[PathVertex],
+        mut weight: impl FnMut(Connection) -> Weight,
+    ) {
+        for s in 2..=y.len().min(self.max_k + 1 - self.z.len()) {
+            self.join(scene, &y[..s], 1.0, &mut weight);
+        }
+    }
+}
+
+/// Segment limits of the camera walk: longest path (segments) and Russian roulette's start.
+#[derive(Clone, Copy, Debug)]
+pub struct Depths {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+}
+
+/// The camera sample of `pixel` in `pass`: its walk and every technique with t ≥ 2 under
+/// `policy`; returns the pixel's estimate (weighted by the film filter).
+pub fn camera_sample<P: CameraPolicy, R: Recorder>(
+    scene: &Scene,
+    (pass, pixel): (Pass, u64),
+    depths: Depths,
+    policy: &mut P,
+    scratch: &mut CameraScratch,
+    rec: &mut R,
+) -> Color {
+    let mut cs = Sampler::for_item(Domain::Camera, pass.seed, pixel, pass.pass as u64);
+    let Some(film) = pixel_sample(scene, pixel, &mut cs) else {
+        return Color::ZERO;
+    };
+    let raster = film.raster;
+    let limits = WalkLimits::camera(depths.max_depth, depths.rr_depth);
+    camera_subpath(scene, raster, &mut cs, limits, &mut scratch.camera);
+    let z = &scratch.camera.vertices;
+    policy.walked(scene, z, raster);
+    rec.begin_sample(pixel, film.weight);
+    rec.lap(Work::CameraWalk);
+    let reached = &mut scratch.reached;
+    let max_k = depths.max_depth as usize;
+    let mut ctx = SampleCtx { raster, rec };
+    let mut l = Color::ZERO;
+    for t in 2..=z.len() {
+        policy.along_segment(scene, &z[..t], &mut ctx, &mut l);
+        let zv = &z[t - 1];
+        // s = 0: the walk hit an emitter at z_{t−1}.
+        if t - 1 <= max_k {
+            if let (Some(x0), Some(li)) = (zv.as_light_endpoint(), zv.emitter()) {
+                let le = scene.lights[li as usize].emitted(x0.ng, x0.wo, x0.uv);
+                if le != Color::ZERO {
+                    let value = zv.beta * le;
+                    l +=
+                        emitter_reached(scene, policy, (&z[..t - 1], x0, value), reached, &mut ctx);
+                }
+                ctx.rec.lap(Work::Connection { s: 0, t: t as u16 });
+            }
+        }
+        if !connectable(scene, zv) {
+            continue;
+        }
+        if policy.connects() {
+            // s = 1: next-event estimation from z_{t−1}.
+            if t <= max_k {
+                l += next_event_weighted(scene, policy, &z[..t], &mut cs, &mut ctx);
+                ctx.rec.lap(Work::Connection { s: 1, t: t as u16 });
+            }
+            let mut joins = Joins {
+                z: &z[..t],
+                max_k,
+                raster,
+                rec: &mut *ctx.rec,
+                l: &mut l,
+            };
+            policy.connect(scene, &mut joins, &mut cs);
+        }
+        policy.at_vertex(scene, &z[..t], &mut ctx, &mut l);
+    }
+    // s = 0 at infinity: the walk left the scene after its last vertex.
+    if let Some(esc) = scratch.camera.escape {
+        if z.len() <= max_k {
+            for &li in &scene.infinite_lights {
+                let le = scene.lights[li as usize].escaped(esc.dir);
+                if le == Color::ZERO {
+                    continue;
+                }
+                let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
+                let value = esc.beta * le;
+                l += emitter_reached(scene, policy, (z, x0, value), reached, &mut ctx);
+            }
+            ctx.rec.lap(Work::Connection {
+                s: 0,
+                t: z.len() as u16 + 1,
+            });
+        }
+    }
+    weighted(l, film.weight)
+}
+
+/// Strategy s = 0: the camera walk `camera` reached light endpoint `x0` with unweighted
+/// contribution `value`; the path is assembled in `path` (weighed and reported as one).
+fn emitter_reached<P: CameraPolicy, R: Recorder>(
+    scene: &Scene,
+    policy: &P,
+    (camera, x0, value): (&[PathVertex], PathVertex, Color),
+    path: &mut Vec<PathVertex>,
+    ctx: &mut SampleCtx<'_, R>,
+) -> Color {
+    path.clear();
+    path.extend_from_slice(camera);
+    path.push(x0);
+    let (w, mixture) = policy.emitter_weight(scene, path, ctx.raster);
+    if R::ACTIVE {
+        if let Some(m) = mixture {
+            ctx.rec.mixture(m);
+        }
+        let n = path.len();
+        ctx.rec.completed(Completed {
+            s: 0,
+            light: &path[n - 1..],
+            camera: &path[..n - 1],
+            weight: w,
+            value,
+            raster: ctx.raster,
+            alternatives: &[],
+        });
+    }
+    value * w as f32
+}
+
+/// Strategy s = 1 at z_{t−1} (`z` = z_0 … z_{t−1}): one light chosen by power and sampled
+/// towards it (`connect::next_event`'s three numbers from `sampler`).
+fn next_event_weighted<P: CameraPolicy, R: Recorder>(
+    scene: &Scene,
+    policy: &P,
+    z: &[PathVertex],
+    sampler: &mut Sampler,
+    ctx: &mut SampleCtx<'_, R>,
+) -> Color {
+    let Some(NextEvent {
+        x0,
+        camera_end,
+        value,
+    }) = next_event(scene, &z[z.len() - 1], sampler)
+    else {
+        return Color::ZERO;
+    };
+    let (w, mixture) = policy.next_event_weight(scene, z, &x0, camera_end, ctx.raster);
+    if R::ACTIVE {
+        if let Some(m) = mixture {
+            ctx.rec.mixture(m);
+        }
+        ctx.rec.completed(Completed {
+            s: 1,
+            light: std::slice::from_ref(&x0),
+            camera: z,
+            weight: w,
+            value,
+            raster: ctx.raster,
+            alternatives: &[],
+        });
+    }
+    value * w as f32
+}
