@@ -12,6 +12,17 @@ use lt_core::math::{Color, Vec2};
 use lt_core::scene::LightDesc;
 use lt_core::texture::Texture;
 
+/// The emitters lt reads (`area` only inside a shape, or referenced from one by id).
+pub(super) const EMITTERS: [&str; 7] = [
+    "area",
+    "point",
+    "spot",
+    "projector",
+    "constant",
+    "directional",
+    "envmap",
+];
+
 impl<'a> Loader<'a> {
     /// The light and, for a point light, its world position in f64 (`WorldBuilder` rounds it).
     pub(super) fn emitter(
@@ -29,7 +40,9 @@ impl<'a> Loader<'a> {
                 let xf = p.transform("to_world")?;
                 let position = match (pos, xf) {
                     (Some(_), Some((_, te))) => {
-                        return Err(p.err(te, "give a point light `position` or `to_world`, not both"))
+                        return Err(
+                            p.err(te, "give a point light `position` or `to_world`, not both")
+                        )
                     }
                     (Some(v), None) => DVec3::from_array(v),
                     (None, Some((x, _))) => x.m.transform_point3(DVec3::ZERO),
@@ -61,7 +74,10 @@ impl<'a> Loader<'a> {
                 // Mitsuba's direction is the one the light travels along; lt's points to the light.
                 let travel = match (d, xf) {
                     (Some(_), Some((_, te))) => {
-                        return Err(p.err(te, "give a directional light `direction` or `to_world`, not both"))
+                        return Err(p.err(
+                            te,
+                            "give a directional light `direction` or `to_world`, not both",
+                        ))
                     }
                     (Some(v), None) => DVec3::from_array(v),
                     (None, Some((x, _))) => x.m.transform_vector3(DVec3::Z),
@@ -98,12 +114,7 @@ impl<'a> Loader<'a> {
             }
             "spot" => return self.spot(p).map(|d| d.map(|(d, at)| (d, Some(at)))),
             "projector" => return self.projector(p).map(|d| d.map(|(d, at)| (d, Some(at)))),
-            other => {
-                return Err(p.err(
-                    e,
-                    format!("emitter `{other}` is not supported (lt reads area, point, spot, projector, constant, directional and envmap)"),
-                ))
-            }
+            _ => return Err(super::kinds::unknown_type(self.doc, e)),
         };
         p.finish(&["sampling_weight"], &mut self.report)?;
         let power = match &desc {

@@ -7,6 +7,15 @@ use crate::xml::props::Plugin;
 use crate::SceneError;
 
 /// What `--approximate` puts in place of Mitsuba's unbounded `max_depth = -1`.
+/// The integrators lt reads (for their max_depth only).
+pub(super) const INTEGRATORS: [&str; 6] = [
+    "path",
+    "volpath",
+    "volpathmis",
+    "ptracer",
+    "direct",
+    "moment",
+];
 pub const UNBOUNDED_DEPTH_SUBSTITUTE: u32 = 64;
 
 impl<'a> Loader<'a> {
@@ -23,12 +32,7 @@ impl<'a> Loader<'a> {
                     "path" | "volpath" | "volpathmis" | "ptracer" => {}
                     "moment" => return self.moment(&p, root),
                     "direct" => return self.direct(&p),
-                    other => {
-                        return Err(p.err(
-                            e,
-                            format!("integrator `{other}` is not supported (lt reads path, volpath, volpathmis, ptracer, direct and moment for their max_depth; the estimator is chosen on lt's command line); where the file writes type=\"$integrator\", -D integrator=path renders it"),
-                        ))
-                    }
+                    _ => return Err(super::kinds::unknown_type(self.doc, e)),
                 }
                 if p.boolean("hide_emitters")? == Some(true) {
                     return Err(p.err(e, "`hide_emitters` = true is not supported"));

@@ -7,13 +7,14 @@ use crate::xml::props::{Ids, Plugin};
 use crate::SceneError;
 use crate::{LoadOptions, LoadReport};
 use lt_core::scene::{RenderSettings, Scene};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
 
 mod bsdf;
 mod bsdf_params;
 mod emitter;
 mod integrator;
+mod kinds;
 mod sensor;
 mod shape;
 mod texture;
@@ -54,6 +55,12 @@ pub(super) fn load(
 ) -> Result<(Scene, LoadReport, Vec<PathBuf>), SceneError> {
     let mut ids = Ids::new();
     collect_ids(doc, &doc.root, &mut ids)?;
+    // Unknown types, undefined ids and media first, all of them, before any value is read.
+    let mut referenced = HashSet::new();
+    let problems = kinds::problems(doc, &ids, &mut referenced);
+    if !problems.is_empty() {
+        return Err(kinds::combined(problems));
+    }
     let mut l = Loader {
         doc,
         opts,
@@ -66,25 +73,6 @@ pub(super) fn load(
     };
     let root = &doc.root;
     let by_tag = |t: &'static str| root.children.iter().filter(move |c| c.tag == t);
-    for c in &root.children {
-        match c.tag.as_str() {
-            "sensor" | "integrator" | "bsdf" | "shape" | "emitter" => {}
-            // Read where they are referenced.
-            "texture" => {}
-            "medium" | "phase" => {
-                return Err(doc.err(
-                    c,
-                    format!("participating media are not supported: <{}>", c.tag),
-                ))
-            }
-            other => {
-                return Err(doc.err(
-                    c,
-                    format!("<{other}> is not supported at the top level of a scene"),
-                ))
-            }
-        }
-    }
     let sensors: Vec<&Elem> = by_tag("sensor").collect();
     let sensor = match sensors[..] {
         [] => return Err(doc.err(root, "the scene has no <sensor> (lt needs a camera)")),
@@ -116,6 +104,11 @@ pub(super) fn load(
     for c in &root.children {
         match c.tag.as_str() {
             "shape" => emitters += l.shape_or_instance(c, &mut b)?,
+            // An area emitter given its own id is attached where a shape references it (Mitsuba
+            // resolves such references in any order).
+            "emitter"
+                if c.attr("type") == Some("area")
+                    && c.attr("id").is_some_and(|id| referenced.contains(id)) => {}
             "emitter" => {
                 match l.emitter(c)? {
                     Some((desc, Some(position))) => b.add_light_at(desc, position),

@@ -20,19 +20,31 @@ const SENSOR_IGNORED: [&str; 5] = [
     "shutter_close",
 ];
 const FILM_IGNORED: [&str; 4] = ["pixel_format", "component_format", "file_format", "banner"];
+/// The types of each kind this file builds.
+pub(super) const SENSORS: [&str; 3] = ["perspective", "thinlens", "orthographic"];
+pub(super) const FILMS: [&str; 1] = ["hdrfilm"];
+pub(super) const RFILTERS: [&str; 6] = [
+    "box",
+    "tent",
+    "gaussian",
+    "mitchell",
+    "catmullrom",
+    "lanczos",
+];
+pub(super) const SAMPLERS: [&str; 5] = [
+    "independent",
+    "stratified",
+    "multijitter",
+    "orthogonal",
+    "ldsampler",
+];
 const SAMPLER_IGNORED: [&str; 3] = ["seed", "jitter", "strength"];
 
 impl<'a> Loader<'a> {
     pub(super) fn sensor(&mut self, e: &'a Elem) -> Result<((LookAt, Optics), u32), SceneError> {
         let p = self.plugin(e)?;
-        if !matches!(p.kind, "perspective" | "thinlens" | "orthographic") {
-            return Err(p.err(
-                e,
-                format!(
-                    "sensor `{}` is not supported (lt reads perspective, thinlens and orthographic)",
-                    p.kind
-                ),
-            ));
+        if !SENSORS.contains(&p.kind) {
+            return Err(super::kinds::unknown_type(self.doc, e));
         }
         let principal = Vec2::new(
             p.float("principal_point_offset_x")?.unwrap_or(0.0) as f32,
@@ -165,7 +177,7 @@ impl<'a> Loader<'a> {
             return Ok((768, 576, gaussian));
         };
         let p = self.plugin(f)?;
-        if p.kind != "hdrfilm" {
+        if !FILMS.contains(&p.kind) {
             return Err(p.err(
                 f,
                 format!("film `{}` is not supported (only hdrfilm)", p.kind),
@@ -242,15 +254,7 @@ impl<'a> Loader<'a> {
                     lobes: lobes as u32,
                 }
             }
-            other => {
-                return Err(rp.err(
-                    r,
-                    format!(
-                        "reconstruction filter `{other}` is not supported (known: box, tent, \
-                         gaussian, mitchell, catmullrom, lanczos)"
-                    ),
-                ))
-            }
+            _ => return Err(super::kinds::unknown_type(self.doc, r)),
         };
         let filter = PixelFilter::new(shape).map_err(|m| rp.err(r, m))?;
         rp.finish(&[], &mut self.report)?;
@@ -260,8 +264,8 @@ impl<'a> Loader<'a> {
     pub(super) fn sampler(&mut self, s: &'a Elem) -> Result<u32, SceneError> {
         let p = self.plugin(s)?;
         match p.kind {
-            "independent" | "stratified" | "multijitter" | "orthogonal" | "ldsampler" => {}
-            other => return Err(p.err(s, format!("sampler `{other}` is not supported"))),
+            kind if SAMPLERS.contains(&kind) => {}
+            _ => return Err(super::kinds::unknown_type(self.doc, s)),
         }
         if p.kind != "independent" {
             self.report.ignored.push(format!(

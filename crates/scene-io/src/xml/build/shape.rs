@@ -17,6 +17,21 @@ use lt_core::scene::TriangleMesh;
 use lt_core::texture::Texture;
 use std::path::PathBuf;
 
+/// The shapes lt reads.
+pub(super) const SHAPES: [&str; 11] = [
+    "rectangle",
+    "cube",
+    "sphere",
+    "disk",
+    "cylinder",
+    "sdfgrid",
+    "obj",
+    "ply",
+    "serialized",
+    "shapegroup",
+    "instance",
+];
+
 impl<'a> Loader<'a> {
     /// Adds the shape; returns whether it emits.
     /// A top-level `<shape>`: a shape, a `shapegroup` (nothing until instanced) or an `instance`
@@ -172,7 +187,10 @@ impl<'a> Loader<'a> {
                     * DMat4::from_translation(p0)
                     * frame
                     * DMat4::from_scale(DVec3::new(r, r, len));
-                if !lt_core::geometry::quadric::is_round_cylinder_map(&glam::DMat3::from_mat4(full), 1e-5) {
+                if !lt_core::geometry::quadric::is_round_cylinder_map(
+                    &glam::DMat3::from_mat4(full),
+                    1e-5,
+                ) {
                     return Err(p.err(
                         xform.as_ref().map_or(e, |(_, te)| te),
                         "a cylinder's to_world must be a rotation, a scale equal along x and y, and a translation (Mitsuba drops shear and unequal x/y scales, with a warning)",
@@ -187,17 +205,24 @@ impl<'a> Loader<'a> {
                 let Some((file, fe)) = p.string("filename")? else {
                     return Err(p.err(e, "shape `sdfgrid` needs a `filename`"));
                 };
-                let smooth = match p.string("normals")? {
-                    None | Some(("smooth", _)) => true,
-                    Some(("analytic", _)) => false,
-                    Some((other, ne)) => {
-                        return Err(p.err(ne, format!("sdfgrid `normals` must be `smooth` or `analytic`, got `{other}`")))
-                    }
-                };
+                let smooth =
+                    match p.string("normals")? {
+                        None | Some(("smooth", _)) => true,
+                        Some(("analytic", _)) => false,
+                        Some((other, ne)) => return Err(p.err(
+                            ne,
+                            format!(
+                                "sdfgrid `normals` must be `smooth` or `analytic`, got `{other}`"
+                            ),
+                        )),
+                    };
                 let path = doc.resolver.resolve(file).map_err(|looked| {
                     p.err(fe, Resolver::not_found("volume grid file", file, &looked))
                 })?;
-                let resolved = Ctx { base_dir: PathBuf::new(), ..doc.ctx(e.src) };
+                let resolved = Ctx {
+                    base_dir: PathBuf::new(),
+                    ..doc.ctx(e.src)
+                };
                 let spanned =
                     toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
                 let grid = crate::mesh::vol::load_sdf_grid(&resolved, &spanned, smooth)?;
@@ -215,18 +240,25 @@ impl<'a> Loader<'a> {
                 let shape_index = match p.kind {
                     "serialized" => p.integer("shape_index")?.map_or(Ok(0), |i| {
                         u32::try_from(i).map_err(|_| {
-                            p.err(e, format!("`shape_index` must be a non-negative integer, got {i}"))
+                            p.err(
+                                e,
+                                format!("`shape_index` must be a non-negative integer, got {i}"),
+                            )
                         })
                     })?,
                     _ => 0,
                 };
                 check_solid(&ctx, &m, span.clone(), "mesh")?;
-                let path = doc.resolver.resolve(file).map_err(|looked| {
-                    p.err(fe, Resolver::not_found("mesh file", file, &looked))
-                })?;
+                let path = doc
+                    .resolver
+                    .resolve(file)
+                    .map_err(|looked| p.err(fe, Resolver::not_found("mesh file", file, &looked)))?;
                 // The mesh readers join their context's folder with the name: give them the
                 // resolved path and no folder.
-                let resolved = Ctx { base_dir: PathBuf::new(), ..doc.ctx(e.src) };
+                let resolved = Ctx {
+                    base_dir: PathBuf::new(),
+                    ..doc.ctx(e.src)
+                };
                 let spanned =
                     toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
                 let mut mesh = match p.kind {
@@ -252,12 +284,7 @@ impl<'a> Loader<'a> {
                 }
                 placed(mesh, span)?
             }
-            other => {
-                return Err(p.err(
-                    e,
-                    format!("shape `{other}` is not supported (lt reads rectangle, cube, sphere, disk, cylinder, sdfgrid, obj, ply and serialized)"),
-                ))
-            }
+            _ => return Err(super::kinds::unknown_type(self.doc, e)),
         };
         let bsdf = p.one_nested(&["bsdf"], "BSDF")?;
         // Mitsuba gives a shape without a BSDF a diffuse one of reflectance 0.5, except an

@@ -10,6 +10,9 @@ use lt_core::math::Color;
 use lt_core::texture::{Texture, UvTransform};
 use std::sync::Arc;
 
+/// The textures lt reads.
+pub(super) const TEXTURES: [&str; 4] = ["bitmap", "checkerboard", "mesh_attribute", "rawconstant"];
+
 impl<'a> Loader<'a> {
     /// A `<texture>`: Mitsuba's `bitmap` (`filename`, `filter_type` bilinear or nearest, `wrap_mode`
     /// repeat, mirror or clamp, `raw`, `to_uv`) or `checkerboard` (`color0` 0.4, `color1` 0.2,
@@ -94,14 +97,7 @@ impl<'a> Loader<'a> {
                 p.finish(&[], &mut self.report)?;
                 Texture::Constant(value)
             }
-            other => {
-                return Err(p.err(
-                    e,
-                    format!(
-                        "texture `{other}` is not supported (lt reads bitmap, checkerboard, mesh_attribute and rawconstant)"
-                    ),
-                ))
-            }
+            _ => return Err(super::kinds::unknown_type(self.doc, e)),
         };
         Ok(texture)
     }
