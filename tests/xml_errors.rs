@@ -782,3 +782,100 @@ fn principled_reads_alike_from_toml_and_xml() {
         assert!(e.contains(&format!(":{line}:")), "line {line} not in: {e}");
     }
 }
+
+/// What a user needs first comes first: an unknown plugin type is named, at its line and with the
+/// known types of its kind, before anything about the sensor or the integrator's max_depth.
+#[test]
+fn xml_unknown_types_come_first_with_the_known_ones() {
+    let d = dir("unknown-first");
+    // No sensor and an unbounded max_depth: both would be refused, but later.
+    let text = r#"<scene version="3.0.0">
+    <integrator type="path"/>
+    <shape type="nosuchshape"/>
+</scene>
+"#;
+    fails(
+        &d,
+        text,
+        3,
+        &[
+            "shape `nosuchshape` is not supported",
+            "rectangle, cube, sphere, disk, cylinder, sdfgrid, obj, ply, serialized",
+        ],
+    );
+    // Deep inside a wrapper, below a valid scene: the BSDF's line and every BSDF type lt reads.
+    let text = scene_xml(
+        "    <shape type=\"sphere\">\n        <bsdf type=\"twosided\">\n            <bsdf type=\"velvet\"/>\n        </bsdf>\n    </shape>",
+    );
+    fails(
+        &d,
+        &text,
+        line_of(&text, "velvet"),
+        &["BSDF `velvet` is not supported", "diffuse", "blendbsdf"],
+    );
+}
+
+/// Several problems of one file are listed together, each with its line, in document order.
+#[test]
+fn xml_problems_of_one_file_are_listed_together() {
+    let d = dir("listed-together");
+    let text = scene_xml(
+        "    <shape type=\"sphere\"><bsdf type=\"velvet\"/></shape>\n    <shape type=\"sphere\"><ref id=\"nowhere\"/></shape>\n    <emitter type=\"sunsky\"/>",
+    );
+    let e = fails(
+        &d,
+        &text,
+        line_of(&text, "velvet"),
+        &[
+            "3 problems",
+            "BSDF `velvet`",
+            "undefined id `nowhere`",
+            "emitter `sunsky`",
+        ],
+    );
+    let shown = e.to_string();
+    for needle in ["velvet", "nowhere", "sunsky"] {
+        let at = format!("scene.xml:{}:", line_of(&text, needle));
+        assert!(shown.contains(&at), "`{shown}` lacks {at}");
+    }
+    let order: Vec<usize> = ["velvet", "`nowhere`", "sunsky"]
+        .iter()
+        .map(|n| shown.rfind(n).unwrap())
+        .collect();
+    assert!(order.windows(2).all(|w| w[0] < w[1]), "{shown}");
+}
+
+/// A top-level `area` emitter referenced by id from a shape (mitsuba-data's `cbox-rgb.xml` does
+/// this), defined before or after the shape, is that shape's emitter, as Mitsuba reads it; an
+/// area emitter no shape references is still refused.
+#[test]
+fn xml_top_level_area_emitters_attach_by_reference() {
+    let d = dir("area-by-id");
+    let light =
+        "    <emitter type=\"area\" id=\"lamp\"><rgb name=\"radiance\" value=\"4\"/></emitter>\n";
+    let shape = "    <shape type=\"rectangle\"><ref id=\"lamp\"/></shape>\n";
+    let nested = "    <shape type=\"rectangle\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"4\"/></emitter></shape>\n";
+    let (reference, _) = load_in(&d, "nested.xml", &scene_xml(nested), LoadOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    for (name, body) in [
+        ("before.xml", format!("{light}{shape}")),
+        ("after.xml", format!("{shape}{light}")),
+    ] {
+        let (scene, _) = load_in(&d, name, &scene_xml(&body), LoadOptions::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(scene.lights.len(), reference.lights.len(), "{name}");
+        assert_eq!(scene.shapes.len(), reference.shapes.len(), "{name}");
+        assert_eq!(
+            format!("{:?}", scene.lights),
+            format!("{:?}", reference.lights),
+            "{name}"
+        );
+    }
+    let text = scene_xml(light);
+    fails(
+        &d,
+        &text,
+        line_of(&text, "lamp"),
+        &["an area emitter must be nested in a shape"],
+    );
+}

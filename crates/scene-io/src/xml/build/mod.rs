@@ -1,0 +1,164 @@
+//! The plugin subset: the XML's sensor, integrator, BSDFs, shapes and emitters turned into a
+//! `Scene` through `SceneBuilder`, each value checked on the way (reference: docs/xml.md).
+
+use crate::world::WorldBuilder;
+use crate::xml::doc::{Doc, Elem};
+use crate::xml::props::{Ids, Plugin};
+use crate::SceneError;
+use crate::{LoadOptions, LoadReport};
+use lt_core::scene::{RenderSettings, Scene};
+use std::collections::{HashMap, HashSet};
+use std::path::PathBuf;
+
+mod bsdf;
+mod bsdf_params;
+mod emitter;
+mod integrator;
+mod kinds;
+mod sensor;
+mod shape;
+mod texture;
+
+pub use integrator::UNBOUNDED_DEPTH_SUBSTITUTE;
+
+pub(super) struct Loader<'a> {
+    doc: &'a Doc,
+    opts: &'a LoadOptions,
+    pub report: LoadReport,
+    ids: Ids<'a>,
+    /// Material ids of BSDF elements already converted (by element address).
+    materials: HashMap<*const Elem, u32>,
+    default_material: Option<u32>,
+    /// The black diffuse of emitting shapes without a BSDF.
+    default_emitter_material: Option<u32>,
+    /// Mesh files read, in order.
+    pub meshes: Vec<PathBuf>,
+}
+
+fn collect_ids<'a>(doc: &'a Doc, e: &'a Elem, ids: &mut Ids<'a>) -> Result<(), SceneError> {
+    for c in &e.children {
+        if c.tag != "ref" {
+            if let Some(id) = c.attr("id") {
+                if ids.insert(id, c).is_some() {
+                    return Err(doc.err(c, format!("the id `{id}` is defined twice")));
+                }
+            }
+        }
+        collect_ids(doc, c, ids)?;
+    }
+    Ok(())
+}
+
+pub(super) fn load(
+    doc: &Doc,
+    opts: &LoadOptions,
+) -> Result<(Scene, LoadReport, Vec<PathBuf>), SceneError> {
+    let mut ids = Ids::new();
+    collect_ids(doc, &doc.root, &mut ids)?;
+    // Unknown types, undefined ids and media first, all of them, before any value is read.
+    let mut referenced = HashSet::new();
+    let problems = kinds::problems(doc, &ids, &mut referenced);
+    if !problems.is_empty() {
+        return Err(kinds::combined(problems));
+    }
+    let mut l = Loader {
+        doc,
+        opts,
+        report: LoadReport::default(),
+        ids,
+        materials: HashMap::new(),
+        default_material: None,
+        default_emitter_material: None,
+        meshes: Vec::new(),
+    };
+    let root = &doc.root;
+    let by_tag = |t: &'static str| root.children.iter().filter(move |c| c.tag == t);
+    let sensors: Vec<&Elem> = by_tag("sensor").collect();
+    let sensor = match sensors[..] {
+        [] => return Err(doc.err(root, "the scene has no <sensor> (lt needs a camera)")),
+        [s] => s,
+        [_, second, ..] => {
+            return Err(doc.err(
+                second,
+                "a second <sensor>: lt renders one camera, keep only one",
+            ))
+        }
+    };
+    let (camera, spp) = l.sensor(sensor)?;
+    let integrators: Vec<&Elem> = by_tag("integrator").collect();
+    if integrators.len() > 1 {
+        return Err(doc.err(integrators[1], "a second <integrator>"));
+    }
+    let (max_depth, rr_depth) = l.integrator(integrators.first().copied(), root)?;
+    let settings = RenderSettings {
+        max_depth,
+        rr_depth,
+        spp,
+    };
+    let mut b = WorldBuilder::new(settings);
+    // Top-level BSDFs first, in document order, so each is checked even when unused.
+    for c in by_tag("bsdf") {
+        l.material(c, &mut b)?;
+    }
+    let mut emitters = 0;
+    for c in &root.children {
+        match c.tag.as_str() {
+            "shape" => emitters += l.shape_or_instance(c, &mut b)?,
+            // An area emitter given its own id is attached where a shape references it (Mitsuba
+            // resolves such references in any order).
+            "emitter"
+                if c.attr("type") == Some("area")
+                    && c.attr("id").is_some_and(|id| referenced.contains(id)) => {}
+            "emitter" => {
+                match l.emitter(c)? {
+                    Some((desc, Some(position))) => b.add_light_at(desc, position),
+                    Some((desc, None)) => b.add_light(desc),
+                    None => continue,
+                }
+                emitters += 1;
+            }
+            _ => {}
+        }
+    }
+    if emitters == 0 {
+        return Err(doc.err(
+            root,
+            "the scene has no light: no emitter with a non-zero value",
+        ));
+    }
+    let Loader { report, meshes, .. } = l;
+    let (camera, optics) = camera;
+    let scene = b.build(|origin| {
+        camera
+            .at(origin)
+            .and_then(|c| optics.apply(c))
+            .map_err(|m| doc.err(sensor, format!("degenerate camera: {m}")))
+    })?;
+    Ok((scene, report, meshes))
+}
+
+impl<'a> Loader<'a> {
+    fn plugin(&mut self, e: &'a Elem) -> Result<Plugin<'a>, SceneError> {
+        Plugin::new(self.doc, &self.ids, e, &mut self.report)
+    }
+
+    /// Refuses, or with `--approximate` records, a substitution.
+    fn substitute(
+        &mut self,
+        e: &Elem,
+        refusal: String,
+        substitution: String,
+    ) -> Result<(), SceneError> {
+        if !self.opts.approximate {
+            return Err(self.doc.err(
+                e,
+                format!("{refusal}; pass --approximate to {substitution}"),
+            ));
+        }
+        let place = self.doc.place(e);
+        self.report
+            .substitutions
+            .push(format!("{place}: {refusal}: {substitution} instead"));
+        Ok(())
+    }
+}
