@@ -7,7 +7,9 @@ use crate::verify::strategies::{make_bdpt, write_pyramid, PyramidIntegrator, Pyr
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use lt_estimators::Image;
-use lt_integrators::{make_integrator, render_runs, EstimatorRef, ProgressLog, RenderOptions};
+use lt_integrators::{
+    make_integrator, render_runs, EstimatorRef, ProgressLog, RenderOptions, RunsResult,
+};
 use lt_scene_io::load_scene;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -78,9 +80,99 @@ fn log_json(log: &ProgressLog) -> serde_json::Value {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
-    if let Some(part) = &args.partial {
-        return run_partial(args, part);
+    match &args.partial {
+        Some(part) => run_partial(args, part),
+        None => render(args),
     }
+}
+
+/// `lt render … -o OUT.exr`: the mean of the passes (or runs), its standard error, side images,
+/// the JSON record, and with `--strategies` bdpt's per-strategy pyramid.
+fn render(args: &RenderArgs) -> Result<(), String> {
+    let output = check_render_args(args)?;
+    let scene = load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let params = args.integrator_args.to_params()?;
+    let pyramid = match &args.strategies {
+        None => None,
+        Some(dir) => Some(pyramid(args, &scene, &params, dir)?),
+    };
+    let plain = match pyramid {
+        None => Some(make_integrator(&args.integrator, &scene, &params)?),
+        Some(_) => None,
+    };
+    let estimator: EstimatorRef = match (&pyramid, &plain) {
+        (Some((_, p, _)), _) => EstimatorRef::Unbiased(p),
+        (None, Some(i)) => i.into(),
+        (None, None) => unreachable!("one of the two is built"),
+    };
+    let kind = estimator.kind();
+    let write_all = |mean: &Image, se: Option<&Image>| -> Result<(), String> {
+        write_outputs(output, mean, se)?;
+        if let Some((dir, integ, meta)) = &pyramid {
+            integ.with_pyramid(|p| write_pyramid(dir, p, meta))?;
+        }
+        Ok(())
+    };
+    let opts = render_options(args, &scene)?;
+    let interrupted = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupted.clone();
+        // A second Ctrl-C still kills the process the usual way once this handler has run.
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
+    let result = render_with_checkpoints(args, &scene, estimator, &opts, &write_all, &interrupted)?;
+    let errors = StdErrors::of(&result);
+    let (se, se_source) = errors.chosen();
+    write_all(&result.across_runs.mean(), se)?;
+    // The first run's side images (one run's choice; `--runs K` repeats it with other seeds).
+    for (name, img) in result.runs[0].log.iter().flat_map(|l| &l.images) {
+        crate::image_io::write_exr(&sibling(output, &format!(".{name}.exr")), img)?;
+    }
+    let runs_done = result.runs.len();
+    let secs = result.elapsed.as_secs_f64();
+    let total_passes: u64 = result.runs.iter().map(|r| r.passes as u64).sum();
+    let first = &result.runs[0];
+    let (across, per_pass) = (&errors.across, &errors.per_pass);
+    let record = serde_json::json!({
+        "scene": args.scene.display().to_string(),
+        "integrator": args.integrator,
+        "kind": kind.name(),
+        "spp": first.passes,
+        "runs": runs_done,
+        "run_seeds": result.runs.iter().map(|r| r.seed).collect::<Vec<_>>(),
+        "run_passes": result.runs.iter().map(|r| r.passes).collect::<Vec<_>>(),
+        "run_seconds": result.runs.iter().map(|r| r.elapsed.as_secs_f64()).collect::<Vec<_>>(),
+        "run_cpu_seconds": result.runs.iter().map(|r| r.cpu.as_secs_f64()).collect::<Vec<_>>(),
+        "seed": args.seed,
+        "threads": args.threads,
+        "ray_core": scene.ray_core(),
+        "max_depth": args.integrator_args.max_depth.unwrap_or(scene.settings.max_depth),
+        "params": params.pairs().iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>(),
+        "seconds": secs,
+        "cpu_seconds": result.cpu.as_secs_f64(),
+        "spp_per_second": total_passes as f64 / secs,
+        "std_error_source": se_source,
+        "mean_std_error": se.map(mean_of),
+        "mean_std_error_across_runs": across.as_ref().map(mean_of),
+        "mean_std_error_per_pass": per_pass.as_ref().map(mean_of),
+        "progress": first.log.as_ref().map(log_json),
+        "invalid_samples": result.invalid_samples,
+        "interrupted": interrupted.load(Ordering::SeqCst),
+        "strategies": pyramid.as_ref().map(|(dir, _, _)| dir.display().to_string()),
+        "strategy_length": pyramid.as_ref().map(|_| args.strategy_length),
+    });
+    crate::image_io::write_atomic(
+        &sibling(output, ".json"),
+        serde_json::to_string_pretty(&record).unwrap().as_bytes(),
+    )?;
+    if !args.quiet {
+        print_summary(args, &result, output);
+    }
+    Ok(())
+}
+
+/// The flags a full render refuses or needs, checked before the scene is read; the output path.
+fn check_render_args(args: &RenderArgs) -> Result<&Path, String> {
     if let Some(p) = &args.passes {
         return Err(format!(
             "--passes {p} renders a part for `lt merge`: give --partial OUT.ltp"
@@ -109,38 +201,29 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if args.runs == 0 {
         return Err("--runs must be at least 1".into());
     }
-    let scene = load_scene(&args.scene).map_err(|e| e.to_string())?;
-    let params = args.integrator_args.to_params()?;
-    let pyramid = match &args.strategies {
-        None => None,
-        Some(dir) => {
-            let bdpt = make_bdpt(&scene, &params)?;
-            let meta = PyramidMeta {
-                scene: args.scene.display().to_string(),
-                seed: args.seed,
-                max_depth: bdpt.params.max_depth,
-            };
-            let integ = PyramidIntegrator::new(&scene, bdpt, args.strategy_length);
-            Some((dir.clone(), integ, meta))
-        }
+    Ok(output)
+}
+
+/// `--strategies DIR`: bdpt wrapped to keep every (s, t) strategy's image, with what the
+/// pyramid's files record.
+fn pyramid(
+    args: &RenderArgs,
+    scene: &lt_core::Scene,
+    params: &lt_integrators::IntegratorParams,
+    dir: &Path,
+) -> Result<(PathBuf, PyramidIntegrator, PyramidMeta), String> {
+    let bdpt = make_bdpt(scene, params)?;
+    let meta = PyramidMeta {
+        scene: args.scene.display().to_string(),
+        seed: args.seed,
+        max_depth: bdpt.params.max_depth,
     };
-    let plain = match pyramid {
-        None => Some(make_integrator(&args.integrator, &scene, &params)?),
-        Some(_) => None,
-    };
-    let estimator: EstimatorRef = match (&pyramid, &plain) {
-        (Some((_, p, _)), _) => EstimatorRef::Unbiased(p),
-        (None, Some(i)) => i.into(),
-        (None, None) => unreachable!("one of the two is built"),
-    };
-    let kind = estimator.kind();
-    let write_all = |mean: &Image, se: Option<&Image>| -> Result<(), String> {
-        write_outputs(output, mean, se)?;
-        if let Some((dir, integ, meta)) = &pyramid {
-            integ.with_pyramid(|p| write_pyramid(dir, p, meta))?;
-        }
-        Ok(())
-    };
+    let integ = PyramidIntegrator::new(scene, bdpt, args.strategy_length);
+    Ok((dir.to_path_buf(), integ, meta))
+}
+
+/// The pass budget (`--spp`, the scene's, or as many as `--time` allows), seed and threads.
+fn render_options(args: &RenderArgs, scene: &lt_core::Scene) -> Result<RenderOptions, String> {
     if args.time.is_some_and(|t| !(t > 0.0 && t.is_finite())) {
         return Err("--time must be a positive number of seconds".into());
     }
@@ -152,19 +235,25 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if passes == 0 {
         return Err("--spp must be at least 1".into());
     }
-    let opts = RenderOptions {
+    Ok(RenderOptions {
         passes,
         time_limit: args.time.map(Duration::from_secs_f64),
         seed: args.seed,
         threads: args.threads,
-    };
+    })
+}
 
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        // A second Ctrl-C still kills the process the usual way once this handler has run.
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    }
+/// The runs with a progress bar, writing the images every `--checkpoint` seconds (one run) or
+/// after every run (several), and stopping at Ctrl-C.
+fn render_with_checkpoints(
+    args: &RenderArgs,
+    scene: &lt_core::Scene,
+    estimator: EstimatorRef,
+    opts: &RenderOptions,
+    write_all: &dyn Fn(&Image, Option<&Image>) -> Result<(), String>,
+    interrupted: &AtomicBool,
+) -> Result<RunsResult, String> {
+    let passes = opts.passes;
     let bar = progress_bar(args, passes);
     let pixels = scene.camera.pixel_count() as f64;
     let mut last_checkpoint = Instant::now();
@@ -172,9 +261,9 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     let checkpoint_error = std::cell::RefCell::new(None);
     let many = args.runs > 1;
     let result = render_runs(
-        &scene,
+        scene,
         estimator,
-        &opts,
+        opts,
         args.runs,
         |k, r| {
             bar.set_position(if args.time.is_some() {
@@ -220,94 +309,76 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if let Some(e) = checkpoint_error.into_inner() {
         return Err(e);
     }
-    let runs_done = result.runs.len();
-    let mean = result.across_runs.mean();
-    // Where the standard error comes from: independent runs when there are two or more, else the
-    // spread of passes for an unbiased estimator, else nowhere.
-    let across = (runs_done >= 2).then(|| result.across_runs.std_error());
-    let per_pass = result.per_pass.as_ref().map(|p| p.std_error());
-    let (se, se_source) = match (&across, &per_pass) {
-        (Some(a), _) => (Some(a), "independent runs"),
-        (None, Some(p)) => (Some(p), "spread of passes"),
-        (None, None) => (
-            None,
-            "none written: the passes of a consistent estimator are not independent; use --runs K",
-        ),
-    };
-    write_all(&mean, se)?;
-    // The first run's side images (one run's choice; `--runs K` repeats it with other seeds).
-    for (name, img) in result.runs[0].log.iter().flat_map(|l| &l.images) {
-        crate::image_io::write_exr(&sibling(output, &format!(".{name}.exr")), img)?;
+    Ok(result)
+}
+
+/// The standard errors a render has: across independent runs (two or more), and from the spread
+/// of passes (an unbiased estimator's).
+struct StdErrors {
+    across: Option<Image>,
+    per_pass: Option<Image>,
+}
+
+impl StdErrors {
+    fn of(result: &RunsResult) -> StdErrors {
+        StdErrors {
+            across: (result.runs.len() >= 2).then(|| result.across_runs.std_error()),
+            per_pass: result.per_pass.as_ref().map(|p| p.std_error()),
+        }
     }
+
+    /// Where the written standard error comes from: independent runs when there are two or
+    /// more, else the spread of passes for an unbiased estimator, else nowhere.
+    fn chosen(&self) -> (Option<&Image>, &'static str) {
+        match (&self.across, &self.per_pass) {
+            (Some(a), _) => (Some(a), "independent runs"),
+            (None, Some(p)) => (Some(p), "spread of passes"),
+            (None, None) => (
+                None,
+                "none written: the passes of a consistent estimator are not independent; use --runs K",
+            ),
+        }
+    }
+}
+
+/// What a finished render prints: passes, runs, time, and its integrators' warnings.
+fn print_summary(args: &RenderArgs, result: &RunsResult, output: &Path) {
+    let runs_done = result.runs.len();
     let secs = result.elapsed.as_secs_f64();
     let total_passes: u64 = result.runs.iter().map(|r| r.passes as u64).sum();
     let first = &result.runs[0];
-    let record = serde_json::json!({
-        "scene": args.scene.display().to_string(),
-        "integrator": args.integrator,
-        "kind": kind.name(),
-        "spp": first.passes,
-        "runs": runs_done,
-        "run_seeds": result.runs.iter().map(|r| r.seed).collect::<Vec<_>>(),
-        "run_passes": result.runs.iter().map(|r| r.passes).collect::<Vec<_>>(),
-        "run_seconds": result.runs.iter().map(|r| r.elapsed.as_secs_f64()).collect::<Vec<_>>(),
-        "run_cpu_seconds": result.runs.iter().map(|r| r.cpu.as_secs_f64()).collect::<Vec<_>>(),
-        "seed": args.seed,
-        "threads": args.threads,
-        "ray_core": scene.ray_core(),
-        "max_depth": args.integrator_args.max_depth.unwrap_or(scene.settings.max_depth),
-        "params": params.pairs().iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>(),
-        "seconds": secs,
-        "cpu_seconds": result.cpu.as_secs_f64(),
-        "spp_per_second": total_passes as f64 / secs,
-        "std_error_source": se_source,
-        "mean_std_error": se.map(mean_of),
-        "mean_std_error_across_runs": across.as_ref().map(mean_of),
-        "mean_std_error_per_pass": per_pass.as_ref().map(mean_of),
-        "progress": first.log.as_ref().map(log_json),
-        "invalid_samples": result.invalid_samples,
-        "interrupted": interrupted.load(Ordering::SeqCst),
-        "strategies": pyramid.as_ref().map(|(dir, _, _)| dir.display().to_string()),
-        "strategy_length": pyramid.as_ref().map(|_| args.strategy_length),
-    });
-    crate::image_io::write_atomic(
-        &sibling(output, ".json"),
-        serde_json::to_string_pretty(&record).unwrap().as_bytes(),
-    )?;
-    if !args.quiet {
-        let runs = if many {
-            format!(" × {runs_done} runs")
-        } else {
-            String::new()
-        };
-        eprintln!(
-            "{}: {} spp{runs} in {:.2} s ({:.2} spp/s) -> {}",
-            args.integrator,
-            first.passes,
-            secs,
-            total_passes as f64 / secs,
-            output.display()
-        );
-        let mut warnings: Vec<&str> = result
-            .runs
-            .iter()
-            .filter_map(|r| r.log.as_ref())
-            .flat_map(|l| l.facts.iter())
-            .filter(|(k, _)| k == "warning")
-            .map(|(_, v)| v.as_str())
-            .collect();
-        warnings.dedup();
-        for w in warnings {
-            eprintln!("warning: {w}");
-        }
-        if result.invalid_samples > 0 {
-            eprintln!(
-                "warning: {} invalid (NaN/Inf/negative) samples were dropped",
-                result.invalid_samples
-            );
-        }
+    let many = args.runs > 1;
+    let runs = if many {
+        format!(" × {runs_done} runs")
+    } else {
+        String::new()
+    };
+    eprintln!(
+        "{}: {} spp{runs} in {:.2} s ({:.2} spp/s) -> {}",
+        args.integrator,
+        first.passes,
+        secs,
+        total_passes as f64 / secs,
+        output.display()
+    );
+    let mut warnings: Vec<&str> = result
+        .runs
+        .iter()
+        .filter_map(|r| r.log.as_ref())
+        .flat_map(|l| l.facts.iter())
+        .filter(|(k, _)| k == "warning")
+        .map(|(_, v)| v.as_str())
+        .collect();
+    warnings.dedup();
+    for w in warnings {
+        eprintln!("warning: {w}");
     }
-    Ok(())
+    if result.invalid_samples > 0 {
+        eprintln!(
+            "warning: {} invalid (NaN/Inf/negative) samples were dropped",
+            result.invalid_samples
+        );
+    }
 }
 
 /// Counts passes against the pass budget, or milliseconds against the time budget when there is

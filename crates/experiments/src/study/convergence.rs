@@ -11,6 +11,7 @@
 
 use super::metrics::{log_log_slope, mean_of_runs, mean_over, mse, rel_mse};
 use super::output::{film, num, pct, stem, StudyOutput};
+use super::reference::Reference;
 use super::{Scale, StudyContext};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
@@ -297,187 +298,27 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         "Convergence: error against samples and time",
         scale,
     )?;
-    out.para(&format!(
-        "Every integrator on every scene of the {} scale at {} px wide, {} independent runs each, \
-         snapshots at 1, 2, 4, … {} passes. MSE is the mean over pixels and channels of \
-         (I − R)² minus the reference's own mean variance (so it estimates the error against the \
-         true image); relMSE divides each term by R² + {}; FLIP is NVIDIA's perceptual error on \
-         the tone-mapped images. Points are means over runs with {} % t intervals; slopes are \
-         fitted to ln MSE against ln N or ln t, with delete-one jackknife intervals over runs. An \
-         unbiased estimator's slope against N is −1.",
-        scale.name,
-        scale.width,
-        scale.runs,
-        scale.max_passes,
-        super::metrics::REL_EPSILON,
-        pct(conf)
-    ));
+    describe(&mut out, scale);
     let before = ctx.spent();
-    let mut all_rows = Vec::new();
-    let mut slope_rows = Vec::new();
-    let mut eff_rows = Vec::new();
-    let mut ref_rows = Vec::new();
+    let mut rows = Rows::default();
     let mut findings_chart = None;
     for scene in &scale.scenes {
         let name = stem(scene);
-        let reference = ctx.reference(scene, None)?;
-        ref_rows.push(vec![
-            name.clone(),
-            reference.integrator.clone(),
-            format!("{} × {}", reference.runs, reference.passes),
-            num(reference.mean_variance),
-            if reference.consistent {
-                "consistent"
-            } else {
-                "unbiased"
-            }
-            .into(),
-            super::reference::integrator_for(&name).1.into(),
-        ]);
+        rows.references
+            .push(reference_row(&name, &*ctx.reference(scene, None)?));
         let mut scene_curves = Vec::new();
         for i in integrators() {
             let c = curves(ctx, scene, i)?;
-            for (j, &p) in c.passes.iter().enumerate() {
-                let all: Vec<usize> = (0..c.runs()).collect();
-                let iv = c.mean_mse(conf)[j];
-                all_rows.push(vec![
-                    name.clone(),
-                    c.integrator.clone(),
-                    p.to_string(),
-                    format!("{:.6}", c.seconds[j]),
-                    format!("{:.6e}", iv.estimate),
-                    format!("{:.6e}", iv.lo),
-                    format!("{:.6e}", iv.hi),
-                    format!("{:.6e}", mean_over(&all, &c.rel_mse[j])),
-                    format!("{:.6e}", mean_over(&all, &c.flip[j])),
-                ]);
-            }
-            let cell = |r: Result<lt_estimators::Jackknifed, String>| match r {
-                Ok(j) => (
-                    num(j.estimate),
-                    format!("[{}, {}]", num(j.interval.lo), num(j.interval.hi)),
-                ),
-                Err(_) => (
-                    "—".into(),
-                    "undefined (an MSE ≤ 0 after subtracting the reference's noise)".into(),
-                ),
-            };
-            let fit_n = c.slope(false, conf);
-            let (mut s_n, ci_n) = cell(fit_n.clone());
-            let (s_t, ci_t) = cell(c.slope(true, conf));
-            let width = fit_n
-                .as_ref()
-                .map_or("—".into(), |j| num(j.interval.hi - j.interval.lo));
-            let expected = expected_slope(&c.integrator, c.consistent);
-            let (inside, said) = match verdict(&c, &fit_n) {
-                Verdict::Slope => {
-                    let j = fit_n.as_ref().expect("a slope has a fit");
-                    let inside = expected.map_or("—", |e| {
-                        if j.interval.lo <= e && e <= j.interval.hi {
-                            "yes"
-                        } else {
-                            "no"
-                        }
-                    });
-                    (inside, "slope".to_string())
-                }
-                Verdict::Flat => ("—", "flat: the MSE does not fall over these N".into()),
-                Verdict::NoSlope(why) => {
-                    s_n = "no slope".into();
-                    ("—", format!("no slope: {why}"))
-                }
-            };
-            slope_rows.push(vec![
-                name.clone(),
-                c.integrator.clone(),
-                if c.consistent {
-                    "consistent"
-                } else {
-                    "unbiased"
-                }
-                .into(),
-                s_n,
-                ci_n,
-                width,
-                expected.map_or("—".into(), num),
-                inside.into(),
-                said,
-                s_t,
-                ci_t,
-            ]);
+            rows.all.extend(measurement_rows(&name, &c, conf));
+            rows.slopes.push(slope_row(&name, &c, conf));
             scene_curves.push(c);
         }
         if *scene == findings_scene(scale) {
             findings_chart = Some(findings_figure(&name, &scene_curves, conf));
         }
-        // Efficiency at the largest N, and time to the scene's target MSE: the median of the
-        // integrators' final MSEs, so some reach it inside the measured range and some do not.
-        let last = |c: &Curves| c.mean_mse(conf).last().map_or(f64::NAN, |i| i.estimate);
-        let mut finals: Vec<f64> = scene_curves.iter().map(last).filter(|v| *v > 0.0).collect();
-        finals.sort_by(f64::total_cmp);
-        let target = finals.get(finals.len() / 2).copied().unwrap_or(f64::NAN);
-        for c in &scene_curves {
-            let (m, t) = (last(c), *c.seconds.last().unwrap_or(&f64::NAN));
-            let curve: Vec<(f64, f64)> = c
-                .seconds
-                .iter()
-                .zip(c.mean_mse(conf))
-                .map(|(&t, i)| (t, i.estimate))
-                .collect();
-            let reach = match (time_to_mse(&curve, target), c.slope(true, conf)) {
-                (Some(s), _) => num(s),
-                // Outside the measured range: along the fitted power law MSE ∝ t^slope, for
-                // unbiased estimators, whose law holds at every N, and only when the slope is
-                // told from 0 (an estimator that misses some light has a flat curve).
-                (None, Ok(j)) if !c.consistent && j.interval.hi < 0.0 => {
-                    format!("≈{}", num(t * (target / m).powf(1.0 / j.estimate)))
-                }
-                (None, _) if m > target => "not reached".into(),
-                (None, _) => "below it at N = 1".into(),
-            };
-            eff_rows.push(vec![
-                name.clone(),
-                c.integrator.clone(),
-                num(m),
-                format!("{t:.3}"),
-                num(lt_estimators::efficiency(m, t)),
-                num(target),
-                reach,
-            ]);
-        }
-        let chart = |time: bool| Chart {
-            title: format!(
-                "{name}: MSE against {}",
-                if time {
-                    "wall time"
-                } else {
-                    "samples per pixel"
-                }
-            ),
-            x_label: if time {
-                "seconds".into()
-            } else {
-                "passes (spp)".into()
-            },
-            y_label: "MSE".into(),
-            log_x: true,
-            log_y: true,
-            series: scene_curves.iter().map(|c| series(c, time, conf)).collect(),
-        };
-        out.chart(
-            &format!("mse-spp-{name}"),
-            &chart(false),
-            &format!(
-                "MSE against passes on {name}, mean of {} runs with {} % intervals.",
-                scale.runs,
-                pct(conf)
-            ),
-        )?;
-        out.chart(
-            &format!("mse-time-{name}"),
-            &chart(true),
-            &format!("MSE against wall time on {name} ({} threads; timings vary ±20 % on this kind of machine).", if ctx.runs.threads == 0 { "all".to_string() } else { ctx.runs.threads.to_string() }),
-        )?;
+        rows.efficiency
+            .extend(efficiency_rows(&name, &scene_curves, conf));
+        scene_charts(&mut out, ctx, &name, &scene_curves)?;
     }
     if let Some(chart) = findings_chart {
         out.chart(
@@ -493,6 +334,222 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             ),
         )?;
     }
+    write_tables(&mut out, rows)?;
+    out.para(&ctx.compute_note(before));
+    out.finish()
+}
+
+/// The study's opening paragraph: what was run and how errors and slopes are measured.
+fn describe(out: &mut StudyOutput, scale: &Scale) {
+    let conf = scale.confidence;
+    out.para(&format!(
+        "Every integrator on every scene of the {} scale at {} px wide, {} independent runs each, \
+         snapshots at 1, 2, 4, … {} passes. MSE is the mean over pixels and channels of \
+         (I − R)² minus the reference's own mean variance (so it estimates the error against the \
+         true image); relMSE divides each term by R² + {}; FLIP is NVIDIA's perceptual error on \
+         the tone-mapped images. Points are means over runs with {} % t intervals; slopes are \
+         fitted to ln MSE against ln N or ln t, with delete-one jackknife intervals over runs. An \
+         unbiased estimator's slope against N is −1.",
+        scale.name,
+        scale.width,
+        scale.runs,
+        scale.max_passes,
+        super::metrics::REL_EPSILON,
+        pct(conf)
+    ));
+}
+
+/// The rows of the study's tables, gathered scene by scene.
+#[derive(Default)]
+struct Rows {
+    references: Vec<Vec<String>>,
+    all: Vec<Vec<String>>,
+    slopes: Vec<Vec<String>>,
+    efficiency: Vec<Vec<String>>,
+}
+
+/// What a scene's errors are measured against.
+fn reference_row(name: &str, reference: &Reference) -> Vec<String> {
+    vec![
+        name.into(),
+        reference.integrator.clone(),
+        format!("{} × {}", reference.runs, reference.passes),
+        num(reference.mean_variance),
+        if reference.consistent {
+            "consistent"
+        } else {
+            "unbiased"
+        }
+        .into(),
+        super::reference::integrator_for(name).1.into(),
+    ]
+}
+
+/// Every snapshot of one integrator's runs: seconds, MSE with its interval, relMSE, FLIP.
+fn measurement_rows(name: &str, c: &Curves, conf: f64) -> Vec<Vec<String>> {
+    let mut rows = Vec::new();
+    for (j, &p) in c.passes.iter().enumerate() {
+        let all: Vec<usize> = (0..c.runs()).collect();
+        let iv = c.mean_mse(conf)[j];
+        rows.push(vec![
+            name.into(),
+            c.integrator.clone(),
+            p.to_string(),
+            format!("{:.6}", c.seconds[j]),
+            format!("{:.6e}", iv.estimate),
+            format!("{:.6e}", iv.lo),
+            format!("{:.6e}", iv.hi),
+            format!("{:.6e}", mean_over(&all, &c.rel_mse[j])),
+            format!("{:.6e}", mean_over(&all, &c.flip[j])),
+        ]);
+    }
+    rows
+}
+
+/// One integrator's fitted slopes against N and t, its expected slope and the verdict.
+fn slope_row(name: &str, c: &Curves, conf: f64) -> Vec<String> {
+    let cell = |r: Result<lt_estimators::Jackknifed, String>| match r {
+        Ok(j) => (
+            num(j.estimate),
+            format!("[{}, {}]", num(j.interval.lo), num(j.interval.hi)),
+        ),
+        Err(_) => (
+            "—".into(),
+            "undefined (an MSE ≤ 0 after subtracting the reference's noise)".into(),
+        ),
+    };
+    let fit_n = c.slope(false, conf);
+    let (mut s_n, ci_n) = cell(fit_n.clone());
+    let (s_t, ci_t) = cell(c.slope(true, conf));
+    let width = fit_n
+        .as_ref()
+        .map_or("—".into(), |j| num(j.interval.hi - j.interval.lo));
+    let expected = expected_slope(&c.integrator, c.consistent);
+    let (inside, said) = match verdict(c, &fit_n) {
+        Verdict::Slope => {
+            let j = fit_n.as_ref().expect("a slope has a fit");
+            let inside = expected.map_or("—", |e| {
+                if j.interval.lo <= e && e <= j.interval.hi {
+                    "yes"
+                } else {
+                    "no"
+                }
+            });
+            (inside, "slope".to_string())
+        }
+        Verdict::Flat => ("—", "flat: the MSE does not fall over these N".into()),
+        Verdict::NoSlope(why) => {
+            s_n = "no slope".into();
+            ("—", format!("no slope: {why}"))
+        }
+    };
+    vec![
+        name.into(),
+        c.integrator.clone(),
+        if c.consistent {
+            "consistent"
+        } else {
+            "unbiased"
+        }
+        .into(),
+        s_n,
+        ci_n,
+        width,
+        expected.map_or("—".into(), num),
+        inside.into(),
+        said,
+        s_t,
+        ci_t,
+    ]
+}
+
+/// Efficiency at the largest N, and time to the scene's target MSE: the median of the
+/// integrators' final MSEs, so some reach it inside the measured range and some do not.
+fn efficiency_rows(name: &str, scene_curves: &[Curves], conf: f64) -> Vec<Vec<String>> {
+    let mut rows = Vec::new();
+    // Efficiency at the largest N, and time to the scene's target MSE: the median of the
+    // integrators' final MSEs, so some reach it inside the measured range and some do not.
+    let last = |c: &Curves| c.mean_mse(conf).last().map_or(f64::NAN, |i| i.estimate);
+    let mut finals: Vec<f64> = scene_curves.iter().map(last).filter(|v| *v > 0.0).collect();
+    finals.sort_by(f64::total_cmp);
+    let target = finals.get(finals.len() / 2).copied().unwrap_or(f64::NAN);
+    for c in scene_curves {
+        let (m, t) = (last(c), *c.seconds.last().unwrap_or(&f64::NAN));
+        let curve: Vec<(f64, f64)> = c
+            .seconds
+            .iter()
+            .zip(c.mean_mse(conf))
+            .map(|(&t, i)| (t, i.estimate))
+            .collect();
+        let reach = match (time_to_mse(&curve, target), c.slope(true, conf)) {
+            (Some(s), _) => num(s),
+            // Outside the measured range: along the fitted power law MSE ∝ t^slope, for
+            // unbiased estimators, whose law holds at every N, and only when the slope is
+            // told from 0 (an estimator that misses some light has a flat curve).
+            (None, Ok(j)) if !c.consistent && j.interval.hi < 0.0 => {
+                format!("≈{}", num(t * (target / m).powf(1.0 / j.estimate)))
+            }
+            (None, _) if m > target => "not reached".into(),
+            (None, _) => "below it at N = 1".into(),
+        };
+        rows.push(vec![
+            name.into(),
+            c.integrator.clone(),
+            num(m),
+            format!("{t:.3}"),
+            num(lt_estimators::efficiency(m, t)),
+            num(target),
+            reach,
+        ]);
+    }
+    rows
+}
+
+/// A scene's MSE against passes and against wall time, every integrator.
+fn scene_charts(
+    out: &mut StudyOutput,
+    ctx: &StudyContext,
+    name: &str,
+    scene_curves: &[Curves],
+) -> Result<(), String> {
+    let (scale, conf) = (&ctx.scale, ctx.scale.confidence);
+    let chart = |time: bool| Chart {
+        title: format!(
+            "{name}: MSE against {}",
+            if time {
+                "wall time"
+            } else {
+                "samples per pixel"
+            }
+        ),
+        x_label: if time {
+            "seconds".into()
+        } else {
+            "passes (spp)".into()
+        },
+        y_label: "MSE".into(),
+        log_x: true,
+        log_y: true,
+        series: scene_curves.iter().map(|c| series(c, time, conf)).collect(),
+    };
+    out.chart(
+        &format!("mse-spp-{name}"),
+        &chart(false),
+        &format!(
+            "MSE against passes on {name}, mean of {} runs with {} % intervals.",
+            scale.runs,
+            pct(conf)
+        ),
+    )?;
+    out.chart(
+            &format!("mse-time-{name}"),
+            &chart(true),
+            &format!("MSE against wall time on {name} ({} threads; timings vary ±20 % on this kind of machine).", if ctx.runs.threads == 0 { "all".to_string() } else { ctx.runs.threads.to_string() }),
+        )?;
+    Ok(())
+}
+
+fn write_tables(out: &mut StudyOutput, rows: Rows) -> Result<(), String> {
     out.table(
         "references",
         "References",
@@ -505,7 +562,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             "kind",
             "why",
         ],
-        ref_rows,
+        rows.references,
         true,
     )?;
     out.table(
@@ -532,7 +589,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             "slope vs t",
             "CI vs t",
         ],
-        slope_rows,
+        rows.slopes,
         true,
     )?;
     out.table(
@@ -550,7 +607,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             "target MSE",
             "seconds to target",
         ],
-        eff_rows,
+        rows.efficiency,
         true,
     )?;
     out.table(
@@ -568,9 +625,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             "rel_mse",
             "flip",
         ],
-        all_rows,
+        rows.all,
         false,
-    )?;
-    out.para(&ctx.compute_note(before));
-    out.finish()
+    )
 }

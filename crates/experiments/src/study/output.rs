@@ -46,6 +46,33 @@ pub fn stem(path: &Path) -> String {
 }
 
 /// A number as the tables print it: 3 significant digits, scientific outside [0.01, 1000).
+/// A fitted slope's table cells against a predicted one: measured, "[lo, hi]", "difference ±
+/// half-width" and whether the interval holds the prediction; the error and dashes when the
+/// slope could not be fitted.
+pub fn slope_cells(
+    slope: &Result<lt_estimators::Jackknifed, String>,
+    against: f64,
+) -> (String, String, String, String) {
+    match slope {
+        Ok(j) => (
+            num(j.estimate),
+            format!("[{}, {}]", num(j.interval.lo), num(j.interval.hi)),
+            format!(
+                "{} ± {}",
+                num(j.estimate - against),
+                num(j.interval.hi - j.estimate)
+            ),
+            if j.interval.contains(against) {
+                "yes"
+            } else {
+                "no"
+            }
+            .to_string(),
+        ),
+        Err(e) => ("—".into(), e.clone(), "—".into(), "—".into()),
+    }
+}
+
 pub fn num(v: f64) -> String {
     if !v.is_finite() {
         return "—".into();

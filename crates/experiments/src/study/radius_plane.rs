@@ -19,7 +19,7 @@
 //! the same camera stream, so bias and variance are of the photon part alone; the K runs differ
 //! in their photon seeds only (independent streams, never correlated passes).
 
-use super::output::{num, pct, StudyOutput};
+use super::output::{num, pct, slope_cells, StudyOutput};
 use super::{Scale, StudyContext};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
@@ -467,6 +467,21 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         "Radius shrinkage at exact points: Knaus & Zwicker's rates measured",
         scale,
     )?;
+    describe(&mut out, &ms, scale, points);
+    rates_table(&mut out, &ms)?;
+    sppm_camera_part(&mut out, &ms, width);
+    exact_check(&mut out, &ms, scale)?;
+    quantity_charts(&mut out, &ms)?;
+    rate_chart(&mut out, &ms)?;
+    ctx.say(&format!(
+        "{NAME}: analysis {:.1} s",
+        t0.elapsed().as_secs_f64()
+    ));
+    out.finish()
+}
+
+/// The study's opening paragraph: the estimators, the scene, the runs and how they are judged.
+fn describe(out: &mut StudyOutput, ms: &[Measured], scale: &Scale, points: usize) {
     let seconds: f64 = ms.iter().map(|m| m.seconds).sum();
     let tail = &ms[0].tail;
     out.para(&format!(
@@ -502,29 +517,18 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             .join(", "),
         secs = seconds,
     ));
-    // The slope table: the columns tests/studies.rs reads.
+}
+
+/// The slope table: the columns tests/studies.rs reads.
+fn rates_table(out: &mut StudyOutput, ms: &[Measured]) -> Result<(), String> {
     let mut rows = Vec::new();
-    for m in &ms {
+    for m in ms {
         let (pv, pb, pm) = predicted(m.alpha);
         for (q, asymptotic) in [(0, pb), (1, pv), (2, pm)] {
             let pred = m.exact_slopes[q];
             let have_exact = pred.is_finite();
-            let (meas, ci, diff, inside) = match &m.slopes[q] {
-                Ok(j) => {
-                    let against = if have_exact { pred } else { asymptotic };
-                    (
-                        num(j.estimate),
-                        format!("[{}, {}]", num(j.interval.lo), num(j.interval.hi)),
-                        format!(
-                            "{} ± {}",
-                            num(j.estimate - against),
-                            num(j.interval.hi - j.estimate)
-                        ),
-                        yes_no(j.interval.contains(against)),
-                    )
-                }
-                Err(e) => ("—".into(), e.clone(), "—".into(), "—".into()),
-            };
+            let against = if have_exact { pred } else { asymptotic };
+            let (meas, ci, diff, inside) = slope_cells(&m.slopes[q], against);
             let asym_inside = match &m.slopes[q] {
                 Ok(j) => yes_no(j.interval.contains(asymptotic)),
                 Err(_) => "—".into(),
@@ -567,8 +571,11 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         ],
         rows,
         true,
-    )?;
-    // sppm's camera part, stated separately: its 1/N against the photon part's variance.
+    )
+}
+
+/// sppm's camera part, stated separately: its 1/N against the photon part's variance.
+fn sppm_camera_part(out: &mut StudyOutput, ms: &[Measured], width: usize) {
     let sigma2 = camera_variance(width);
     let last = *ms[0].snaps.last().unwrap_or(&1);
     let photon_var: Vec<(f64, f64)> = ms
@@ -593,8 +600,11 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             .collect::<Vec<_>>()
             .join(", "),
     ));
-    // Every snapshot: the measured bias² and variance against the exact ones, at a Bonferroni
-    // level so that the table's many checks miss by luck with ≈ 5 % in all.
+}
+
+/// Every snapshot: the measured bias² and variance against the exact ones, at a Bonferroni
+/// level so that the table's many checks miss by luck with ≈ 5 % in all.
+fn exact_check(out: &mut StudyOutput, ms: &[Measured], scale: &Scale) -> Result<(), String> {
     let exact_ms: Vec<&Measured> = ms
         .iter()
         .filter(|m| m.exact_slopes[0].is_finite())
@@ -657,10 +667,14 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         ],
         exact_rows,
         false,
-    )?;
+    )
+}
+
+/// bias², variance and MSE against N, one chart each, every estimator and α with its exact curve.
+fn quantity_charts(out: &mut StudyOutput, ms: &[Measured]) -> Result<(), String> {
     for (q, file) in [(0, "bias2"), (1, "variance"), (2, "mse")] {
         let mut series = Vec::new();
-        for m in &ms {
+        for m in ms {
             let tag = format!("{}, α = {}", m.schedule.label(), alpha_text(m.alpha));
             series.push(Series {
                 name: tag.clone(),
@@ -711,8 +725,12 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             ),
         )?;
     }
-    // The lecture's figure: MSE rate against α, all three estimators (shifted by ±0.01 in α so
-    // their intervals do not overlap), K&Z's curve through them.
+    Ok(())
+}
+
+/// The lecture's figure: MSE rate against α, all three estimators (shifted by ±0.01 in α so
+/// their intervals do not overlap), K&Z's curve through them; and how to read it.
+fn rate_chart(out: &mut StudyOutput, ms: &[Measured]) -> Result<(), String> {
     let curve: Vec<(f64, f64)> = (0..=100)
         .map(|i| {
             let a = 0.2 + 0.8 * i as f64 / 100.0;
@@ -783,11 +801,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
          (`inside asymptotic`): r_1 = h/2 keeps the O(r⁴) term of the disc average visible \
          (K&Z's bias ≈ (r²/8)∇²L is its first term).",
     );
-    ctx.say(&format!(
-        "{NAME}: analysis {:.1} s",
-        t0.elapsed().as_secs_f64()
-    ));
-    out.finish()
+    Ok(())
 }
 
 fn yes_no(b: bool) -> String {

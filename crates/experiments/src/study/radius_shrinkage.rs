@@ -10,8 +10,8 @@
 //! delete-one jackknife intervals over the independent runs.
 
 use super::metrics::subset_bias_variance;
-use super::output::{num, pct, stem, StudyOutput};
-use super::unbiased_consistent::{config_specs, decompose, runs};
+use super::output::{num, pct, slope_cells, stem, StudyOutput};
+use super::unbiased_consistent::{config_specs, decompose, runs, Decomposition};
 use super::{Scale, StudyContext};
 use crate::plot::{Chart, Series, Style};
 use crate::runs::RunSpec;
@@ -139,7 +139,7 @@ pub fn rates(
     integrator: &str,
     alpha: f64,
     fixed_points: bool,
-) -> Result<(Rates, super::unbiased_consistent::Decomposition), String> {
+) -> Result<(Rates, Decomposition), String> {
     let scale = &ctx.scale;
     let owned = params(integrator, alpha, fixed_points);
     let params: Vec<(&str, &str)> = owned.iter().map(|(k, v)| (*k, v.as_str())).collect();
@@ -244,27 +244,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         "Radius shrinkage: measured rates against Knaus & Zwicker's",
         scale,
     )?;
-    out.para(&format!(
-        "ppm, sppm and vcm on `{scene}` ({w} px wide), {k} independent runs of {n} passes for each \
-         α. With r_N² ∝ N^(α−1), Knaus & Zwicker predict variance ∝ N^(−α), bias² ∝ N^(−2(1−α)) \
-         and MSE ∝ N^(−min(α, 2(1−α))) — fastest at α = 2/3 — and r² ∝ N^(α−1). Slopes are fitted \
-         over the snapshots with N ≥ {tail} (the asymptotic tail), with {c} % delete-one \
-         jackknife intervals over runs. sppm's variance also has a 1/N part from its new camera \
-         samples each pass; it is the smaller one at large N only when α < 1. ppm's visible points \
-         are drawn once per run, so its spread over runs also holds where in its pixel each point \
-         fell, which no pass reduces: the rate K&Z predict is that of the variance at fixed \
-         points, measured from runs that share their camera pass (`visible_seed`). ppm and sppm take \
-         all light from photons here (`direct=photons`), since next-event estimation re-sampled \
-         every pass adds a 1/N variance whatever α. A bias² too \
-         small to tell from 0 at some N has no slope (—). The r² rows check the logged radii \
-         against each integrator's schedule: ppm's and sppm's product r_N² = r_1² Π (j + α)/(j + 1), \
-         whose slope over a finite tail is near, not at, α − 1, and vcm's r_N² = r_1² N^(α−1).",
-        w = scale.width,
-        k = runs(scale),
-        n = scale.progressive_passes,
-        tail = (scale.progressive_passes / 8).max(1),
-        c = pct(scale.confidence)
-    ));
+    describe(&mut out, scale, &scene);
     let mut rows = Vec::new();
     let mut r2_series = Vec::new();
     for integrator in INTEGRATORS {
@@ -273,140 +253,21 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         let mut fixed_decs = Vec::new();
         for &alpha in &scale.alphas {
             let (r, dec) = rates(ctx, integrator, alpha, false)?;
-            let (pv, pb, pm, pr) = predicted(alpha);
-            let tail = tail_of(&dec.passes, scale.progressive_passes);
-            let (fv, fb) = predicted_at(integrator, alpha, &tail);
-            // (quantity, asymptotic rate, rate at these N, measured)
-            let mut quantities = vec![
-                ("variance", pv, fv, r.slopes[0].clone()),
-                ("bias²", pb, fb, r.slopes[1].clone()),
-                ("MSE", pm, pm, r.slopes[2].clone()),
-            ];
-            if takes(integrator, FIXED_POINTS.0) {
-                let (f, fdec) = rates(ctx, integrator, alpha, true)?;
+            let fixed = if takes(integrator, FIXED_POINTS.0) {
+                Some(rates(ctx, integrator, alpha, true)?)
+            } else {
+                None
+            };
+            let at_fixed = fixed.as_ref().map(|(f, _)| f);
+            rows.extend(slope_rows(integrator, alpha, &r, &dec, at_fixed, scale));
+            rows.push(radius_row(integrator, alpha, &r));
+            if let Some((_, fdec)) = fixed {
+                r2_series.push(radius_series(alpha, &r));
                 fixed_decs.push(fdec);
-                quantities.insert(1, ("variance at fixed points", pv, fv, f.slopes[0].clone()));
-            }
-            for (name, asymptotic, pred, slope) in &quantities {
-                let (m, ci, diff, inside) = match slope {
-                    Ok(j) => (
-                        num(j.estimate),
-                        format!("[{}, {}]", num(j.interval.lo), num(j.interval.hi)),
-                        format!(
-                            "{} ± {}",
-                            num(j.estimate - pred),
-                            num(j.interval.hi - j.estimate)
-                        ),
-                        if j.interval.contains(*pred) {
-                            "yes"
-                        } else {
-                            "no"
-                        }
-                        .to_string(),
-                    ),
-                    Err(e) => ("—".into(), e.clone(), "—".into(), "—".into()),
-                };
-                rows.push(vec![
-                    integrator.to_string(),
-                    alpha_text(alpha),
-                    name.to_string(),
-                    m,
-                    ci,
-                    num(*asymptotic),
-                    num(*pred),
-                    diff,
-                    inside,
-                ]);
-            }
-            // The radius follows the product schedule exactly; its slope over a finite tail is
-            // near α − 1, not equal to it.
-            rows.push(vec![
-                integrator.to_string(),
-                alpha_text(alpha),
-                "r²".into(),
-                num(r.r2_slope),
-                format!("schedule matched to {:.1e}", r.schedule_error),
-                num(pr),
-                "—".into(),
-                num(r.r2_slope - pr),
-                if r.schedule_error < SCHEDULE_TOLERANCE {
-                    "yes"
-                } else {
-                    "no"
-                }
-                .into(),
-            ]);
-            if takes(integrator, FIXED_POINTS.0) {
-                r2_series.push(Series {
-                    name: format!("α = {}", alpha_text(alpha)),
-                    points: r
-                        .passes
-                        .iter()
-                        .zip(&r.r2)
-                        .map(|(&n, &v)| (n as f64, v))
-                        .collect(),
-                    y_interval: Vec::new(),
-                    style: Style::Measured,
-                });
             }
             decs.push(dec);
         }
-        for (what, pick) in [
-            (
-                "variance",
-                (|d: &super::unbiased_consistent::Decomposition| d.variance.clone())
-                    as fn(&_) -> Vec<_>,
-            ),
-            ("bias²", |d| d.bias2.clone()),
-            ("MSE", |d| d.mse.clone()),
-        ] {
-            let source = if what == "variance" && !fixed_decs.is_empty() {
-                &fixed_decs
-            } else {
-                &decs
-            };
-            let series = source
-                .iter()
-                .map(|d| {
-                    let iv = pick(d);
-                    Series {
-                        name: d.label.clone(),
-                        points: d
-                            .passes
-                            .iter()
-                            .zip(&iv)
-                            .map(|(&n, i)| (n as f64, i.estimate))
-                            .collect(),
-                        y_interval: iv.iter().map(|i| (i.lo, i.hi)).collect(),
-                        style: Style::Measured,
-                    }
-                })
-                .collect();
-            let file = match what {
-                "bias²" => "bias2",
-                w => w,
-            }
-            .to_lowercase();
-            out.chart(
-                &format!("{integrator}-{file}"),
-                &Chart {
-                    title: format!("{integrator} on {scene}: {what} against passes, per α"),
-                    x_label: "passes".into(),
-                    y_label: what.into(),
-                    log_x: true,
-                    log_y: true,
-                    series,
-                },
-                &format!(
-                    "{integrator}: {what} of one run against passes for each α, jackknife intervals{}.",
-                    if what == "variance" && !fixed_decs.is_empty() {
-                        " (ppm: runs sharing their visible points, the variance at fixed points)"
-                    } else {
-                        ""
-                    }
-                ),
-            )?;
-        }
+        decomposition_charts(&mut out, integrator, &scene, &decs, &fixed_decs)?;
     }
     out.chart(
         "radius",
@@ -443,4 +304,172 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         true,
     )?;
     out.finish()
+}
+
+/// The study's opening paragraph: the predicted rates and how they are measured.
+fn describe(out: &mut StudyOutput, scale: &Scale, scene: &str) {
+    out.para(&format!(
+        "ppm, sppm and vcm on `{scene}` ({w} px wide), {k} independent runs of {n} passes for each \
+         α. With r_N² ∝ N^(α−1), Knaus & Zwicker predict variance ∝ N^(−α), bias² ∝ N^(−2(1−α)) \
+         and MSE ∝ N^(−min(α, 2(1−α))) — fastest at α = 2/3 — and r² ∝ N^(α−1). Slopes are fitted \
+         over the snapshots with N ≥ {tail} (the asymptotic tail), with {c} % delete-one \
+         jackknife intervals over runs. sppm's variance also has a 1/N part from its new camera \
+         samples each pass; it is the smaller one at large N only when α < 1. ppm's visible points \
+         are drawn once per run, so its spread over runs also holds where in its pixel each point \
+         fell, which no pass reduces: the rate K&Z predict is that of the variance at fixed \
+         points, measured from runs that share their camera pass (`visible_seed`). ppm and sppm take \
+         all light from photons here (`direct=photons`), since next-event estimation re-sampled \
+         every pass adds a 1/N variance whatever α. A bias² too \
+         small to tell from 0 at some N has no slope (—). The r² rows check the logged radii \
+         against each integrator's schedule: ppm's and sppm's product r_N² = r_1² Π (j + α)/(j + 1), \
+         whose slope over a finite tail is near, not at, α − 1, and vcm's r_N² = r_1² N^(α−1).",
+        w = scale.width,
+        k = runs(scale),
+        n = scale.progressive_passes,
+        tail = (scale.progressive_passes / 8).max(1),
+        c = pct(scale.confidence)
+    ));
+}
+
+/// One integrator and α: each quantity's measured slope against the asymptotic rate and the rate
+/// at these N (`at_fixed`: ppm's runs sharing their visible points, whose variance K&Z describe).
+fn slope_rows(
+    integrator: &str,
+    alpha: f64,
+    r: &Rates,
+    dec: &Decomposition,
+    at_fixed: Option<&Rates>,
+    scale: &Scale,
+) -> Vec<Vec<String>> {
+    let (pv, pb, pm, _) = predicted(alpha);
+    let tail = tail_of(&dec.passes, scale.progressive_passes);
+    let (fv, fb) = predicted_at(integrator, alpha, &tail);
+    // (quantity, asymptotic rate, rate at these N, measured)
+    let mut quantities = vec![
+        ("variance", pv, fv, r.slopes[0].clone()),
+        ("bias²", pb, fb, r.slopes[1].clone()),
+        ("MSE", pm, pm, r.slopes[2].clone()),
+    ];
+    if let Some(f) = at_fixed {
+        quantities.insert(1, ("variance at fixed points", pv, fv, f.slopes[0].clone()));
+    }
+    let mut rows = Vec::new();
+    for (name, asymptotic, pred, slope) in &quantities {
+        let (m, ci, diff, inside) = slope_cells(slope, *pred);
+        rows.push(vec![
+            integrator.to_string(),
+            alpha_text(alpha),
+            name.to_string(),
+            m,
+            ci,
+            num(*asymptotic),
+            num(*pred),
+            diff,
+            inside,
+        ]);
+    }
+    rows
+}
+
+/// The radius follows the product schedule exactly; its slope over a finite tail is near α − 1,
+/// not equal to it.
+fn radius_row(integrator: &str, alpha: f64, r: &Rates) -> Vec<String> {
+    let pr = predicted(alpha).3;
+    vec![
+        integrator.to_string(),
+        alpha_text(alpha),
+        "r²".into(),
+        num(r.r2_slope),
+        format!("schedule matched to {:.1e}", r.schedule_error),
+        num(pr),
+        "—".into(),
+        num(r.r2_slope - pr),
+        if r.schedule_error < SCHEDULE_TOLERANCE {
+            "yes"
+        } else {
+            "no"
+        }
+        .into(),
+    ]
+}
+
+/// (r_N / r_1)² against N of one α, for the radius chart.
+fn radius_series(alpha: f64, r: &Rates) -> Series {
+    Series {
+        name: format!("α = {}", alpha_text(alpha)),
+        points: r
+            .passes
+            .iter()
+            .zip(&r.r2)
+            .map(|(&n, &v)| (n as f64, v))
+            .collect(),
+        y_interval: Vec::new(),
+        style: Style::Measured,
+    }
+}
+
+/// variance, bias² and MSE against passes of one integrator, a curve per α.
+fn decomposition_charts(
+    out: &mut StudyOutput,
+    integrator: &str,
+    scene: &str,
+    decs: &[Decomposition],
+    fixed_decs: &[Decomposition],
+) -> Result<(), String> {
+    for (what, pick) in [
+        (
+            "variance",
+            (|d: &Decomposition| d.variance.clone()) as fn(&_) -> Vec<_>,
+        ),
+        ("bias²", |d| d.bias2.clone()),
+        ("MSE", |d| d.mse.clone()),
+    ] {
+        let source = if what == "variance" && !fixed_decs.is_empty() {
+            fixed_decs
+        } else {
+            decs
+        };
+        let series = source
+            .iter()
+            .map(|d| {
+                let iv = pick(d);
+                Series {
+                    name: d.label.clone(),
+                    points: d
+                        .passes
+                        .iter()
+                        .zip(&iv)
+                        .map(|(&n, i)| (n as f64, i.estimate))
+                        .collect(),
+                    y_interval: iv.iter().map(|i| (i.lo, i.hi)).collect(),
+                    style: Style::Measured,
+                }
+            })
+            .collect();
+        let file = match what {
+            "bias²" => "bias2",
+            w => w,
+        }
+        .to_lowercase();
+        out.chart(
+            &format!("{integrator}-{file}"),
+            &Chart {
+                title: format!("{integrator} on {scene}: {what} against passes, per α"),
+                x_label: "passes".into(),
+                y_label: what.into(),
+                log_x: true,
+                log_y: true,
+                series,
+            },
+            &format!(
+                "{integrator}: {what} of one run against passes for each α, jackknife intervals{}.",
+                if what == "variance" && !fixed_decs.is_empty() {
+                    " (ppm: runs sharing their visible points, the variance at fixed points)"
+                } else {
+                    ""
+                }
+            ),
+        )?;
+    }
+    Ok(())
 }

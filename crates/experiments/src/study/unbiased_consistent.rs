@@ -405,12 +405,64 @@ fn iv(j: &Jackknifed) -> String {
 
 pub fn run(ctx: &StudyContext) -> Result<(), String> {
     let scale = &ctx.scale;
-    let (k, passes, photons) = uc_scale(scale);
-    let scene_path = scene(scale);
-    let width = lt_scene_io::load_scene(&scene_path)
-        .map_err(|e| e.to_string())?
-        .camera
-        .width as usize;
+    let setup = Setup::of(scale)?;
+    let ms = measure_all(ctx, &setup)?;
+    let mut out = StudyOutput::new(
+        ctx.study_dir(NAME),
+        NAME,
+        "Unbiased against consistent: bias² against N with an exact reference",
+        scale,
+    )?;
+    describe(&mut out, &setup, &ms, scale);
+    claims_table(&mut out, &ms)?;
+    rates_table(&mut out, &ms)?;
+    ppm_floor(&mut out, &ms, &setup);
+    bias_variance_table(&mut out, &ms)?;
+    bias_charts(&mut out, &ms)?;
+    mse_and_variance_charts(&mut out, &ms)?;
+    super::lecture::write(&mut out, scale)?;
+    out.finish()
+}
+
+/// The study's size at a scale and its family-wise level.
+struct Setup {
+    /// Runs per configuration, passes per run, photon or light paths per pass.
+    runs: usize,
+    passes: u32,
+    photons: u64,
+    /// The film's side in pixels (the scene's own).
+    width: usize,
+    /// The "contains 0" and "excludes 0" claims (configs × snapshots) and the Bonferroni level
+    /// each is made at.
+    claims: usize,
+    strict: f64,
+}
+
+impl Setup {
+    fn of(scale: &Scale) -> Result<Setup, String> {
+        let (runs, passes, photons) = uc_scale(scale);
+        let width = lt_scene_io::load_scene(&scene(scale))
+            .map_err(|e| e.to_string())?
+            .camera
+            .width as usize;
+        // Every "contains 0" and "excludes 0" claim is one of configs × snapshots: Bonferroni.
+        let claims = CONFIGS.len() * Scale::doublings(passes).len();
+        let strict = 1.0 - (1.0 - scale.confidence) / claims as f64;
+        Ok(Setup {
+            runs,
+            passes,
+            photons,
+            width,
+            claims,
+            strict,
+        })
+    }
+}
+
+/// Every configuration measured against the exact pixel values and, where the radius schedule is
+/// deterministic, the exact bias.
+fn measure_all(ctx: &StudyContext, setup: &Setup) -> Result<Vec<Measured>, String> {
+    let (width, passes) = (setup.width, setup.passes);
     let q = DiscAverage::new(16, 32);
     let exact = pixel_averages(width, None, &q);
     // A_p(D_{rᵢ}) for every pass of a deterministic schedule (ppm and sppm share K&Z's; pm's is
@@ -427,19 +479,22 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         Radius::Fixed => Some(vec![fixed.clone(); last as usize]),
         _ => None,
     };
-    // Every "contains 0" and "excludes 0" claim below is one of configs × snapshots: Bonferroni.
-    let claims = CONFIGS.len() * Scale::doublings(passes).len();
-    let strict = 1.0 - (1.0 - scale.confidence) / claims as f64;
-    let ms: Vec<Measured> = CONFIGS
+    CONFIGS
         .iter()
-        .map(|(l, i, p)| measure(ctx, l, i, p, &exact, &exact_d, strict))
-        .collect::<Result<_, _>>()?;
-    let mut out = StudyOutput::new(
-        ctx.study_dir(NAME),
-        NAME,
-        "Unbiased against consistent: bias² against N with an exact reference",
-        scale,
-    )?;
+        .map(|(l, i, p)| measure(ctx, l, i, p, &exact, &exact_d, setup.strict))
+        .collect()
+}
+
+/// The study's opening paragraph: what was run and how it is judged.
+fn describe(out: &mut StudyOutput, setup: &Setup, ms: &[Measured], scale: &Scale) {
+    let Setup {
+        runs: k,
+        passes,
+        photons,
+        width,
+        claims,
+        strict,
+    } = *setup;
     let seconds: f64 = ms.iter().map(|m| m.seconds).sum();
     out.para(&format!(
         "{k} independent runs of each estimator on `point-plane-pinhole` ({width}×{width} px: a \
@@ -463,9 +518,12 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             .collect::<Vec<_>>()
             .join(", "),
     ));
-    // The claims, one row each: what tests/studies.rs holds the committed CSV to.
+}
+
+/// The claims, one row each: what tests/studies.rs holds the committed CSV to.
+fn claims_table(out: &mut StudyOutput, ms: &[Measured]) -> Result<(), String> {
     let mut rows = Vec::new();
-    for m in &ms {
+    for m in ms {
         let first = &m.bias2[0];
         let lastb = m.bias2.last().unwrap();
         let zero_inside = m.bias2.iter().filter(|j| j.interval.contains(0.0)).count();
@@ -507,10 +565,13 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         ],
         rows,
         true,
-    )?;
-    // The slopes of the shrinking estimators, in the rates format the claims test reads.
+    )
+}
+
+/// The slopes of the shrinking estimators, in the rates format the claims test reads.
+fn rates_table(out: &mut StudyOutput, ms: &[Measured]) -> Result<(), String> {
     let mut srows = Vec::new();
-    for m in &ms {
+    for m in ms {
         let (measured, predicted) = &m.mse_slope;
         let (meas, ci, inside) = match measured {
             Ok(j) => (
@@ -536,7 +597,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             inside,
         ]);
     }
-    for m in &ms {
+    for m in ms {
         let Some((measured, asymptotic, at_n)) = &m.slope else {
             continue;
         };
@@ -583,10 +644,13 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         ],
         srows,
         true,
-    )?;
-    // ppm's one camera pass per run: its pixel converges to L at one random point of the pixel,
-    // so over runs its variance keeps the pixel variance of L, which no pass lowers.
-    let sigma2 = super::radius_plane::camera_variance(width);
+    )
+}
+
+/// ppm's one camera pass per run: its pixel converges to L at one random point of the pixel,
+/// so over runs its variance keeps the pixel variance of L, which no pass lowers.
+fn ppm_floor(out: &mut StudyOutput, ms: &[Measured], setup: &Setup) {
+    let sigma2 = super::radius_plane::camera_variance(setup.width);
     if let Some(ppm) = ms
         .iter()
         .find(|m| find(m.integrator).is_ok_and(|i| i.takes("visible_seed")))
@@ -599,12 +663,16 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
              predicted rate (the table); sppm, drawing new points every pass, does not have the \
              floor.",
             num(sigma2),
-            passes,
+            setup.passes,
             iv(ppm.variance.last().unwrap()),
         ));
     }
+}
+
+/// bias², variance and MSE of every estimator at every N, for the claims test and by hand.
+fn bias_variance_table(out: &mut StudyOutput, ms: &[Measured]) -> Result<(), String> {
     let mut rows = Vec::new();
-    for m in &ms {
+    for m in ms {
         for (j, &p) in m.passes.iter().enumerate() {
             let (b, v) = (&m.bias2[j], &m.variance[j]);
             rows.push(vec![
@@ -648,7 +716,11 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         ],
         rows,
         false,
-    )?;
+    )
+}
+
+/// One chart of bias² against N per family, with the exact bias² where there is one.
+fn bias_charts(out: &mut StudyOutput, ms: &[Measured]) -> Result<(), String> {
     let measured = |m: &Measured| Series {
         name: m.label.into(),
         points: m
@@ -721,6 +793,11 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             caption,
         )?;
     }
+    Ok(())
+}
+
+/// MSE and variance of one run against N, every estimator on one chart each.
+fn mse_and_variance_charts(out: &mut StudyOutput, ms: &[Measured]) -> Result<(), String> {
     out.chart(
         "mse",
         &Chart {
@@ -782,95 +859,5 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
                 .collect(),
         },
         "Variance of one run against passes.",
-    )?;
-    // The lecture's example.
-    let ns = Scale::doublings(64);
-    let lecture = super::lecture::measure(&ns, scale.lecture_repetitions, scale.confidence);
-    let mut lrows = Vec::new();
-    for r in &lecture {
-        lrows.push(vec![
-            r.n.to_string(),
-            num(r.exact_bias),
-            format!(
-                "{} [{}, {}]",
-                num(r.biased.estimate),
-                num(r.biased.lo),
-                num(r.biased.hi)
-            ),
-            if r.biased.contains(r.exact_bias) {
-                "yes"
-            } else {
-                "no"
-            }
-            .into(),
-            format!(
-                "{} [{}, {}]",
-                num(r.unbiased.estimate),
-                num(r.unbiased.lo),
-                num(r.unbiased.hi)
-            ),
-            num(r.exact_variance_biased),
-            num(r.measured_variance_biased),
-        ]);
-    }
-    out.para(&format!(
-        "**The lecture's example.** f(x) = 3x² on [0, 1] (μ = 1, σ² = 0.8), {} repetitions per N: \
-         (1/N) Σ f is unbiased; (1/(N+1)) Σ f has bias exactly −μ/(N+1), which vanishes as N \
-         grows — biased yet consistent.",
-        scale.lecture_repetitions
-    ));
-    out.table(
-        "lecture",
-        "(1/N) Σ f against (1/(N+1)) Σ f",
-        "Exact and measured bias (t intervals over the repetitions), and the biased estimator's \
-         variance N σ²/(N+1)² exact and measured.",
-        &[
-            "N",
-            "exact bias of 1/(N+1)",
-            "measured",
-            "exact inside",
-            "bias of 1/N",
-            "variance exact",
-            "variance measured",
-        ],
-        lrows,
-        true,
-    )?;
-    let xs: Vec<f64> = lecture.iter().map(|r| r.n as f64).collect();
-    out.chart(
-        "lecture",
-        &Chart {
-            title: "The lecture's example: |bias| of (1/(N+1)) Σ f".into(),
-            x_label: "N".into(),
-            y_label: "|bias|".into(),
-            log_x: true,
-            log_y: true,
-            series: vec![
-                Series {
-                    name: "exact μ/(N+1)".into(),
-                    points: lecture
-                        .iter()
-                        .map(|r| (r.n as f64, -r.exact_bias))
-                        .collect(),
-                    y_interval: Vec::new(),
-                    style: Style::Fitted,
-                },
-                Series {
-                    name: "measured".into(),
-                    points: xs
-                        .iter()
-                        .zip(&lecture)
-                        .map(|(&x, r)| (x, -r.biased.estimate))
-                        .collect(),
-                    y_interval: lecture
-                        .iter()
-                        .map(|r| (-r.biased.hi, -r.biased.lo))
-                        .collect(),
-                    style: Style::Measured,
-                },
-            ],
-        },
-        "Measured bias (t intervals) against the exact −μ/(N+1).",
-    )?;
-    out.finish()
+    )
 }
