@@ -476,3 +476,16 @@ fn free_flight_weights_are_unbiased() {
     let failures = z_failures(&cases, cases.len());
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+#[test]
+fn world_bounds_are_the_placed_unit_cube() {
+    let (_, vol) = product_medium(1, 1);
+    let [lo, hi] = vol.world_bounds();
+    let (want_lo, want_hi) = (Vec3::new(-1.0, 0.0, -0.5), Vec3::new(2.0, 1.5, 0.5));
+    // Through an inverse and back: a few ulps of the extent.
+    let tol = 8.0 * f32::EPSILON * 3.0;
+    assert!(
+        (lo - want_lo).abs().max_element() <= tol && (hi - want_hi).abs().max_element() <= tol,
+        "{lo} {hi}"
+    );
+}

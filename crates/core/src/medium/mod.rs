@@ -26,6 +26,12 @@
 //! forward-scattering HG (g > 0) favours ω_i = −ω_o. Their densities are solid angle, their values
 //! per steradian and reciprocal (p(ω_o, ω_i) = p(ω_i, ω_o)), so transport mode does not enter.
 //!
+//! Two media: [`Homogeneous`] (closed forms, allocation-free: what photon beams read through
+//! [`Medium::as_homogeneous`]) and [`GridMedium`] (Mitsuba's `heterogeneous` over a `gridvolume`
+//! or `constvolume`; its scheme, a uniformly chosen channel tracked by delta tracking and weighed
+//! by the mean density over channels with the exact deterministic T, is in `grid.rs`). Parameters
+//! are checked by the constructors in [`params`].
+//!
 //! A scene without media holds none of this: `Scene::media` is empty and no walk asks.
 
 pub mod grid;

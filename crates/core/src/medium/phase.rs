@@ -111,14 +111,16 @@ mod tests {
             assert_eq!(sample_hg_cos(0.0, g), -1.0);
             assert!((sample_hg_cos(1.0, g) - 1.0).abs() < 1e-6);
         }
-        // The mean cosine is g: midpoint rule over u on a fine grid.
+        // The mean cosine is g: midpoint rule over u. μ(u) is monotone with total variation 2,
+        // so the rule errs by at most 2/n; each f32 value adds ε/2 relative.
         for g in [-0.7f32, 0.3, 0.7] {
             let n = 100_000;
             let mean: f64 = (0..n)
                 .map(|i| sample_hg_cos((i as f32 + 0.5) / n as f32, g) as f64)
                 .sum::<f64>()
                 / n as f64;
-            assert!((mean - g as f64).abs() < 1e-3, "g {g}: mean {mean}");
+            let bound = 2.0 / n as f64 + f32::EPSILON as f64;
+            assert!((mean - g as f64).abs() <= bound, "g {g}: mean {mean}");
         }
     }
 

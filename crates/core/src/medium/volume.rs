@@ -151,6 +151,19 @@ impl GridVolume {
         })
     }
 
+    /// World-space bounding box of the unit cube the grid spans (where it is not extended by the
+    /// wrap mode): its eight corners mapped by to_local⁻¹.
+    pub fn world_bounds(&self) -> [Vec3; 2] {
+        let to_world = self.to_local.inverse();
+        let mut b = [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)];
+        for i in 0..8 {
+            let c = Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32);
+            let w = to_world.transform_point3(c);
+            b = [b[0].min(w), b[1].max(w)];
+        }
+        b
+    }
+
     /// Sample-space coordinates u = local·n − ½ of a world point (samples at integer u).
     #[inline]
     pub fn sample_space(&self, p: Vec3) -> Vec3 {
