@@ -36,3 +36,19 @@ pub fn geometry_term(x: Vec3, nx: Vec3, y: Vec3, ny: Vec3) -> f32 {
 pub fn perpendicular_to_area(pdf_perp: f32, dir: Vec3, n_to: Vec3) -> f32 {
     pdf_perp * n_to.dot(dir).abs()
 }
+
+/// Converts a solid-angle density at `from` into a volume density at the point `to` inside a
+/// medium, per unit length of free flight: p_V = p_ω · p_ff / ‖to − from‖², because a volume
+/// element seen from `from` is dV = r² dr dω (Pauly et al. 2000, §3). There is no cosine: a
+/// point in a medium has no surface facing the ray. `pdf_len` is the free-flight density per
+/// unit length with which the walk stopped at `to` (`Medium::free_flight_density`, scattered);
+/// a surface reached through media instead takes `solid_angle_to_area` times the probability of
+/// passing every medium on the way, which is a probability, not a density, so no measure changes.
+#[inline]
+pub fn solid_angle_to_volume(pdf_w: f32, pdf_len: f32, from: Vec3, to: Vec3) -> f32 {
+    let d2 = (to - from).length_squared();
+    if d2 == 0.0 {
+        return 0.0;
+    }
+    pdf_w * pdf_len / d2
+}

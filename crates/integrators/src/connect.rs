@@ -79,7 +79,8 @@ pub fn connect_to_camera(
             let ev = eval_towards(scene, y, -lens.dir, TransportMode::Importance)?;
             (lens, y.beta * ev.f_cos, Some(ev))
         }
-        VertexKind::Camera => return None,
+        // Medium vertices: no integrator walks media yet (issue 43, item 4).
+        VertexKind::Camera | VertexKind::Medium { .. } => return None,
     };
     if value == Color::ZERO {
         return None;

@@ -23,6 +23,7 @@ mod glossy;
 pub mod mask;
 pub mod microfacet;
 mod mirror;
+pub mod null;
 pub mod perturbed;
 pub mod plastic;
 mod principled;
@@ -44,6 +45,7 @@ pub use diffuse::{Diffuse, FrontDiffuse};
 pub use glossy::Glossy;
 pub use mask::Mask;
 pub use mirror::Mirror;
+pub use null::Null;
 pub use perturbed::{NormalSource, Perturbed};
 pub use plastic::Plastic;
 pub use principled::Principled;
@@ -212,6 +214,8 @@ pub enum Material {
     Mask(Box<Mask>),
     /// A weighted sum of two materials (Mitsuba's `blendbsdf`).
     Blend(Box<Blend>),
+    /// Mitsuba's `null`: a boundary between media that scatters nothing (`null.rs`).
+    Null(Null),
 }
 
 /// Matches `$material`'s plain variants with `$m` bound to its BSDF, each arm its own copy of
@@ -234,6 +238,7 @@ macro_rules! match_plain {
             Material::Principled($m) => $body,
             Material::PrincipledThin($m) => $body,
             Material::TwoSided($m) => $body,
+            Material::Null($m) => $body,
             $($rest)*
         }
     };

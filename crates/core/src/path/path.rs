@@ -10,14 +10,15 @@ use crate::math::Color;
 use crate::scene::Scene;
 use glam::DVec3;
 
-/// A full path, light end first. Interior vertices are `Surface`s.
+/// A full path, light end first. Interior vertices are `Surface`s or `Medium` points.
 #[derive(Clone, Debug)]
 pub struct Path {
     pub vertices: Vec<PathVertex>,
 }
 
 impl Path {
-    /// Panics unless x0 is a light, xk the camera and the rest surfaces (a programming error).
+    /// Panics unless x0 is a light, xk the camera and the rest surfaces or medium points (a
+    /// programming error).
     pub fn new(vertices: Vec<PathVertex>) -> Path {
         let n = vertices.len();
         assert!(n >= 2, "a path needs a light and a camera vertex");
@@ -30,10 +31,11 @@ impl Path {
             "xk must be the camera"
         );
         assert!(
-            vertices[1..n - 1]
-                .iter()
-                .all(|v| matches!(v.kind, VertexKind::Surface { .. })),
-            "interior vertices must be surfaces"
+            vertices[1..n - 1].iter().all(|v| matches!(
+                v.kind,
+                VertexKind::Surface { .. } | VertexKind::Medium { .. }
+            )),
+            "interior vertices must be surfaces or medium points"
         );
         Path { vertices }
     }
@@ -69,6 +71,32 @@ impl Path {
         )
     }
 
+    /// T(x_i ↔ x_j) per channel through every medium between them (`Scene::edge_transmittance`),
+    /// starting in the medium x_i leaves into. 1 in a scene without media, which asks nothing.
+    fn transmittance(&self, scene: &Scene, i: usize, j: usize) -> DVec3 {
+        if !scene.has_media {
+            return DVec3::ONE;
+        }
+        let v = &self.vertices;
+        let medium = v[i].medium_towards(scene, v[i].dir_to(&v[j]));
+        scene
+            .edge_transmittance((&v[i]).into(), (&v[j]).into(), medium)
+            .as_dvec3()
+    }
+
+    /// The free-flight density of the walk from x_from reaching x_to (`Scene::free_flight_density`:
+    /// per unit length when x_to is a medium point, a pass probability when it is a surface),
+    /// which multiplies the converted direction density into x_to's density. 1 without media.
+    fn free_flight(&self, scene: &Scene, from: usize, to: usize) -> f64 {
+        if !scene.has_media {
+            return 1.0;
+        }
+        let v = &self.vertices;
+        let medium = v[from].medium_towards(scene, v[from].dir_to(&v[to]));
+        let (a, b) = ((&v[from]).into(), (&v[to]).into());
+        scene.free_flight_density(a, b, medium, v[to].in_medium()) as f64
+    }
+
     fn light<'a>(&self, scene: &'a Scene) -> &'a Light {
         match self.vertices[0].kind {
             VertexKind::Light { light, .. } => &scene.lights[light as usize],
@@ -95,6 +123,10 @@ impl Path {
     /// (a delta in direction, stripped like a delta lobe) its irradiance.
     /// The result is f64: per-segment factors scale as 1/length², which underflows f32 for long
     /// paths in scenes measured in kilometres.
+    ///
+    /// Through media (Pauly et al. 2000) every edge carries T(x_i ↔ x_{i+1}) through every
+    /// medium and null boundary between them, and a medium vertex scatters by σs · phase with no
+    /// cosine in its G (`scatter`, `path/mod.rs`).
     pub fn contribution(&self, scene: &Scene) -> DVec3 {
         self.contribution_for(scene, 0)
     }
@@ -115,7 +147,7 @@ impl Path {
             l if x0.is_infinite() => l.escaped(x0.p),
             l => l.emitted(x0.ng, x0.dir_to(&v[1]), x0.uv),
         };
-        let mut f = le.as_dvec3() * geometry(x0, &v[1]) as f64;
+        let mut f = le.as_dvec3() * geometry(x0, &v[1]) as f64 * self.transmittance(scene, 0, 1);
         for i in 1..k {
             let fs = if i < s {
                 self.scatter_at(scene, i, i - 1, i + 1, TransportMode::Importance)
@@ -124,7 +156,9 @@ impl Path {
                 self.scatter_at(scene, i, i + 1, i - 1, TransportMode::Radiance)
                     .f
             };
-            f *= fs.as_dvec3() * geometry(&v[i], &v[i + 1]) as f64;
+            f *= fs.as_dvec3()
+                * geometry(&v[i], &v[i + 1]) as f64
+                * self.transmittance(scene, i, i + 1);
         }
         f * scene.camera.importance(v[k].p, v[k].dir_to(&v[k - 1])) as f64
     }
@@ -145,14 +179,18 @@ impl Path {
         let d01 = x0.dir_to(x1);
         let (pos, dir) = light.pdf_le(x0.ng, d01, scene.bounding_sphere);
         pl[0] = pmf * if x0.is_infinite() { dir } else { pos } as f64;
+        // Through media each density is the converted direction density times the free flight's
+        // (`PathVertex::convert_density`).
         if k >= 2 {
-            pl[1] = x0.convert_density(if x0.is_infinite() { pos } else { dir }, x1) as f64;
+            pl[1] = x0.convert_density(if x0.is_infinite() { pos } else { dir }, x1) as f64
+                * self.free_flight(scene, 0, 1);
         }
         for i in 2..k {
             let pdf_w = self
                 .scatter_at(scene, i - 1, i - 2, i, TransportMode::Importance)
                 .pdf_w;
-            pl[i] = v[i - 1].convert_density(pdf_w, &v[i]) as f64;
+            pl[i] =
+                v[i - 1].convert_density(pdf_w, &v[i]) as f64 * self.free_flight(scene, i - 1, i);
         }
 
         // Next-event estimation of x0 from x1: a delta light (point or directional) is chosen
@@ -168,12 +206,14 @@ impl Path {
         let mut pc = vec![0.0f64; k + 1];
         pc[k] = 1.0;
         let pdf_dir = scene.camera.pdf_dir(v[k].p, v[k].dir_to(&v[k - 1]));
-        pc[k - 1] = v[k].convert_density(pdf_dir, &v[k - 1]) as f64;
+        pc[k - 1] =
+            v[k].convert_density(pdf_dir, &v[k - 1]) as f64 * self.free_flight(scene, k, k - 1);
         for i in (0..k.saturating_sub(1)).rev() {
             let pdf_w = self
                 .scatter_at(scene, i + 1, i + 2, i, TransportMode::Radiance)
                 .pdf_w;
-            pc[i] = v[i + 1].convert_density(pdf_w, &v[i]) as f64;
+            pc[i] =
+                v[i + 1].convert_density(pdf_w, &v[i]) as f64 * self.free_flight(scene, i + 1, i);
         }
         // No walk hits a delta light: a point has no area, a directional light's one direction
         // has no solid angle.

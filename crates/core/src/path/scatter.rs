@@ -53,7 +53,8 @@ pub struct Scatter {
     pub delta: bool,
 }
 
-/// Evaluates the vertex's material. `v` must be a `Surface` vertex; anything else scatters nothing.
+/// Evaluates the vertex's material, or at a `Medium` vertex its phase function
+/// (`scatter_in_medium`); an endpoint scatters nothing.
 /// A delta lobe matches `wi` when the lobe's direction is within `tol` (see `delta_tolerance`).
 pub fn scatter(
     scene: &Scene,
@@ -63,8 +64,10 @@ pub fn scatter(
     mode: TransportMode,
     tol: f32,
 ) -> Scatter {
-    let VertexKind::Surface { material } = v.kind else {
-        return Scatter::default();
+    let material = match v.kind {
+        VertexKind::Surface { material } => material,
+        VertexKind::Medium { medium } => return scatter_in_medium(scene, v, medium, wo, wi),
+        _ => return Scatter::default(),
     };
     let m = scene.material(material);
     let sf = v.shading_frame();
@@ -132,6 +135,29 @@ pub fn scatter(
     }
 }
 
+/// Scattering at a medium vertex (Pauly et al. 2000): the factor of f(x̄) is σs(x) · p(ω_o, ω_i),
+/// the phase function per steradian times the scattering coefficient per unit length — the
+/// volume measure's dV has one more length than a surface's dA, and σs carries it. No cosine: a
+/// point in a medium has no surface (its G has none either). The phase function is reciprocal,
+/// so neither transport mode nor which side `wo` is changes it, and it is never a delta. Its
+/// sampling density is the phase function itself (isotropic and Henyey–Greenstein are sampled
+/// exactly, `medium::phase`).
+fn scatter_in_medium(
+    scene: &Scene,
+    v: &PathVertex,
+    medium: crate::medium::MediumId,
+    wo: Vec3,
+    wi: Vec3,
+) -> Scatter {
+    let m = &scene.media[medium as usize];
+    let phase = m.phase().eval(wo, wi);
+    Scatter {
+        f: m.sigma_s(v.p) * phase,
+        pdf_w: phase,
+        delta: false,
+    }
+}
+
 /// Largest mismatch (chord) accepted for an unambiguous lobe: 20× magnification of 5e-4.
 const MAGNIFIED_TOL: f32 = 1e-2;
 
@@ -163,5 +189,7 @@ pub fn connectable(scene: &Scene, v: &PathVertex) -> bool {
         VertexKind::Light { light, .. } => !scene.lights[light as usize].delta_direction(),
         // An orthographic camera is a delta in direction (`PathVertex::camera_at`).
         VertexKind::Camera => !v.delta,
+        // A phase function has no delta: a medium vertex joins every technique.
+        VertexKind::Medium { .. } => true,
     }
 }

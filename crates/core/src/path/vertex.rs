@@ -23,6 +23,11 @@ pub enum VertexKind {
     Light { light: u32, infinite: bool },
     /// A scattering surface.
     Surface { material: u32 },
+    /// A scattering point inside medium `medium` (`Scene::media`). It has no surface: `ng` =
+    /// `ns` = 0, so G carries no cosine at it (as at a point light), its densities are volume
+    /// measure (`measure::solid_angle_to_volume`) and it scatters by the medium's phase function,
+    /// never a delta.
+    Medium { medium: crate::medium::MediumId },
 }
 
 /// A path vertex (pbrt-v4's `Vertex` without the union): `Copy`, integrator-independent.
@@ -67,6 +72,10 @@ pub struct PathVertex {
     /// The hit's `SurfaceHit::tangent` (zero unless the material is anisotropic), so frames
     /// rebuilt at this vertex agree with the one the walk sampled with.
     pub tangent: Vec3,
+    /// The media on either side of a surface vertex: an index into `Scene::interfaces` (0: no
+    /// medium on either side, every vertex of a scene without media). A u16 fits the padding
+    /// beside `delta`, so the vertex stays at 128 bytes.
+    pub interface: u16,
 }
 
 // Walks push a vertex per bounce; beyond 128 bytes each copy is a `memcpy` call.
@@ -91,6 +100,7 @@ impl PathVertex {
             emitter: NO_EMITTER,
             uv: Default::default(),
             tangent: Vec3::ZERO,
+            interface: 0,
         }
     }
 
@@ -135,9 +145,64 @@ impl PathVertex {
             emitter: hit.light.unwrap_or(NO_EMITTER),
             uv: hit.uv,
             tangent: hit.tangent,
+            interface: hit.interface,
         };
         v.pdf_fwd = prev.convert_density(pdf, &v);
         v
+    }
+
+    /// `surface` reached through participating media: the walk passed every medium piece between
+    /// `prev` and the hit with probability `p_pass` (the product of `Medium::free_flight_density`
+    /// of the passes, `Scene::free_flight_density`), so `pdf_fwd` = p_ω |cos| / d² · P_pass.
+    pub fn surface_through_media(
+        hit: &SurfaceHit,
+        wo: Vec3,
+        beta: Color,
+        pdf: f32,
+        p_pass: f32,
+        prev: &PathVertex,
+    ) -> PathVertex {
+        let mut v = PathVertex::surface(hit, wo, beta, pdf, prev);
+        v.pdf_fwd *= p_pass;
+        v
+    }
+
+    /// A scattering point `p` in medium `medium`, reached from `prev` along −`wo` by a direction
+    /// sampled with solid-angle density `pdf_w` and a free flight that stopped at `p` with density
+    /// `p_ff` per unit length (`Scene::free_flight_density`, scattered at the end): `pdf_fwd` =
+    /// p_ω p_ff / d², volume measure (`measure::solid_angle_to_volume`). No normal, no uv.
+    pub fn medium(
+        medium: crate::medium::MediumId,
+        p: Vec3,
+        wo: Vec3,
+        beta: Color,
+        pdf_w: f32,
+        p_ff: f32,
+        prev: &PathVertex,
+    ) -> PathVertex {
+        let mut v = PathVertex::endpoint(VertexKind::Medium { medium }, p, Vec3::ZERO, beta, 0.0);
+        v.wo = wo;
+        v.pdf_fwd = prev.convert_density(pdf_w, &v) * p_ff;
+        v
+    }
+
+    /// The medium a segment leaving this vertex in direction `w` lies in, at its start (Mitsuba's
+    /// per-ray medium, `scene/media.rs`): a medium vertex's own, the side of a surface `w` leaves
+    /// into, the camera's, the medium a light emits into (an area light's: the side its normal
+    /// faces; at infinity none). Later null boundaries on the way are `Scene`'s business.
+    pub fn medium_towards(&self, scene: &Scene, w: Vec3) -> Option<crate::medium::MediumId> {
+        match self.kind {
+            VertexKind::Medium { medium } => Some(medium),
+            VertexKind::Surface { .. } => scene.medium_across(self.interface, self.ng, w),
+            VertexKind::Camera => scene.camera_medium,
+            VertexKind::Light { light, .. } => scene.light_medium(light),
+        }
+    }
+
+    /// True for a scattering point inside a medium.
+    #[inline]
+    pub fn in_medium(&self) -> bool {
+        matches!(self.kind, VertexKind::Medium { .. })
     }
 
     /// The BSDF's frame at a surface vertex: the same as `SurfaceHit::shading_frame` of its hit.
@@ -286,10 +351,24 @@ impl PathVertex {
     /// pbrt's `ConvertDensity`: a density with which this vertex chose the direction towards
     /// `next` (solid angle; for a vertex at infinity, the perpendicular-disk density) turned into
     /// the measure `next` is stored in. A vertex at infinity keeps solid angle.
+    ///
+    /// Through media this is the density of `next` given that the free flight reached it: the
+    /// caller multiplies the free-flight density of the segment (`Scene::free_flight_density`:
+    /// per unit length when `next` is a medium vertex, which makes the product a volume density;
+    /// the probability of passing every medium when `next` is a surface).
     #[inline]
     pub fn convert_density(&self, pdf: f32, next: &PathVertex) -> f32 {
         if next.is_infinite() {
             return pdf;
+        }
+        if next.in_medium() {
+            let from = if self.is_infinite() {
+                // A parallel ray from the disk of a light at infinity: no 1/d² (`perpendicular`).
+                return pdf;
+            } else {
+                self.p
+            };
+            return measure::solid_angle_to_volume(pdf, 1.0, from, next.p);
         }
         let n = if next.on_surface() {
             next.ng

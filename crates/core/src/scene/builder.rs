@@ -1,7 +1,7 @@
 //! Assembling a scene in code: the loader and the tests both go through this one path, so a scene
 //! built by hand is checked and indexed exactly like one read from a file.
 
-use super::{RenderSettings, Scene, Shape};
+use super::{MediumInterface, RenderSettings, Scene, Shape};
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::geometry::quad::Parallelogram;
@@ -10,6 +10,7 @@ use crate::geometry::sdf::SdfVoxel;
 use crate::geometry::{Accel, Primitive};
 use crate::light::{Light, LightDesc, LightSampler};
 use crate::math::{Color, Vec3};
+use crate::medium::{Medium, MediumId};
 use crate::shape::{ShapeGeometry, TriangleMesh};
 use crate::texture::Texture;
 
@@ -101,6 +102,12 @@ pub struct SceneBuilder {
     lights: Vec<LightDesc>,
     /// Set by a loader that recentred in f64 itself (`set_origin`).
     origin: Option<Vec3>,
+    media: Vec<Medium>,
+    /// Per shape, parallel to `shapes`.
+    shape_media: Vec<MediumInterface>,
+    /// Per light description, parallel to `lights`.
+    light_media: Vec<Option<MediumId>>,
+    camera_medium: Option<MediumId>,
 }
 
 impl SceneBuilder {
@@ -112,7 +119,36 @@ impl SceneBuilder {
             shapes: Vec::new(),
             lights: Vec::new(),
             origin: None,
+            media: Vec::new(),
+            shape_media: Vec::new(),
+            light_media: Vec::new(),
+            camera_medium: None,
         }
+    }
+
+    /// Returns the medium's id for shapes, the camera and lights to refer to.
+    pub fn add_medium(&mut self, m: Medium) -> MediumId {
+        self.media.push(m);
+        (self.media.len() - 1) as MediumId
+    }
+
+    /// The medium the camera sits in.
+    pub fn set_camera_medium(&mut self, medium: Option<MediumId>) {
+        self.camera_medium = medium;
+    }
+
+    /// The media inside and outside the shape added last (Mitsuba's `interior`/`exterior`; the
+    /// exterior is the side its normal faces, after `flip_normals`).
+    pub fn set_last_shape_media(&mut self, media: MediumInterface) {
+        if let Some(last) = self.shape_media.last_mut() {
+            *last = media;
+        }
+    }
+
+    /// `add_light` for a light that sits in a medium (a point or spot light inside fog).
+    pub fn add_light_in_medium(&mut self, light: LightDesc, medium: Option<MediumId>) {
+        self.lights.push(light);
+        self.light_media.push(medium);
     }
 
     /// Declares every position given (shapes, point lights, the camera eye) to be world − `origin`
@@ -151,10 +187,11 @@ impl SceneBuilder {
     ) {
         self.shapes
             .push((geometry, material, radiance, flip_normals));
+        self.shape_media.push(MediumInterface::default());
     }
 
     pub fn add_light(&mut self, light: LightDesc) {
-        self.lights.push(light);
+        self.add_light_in_medium(light, None);
     }
 
     /// Indexes the scene, recentred on `scene_origin` of its geometry: every shape, positioned light
@@ -182,8 +219,12 @@ impl SceneBuilder {
         }
         let mut shapes = Vec::with_capacity(self.shapes.len());
         let mut lights = Vec::new();
+        let mut light_media = Vec::new();
         let mut prims = Vec::new();
-        for (geometry, material, emission, flip_normals) in self.shapes {
+        let mut interfaces = vec![MediumInterface::default()];
+        for ((geometry, material, emission, flip_normals), media) in
+            self.shapes.into_iter().zip(self.shape_media)
+        {
             let shape_id = shapes.len() as u32;
             match &geometry {
                 ShapeGeometry::Mesh(m) => push_mesh_primitives(m, shape_id, &mut prims),
@@ -215,8 +256,16 @@ impl SceneBuilder {
             let textured_light = matches!(&emission, Some(e) if !matches!(e, Texture::Constant(_)));
             let light = emission.map(|e| {
                 lights.push(Light::area(shape_id, &geometry, &e, flip_normals));
+                light_media.push(media.exterior);
                 (lights.len() - 1) as u32
             });
+            let interface = match interfaces.iter().position(|i| *i == media) {
+                Some(i) => i,
+                None => {
+                    interfaces.push(media);
+                    interfaces.len() - 1
+                }
+            };
             // A missing attribute reads as zero (the loaders report it first).
             let attribute = match (
                 &geometry,
@@ -234,6 +283,9 @@ impl SceneBuilder {
                 light,
                 flip_normals,
                 attribute,
+                interface: u16::try_from(interface)
+                    .expect("more than 65 535 distinct (interior, exterior) media pairs"),
+                null: matches!(m, Material::Null(_)),
             });
         }
         let accel = Accel::build(prims);
@@ -242,13 +294,21 @@ impl SceneBuilder {
         let radius = (0.5 * (hi - lo).length()).max(f32::MIN_POSITIVE);
         let bounding_sphere = (center, radius);
         let mut infinite_lights = Vec::new();
-        for desc in self.lights {
+        for (desc, medium) in self.lights.into_iter().zip(self.light_media) {
             let light = Light::from_desc(&desc);
             if light.is_infinite() {
                 infinite_lights.push(lights.len() as u32);
             }
             lights.push(light);
+            light_media.push(if desc_is_infinite(&lights) {
+                None
+            } else {
+                medium
+            });
         }
+        let has_media = self.camera_medium.is_some()
+            || interfaces.len() > 1
+            || light_media.iter().any(Option::is_some);
         let light_sampler = LightSampler::new(&lights, bounding_sphere);
         Scene {
             origin,
@@ -262,7 +322,17 @@ impl SceneBuilder {
             infinite_lights,
             bounding_sphere,
             source_files: Vec::new(),
+            media: self.media,
+            interfaces,
+            camera_medium: self.camera_medium,
+            light_media,
+            has_media,
             accel,
         }
     }
+}
+
+/// True when the light pushed last sits at infinity (it emits into no medium).
+fn desc_is_infinite(lights: &[Light]) -> bool {
+    lights.last().is_some_and(Light::is_infinite)
 }

@@ -32,6 +32,8 @@ pub struct SurfaceHit {
     pub material: u32,
     /// Index into `Scene::lights` when the surface emits.
     pub light: Option<u32>,
+    /// The shape's media (`Scene::interfaces`; 0 without media), copied into its path vertex.
+    pub interface: u16,
 }
 
 impl SurfaceHit {
@@ -174,6 +176,7 @@ impl SurfaceHit {
             shape: prim.shape(),
             material: shape.material,
             light: shape.light,
+            interface: shape.interface,
         }
     }
 

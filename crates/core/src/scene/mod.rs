@@ -4,6 +4,7 @@
 
 mod builder;
 mod hit;
+mod media;
 pub mod ray_stats;
 mod translated;
 mod visibility;
@@ -12,6 +13,7 @@ pub use crate::light::LightDesc;
 pub use crate::shape::{MeshAttribute, ShapeGeometry, TriangleMesh};
 pub use builder::SceneBuilder;
 pub use hit::SurfaceHit;
+pub use media::{MediumInterface, MediumPiece};
 pub use visibility::ConnectionEnd;
 
 use crate::bsdf::Material;
@@ -60,6 +62,11 @@ pub struct Shape {
     pub reads_uv: bool,
     /// `Material::needs_tangent`, asked once here instead of at every hit.
     pub needs_tangent: bool,
+    /// The media inside and outside the shape: an index into `Scene::interfaces` (0: none).
+    pub interface: u16,
+    /// The shape is a `null` boundary (`Material::Null`, resolved once at build): it only
+    /// separates media; a media-aware walk passes through it without making a vertex.
+    pub null: bool,
 }
 
 pub struct Scene {
@@ -84,6 +91,18 @@ pub struct Scene {
     /// The files the scene was read from, the scene file first, then every mesh it names in file
     /// order: what a content hash of the scene must cover. Empty for scenes built in code.
     pub source_files: Vec<std::path::PathBuf>,
+    /// Participating media, indexed by `MediumId` (empty for a scene without media).
+    pub media: Vec<crate::medium::Medium>,
+    /// The distinct (interior, exterior) pairs of the shapes; entry 0 is (none, none).
+    pub interfaces: Vec<MediumInterface>,
+    /// The medium the camera sits in.
+    pub camera_medium: Option<crate::medium::MediumId>,
+    /// The medium each light emits into (an area light: its shape's exterior, the side its
+    /// normal faces; a light at infinity: none).
+    pub light_media: Vec<Option<crate::medium::MediumId>>,
+    /// True when any medium is referenced by a shape, the camera or a light: every media query
+    /// is behind this one flag, so a scene without media does no extra work.
+    pub has_media: bool,
     pub(crate) accel: Accel,
 }
 

@@ -23,9 +23,9 @@ pub struct ConnectionEnd {
 /// One end of a shadow ray: a point, its per-axis error bound and its geometric normal (zero when
 /// it has none: a point light, a bare point).
 #[derive(Clone, Copy, Debug)]
-struct End {
-    p: Vec3,
-    err: Vec3,
+pub(super) struct End {
+    pub(super) p: Vec3,
+    pub(super) err: Vec3,
     ng: Vec3,
 }
 
@@ -33,7 +33,7 @@ impl End {
     /// The point moved out of its error box to the side `w` points into. Without a normal it moves
     /// along `w` itself, which leaves the box just as surely.
     #[inline]
-    fn towards(&self, w: Vec3) -> Vec3 {
+    pub(super) fn towards(&self, w: Vec3) -> Vec3 {
         let n = if self.ng == Vec3::ZERO {
             w.normalize_or_zero()
         } else {
@@ -52,7 +52,7 @@ impl Scene {
         (lo.abs().max(hi.abs()).max(p.abs())) * gamma(7)
     }
 
-    fn end(&self, p: Vec3, err: Vec3, ng: Vec3) -> End {
+    pub(super) fn end(&self, p: Vec3, err: Vec3, ng: Vec3) -> End {
         let err = if err == Vec3::ZERO {
             self.default_error(p)
         } else {

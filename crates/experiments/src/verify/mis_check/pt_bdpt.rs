@@ -327,6 +327,7 @@ fn is_delta(scene: &Scene, v: &PathVertex, d: &lt_core::path::Densities, i: usiz
         }
         VertexKind::Light { light, .. } => scene.lights[light as usize].delta_direction(),
         VertexKind::Camera => scene.camera.is_delta_direction(),
+        VertexKind::Medium { .. } => false,
     }
 }
 
@@ -576,6 +577,7 @@ fn kind_name(scene: &Scene, v: &PathVertex) -> String {
                 if m.is_delta() { "(delta)" } else { "" }
             )
         }
+        VertexKind::Medium { medium } => format!("medium#{medium}"),
     }
 }
 

@@ -1,0 +1,262 @@
+//! Participating media as the scene sees them: which medium a ray is in, and what a segment
+//! between two points passes through.
+//!
+//! **How the medium of a ray is tracked: Mitsuba's per-ray medium.** Each shape names the medium
+//! inside it and the one outside (`MediumInterface`; the exterior is the side its geometric normal
+//! faces, after `flip_normals`), the camera and each light the medium they sit in. A ray leaving a
+//! surface is in the medium on the side it leaves into, a ray leaving a medium vertex in that
+//! vertex's medium, and crossing a `null` boundary switches to the medium on the far side
+//! (`MediumInterface::towards`). So the medium of every segment is a function of one end vertex
+//! and the direction, never of the path's history: the light walk and the camera walk use the
+//! same rule and agree by construction, a connection between any two subpath vertices knows its
+//! medium from either end, the from-scratch oracle recomputes it, and a vertex carries it in two
+//! bytes (`PathVertex::interface`). SmallUPBP's boundary stack with priorities instead carries the
+//! history (which boundaries were entered), which must then travel with every vertex and be merged
+//! at every connection; what it buys — overlapping media resolved by priority without saying what
+//! is outside — is had here by declaring the exterior: a medium nested in another names the outer
+//! medium as its exterior, and a medium inside glass is the dielectric's interior (its exterior the
+//! air or fog around it), which is Mitsuba's convention and so its test scenes'.
+
+use super::{ConnectionEnd, Scene};
+use crate::geometry::{offset_ray_origin, Ray};
+use crate::math::{gamma, Color, Vec3};
+use crate::medium::MediumId;
+use crate::sampling::Sampler;
+
+/// The media on the two sides of a shape (Mitsuba's `interior` and `exterior`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MediumInterface {
+    pub interior: Option<MediumId>,
+    pub exterior: Option<MediumId>,
+}
+
+impl MediumInterface {
+    /// The medium on the side of a surface with geometric normal `ng` that `w` points into.
+    #[inline]
+    pub fn towards(&self, ng: Vec3, w: Vec3) -> Option<MediumId> {
+        if ng.dot(w) > 0.0 {
+            self.exterior
+        } else {
+            self.interior
+        }
+    }
+}
+
+/// One straight piece of a segment inside one medium (`None`: vacuum), from `a` to `b`.
+#[derive(Clone, Copy, Debug)]
+pub struct MediumPiece {
+    pub medium: Option<MediumId>,
+    pub a: Vec3,
+    pub b: Vec3,
+}
+
+/// Where a segment towards a light at infinity is cut off: far enough that any positive σt
+/// extinguishes it (T = 0, as over an infinite medium), representable in f32.
+const FAR: f32 = 1e30;
+
+/// More boundary crossings than this on one segment is a ray caught in a degenerate spot.
+const MAX_CROSSINGS: usize = 1024;
+
+/// Which surfaces a segment walk passes: every one (the oracle, whose f excludes visibility:
+/// an opaque surface is then a boundary like a null one, and V zeroes the edge anyway), or null
+/// ones only (a shadow ray: an opaque surface blocks).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Crossing {
+    Everything,
+    NullOnly,
+}
+
+impl Scene {
+    /// The medium on the side of a surface with interface `interface` and normal `ng` that `w`
+    /// leaves into (0 is (none, none): no lookup needed without media).
+    #[inline]
+    pub fn medium_across(&self, interface: u16, ng: Vec3, w: Vec3) -> Option<MediumId> {
+        self.interfaces[interface as usize].towards(ng, w)
+    }
+
+    /// The medium light `light` emits into.
+    #[inline]
+    pub fn light_medium(&self, light: u32) -> Option<MediumId> {
+        self.light_media[light as usize]
+    }
+
+    /// Cuts the segment a → b (either end may be at infinity, not both) into its pieces between
+    /// boundaries, starting in `medium` at `a`, in order from `a`; `visit` sees each. Returns false
+    /// (having visited the pieces before it) when a surface that `crossing` does not pass blocks.
+    pub fn for_each_medium_piece(
+        &self,
+        a: ConnectionEnd,
+        b: ConnectionEnd,
+        medium: Option<MediumId>,
+        crossing: Crossing,
+        mut visit: impl FnMut(MediumPiece),
+    ) -> bool {
+        // Crossings are found from a finite end; from a light at infinity they are found from the
+        // other end and walked backwards.
+        let (from, to, reversed) = if a.infinite {
+            (b, a, true)
+        } else {
+            (a, b, false)
+        };
+        let Some(crossings) = self.crossings(from, to) else {
+            return false;
+        };
+        let dir = if to.infinite {
+            to.p
+        } else {
+            (to.p - from.p).normalize()
+        };
+        let far = |p: Vec3, d: Vec3| p + d * FAR;
+        let (start, end, d) = if reversed {
+            (far(from.p, dir), from.p, -dir)
+        } else if to.infinite {
+            (from.p, far(from.p, dir), dir)
+        } else {
+            (from.p, to.p, dir)
+        };
+        let order: Box<dyn Iterator<Item = &(Vec3, u32, Vec3)>> = if reversed {
+            Box::new(crossings.iter().rev())
+        } else {
+            Box::new(crossings.iter())
+        };
+        let (mut current, mut here) = (medium, start);
+        for &(p, shape, ng) in order {
+            let s = &self.shapes[shape as usize];
+            if crossing == Crossing::NullOnly && !s.null {
+                return false;
+            }
+            visit(MediumPiece {
+                medium: current,
+                a: here,
+                b: p,
+            });
+            current = self.medium_across(s.interface, ng, d);
+            here = p;
+        }
+        visit(MediumPiece {
+            medium: current,
+            a: here,
+            b: end,
+        });
+        true
+    }
+
+    /// The surfaces strictly between `from` (finite) and `to`, in order from `from`: each hit
+    /// point with its shape and its outward geometric normal. `None` when the walk does not end (a degenerate spot).
+    fn crossings(&self, from: ConnectionEnd, to: ConnectionEnd) -> Option<Vec<(Vec3, u32, Vec3)>> {
+        let a = self.end(from.p, from.p_err, from.ng);
+        let target = (!to.infinite).then(|| self.end(to.p, to.p_err, to.ng));
+        let dir0 = match &target {
+            Some(b) => b.p - a.p,
+            None => to.p,
+        };
+        let mut origin = a.towards(dir0);
+        let mut found = Vec::new();
+        for _ in 0..MAX_CROSSINGS {
+            let (dir, t_max) = match &target {
+                Some(b) => {
+                    let d = b.towards(-dir0) - origin;
+                    if !(d.dot(dir0) > 0.0) {
+                        return Some(found);
+                    }
+                    let len = d.length();
+                    let dir = d / len;
+                    (dir, (len - dir.abs().dot(b.err)) * (1.0 - gamma(2)))
+                }
+                None => (dir0.normalize(), f32::INFINITY),
+            };
+            if !(t_max > 0.0) {
+                return Some(found);
+            }
+            let Some(hit) = self.intersect(&Ray {
+                o: origin,
+                d: dir,
+                t_max,
+            }) else {
+                return Some(found);
+            };
+            found.push((hit.p, hit.shape, hit.ng));
+            origin = offset_ray_origin(hit.p, hit.p_err, hit.ng, dir);
+        }
+        None
+    }
+
+    /// T(a, b) through null boundaries, deterministic (each medium's exact `transmittance`), or
+    /// `None` when an opaque surface blocks: what a shadow ray or connection is worth.
+    pub fn transmittance(
+        &self,
+        a: ConnectionEnd,
+        b: ConnectionEnd,
+        medium: Option<MediumId>,
+    ) -> Option<Color> {
+        let mut t = Color::ONE;
+        let open = self.for_each_medium_piece(a, b, medium, Crossing::NullOnly, |piece| {
+            if let Some(m) = piece.medium {
+                t *= self.media[m as usize].transmittance(piece.a, piece.b);
+            }
+        });
+        open.then_some(t)
+    }
+
+    /// An unbiased estimate of T(a, b) through null boundaries (`Medium::transmittance_estimate`
+    /// per piece), or `None` when an opaque surface blocks: for integrators' shadow rays.
+    pub fn transmittance_estimate(
+        &self,
+        a: ConnectionEnd,
+        b: ConnectionEnd,
+        medium: Option<MediumId>,
+        sampler: &mut Sampler,
+    ) -> Option<Color> {
+        let mut t = Color::ONE;
+        let open = self.for_each_medium_piece(a, b, medium, Crossing::NullOnly, |piece| {
+            if let Some(m) = piece.medium {
+                t *= self.media[m as usize].transmittance_estimate(piece.a, piece.b, sampler);
+            }
+        });
+        open.then_some(t)
+    }
+
+    /// The oracle's T of a path edge: every surface crossed is a boundary (visibility is not
+    /// part of f(x̄)), so it is defined for every edge; on a visible edge it is `transmittance`.
+    pub fn edge_transmittance(
+        &self,
+        a: ConnectionEnd,
+        b: ConnectionEnd,
+        medium: Option<MediumId>,
+    ) -> Color {
+        let mut t = Color::ONE;
+        self.for_each_medium_piece(a, b, medium, Crossing::Everything, |piece| {
+            if let Some(m) = piece.medium {
+                t *= self.media[m as usize].transmittance(piece.a, piece.b);
+            }
+        });
+        t
+    }
+
+    /// The density with which free-flight sampling from `a` towards `b`, restarted in each medium
+    /// piece after a boundary, produces the outcome that ends at `b`: the product of the pieces'
+    /// pass probabilities, times (when `scattered_at_b`) the last piece's density per unit length
+    /// of scattering at `b` instead of its pass probability (`Medium::free_flight_density`). A
+    /// vacuum piece is passed with probability 1 (and nothing scatters in it: density 0).
+    pub fn free_flight_density(
+        &self,
+        a: ConnectionEnd,
+        b: ConnectionEnd,
+        medium: Option<MediumId>,
+        scattered_at_b: bool,
+    ) -> f32 {
+        let mut pieces = Vec::new();
+        self.for_each_medium_piece(a, b, medium, Crossing::Everything, |p| pieces.push(p));
+        let last = pieces.len() - 1;
+        let mut p = 1.0;
+        for (i, piece) in pieces.iter().enumerate() {
+            let scattered = scattered_at_b && i == last;
+            p *= match piece.medium {
+                Some(m) => self.media[m as usize].free_flight_density(piece.a, piece.b, scattered),
+                None if scattered => 0.0,
+                None => 1.0,
+            };
+        }
+        p
+    }
+}
