@@ -45,15 +45,15 @@ enum Command {
     /// Write one of our scenes as Mitsuba 3 XML.
     Convert(x::commands::convert::ConvertArgs),
     /// Merge partial renders (--partial) or independent runs exactly into one image.
-    Merge(x::cluster::MergeArgs),
+    Merge(x::commands::merge::MergeArgs),
     /// Split a render or a study into independent shards for a cluster.
-    Plan(x::cluster::PlanArgs),
+    Plan(x::commands::plan::PlanArgs),
     /// Run one shard of a plan.
-    RunShard(x::cluster::RunShardArgs),
+    RunShard(x::commands::run_shard::RunShardArgs),
     /// Hand a plan to Slurm, GNU parallel or the local pool.
-    Submit(x::cluster::SubmitArgs),
+    Submit(x::commands::submit::SubmitArgs),
     /// Merge a plan's finished shards into its render or study outputs.
-    Collect(x::cluster::CollectArgs),
+    Collect(x::commands::collect::CollectArgs),
     /// Render Mitsuba 3's render-test suite (mitsuba-data's tests/scenes) and judge each scene
     /// against its reference: results/mitsuba-render-tests.md.
     MitsubaSuite(x::commands::mitsuba_suite::SuiteArgs),
@@ -74,11 +74,11 @@ fn main() -> ExitCode {
         Command::Study(a) => x::commands::study::run(a),
         Command::Report(a) => x::commands::report::run(a),
         Command::Convert(a) => x::commands::convert::run(a),
-        Command::Merge(a) => x::cluster::merge(a),
-        Command::Plan(a) => x::cluster::plan(a),
-        Command::RunShard(a) => x::cluster::run_shard(a),
-        Command::Submit(a) => x::cluster::submit(a),
-        Command::Collect(a) => x::cluster::collect(a),
+        Command::Merge(a) => x::commands::merge::run(a),
+        Command::Plan(a) => x::commands::plan::run(a),
+        Command::RunShard(a) => x::commands::run_shard::run(a),
+        Command::Submit(a) => x::commands::submit::run(a),
+        Command::Collect(a) => x::commands::collect::run(a),
         Command::MitsubaSuite(a) => x::commands::mitsuba_suite::run(a),
         Command::List => x::commands::list::run(),
     };

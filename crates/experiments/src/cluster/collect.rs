@@ -8,21 +8,18 @@ use super::partial::{merge, Partial, ENTRY_FILE};
 use super::plan::{absolute, log_path, Plan, Target};
 use super::shard::{read_state, utc};
 use super::study_link;
-use clap::Args;
 use std::path::{Path, PathBuf};
 
-#[derive(Args, Debug)]
-pub struct CollectArgs {
+/// What `lt collect` is asked: the plan folder and how to treat missing shards.
+#[derive(Clone, Debug)]
+pub struct CollectOptions {
     /// The plan folder.
     pub plan: PathBuf,
-    /// Merge the finished shards even if some are missing (the record lists what is missing).
-    #[arg(long)]
+    /// Merge the finished shards even if some are missing.
     pub allow_incomplete: bool,
-    /// Write the render here instead of where the plan says (render plans).
-    #[arg(long, short)]
+    /// Where the render goes instead of where the plan says (render plans).
     pub output: Option<PathBuf>,
     /// Worker threads for what a study renders itself (0 = one per core).
-    #[arg(long, default_value_t = 0)]
     pub threads: usize,
 }
 
@@ -79,7 +76,8 @@ pub fn why_missing(dir: &Path, plan: &Plan, i: usize) -> String {
     format!("shard {i} ({}): {what}; {log_note}", shard.label)
 }
 
-pub fn collect(args: &CollectArgs) -> Result<(), String> {
+/// Merges a plan's finished shards into its render, or reruns its study from the cache.
+pub fn collect(args: &CollectOptions) -> Result<(), String> {
     let dir = absolute(&args.plan)?;
     let plan = Plan::read(&dir)?;
     plan.check_code(&dir)?;

@@ -5,27 +5,20 @@
 //!
 //! - `partial`: the `.ltp` format (count, per-pixel mean and M2 in f64, identity), the pass-range
 //!   and run-set renders, and the exact merge with its refusals.
-//! - `merge`: `lt merge`.
-//! - `plan`: `lt plan render|study`, the plan folder.
-//! - `shard`: `lt run-shard`, with per-shard state files.
-//! - `submit`: `lt submit --slurm|--parallel|--local`.
-//! - `collect`: `lt collect`.
+//! - `plan`: plans of a render or a study (`lt plan render|study`), the plan folder.
+//! - `shard`: one shard run into the cache, with its state file (`lt run-shard`).
+//! - `submit`: a plan handed to Slurm, GNU parallel or the local pool (`lt submit`).
+//! - `collect`: finished shards merged into the render or the study (`lt collect`).
 //! - `assemble`: a study render split into pass ranges made back into its cache entry.
 //! - `study_link`: which renders a study needs and how its outputs are made.
 //!
-//! See docs/cluster.md.
+//! The five subcommands' arguments live in `crate::commands` (`merge`, `plan`, `run_shard`,
+//! `submit`, `collect`), which hands them here. See docs/cluster.md.
 
 pub mod assemble;
 pub mod collect;
-pub mod merge;
 pub mod partial;
 pub mod plan;
 pub mod shard;
 pub mod study_link;
 pub mod submit;
-
-pub use collect::{collect, CollectArgs};
-pub use merge::{merge, MergeArgs};
-pub use plan::{plan, PlanArgs};
-pub use shard::{run_shard, RunShardArgs};
-pub use submit::{submit, SubmitArgs};

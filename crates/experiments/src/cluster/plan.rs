@@ -12,7 +12,6 @@ use super::partial::{normalize_params, parse_resolution, PartialJob, Span};
 use super::study_link;
 use crate::cache::{key_of, RenderCache, CODE_VERSION};
 use crate::runs::RunSpec;
-use clap::{Args, Subcommand};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -94,6 +93,25 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// A plan of this build's code, run by the lt binary the setup names.
+    fn of(
+        target: Target,
+        shards: Vec<Shard>,
+        assemble: Vec<Assembly>,
+        setup: &PlanSetup,
+    ) -> Result<Plan, String> {
+        Ok(Plan {
+            format: PLAN_FORMAT.into(),
+            version: PLAN_VERSION,
+            code_version: CODE_VERSION.into(),
+            lt: lt_binary(&setup.lt)?,
+            threads: setup.threads,
+            target,
+            shards,
+            assemble,
+        })
+    }
+
     pub fn read(dir: &Path) -> Result<Plan, String> {
         let path = dir.join(PLAN_FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| {
@@ -193,101 +211,53 @@ pub fn state_path(plan_dir: &Path, i: usize) -> PathBuf {
     state_dir(plan_dir).join(format!("shard-{i}.json"))
 }
 
-#[derive(Args, Debug)]
-pub struct PlanArgs {
-    #[command(subcommand)]
-    pub what: PlanWhat,
-}
-
-#[derive(Subcommand, Debug)]
-#[allow(clippy::large_enum_variant)] // parsed once
-pub enum PlanWhat {
-    /// Split one render into shards: pass ranges of one seed (unbiased integrators) or groups of
-    /// independent runs (--runs K; the only split of pm, ppm, sppm, bpm, vcm).
-    Render(PlanRenderArgs),
-    /// Split a study into its cached renders, one shard each.
-    Study(PlanStudyArgs),
-}
-
-#[derive(Args, Debug, Clone)]
-pub struct PlanCommon {
+/// Where a plan is written and how its shards run: what `lt plan`'s common flags give.
+#[derive(Clone, Debug)]
+pub struct PlanSetup {
     /// The plan folder to write.
-    #[arg(long, short)]
     pub output: PathBuf,
-    /// The cache the shards write into (default results/cache; for a study plan RESULTS/cache,
-    /// the one `lt study` reads, with its references in RESULTS/references).
-    #[arg(long)]
+    /// The cache the shards write into (default results/cache; for a study RESULTS/cache).
     pub cache: Option<PathBuf>,
-    /// The lt binary the shard commands run (default: this one). On a cluster it must be on a
-    /// filesystem every node mounts at the same path.
-    #[arg(long)]
+    /// The lt binary the shard commands run (default: this one).
     pub lt: Option<PathBuf>,
     /// Worker threads per shard (0 = one per core the shard may use).
-    #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Replace an existing, different plan in the folder (its state, logs and joblog go too).
-    #[arg(long)]
+    /// Replace an existing, different plan in the folder.
     pub force: bool,
 }
 
-#[derive(Args, Debug)]
-pub struct PlanRenderArgs {
-    /// Scene file.
+/// One render to split: pass ranges of one seed, or groups of independent runs.
+#[derive(Clone, Debug)]
+pub struct RenderSplit {
     pub scene: PathBuf,
-    #[arg(long, short, default_value = "pt")]
     pub integrator: String,
-    /// Passes (samples per pixel) of the whole render, or of each run with --runs; default the
-    /// scene's.
-    #[arg(long)]
+    /// Passes of the whole render (or of each run); default the scene's.
     pub spp: Option<u32>,
-    #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Independent runs (seeds seed, seed+1, …): the render is their mean with the standard
-    /// error across them, as `lt render --runs K`; shards are groups of runs.
-    #[arg(long, default_value_t = 1)]
+    /// Independent runs (seeds seed, seed + 1, …).
     pub runs: u32,
-    /// Film size WxH instead of the scene's (the camera keeps its field of view).
-    #[arg(long)]
+    /// Film size WxH instead of the scene's.
     pub resolution: Option<String>,
-    /// Number of shards (passes or runs split as evenly as possible).
-    #[arg(long)]
+    /// Number of shards, or passes (runs) per shard.
     pub shards: Option<u32>,
-    /// Passes per shard (the last may be shorter); instead of --shards.
-    #[arg(long)]
     pub passes_per_shard: Option<u32>,
-    /// Runs per shard with --runs (default 1); instead of --shards.
-    #[arg(long)]
     pub runs_per_shard: Option<u32>,
-    /// Where `lt collect` writes the render (default PLAN/render.exr), with .png, .stderr.exr
-    /// and .json beside it.
-    #[arg(long)]
+    /// Where `lt collect` writes the render (default PLAN/render.exr).
     pub image: Option<PathBuf>,
-    #[command(flatten)]
     pub integrator_args: crate::integrator_args::IntegratorArgs,
-    #[command(flatten)]
-    pub common: PlanCommon,
 }
 
-#[derive(Args, Debug)]
-pub struct PlanStudyArgs {
+/// A study to split into its cached renders.
+#[derive(Clone, Debug)]
+pub struct StudySplit {
     /// The study (`lt study`'s names).
     pub name: String,
-    /// quick, full or test.
-    #[arg(long, default_value = "quick")]
     pub scale: String,
     /// Where `lt collect` writes the study's outputs.
-    #[arg(long, default_value = "results")]
     pub results: PathBuf,
-    /// The shipped scenes.
-    #[arg(long, default_value = "scenes")]
     pub scenes: PathBuf,
-    /// Split every single-run render of an unbiased integrator longer than M passes (a long
-    /// reference) into pass ranges of at most M, cut at its snapshots too; collecting merges
-    /// them into the render's cache entry, where the study finds it.
-    #[arg(long, value_name = "M")]
+    /// Split single-run unbiased renders longer than M passes into ranges of at most M.
     pub split_passes: Option<u32>,
-    #[command(flatten)]
-    pub common: PlanCommon,
 }
 
 /// Splits `0..n` into `k` contiguous pieces as even as possible.
@@ -355,7 +325,7 @@ fn pieces(
 }
 
 /// The shards of a render plan.
-pub fn render_shards(args: &PlanRenderArgs, cache: &Path) -> Result<(Vec<Shard>, Span), String> {
+pub fn render_shards(args: &RenderSplit, cache: &Path) -> Result<(Vec<Shard>, Span), String> {
     let scene_path = absolute(&args.scene)?;
     let resolution = args
         .resolution
@@ -538,117 +508,102 @@ fn lt_binary(given: &Option<PathBuf>) -> Result<PathBuf, String> {
     }
 }
 
-pub fn plan(args: &PlanArgs) -> Result<(), String> {
-    let (dir, plan, force) = match &args.what {
-        PlanWhat::Render(a) => {
-            let c = &a.common;
-            let dir = absolute(&c.output)?;
-            let cache = absolute(c.cache.as_deref().unwrap_or(Path::new("results/cache")))?;
-            let (shards, span) = render_shards(a, &cache)?;
-            let output = match &a.image {
-                Some(p) => absolute(p)?,
-                None => dir.join("render.exr"),
-            };
-            let plan = Plan {
-                format: PLAN_FORMAT.into(),
-                version: PLAN_VERSION,
-                code_version: CODE_VERSION.into(),
-                lt: lt_binary(&c.lt)?,
-                threads: c.threads,
-                target: Target::Render {
-                    output,
-                    scene: absolute(&a.scene)?,
-                    integrator: a.integrator.clone(),
-                    span,
-                },
-                shards,
-                assemble: Vec::new(),
-            };
-            (dir, plan, c.force)
-        }
-        PlanWhat::Study(a) => {
-            let c = &a.common;
-            let dir = absolute(&c.output)?;
-            let results = absolute(&a.results)?;
-            let cache = absolute(&c.cache.clone().unwrap_or_else(|| results.join("cache")))?;
-            let scenes = absolute(&a.scenes)?;
-            if a.split_passes == Some(0) {
-                return Err("--split-passes must be at least 1".into());
-            }
-            let mut shards = Vec::new();
-            let mut assemble = Vec::new();
-            for (spec, role) in study_link::plan(&a.name, &a.scale, &results, &scenes, &cache)? {
-                let mut spec = spec;
-                let cache = study_link::cache_for(role, &cache, &results);
-                spec.scene = absolute(&spec.scene)?;
-                let scene = spec.load_scene()?;
-                let key = key_of(&spec.key_material(&scene)?).0;
-                let kind = lt_integrators::registry::find(&spec.integrator)?.kind;
-                let split = a.split_passes.filter(|&m| {
-                    spec.runs == 1 && kind == lt_integrators::Kind::Unbiased && spec.passes > m
-                });
-                let Some(m) = split else {
-                    shards.push(Shard {
-                        index: shards.len(),
-                        key,
-                        cache: cache.clone(),
-                        label: spec.label(),
-                        work: ShardWork::Run(spec),
-                    });
-                    continue;
-                };
-                let mut parts = Vec::new();
-                for (start, end) in cuts(spec.passes, &spec.snapshots, m) {
-                    let job = PartialJob {
-                        scene: spec.scene.clone(),
-                        resolution: spec.resolution,
-                        integrator: spec.integrator.clone(),
-                        params: normalize_params(&spec.params),
-                        span: Span::Passes {
-                            seed: spec.seed,
-                            start,
-                            end,
-                        },
-                    };
-                    parts.push(shards.len());
-                    shards.push(Shard {
-                        index: shards.len(),
-                        key: key_of(&job.key_material(&scene)?).0,
-                        cache: cache.clone(),
-                        label: format!("{}: passes {start}..{end}", spec.label()),
-                        work: ShardWork::Partial(job),
-                    });
-                }
-                assemble.push(Assembly {
-                    spec,
-                    key,
-                    cache: cache.clone(),
-                    shards: parts,
-                });
-            }
-            let plan = Plan {
-                format: PLAN_FORMAT.into(),
-                version: PLAN_VERSION,
-                code_version: CODE_VERSION.into(),
-                lt: lt_binary(&c.lt)?,
-                threads: c.threads,
-                target: Target::Study {
-                    name: a.name.clone(),
-                    scale: a.scale.clone(),
-                    results,
-                    scenes,
-                    cache,
-                },
-                shards,
-                assemble,
-            };
-            (dir, plan, c.force)
-        }
+/// `lt plan render`: the shards of one render, written as a plan.
+pub fn plan_render(a: &RenderSplit, c: &PlanSetup) -> Result<(), String> {
+    let dir = absolute(&c.output)?;
+    let cache = absolute(c.cache.as_deref().unwrap_or(Path::new("results/cache")))?;
+    let (shards, span) = render_shards(a, &cache)?;
+    let output = match &a.image {
+        Some(p) => absolute(p)?,
+        None => dir.join("render.exr"),
     };
+    let target = Target::Render {
+        output,
+        scene: absolute(&a.scene)?,
+        integrator: a.integrator.clone(),
+        span,
+    };
+    let plan = Plan::of(target, shards, Vec::new(), c)?;
+    publish(&dir, &plan, c.force)
+}
+
+/// `lt plan study`: a study's renders, one shard each (long ones split), written as a plan.
+pub fn plan_study(a: &StudySplit, c: &PlanSetup) -> Result<(), String> {
+    let dir = absolute(&c.output)?;
+    let results = absolute(&a.results)?;
+    let cache = absolute(&c.cache.clone().unwrap_or_else(|| results.join("cache")))?;
+    let scenes = absolute(&a.scenes)?;
+    if a.split_passes == Some(0) {
+        return Err("--split-passes must be at least 1".into());
+    }
+    let mut shards = Vec::new();
+    let mut assemble = Vec::new();
+    for (spec, role) in study_link::plan(&a.name, &a.scale, &results, &scenes, &cache)? {
+        let mut spec = spec;
+        let cache = study_link::cache_for(role, &cache, &results);
+        spec.scene = absolute(&spec.scene)?;
+        let scene = spec.load_scene()?;
+        let key = key_of(&spec.key_material(&scene)?).0;
+        let kind = lt_integrators::registry::find(&spec.integrator)?.kind;
+        let split = a.split_passes.filter(|&m| {
+            spec.runs == 1 && kind == lt_integrators::Kind::Unbiased && spec.passes > m
+        });
+        let Some(m) = split else {
+            shards.push(Shard {
+                index: shards.len(),
+                key,
+                cache: cache.clone(),
+                label: spec.label(),
+                work: ShardWork::Run(spec),
+            });
+            continue;
+        };
+        let mut parts = Vec::new();
+        for (start, end) in cuts(spec.passes, &spec.snapshots, m) {
+            let job = PartialJob {
+                scene: spec.scene.clone(),
+                resolution: spec.resolution,
+                integrator: spec.integrator.clone(),
+                params: normalize_params(&spec.params),
+                span: Span::Passes {
+                    seed: spec.seed,
+                    start,
+                    end,
+                },
+            };
+            parts.push(shards.len());
+            shards.push(Shard {
+                index: shards.len(),
+                key: key_of(&job.key_material(&scene)?).0,
+                cache: cache.clone(),
+                label: format!("{}: passes {start}..{end}", spec.label()),
+                work: ShardWork::Partial(job),
+            });
+        }
+        assemble.push(Assembly {
+            spec,
+            key,
+            cache: cache.clone(),
+            shards: parts,
+        });
+    }
+    let target = Target::Study {
+        name: a.name.clone(),
+        scale: a.scale.clone(),
+        results,
+        scenes,
+        cache,
+    };
+    let plan = Plan::of(target, shards, assemble, c)?;
+    publish(&dir, &plan, c.force)
+}
+
+/// Writes the plan and says how to run it.
+fn publish(dir: &Path, plan: &Plan, force: bool) -> Result<(), String> {
     if plan.shards.is_empty() {
         return Err("the plan has no shards".into());
     }
-    write_plan(&dir, &plan, force)?;
+    write_plan(dir, plan, force)?;
     let done = plan.shards.len() - plan.unfinished().len();
     eprintln!(
         "plan {}: {} shards ({done} already in the cache); run them with `lt submit {} \

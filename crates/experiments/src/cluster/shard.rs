@@ -7,21 +7,9 @@ use super::partial::ENTRY_FILE;
 use super::plan::{state_dir, state_path, Plan, Shard, ShardWork};
 use crate::cache::{key_of, Key, RenderCache};
 use crate::runs::Executor;
-use clap::Args;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
-
-#[derive(Args, Debug)]
-pub struct RunShardArgs {
-    /// The plan folder (`lt plan … -o PLAN`).
-    pub plan: PathBuf,
-    /// The shard's index (0-based, as in commands.txt).
-    pub index: usize,
-    /// Worker threads (default: the plan's; under Slurm, the CPUs the task was given).
-    #[arg(long)]
-    pub threads: Option<usize>,
-}
 
 /// What `state/shard-I.json` says.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -247,11 +235,4 @@ pub fn run_one(
             Err(msg)
         }
     }
-}
-
-pub fn run_shard(args: &RunShardArgs) -> Result<(), String> {
-    let dir = super::plan::absolute(&args.plan)?;
-    let plan = Plan::read(&dir)?;
-    plan.check_code(&dir)?;
-    run_one(&dir, &plan, args.index, args.threads)
 }

@@ -5,54 +5,55 @@
 //! of just those indices; GNU parallel's `--resume-failed` reruns only the failed jobs of its
 //! job log; and every shard that is in the cache returns at once anyway.
 
-use super::collect::{collect, CollectArgs};
+use super::collect::{collect, CollectOptions};
 use super::plan::{absolute, logs_dir, shell_quote, Plan, JOBLOG};
-use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-#[derive(Args, Debug)]
-pub struct SubmitArgs {
+/// Where the shards run, with that scheduler's options.
+#[derive(Clone, Debug)]
+pub enum Engine {
+    /// An sbatch job array of the unfinished shards and a collect job after it.
+    Slurm(SlurmOptions),
+    /// GNU parallel (--joblog, --resume-failed), then collect.
+    Parallel(ParallelOptions),
+    /// Here, one shard after the other, then collect.
+    Local,
+}
+
+/// Slurm's options for the shards' job (`lt submit --slurm`'s flags).
+#[derive(Clone, Debug, Default)]
+pub struct SlurmOptions {
+    pub partition: Option<String>,
+    /// At most N shards at once (--array=…%N).
+    pub max_running: Option<u32>,
+    pub cpus_per_task: Option<u32>,
+    /// sbatch --mem.
+    pub mem: Option<String>,
+    /// sbatch --time.
+    pub time_limit: Option<String>,
+    /// Further sbatch options, each a line `#SBATCH OPTION`.
+    pub sbatch_args: Vec<String>,
+}
+
+/// GNU parallel's options (`lt submit --parallel`'s flags).
+#[derive(Clone, Debug, Default)]
+pub struct ParallelOptions {
+    /// Jobs at once (default: cores / threads per shard).
+    pub jobs: Option<String>,
+    /// Hosts to run on (--sshloginfile).
+    pub sshloginfile: Option<PathBuf>,
+}
+
+/// A plan handed to a scheduler.
+#[derive(Clone, Debug)]
+pub struct Submission {
     /// The plan folder.
     pub plan: PathBuf,
-    /// Submit an sbatch job array of the unfinished shards and a collect job after it.
-    #[arg(long)]
-    pub slurm: bool,
-    /// Run the shards with GNU parallel (--joblog, --resume-failed), then collect.
-    #[arg(long)]
-    pub parallel: bool,
-    /// Run the unfinished shards here, one after the other, then collect.
-    #[arg(long)]
-    pub local: bool,
-    /// Slurm: the partition.
-    #[arg(long)]
-    pub partition: Option<String>,
-    /// Slurm: at most N shards at once (--array=…%N).
-    #[arg(long)]
-    pub max_running: Option<u32>,
-    /// Slurm: CPUs per shard (shards then use that many threads unless the plan says).
-    #[arg(long)]
-    pub cpus_per_task: Option<u32>,
-    /// Slurm: memory per shard (sbatch --mem, e.g. 2G).
-    #[arg(long)]
-    pub mem: Option<String>,
-    /// Slurm: time limit per shard (sbatch --time, e.g. 1:00:00).
-    #[arg(long)]
-    pub time_limit: Option<String>,
-    /// Slurm: any further sbatch option for the shards' job (repeatable), e.g. --sbatch-arg=--qos=low.
-    #[arg(long = "sbatch-arg", value_name = "OPTION", allow_hyphen_values = true)]
-    pub sbatch_args: Vec<String>,
-    /// GNU parallel: jobs at once (default: cores / threads per shard, or 1 when shards use every core).
-    #[arg(long)]
-    pub jobs: Option<String>,
-    /// GNU parallel: run on the hosts of this file (--sshloginfile); they must share the plan's filesystem.
-    #[arg(long)]
-    pub sshloginfile: Option<PathBuf>,
+    pub engine: Engine,
     /// Write the scripts and print the commands instead of running them.
-    #[arg(long)]
     pub print: bool,
     /// GNU parallel and local: do not collect after the shards.
-    #[arg(long)]
     pub no_collect: bool,
 }
 
@@ -100,7 +101,13 @@ fn write_script(path: &Path, text: &str) -> Result<(), String> {
     Ok(())
 }
 
-fn slurm(dir: &Path, plan: &Plan, todo: &[usize], args: &SubmitArgs) -> Result<(), String> {
+fn slurm(
+    dir: &Path,
+    plan: &Plan,
+    todo: &[usize],
+    args: &SlurmOptions,
+    print: bool,
+) -> Result<(), String> {
     let q = |p: &Path| shell_quote(&p.display().to_string());
     let sdir = dir.join("slurm");
     std::fs::create_dir_all(&sdir).map_err(|e| format!("cannot create {}: {e}", sdir.display()))?;
@@ -171,7 +178,7 @@ fn slurm(dir: &Path, plan: &Plan, todo: &[usize], args: &SubmitArgs) -> Result<(
     let collect_path = sdir.join("collect.sbatch");
     write_script(&shards_path, &shards_script)?;
     write_script(&collect_path, &collect_script)?;
-    if args.print {
+    if print {
         println!("JOB=$(sbatch --parsable {})", q(&shards_path));
         println!(
             "sbatch --parsable --dependency=afterok:${{JOB%%;*}} --kill-on-invalid-dep=yes {}",
@@ -244,7 +251,7 @@ pub fn joblog_results(path: &Path) -> Vec<(usize, i64, i64)> {
     last
 }
 
-fn parallel(dir: &Path, plan: &Plan, args: &SubmitArgs) -> Result<bool, String> {
+fn parallel(dir: &Path, plan: &Plan, args: &ParallelOptions, print: bool) -> Result<bool, String> {
     let q = |p: &Path| shell_quote(&p.display().to_string());
     std::fs::create_dir_all(logs_dir(dir))
         .map_err(|e| format!("cannot create {}: {e}", logs_dir(dir).display()))?;
@@ -284,7 +291,7 @@ fn parallel(dir: &Path, plan: &Plan, args: &SubmitArgs) -> Result<bool, String> 
     pargs.push(template);
     pargs.push(":::".into());
     pargs.extend((0..plan.shards.len()).map(|i| i.to_string()));
-    if args.print {
+    if print {
         let words: Vec<String> = pargs.iter().map(|a| shell_quote(a)).collect();
         println!("parallel {}", words.join(" "));
         println!("{} collect {}", q(&plan.lt), q(dir));
@@ -333,11 +340,9 @@ fn parallel(dir: &Path, plan: &Plan, args: &SubmitArgs) -> Result<bool, String> 
     ))
 }
 
-pub fn submit(args: &SubmitArgs) -> Result<(), String> {
-    let engines = [args.slurm, args.parallel, args.local];
-    if engines.iter().filter(|&&e| e).count() != 1 {
-        return Err("say where the shards run: one of --slurm, --parallel, --local".into());
-    }
+/// Runs (or, with `print`, prints) a plan's unfinished shards where `args.engine` says, and
+/// collects them unless `no_collect` (Slurm: a collect job after the shards' array).
+pub fn submit(args: &Submission) -> Result<(), String> {
     let dir = absolute(&args.plan)?;
     let plan = Plan::read(&dir)?;
     plan.check_code(&dir)?;
@@ -348,13 +353,13 @@ pub fn submit(args: &SubmitArgs) -> Result<(), String> {
         ));
     }
     let todo = plan.unfinished();
-    let collect_args = CollectArgs {
+    let collect_args = CollectOptions {
         plan: dir.clone(),
         allow_incomplete: false,
         output: None,
         threads: plan.threads,
     };
-    if args.slurm {
+    if let Engine::Slurm(slurm_options) = &args.engine {
         if todo.is_empty() {
             eprintln!(
                 "all {} shards are finished: nothing to submit; `lt collect {}` merges them",
@@ -363,10 +368,10 @@ pub fn submit(args: &SubmitArgs) -> Result<(), String> {
             );
             return Ok(());
         }
-        return slurm(&dir, &plan, &todo, args);
+        return slurm(&dir, &plan, &todo, slurm_options, args.print);
     }
-    if args.parallel {
-        let ran = parallel(&dir, &plan, args)?;
+    if let Engine::Parallel(parallel_options) = &args.engine {
+        let ran = parallel(&dir, &plan, parallel_options, args.print)?;
         if ran && !args.no_collect {
             collect(&collect_args)?;
         }

@@ -1,7 +1,7 @@
 //! `lt merge PARTS… -o OUT.exr`: partial renders (`lt render … --partial`) merged exactly into
 //! what `lt render` writes, or into one larger part (`--partial`) for merging in stages.
 
-use super::partial::{merge as merge_parts, Partial};
+use crate::cluster::partial::{merge as merge_parts, Partial, Span};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -24,7 +24,7 @@ pub struct MergeArgs {
     pub quiet: bool,
 }
 
-pub fn merge(args: &MergeArgs) -> Result<(), String> {
+pub fn run(args: &MergeArgs) -> Result<(), String> {
     let mut parts = Vec::new();
     for p in &args.parts {
         parts.push((p.clone(), Partial::read(p)?));
@@ -54,7 +54,7 @@ pub fn merge(args: &MergeArgs) -> Result<(), String> {
             merged.parts,
             merged.span.describe(),
             merged.acc.count(),
-            if matches!(merged.span, super::partial::Span::Passes { .. }) {
+            if matches!(merged.span, Span::Passes { .. }) {
                 "passes"
             } else {
                 "runs"
