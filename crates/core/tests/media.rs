@@ -512,3 +512,19 @@ fn an_unbounded_walk_through_a_grid_ends() {
         let _ = m.sample_free_flight(Vec3::splat(0.5), d, f32::INFINITY, &mut s);
     }
 }
+
+#[test]
+fn homogeneous_transmittance_over_an_infinite_distance_is_a_number() {
+    let h = Homogeneous::new(
+        Color::new(0.0, 1.0, 2.0),
+        Color::ONE,
+        1.0,
+        PhaseFunction::Isotropic,
+    )
+    .unwrap();
+    assert_eq!(h.transmittance(f32::INFINITY), Color::new(1.0, 0.0, 0.0));
+    assert_eq!(
+        h.transmittance(1.0),
+        Color::new(1.0, (-1.0f32).exp(), (-2.0f32).exp())
+    );
+}
