@@ -489,3 +489,42 @@ fn world_bounds_are_the_placed_unit_cube() {
         "{lo} {hi}"
     );
 }
+
+#[test]
+fn an_unbounded_walk_through_a_grid_ends() {
+    // σt > 0 only at the centre sample: beyond the cube the clamped field is 0 under a positive
+    // bound, where tracking without an end would draw tentative collisions forever.
+    let mut data = vec![0.0; 27];
+    data[13] = 2.0;
+    let grid = VolumeGrid::new([3, 3, 3], 1, data, [Vec3::ZERO, Vec3::ONE]).unwrap();
+    let vol = GridVolume::new(Arc::new(grid), Mat4::IDENTITY, false, WrapMode::Clamp).unwrap();
+    let g = GridMedium::new(
+        Volume::Grid(vol),
+        1.0,
+        Volume::Constant(Color::ONE),
+        PhaseFunction::Isotropic,
+    )
+    .unwrap();
+    let m = Medium::Grid(Box::new(g));
+    let mut s = Sampler::new(71, 0, 0);
+    for _ in 0..1000 {
+        let d = (s.next_2d().extend(s.next_f32()) - 0.5).normalize();
+        let _ = m.sample_free_flight(Vec3::splat(0.5), d, f32::INFINITY, &mut s);
+    }
+}
+
+#[test]
+fn homogeneous_transmittance_over_an_infinite_distance_is_a_number() {
+    let h = Homogeneous::new(
+        Color::new(0.0, 1.0, 2.0),
+        Color::ONE,
+        1.0,
+        PhaseFunction::Isotropic,
+    )
+    .unwrap();
+    assert_eq!(h.transmittance(f32::INFINITY), Color::new(1.0, 0.0, 0.0));
+    assert_eq!(
+        h.transmittance(1.0),
+        Color::new(1.0, (-1.0f32).exp(), (-2.0f32).exp())
+    );
+}

@@ -201,7 +201,27 @@ impl GridMedium {
         hit
     }
 
-    /// Free-flight sampling (see the module doc for the scheme and its density).
+    /// `t_max`, or where the ray leaves the grid's placed unit cube when `t_max` is infinite: a
+    /// `heterogeneous` medium sits inside a closed boundary (every walk through it has a finite
+    /// t_max; the loaders refuse one without), and this only keeps an unbounded walk from
+    /// tracking forever through a clamped or periodic field.
+    fn reach(&self, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        let Some(g) = self.sigma_t.as_grid().filter(|_| !t_max.is_finite()) else {
+            return t_max;
+        };
+        let [lo, hi] = g.world_bounds();
+        let (ta, tb) = ((lo - o) / d, (hi - o) / d);
+        let exit = ta.max(tb).min_element();
+        if exit.is_finite() {
+            exit.max(0.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Free-flight sampling (see the module doc for the scheme and its density). For a grid,
+    /// `t_max` must be finite for the outcome to be the one `free_flight_density` describes
+    /// ([`GridMedium::reach`]).
     pub fn sample_free_flight(
         &self,
         o: Vec3,
@@ -209,6 +229,7 @@ impl GridMedium {
         t_max: f32,
         sampler: &mut Sampler,
     ) -> FreeFlight {
+        let t_max = self.reach(o, d, t_max);
         let channel = ((sampler.next_f32() * 3.0) as usize).min(2);
         match self.delta_track(o, d, t_max, channel, sampler) {
             Some(t) => {

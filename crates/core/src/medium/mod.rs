@@ -183,10 +183,16 @@ impl Homogeneous {
         self.sigma_t * self.albedo
     }
 
-    /// T over a distance, per channel.
+    /// T over a distance, per channel (1 in a channel with σt = 0 even over an infinite
+    /// distance, where σt·d would be NaN).
     #[inline]
     pub fn transmittance(&self, distance: f32) -> Color {
-        exp_neg(self.sigma_t * distance)
+        let depth = self.sigma_t * distance;
+        exp_neg(Color::select(
+            self.sigma_t.cmpeq(Color::ZERO),
+            Color::ZERO,
+            depth,
+        ))
     }
 }
 
