@@ -35,6 +35,30 @@
 //!   averages over M instead: f / (M · p_k), and MIS weighs technique k by n_k/n_s = M/N
 //!   (`Densities::light_tracing_ratio`, `mis`). The `path_space` test proves the normalisation by
 //!   letting s = 0, 1 and 2 estimate the same pixels of an analytic scene.
+//! - **Media** (Pauly, Kollig & Keller 2000, the volumetric path integral; Veach's form with
+//!   vertices in volumes). A vertex lies on a surface (measure dA) or inside a medium (measure
+//!   dV, `VertexKind::Medium`); the path measure is the product of the vertices' measures, so
+//!   I = ∫ f(x̄) dμ(x̄) sums over every arrangement of surface and volume vertices. With
+//!   dω = |cos θ_y| dA(y) / r² at a surface and dV(y) = r² dr dω at a medium point, the
+//!   contribution is
+//!   f(x̄) = Le(x0→x1) ∏_{i=0}^{k−1} G(x_i↔x_{i+1}) T(x_i↔x_{i+1}) ∏_{i=1}^{k−1} ρ(x_i) · We,
+//!   with ρ = fs at a surface and ρ = σs(x) p(ω_o, ω_i) at a medium point (σs carries the extra
+//!   length of dV), G = cos·cos / r² with a cosine only at the ends that have a surface (none at
+//!   a medium point, as none at a point light), and T(x↔y) = exp(−∫ σt) along the edge through
+//!   every medium and null boundary between (`Scene::edge_transmittance`). T is in f because it is
+//!   the physics of the edge, whichever technique made it. A walk's density, by contrast, is how
+//!   it chose the vertex: a direction (solid angle) and then a free flight along it — per unit
+//!   length where it stopped in a medium (σt T when sampled in proportion to T), the probability
+//!   of passing every medium when it reached a surface — so the free-flight density enters p and
+//!   not f: a medium vertex stores p_ω · p_ff / r² (`measure::solid_angle_to_volume`), a surface
+//!   reached through media p_ω |cos| / r² · P_pass (`PathVertex::medium`,
+//!   `surface_through_media`, `Scene::free_flight_density`). A connection or next-event
+//!   estimation samples no free flight: its edge has T in f and nothing in p, and is estimated by
+//!   `Scene::transmittance_estimate` (unbiased) so that f/p stays unbiased. Because f and p hold
+//!   these factors per vertex, `Chain` and every MIS weight read medium vertices unchanged. The
+//!   medium of each edge follows from one end and the direction (Mitsuba's per-ray medium:
+//!   `scene/media.rs`), so both walks and the oracle agree on it. A scene without media
+//!   (`Scene::has_media` false) asks none of this.
 
 pub mod camis;
 pub mod correlation;

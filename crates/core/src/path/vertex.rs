@@ -170,7 +170,8 @@ impl PathVertex {
     /// A scattering point `p` in medium `medium`, reached from `prev` along −`wo` by a direction
     /// sampled with solid-angle density `pdf_w` and a free flight that stopped at `p` with density
     /// `p_ff` per unit length (`Scene::free_flight_density`, scattered at the end): `pdf_fwd` =
-    /// p_ω p_ff / d², volume measure (`measure::solid_angle_to_volume`). No normal, no uv.
+    /// p_ω p_ff / d², volume measure (`measure::solid_angle_to_volume`). No normal, no uv; `p_err`
+    /// bounds the rounding of the point along the ray.
     pub fn medium(
         medium: crate::medium::MediumId,
         p: Vec3,
@@ -182,6 +183,15 @@ impl PathVertex {
     ) -> PathVertex {
         let mut v = PathVertex::endpoint(VertexKind::Medium { medium }, p, Vec3::ZERO, beta, 0.0);
         v.wo = wo;
+        // p = o + t·d rounds by at most γ₂(|o| + |t·d|) ≤ γ₂(2|o| + |p|) per axis, o within
+        // `prev`'s own bound (a ray from a surface starts an offset away); from infinity the
+        // origin lies on the scene's bounding disk, bounded by |p| + the scene's size ~ |p| here.
+        let o = if prev.is_infinite() {
+            p.abs()
+        } else {
+            prev.p.abs()
+        };
+        v.p_err = (2.0 * o + p.abs()) * crate::math::gamma(3) + prev.p_err;
         v.pdf_fwd = prev.convert_density(pdf_w, &v) * p_ff;
         v
     }

@@ -44,7 +44,8 @@ pub fn tolerance(scene: &Scene, path: &Path, s: usize) -> (f64, f64) {
     let rel = |d: f64, x: f64| if x > 0.0 { d / x } else { 0.0 };
     let v = &path.vertices;
     let mut arith = 1e-4;
-    for i in 1..v.len() - 1 {
+    // A medium vertex has no surface: no cosine to round.
+    for i in (1..v.len() - 1).filter(|&i| v[i].on_surface()) {
         for w in [v[i].dir_to(&v[i - 1]), v[i].dir_to(&v[i + 1])] {
             arith += 5e-7 * (1.0 / v[i].ns.dot(w).abs() as f64 + 1.0 / v[i].ng.dot(w).abs() as f64);
         }
