@@ -1,6 +1,6 @@
 //! One error type for every scene file, and the context that turns a byte span into file:line:col.
 
-use crate::format::{ColorDef, S, V3};
+use crate::toml_scene::schema::{ColorDef, S, V3};
 use glam::DVec3;
 use lt_core::math::{Color, Vec3};
 use std::ops::Range;

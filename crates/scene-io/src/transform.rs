@@ -4,7 +4,7 @@
 //! and cosines).
 
 use crate::error::Ctx;
-use crate::format::{ShapeDef, S};
+use crate::toml_scene::schema::{ShapeDef, S};
 use crate::SceneError;
 use glam::{DMat3, DMat4, DVec3};
 
@@ -63,7 +63,10 @@ pub fn shape_matrix(
 }
 
 /// The rotation a `rotate` table describes (checked as for shapes).
-pub fn rotate_def(ctx: &Ctx, r: &S<crate::format::RotateDef>) -> Result<DMat3, SceneError> {
+pub fn rotate_def(
+    ctx: &Ctx,
+    r: &S<crate::toml_scene::schema::RotateDef>,
+) -> Result<DMat3, SceneError> {
     let axis = DVec3::from_array(r.get_ref().axis);
     let angle = r.get_ref().angle;
     if !axis.is_finite() || !angle.is_finite() {

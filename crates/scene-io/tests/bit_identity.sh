@@ -39,8 +39,8 @@ for s in $scenes; do
 done
 for s in $(find scenes -name '*.toml' | sort); do
   key=$(echo "$s" | tr '/' '_')
-  "$base" convert "$s" -o "$out/base/$key.xml" >/dev/null 2>&1 || echo "(baseline refuses to convert $s)" > "$out/base/$key.xml"
-  "$new" convert "$s" -o "$out/new/$key.xml" >/dev/null 2>&1 || echo "(baseline refuses to convert $s)" > "$out/new/$key.xml"
+  "$base" convert "$s" -o "$out/base/$key.xml" >/dev/null 2>&1 || echo "(refuses to convert $s)" > "$out/base/$key.xml"
+  "$new" convert "$s" -o "$out/new/$key.xml" >/dev/null 2>&1 || echo "(refuses to convert $s)" > "$out/new/$key.xml"
   cmp -s "$out/base/$key.xml" "$out/new/$key.xml" || echo "convert output differs: $s (diff $out/{base,new}/$key.xml)"
 done
 echo "images identical: $same, refused by both: $refused, differing: $diff"

@@ -1,5 +1,5 @@
 //! `lt convert SCENE.toml -o SCENE.xml`: one of our scenes as Mitsuba 3 XML, wherever Mitsuba
-//! can express it (`lt_core::scene::xml::write`; a scene with a finite-cone sun is refused).
+//! can express it (`lt_scene_io::xml::write`; a scene with a finite-cone sun is refused).
 //! Mesh files are referenced relative to the output's folder. Reading the XML back with `lt`
 //! gives the same scene (tests/xml_roundtrip.rs); `scripts/mitsuba_reference.py` renders it.
 

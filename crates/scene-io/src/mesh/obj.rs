@@ -3,7 +3,7 @@
 //! which tobj's errors do not.
 
 use crate::error::Ctx;
-use crate::format::S;
+use crate::toml_scene::schema::S;
 use crate::SceneError;
 use lt_core::math::{Vec2, Vec3};
 use lt_core::scene::TriangleMesh;

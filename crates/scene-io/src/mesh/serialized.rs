@@ -8,7 +8,7 @@
 
 use super::le_bytes::{f32s, f64s_as_f32, u16_at, u32_at, u32s, u64_at};
 use crate::error::Ctx;
-use crate::format::S;
+use crate::toml_scene::schema::S;
 use crate::SceneError;
 use flate2::read::ZlibDecoder;
 use lt_core::math::{Vec2, Vec3};

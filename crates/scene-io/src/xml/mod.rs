@@ -1,15 +1,17 @@
 //! Mitsuba 3 scene XML, in and out (docs/xml.md lists what is covered and what is refused).
 //!
-//! In: `load_scene` reads a `.xml` file through `doc` (the XML tree with includes, defaults,
-//! `$` substitution and the 0.6 → 3 name upgrade), `values` (numbers, colours, transforms),
-//! `props` (each plugin's parameters, every one taken or reported) and `build` (the plugin subset,
-//! assembled through `SceneBuilder`). Meshes come from `crate::mesh` (OBJ and PLY). Out: `write::to_mitsuba_xml` writes one of our TOML scenes as Mitsuba 3 XML.
+//! In: `load_xml` reads a `.xml` file through `doc` (the plugin tree: includes, defaults, `$`
+//! substitution and the 0.6 → 3 name upgrade), `values` (numbers, colours, transforms), `props`
+//! (each plugin's parameters, every one taken or reported) and `build/` (one builder per plugin
+//! kind, assembled through `SceneBuilder`; `build/kinds.rs` checks the whole tree first). Meshes
+//! come from `crate::mesh`. Out: `write::to_mitsuba_xml` writes one of our TOML scenes as
+//! Mitsuba 3 XML.
 //!
 //! Relative file names go through `resolve` (Mitsuba's resolver: the scene's folder, then each
 //! `<path>`); spectra become RGB exactly as Mitsuba's RGB variants convert them (`spectrum`,
 //! with the tables in `cie_table`).
 //!
-//! Where a file asks for something lt lacks but has a near equivalent of (a Gaussian or other pixel filter → the box, max_depth = -1 → 64),
+//! Where a file asks for something lt lacks but has a near equivalent of (max_depth = -1 → 64),
 //! the load is refused unless `LoadOptions::approximate`, and every substitution made is listed
 //! in the `LoadReport`. Parameters Mitsuba writes by default that change nothing lt renders
 //! (`near_clip`, a film's `pixel_format`, a `ref`'s `name`, …) are accepted and listed too.

@@ -10,7 +10,7 @@
 //! directional light or an environment map would change the image, so nothing is approximated).
 
 use crate::error::Ctx;
-use crate::format::{ColorDef, MaterialDef, SceneFile, ShapeDef, S};
+use crate::toml_scene::schema::{ColorDef, MaterialDef, SceneFile, ShapeDef, S};
 use crate::transform::shape_matrix;
 use crate::SceneError;
 use lt_core::bsdf::plastic::{AIR_IOR, POLYPROPYLENE_IOR};
@@ -39,7 +39,7 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
         });
     }
     // Everything checked exactly as for rendering.
-    let loaded = crate::toml_file::load_scene_str(&text, scene)?;
+    let loaded = crate::toml_scene::load_scene_str(&text, scene)?;
     let ctx = Ctx {
         file: scene.display().to_string(),
         text: &text,
@@ -597,7 +597,7 @@ fn relative(path: &Path, dir: &Path) -> PathBuf {
 /// the wrapper takes the id.
 fn perturbation_xml(
     ctx: &Ctx,
-    d: &crate::format::MaterialDef,
+    d: &crate::toml_scene::schema::MaterialDef,
     id: &str,
     body: String,
     out_dir: &Path,
@@ -641,7 +641,7 @@ fn perturbation_xml(
 /// `body` inside Mitsuba's `mask` when the material has an `opacity` or `opacity_texture`.
 fn mask_xml(
     ctx: &Ctx,
-    d: &crate::format::MaterialDef,
+    d: &crate::toml_scene::schema::MaterialDef,
     id: &str,
     body: String,
     out_dir: &Path,
@@ -661,7 +661,12 @@ fn mask_xml(
     format!("<bsdf type=\"mask\" id=\"{id}\">\n{opacity}    {inner}\n    </bsdf>")
 }
 
-fn texture_xml(ctx: &Ctx, t: &crate::format::TextureDef, name: &str, out_dir: &Path) -> String {
+fn texture_xml(
+    ctx: &Ctx,
+    t: &crate::toml_scene::schema::TextureDef,
+    name: &str,
+    out_dir: &Path,
+) -> String {
     let mut x = format!(
         "            <texture type=\"{}\" name=\"{name}\">\n",
         esc(t.kind.get_ref())

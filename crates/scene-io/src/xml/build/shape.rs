@@ -17,20 +17,11 @@ use lt_core::scene::TriangleMesh;
 use lt_core::texture::Texture;
 use std::path::PathBuf;
 
-/// The shapes lt reads.
-pub(super) const SHAPES: [&str; 11] = [
-    "rectangle",
-    "cube",
-    "sphere",
-    "disk",
-    "cylinder",
-    "sdfgrid",
-    "obj",
-    "ply",
-    "serialized",
-    "shapegroup",
-    "instance",
-];
+/// The shapes lt reads: every geometry of `GEOMETRIES`, groups and instances.
+pub(super) fn shape_types() -> Vec<&'static str> {
+    let geometries = GEOMETRIES.iter().map(|(name, _)| *name);
+    geometries.chain(["shapegroup", "instance"]).collect()
+}
 
 impl<'a> Loader<'a> {
     /// Adds the shape; returns whether it emits.
@@ -114,178 +105,16 @@ impl<'a> Loader<'a> {
             Some((x, te)) => (x.m, te.range.clone()),
             None => (DMat4::IDENTITY, e.range.clone()),
         };
-        let placed = |mesh: WorldMesh, span: std::ops::Range<usize>| match mesh.out_of_range() {
-            Some(p) => Err(ctx.at(span, out_of_range_message("the transformed shape", p))),
-            None => Ok(WorldGeometry::Mesh(mesh)),
+        let Some(&(_, build)) = GEOMETRIES.iter().find(|(name, _)| *name == p.kind) else {
+            return Err(super::kinds::unknown_type(self.doc, e));
         };
-        let geometry = match p.kind {
-            "rectangle" => {
-                check_quad(&ctx, &m, span.clone())?;
-                placed(WorldMesh::place(&TriangleMesh::unit_rectangle(), &m), span)?
-            }
-            "cube" => {
-                check_solid(&ctx, &m, span.clone(), "cube")?;
-                placed(WorldMesh::place(&TriangleMesh::unit_cube(), &m), span)?
-            }
-            "sphere" => {
-                let c = DVec3::from_array(p.vec3("center")?.unwrap_or([0.0; 3]));
-                let r = p.float("radius")?.unwrap_or(1.0);
-                if !(r > 0.0) {
-                    return Err(p.err(e, format!("sphere `radius` must be positive, got {r}")));
-                }
-                let (center, radius, rotation) = match &xform {
-                    None => (c, r, None),
-                    Some((x, te)) => {
-                        let s = similarity_scale(&x.m).ok_or_else(|| {
-                            p.err(te, "a sphere's to_world must be a rotation, uniform scale and translation (an ellipsoid is not supported)")
-                        })?;
-                        // The rotation is kept for uv and tangents (Mitsuba's are in the
-                        // sphere's object frame); none when there is none.
-                        let rot = glam::DMat3::from_mat4(x.m) * (1.0 / s);
-                        let rotation = (rot != glam::DMat3::IDENTITY).then_some(rot);
-                        (x.m.transform_point3(c), r * s, rotation)
-                    }
-                };
-                if !crate::world::in_range(center) || !(radius as f32).is_finite() {
-                    return Err(p.err(e, out_of_range_message("the sphere", center + radius)));
-                }
-                WorldGeometry::Sphere {
-                    center,
-                    radius,
-                    rotation,
-                }
-            }
-            // Exact disk: the unit disk under `to_world` (an ellipse under a non-uniform scale).
-            "disk" => {
-                check_quad(&ctx, &m, span.clone())?;
-                WorldGeometry::Disk {
-                    to_world: checked_map(&p, e, &m, "disk")?,
-                }
-            }
-            // Mitsuba's cylinder: to_world · translate(p0) · to_frame(p1 − p0) · scale(r, r, |p1 −
-            // p0|) maps the unit cylinder; Mitsuba then keeps only that map's rotation and its
-            // diagonal stretch (r, l), so a shear or unequal x/y scale is refused here rather
-            // than rendered differently.
-            "cylinder" => {
-                let r = p.float("radius")?.unwrap_or(1.0);
-                let p0 = DVec3::from_array(p.vec3("p0")?.unwrap_or([0.0; 3]));
-                let p1 = DVec3::from_array(p.vec3("p1")?.unwrap_or([0.0, 0.0, 1.0]));
-                let axis = p1 - p0;
-                let len = axis.length();
-                if !(len > 0.0) || !(r != 0.0) || !r.is_finite() {
-                    return Err(p.err(e, format!("a cylinder needs p0 ≠ p1 and a non-zero radius (got radius {r}, |p1 − p0| = {len})")));
-                }
-                // Duff et al.'s orthonormal basis around the axis (Mitsuba's Frame, lt's Frame::from_z).
-                let f = lt_core::math::Frame::from_z(axis.normalize().as_vec3());
-                let frame = DMat4::from_cols(
-                    f.x.as_dvec3().extend(0.0),
-                    f.y.as_dvec3().extend(0.0),
-                    (axis / len).extend(0.0),
-                    glam::DVec4::W,
-                );
-                let full = m
-                    * DMat4::from_translation(p0)
-                    * frame
-                    * DMat4::from_scale(DVec3::new(r, r, len));
-                if !lt_core::geometry::quadric::is_round_cylinder_map(
-                    &glam::DMat3::from_mat4(full),
-                    1e-5,
-                ) {
-                    return Err(p.err(
-                        xform.as_ref().map_or(e, |(_, te)| te),
-                        "a cylinder's to_world must be a rotation, a scale equal along x and y, and a translation (Mitsuba drops shear and unequal x/y scales, with a warning)",
-                    ));
-                }
-                WorldGeometry::Cylinder {
-                    to_world: checked_map(&p, e, &full, "cylinder")?,
-                }
-            }
-            // Mitsuba's SDF grid: its file's values over the unit cube, under to_world.
-            "sdfgrid" => {
-                let Some((file, fe)) = p.string("filename")? else {
-                    return Err(p.err(e, "shape `sdfgrid` needs a `filename`"));
-                };
-                let smooth =
-                    match p.string("normals")? {
-                        None | Some(("smooth", _)) => true,
-                        Some(("analytic", _)) => false,
-                        Some((other, ne)) => return Err(p.err(
-                            ne,
-                            format!(
-                                "sdfgrid `normals` must be `smooth` or `analytic`, got `{other}`"
-                            ),
-                        )),
-                    };
-                let path = doc.resolver.resolve(file).map_err(|looked| {
-                    p.err(fe, Resolver::not_found("volume grid file", file, &looked))
-                })?;
-                let resolved = Ctx {
-                    base_dir: PathBuf::new(),
-                    ..doc.ctx(e.src)
-                };
-                let spanned =
-                    toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
-                let grid = crate::mesh::vol::load_sdf_grid(&resolved, &spanned, smooth)?;
-                self.meshes.push(path);
-                WorldGeometry::SdfGrid {
-                    grid: std::sync::Arc::new(grid),
-                    to_world: checked_map(&p, e, &m, "sdfgrid")?,
-                }
-            }
-            "obj" | "ply" | "serialized" => {
-                let Some((file, fe)) = p.string("filename")? else {
-                    return Err(p.err(e, format!("shape `{}` needs a `filename`", p.kind)));
-                };
-                let mut face_normals = p.boolean("face_normals")?.unwrap_or(false);
-                let shape_index = match p.kind {
-                    "serialized" => p.integer("shape_index")?.map_or(Ok(0), |i| {
-                        u32::try_from(i).map_err(|_| {
-                            p.err(
-                                e,
-                                format!("`shape_index` must be a non-negative integer, got {i}"),
-                            )
-                        })
-                    })?,
-                    _ => 0,
-                };
-                check_solid(&ctx, &m, span.clone(), "mesh")?;
-                let path = doc
-                    .resolver
-                    .resolve(file)
-                    .map_err(|looked| p.err(fe, Resolver::not_found("mesh file", file, &looked)))?;
-                // The mesh readers join their context's folder with the name: give them the
-                // resolved path and no folder.
-                let resolved = Ctx {
-                    base_dir: PathBuf::new(),
-                    ..doc.ctx(e.src)
-                };
-                let spanned =
-                    toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
-                let mut mesh = match p.kind {
-                    "obj" => crate::mesh::obj::load_obj(&resolved, &spanned)?,
-                    "ply" => ply::load_ply(&resolved, &spanned)?,
-                    _ => {
-                        // The file's own "face normals" flag is the same as `face_normals`.
-                        let s = serialized::load_serialized(&resolved, &spanned, shape_index)?;
-                        face_normals |= s.face_normals;
-                        s.mesh
-                    }
-                };
-                self.meshes.push(path);
-                if face_normals {
-                    mesh.normals = None;
-                } else if mesh.normals.is_none() {
-                    // Mitsuba shades a mesh without normals smoothly, with normals it computes.
-                    mesh.normals = Some(vertex_normals(&mesh));
-                }
-                let mesh = WorldMesh::place(&mesh, &m);
-                if !(mesh.area() > 0.0) {
-                    return Err(p.err(fe, "the mesh has zero area (every triangle is degenerate)"));
-                }
-                placed(mesh, span)?
-            }
-            _ => return Err(super::kinds::unknown_type(self.doc, e)),
+        let at = Placement {
+            ctx,
+            m,
+            span,
+            xform,
         };
+        let geometry = build(self, &p, &at)?;
         let bsdf = p.one_nested(&["bsdf"], "BSDF")?;
         // Mitsuba gives a shape without a BSDF a diffuse one of reflectance 0.5, except an
         // emitting shape, whose default is black: a light does not reflect unless it is told to
@@ -484,4 +313,249 @@ mod tests {
         let k = -(1.0f32 / 3.0).sqrt();
         assert!((n[0] - glam::Vec3::splat(k)).abs().max_element() < 1e-6);
     }
+}
+
+/// Where a shape goes: its file (for errors), its object-to-world map `m` with the span of its
+/// `to_world` (else of the shape), and the transform as written.
+pub(super) struct Placement<'a> {
+    ctx: Ctx<'a>,
+    m: DMat4,
+    span: std::ops::Range<usize>,
+    xform: Option<(Xform, &'a Elem)>,
+}
+
+/// A geometry builder: the shape's geometry from its parameters and placement.
+type ShapeBuilder = for<'a, 'p> fn(
+    &mut Loader<'a>,
+    &'p Plugin<'a>,
+    &'p Placement<'a>,
+) -> Result<WorldGeometry, SceneError>;
+
+/// Every shape type a `<shape>` can have (groups and instances are read in
+/// `shape_or_instance`), with its geometry builder.
+const GEOMETRIES: &[(&str, ShapeBuilder)] = &[
+    ("rectangle", rectangle),
+    ("cube", cube),
+    ("sphere", sphere),
+    ("disk", disk),
+    ("cylinder", cylinder),
+    ("sdfgrid", sdfgrid),
+    ("obj", obj_ply_serialized),
+    ("ply", obj_ply_serialized),
+    ("serialized", obj_ply_serialized),
+];
+
+/// A mesh placed in the world whose every vertex is in range, else an error at `span`.
+fn placed(
+    ctx: &Ctx,
+    mesh: WorldMesh,
+    span: std::ops::Range<usize>,
+) -> Result<WorldGeometry, SceneError> {
+    match mesh.out_of_range() {
+        Some(p) => Err(ctx.at(span, out_of_range_message("the transformed shape", p))),
+        None => Ok(WorldGeometry::Mesh(mesh)),
+    }
+}
+
+fn rectangle<'a>(
+    _: &mut Loader<'a>,
+    _: &Plugin<'a>,
+    at: &Placement<'a>,
+) -> Result<WorldGeometry, SceneError> {
+    let (ctx, m, span) = (&at.ctx, at.m, at.span.clone());
+    check_quad(&ctx, &m, span.clone())?;
+    placed(
+        ctx,
+        WorldMesh::place(&TriangleMesh::unit_rectangle(), &m),
+        span,
+    )
+}
+
+fn cube<'a>(
+    _: &mut Loader<'a>,
+    _: &Plugin<'a>,
+    at: &Placement<'a>,
+) -> Result<WorldGeometry, SceneError> {
+    let (ctx, m, span) = (&at.ctx, at.m, at.span.clone());
+    check_solid(&ctx, &m, span.clone(), "cube")?;
+    placed(ctx, WorldMesh::place(&TriangleMesh::unit_cube(), &m), span)
+}
+
+fn sphere<'a>(
+    _: &mut Loader<'a>,
+    p: &Plugin<'a>,
+    at: &Placement<'a>,
+) -> Result<WorldGeometry, SceneError> {
+    let (e, xform) = (p.elem, &at.xform);
+    let c = DVec3::from_array(p.vec3("center")?.unwrap_or([0.0; 3]));
+    let r = p.float("radius")?.unwrap_or(1.0);
+    if !(r > 0.0) {
+        return Err(p.err(e, format!("sphere `radius` must be positive, got {r}")));
+    }
+    let (center, radius, rotation) = match &xform {
+        None => (c, r, None),
+        Some((x, te)) => {
+            let s = similarity_scale(&x.m).ok_or_else(|| {
+                p.err(te, "a sphere's to_world must be a rotation, uniform scale and translation (an ellipsoid is not supported)")
+            })?;
+            // The rotation is kept for uv and tangents (Mitsuba's are in the
+            // sphere's object frame); none when there is none.
+            let rot = glam::DMat3::from_mat4(x.m) * (1.0 / s);
+            let rotation = (rot != glam::DMat3::IDENTITY).then_some(rot);
+            (x.m.transform_point3(c), r * s, rotation)
+        }
+    };
+    if !crate::world::in_range(center) || !(radius as f32).is_finite() {
+        return Err(p.err(e, out_of_range_message("the sphere", center + radius)));
+    }
+    Ok(WorldGeometry::Sphere {
+        center,
+        radius,
+        rotation,
+    })
+}
+
+/// Exact disk: the unit disk under `to_world` (an ellipse under a non-uniform scale).
+fn disk<'a>(
+    _: &mut Loader<'a>,
+    p: &Plugin<'a>,
+    at: &Placement<'a>,
+) -> Result<WorldGeometry, SceneError> {
+    let (e, ctx, m, span) = (p.elem, &at.ctx, at.m, at.span.clone());
+    check_quad(&ctx, &m, span.clone())?;
+    Ok(WorldGeometry::Disk {
+        to_world: checked_map(&p, e, &m, "disk")?,
+    })
+}
+
+/// Mitsuba's cylinder: to_world · translate(p0) · to_frame(p1 − p0) · scale(r, r, |p1 −
+/// p0|) maps the unit cylinder; Mitsuba then keeps only that map's rotation and its
+/// diagonal stretch (r, l), so a shear or unequal x/y scale is refused here rather
+/// than rendered differently.
+fn cylinder<'a>(
+    _: &mut Loader<'a>,
+    p: &Plugin<'a>,
+    at: &Placement<'a>,
+) -> Result<WorldGeometry, SceneError> {
+    let (e, m, xform) = (p.elem, at.m, &at.xform);
+    let r = p.float("radius")?.unwrap_or(1.0);
+    let p0 = DVec3::from_array(p.vec3("p0")?.unwrap_or([0.0; 3]));
+    let p1 = DVec3::from_array(p.vec3("p1")?.unwrap_or([0.0, 0.0, 1.0]));
+    let axis = p1 - p0;
+    let len = axis.length();
+    if !(len > 0.0) || !(r != 0.0) || !r.is_finite() {
+        return Err(p.err(e, format!("a cylinder needs p0 ≠ p1 and a non-zero radius (got radius {r}, |p1 − p0| = {len})")));
+    }
+    // Duff et al.'s orthonormal basis around the axis (Mitsuba's Frame, lt's Frame::from_z).
+    let f = lt_core::math::Frame::from_z(axis.normalize().as_vec3());
+    let frame = DMat4::from_cols(
+        f.x.as_dvec3().extend(0.0),
+        f.y.as_dvec3().extend(0.0),
+        (axis / len).extend(0.0),
+        glam::DVec4::W,
+    );
+    let full = m * DMat4::from_translation(p0) * frame * DMat4::from_scale(DVec3::new(r, r, len));
+    if !lt_core::geometry::quadric::is_round_cylinder_map(&glam::DMat3::from_mat4(full), 1e-5) {
+        return Err(p.err(
+            xform.as_ref().map_or(e, |(_, te)| te),
+            "a cylinder's to_world must be a rotation, a scale equal along x and y, and a translation (Mitsuba drops shear and unequal x/y scales, with a warning)",
+        ));
+    }
+    Ok(WorldGeometry::Cylinder {
+        to_world: checked_map(&p, e, &full, "cylinder")?,
+    })
+}
+
+/// Mitsuba's SDF grid: its file's values over the unit cube, under to_world.
+fn sdfgrid<'a>(
+    l: &mut Loader<'a>,
+    p: &Plugin<'a>,
+    at: &Placement<'a>,
+) -> Result<WorldGeometry, SceneError> {
+    let (e, doc, m) = (p.elem, l.doc, at.m);
+    let Some((file, fe)) = p.string("filename")? else {
+        return Err(p.err(e, "shape `sdfgrid` needs a `filename`"));
+    };
+    let smooth = match p.string("normals")? {
+        None | Some(("smooth", _)) => true,
+        Some(("analytic", _)) => false,
+        Some((other, ne)) => {
+            return Err(p.err(
+                ne,
+                format!("sdfgrid `normals` must be `smooth` or `analytic`, got `{other}`"),
+            ))
+        }
+    };
+    let path = doc
+        .resolver
+        .resolve(file)
+        .map_err(|looked| p.err(fe, Resolver::not_found("volume grid file", file, &looked)))?;
+    let resolved = Ctx {
+        base_dir: PathBuf::new(),
+        ..doc.ctx(e.src)
+    };
+    let spanned = toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
+    let grid = crate::mesh::vol::load_sdf_grid(&resolved, &spanned, smooth)?;
+    l.meshes.push(path);
+    Ok(WorldGeometry::SdfGrid {
+        grid: std::sync::Arc::new(grid),
+        to_world: checked_map(&p, e, &m, "sdfgrid")?,
+    })
+}
+
+fn obj_ply_serialized<'a>(
+    l: &mut Loader<'a>,
+    p: &Plugin<'a>,
+    at: &Placement<'a>,
+) -> Result<WorldGeometry, SceneError> {
+    let (e, doc, ctx, m, span) = (p.elem, l.doc, &at.ctx, at.m, at.span.clone());
+    let Some((file, fe)) = p.string("filename")? else {
+        return Err(p.err(e, format!("shape `{}` needs a `filename`", p.kind)));
+    };
+    let mut face_normals = p.boolean("face_normals")?.unwrap_or(false);
+    let shape_index = match p.kind {
+        "serialized" => p.integer("shape_index")?.map_or(Ok(0), |i| {
+            u32::try_from(i).map_err(|_| {
+                p.err(
+                    e,
+                    format!("`shape_index` must be a non-negative integer, got {i}"),
+                )
+            })
+        })?,
+        _ => 0,
+    };
+    check_solid(&ctx, &m, span.clone(), "mesh")?;
+    let path = doc
+        .resolver
+        .resolve(file)
+        .map_err(|looked| p.err(fe, Resolver::not_found("mesh file", file, &looked)))?;
+    // The mesh readers join their context's folder with the name: give them the
+    // resolved path and no folder.
+    let resolved = Ctx {
+        base_dir: PathBuf::new(),
+        ..doc.ctx(e.src)
+    };
+    let spanned = toml::Spanned::new(fe.range.clone(), path.to_string_lossy().into_owned());
+    let mut mesh = match p.kind {
+        "obj" => crate::mesh::obj::load_obj(&resolved, &spanned)?,
+        "ply" => ply::load_ply(&resolved, &spanned)?,
+        _ => {
+            // The file's own "face normals" flag is the same as `face_normals`.
+            let s = serialized::load_serialized(&resolved, &spanned, shape_index)?;
+            face_normals |= s.face_normals;
+            s.mesh
+        }
+    };
+    l.meshes.push(path);
+    if face_normals {
+        mesh.normals = None;
+    } else if mesh.normals.is_none() {
+        // Mitsuba shades a mesh without normals smoothly, with normals it computes.
+        mesh.normals = Some(vertex_normals(&mesh));
+    }
+    let mesh = WorldMesh::place(&mesh, &m);
+    if !(mesh.area() > 0.0) {
+        return Err(p.err(fe, "the mesh has zero area (every triangle is degenerate)"));
+    }
+    placed(ctx, mesh, span)
 }

@@ -142,7 +142,7 @@ pub struct MaterialDef {
     /// through with probability 1 − α), a number in [0, 1] or a texture (its luminance).
     pub opacity: Option<S<f64>>,
     pub opacity_texture: Option<S<TextureDef>>,
-    /// `principled` and `principledthin` (Mitsuba's names, `principled_def.rs`): `base_color`
+    /// `principled` and `principledthin` (Mitsuba's names, `principled.rs`): `base_color`
     /// or `base_color_texture`, `roughness` and `ior` as above, and these scalars.
     pub base_color: Option<S<ColorDef>>,
     pub base_color_texture: Option<S<TextureDef>>,

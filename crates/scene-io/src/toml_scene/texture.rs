@@ -1,8 +1,8 @@
 //! A TOML `*_texture` table turned into a core `Texture` (the keys are in `format::TextureDef`).
 
 use crate::error::Ctx;
-use crate::format::{TextureDef, S};
 use crate::image_file::{filter_type_named, read_bitmap, wrap_mode_named};
+use crate::toml_scene::schema::{TextureDef, S};
 use crate::SceneError;
 use lt_core::math::Vec2;
 use lt_core::texture::{Texture, UvTransform};
@@ -43,7 +43,7 @@ pub fn texture(ctx: &Ctx, def: &S<TextureDef>) -> Result<Texture, SceneError> {
         }
         "checkerboard" => {
             ctx.only(&given, &["color0", "color1", "scale"], &what)?;
-            let color = |c: &Option<S<crate::format::ColorDef>>, key, default: f32| {
+            let color = |c: &Option<S<crate::toml_scene::schema::ColorDef>>, key, default: f32| {
                 c.as_ref()
                     .map(|c| ctx.color(c, key, false))
                     .transpose()

@@ -1,10 +1,27 @@
-//! The TOML scene format (docs/scene-format.md): text → `SceneFile` (format.rs) → `Scene`
-//! (elements.rs).
+//! The TOML scene format (docs/scene-format.md): text → `SceneFile` (`schema`, serde's view of
+//! the file) → `Scene` (`assemble` here, with one file per table: `camera`, `material` with
+//! `material_params`, `principled` and `texture`, `shape`, `light`).
+
+mod camera;
+mod light;
+mod material;
+mod material_params;
+pub(crate) mod principled;
+pub(crate) mod schema;
+mod shape;
+pub(crate) mod texture;
 
 use crate::error::Ctx;
-use crate::format::SceneFile;
+use crate::world::WorldBuilder;
 use crate::SceneError;
+use camera::{camera, render};
+use glam::DVec3;
+use light::{light, Placed};
 use lt_core::Scene;
+use material::material;
+use schema::SceneFile;
+use shape::shape;
+use std::collections::HashMap;
 use std::path::Path;
 
 pub(crate) fn load_toml(path: &Path) -> Result<Scene, SceneError> {
@@ -29,7 +46,7 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
         Some(span) => ctx.at(span, e.message().trim_end().to_string()),
         None => ctx.whole(e.message().trim_end().to_string()),
     })?;
-    let mut scene = crate::elements::assemble(&ctx, &file)?;
+    let mut scene = assemble(&ctx, &file)?;
     let meshes = file.shapes.iter().filter_map(|s| s.get_ref().file.as_ref());
     // Texture files in material order (as the XML loader meets them: BSDFs before shapes).
     let mut materials: Vec<_> = file.materials.values().collect();
@@ -61,4 +78,37 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
         .chain(envmaps.map(|f| ctx.base_dir.join(f.get_ref())))
         .collect();
     Ok(scene)
+}
+
+/// The parsed file as a scene, built in file order so that ids and the first error follow it.
+fn assemble(ctx: &Ctx, file: &SceneFile) -> Result<Scene, SceneError> {
+    // Checked here, at the origin, so that a degenerate camera is the error reported first.
+    camera(ctx, &file.camera, DVec3::ZERO)?;
+    let settings = render(ctx, file)?;
+    let mut b = WorldBuilder::new(settings);
+    let mut ids = HashMap::new();
+    // In file order, so ids and the first error reported follow the file.
+    let mut materials: Vec<_> = file.materials.iter().collect();
+    materials.sort_by_key(|(_, def)| def.span().start);
+    for (name, def) in materials {
+        ids.insert(name.as_str(), b.add_material(material(ctx, name, def)?));
+    }
+    let mut emitters = 0;
+    for def in &file.shapes {
+        emitters += shape(ctx, def, &ids, &mut b)? as usize;
+    }
+    for def in &file.lights {
+        match light(ctx, def)? {
+            Some(Placed::At(position, l)) => b.add_light_at(l, position),
+            Some(Placed::Anywhere(l)) => b.add_light(l),
+            None => continue,
+        }
+        emitters += 1;
+    }
+    if emitters == 0 {
+        return Err(ctx.whole(
+            "the scene has no light: give a shape a non-zero `emission` or add a [[lights]] entry",
+        ));
+    }
+    b.build(|origin| camera(ctx, &file.camera, origin))
 }

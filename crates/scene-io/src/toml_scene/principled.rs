@@ -6,8 +6,8 @@
 //! and `ior` (1.5). Scalars are numbers here; Mitsuba XML also takes textures for them.
 
 use crate::error::Ctx;
-use crate::format::{MaterialDef, S};
 use crate::principled_keys::{principled_eta, scalar_in_range, thin_eta};
+use crate::toml_scene::schema::{MaterialDef, S};
 use crate::SceneError;
 use lt_core::bsdf::{Material, Principled, PrincipledThin};
 use lt_core::math::Color;
