@@ -489,3 +489,54 @@ fn fog_techniques_agree_on_the_film() {
     }
     println!("{report}");
 }
+
+/// The scene's media queries on the null-bounded fog cube [-½,½]³ (σt 1.5) in air: T through
+/// the null boundaries is exp(−σt · chord) (the chord known from the geometry), an opaque floor
+/// blocks a shadow ray but not the oracle's edge, and the free-flight density of stopping inside
+/// the cube is σt e^{−σt t}. The bound: σt × the hit points' rounding (coordinates ≤ 2, a few
+/// f32 ulps: < 1e-6 per crossing) — 1e-5 relative leaves a factor 5 over it.
+#[test]
+fn fog_queries_pass_null_boundaries_and_stop_at_opaque_ones() {
+    use lt_core::scene::ConnectionEnd;
+    let fs = media::null_box_in_air();
+    let s = &fs.scene;
+    let end = |p: Vec3| ConnectionEnd {
+        p,
+        p_err: Vec3::ZERO,
+        ng: Vec3::ZERO,
+        infinite: false,
+    };
+    let sigma = fs.sigma_t as f64;
+    let (a, b) = (Vec3::new(0.1, 0.2, 2.0), Vec3::new(-0.1, 0.1, -2.0));
+    let chord = (b - a).length() as f64 * 0.25;
+    let t = s
+        .transmittance(end(a), end(b), None)
+        .expect("only null boundaries between");
+    assert!(
+        rel_close(t.x as f64, (-sigma * chord).exp(), 1e-5),
+        "{t} vs chord {chord}"
+    );
+    let mut rng = lt_core::sampling::Sampler::new(1, 0, 0);
+    let est = s
+        .transmittance_estimate(end(b), end(a), None, &mut rng)
+        .unwrap();
+    assert!(rel_close(est.x as f64, t.x as f64, 1e-5), "{est} vs {t}");
+    // Into the cube: the medium after the boundary is its interior.
+    let inside = Vec3::new(0.0, 0.1, 0.0);
+    let to_inside = (inside - a).length() as f64 * (0.5 / 2.0);
+    let p = s.free_flight_density(end(a), end(inside), None, true) as f64;
+    let expect = sigma * (-sigma * to_inside).exp();
+    assert!(rel_close(p, expect, 1e-5), "{p} vs {expect}");
+    let pass = s.free_flight_density(end(inside), end(a), Some(0), false) as f64;
+    assert!(rel_close(pass, (-sigma * to_inside).exp(), 1e-5), "{pass}");
+    // Through the opaque floor: a shadow ray is blocked, the oracle's edge is not (0.6 of it in
+    // the cube: y from 0.1 to −0.5).
+    let below = Vec3::new(0.0, -1.5, 0.0);
+    assert!(s.transmittance(end(inside), end(below), Some(0)).is_none());
+    let edge = s.edge_transmittance(end(inside), end(below), Some(0)).x as f64;
+    assert!(rel_close(edge, (-sigma * 0.6).exp(), 1e-5), "{edge}");
+    // A scene without media pays nothing: the flag is off, every vertex's interface is 0.
+    let plain = cornell(BoxConfig::default());
+    assert!(!plain.has_media && plain.interfaces.len() == 1 && s.has_media);
+    assert_eq!(std::mem::size_of::<PathVertex>(), 128);
+}
