@@ -1,35 +1,33 @@
-//! Light-transport estimators over the shared path-space core. One integrator per file; each opens
-//! with a table of its parameters. `registry` maps names to constructors, `render` drives passes.
+//! Light-transport estimators over the shared path-space core. One integrator per file, grouped
+//! by family (`unidirectional`, `bidirectional`, `photon`, `vcm`); each opens with a table of its
+//! parameters. The machinery they share is in `subpath` (walks, joins, the bidirectional camera
+//! loop), `film` (pixel samples, splats), `density` (photon maps, radii), `record` (what
+//! integrators report: mis-check, tallies); `registry` maps names to constructors, `render`
+//! drives passes.
 
-pub mod bdpt;
-pub mod bpm;
-pub mod camera_loop;
-pub mod connect;
-pub mod connect_merge;
-pub mod cpu_clock;
-pub mod eamis;
-pub mod light;
-pub mod lvc_bdpt;
+// The estimators, by family (each file opens with its key table).
+pub mod bidirectional;
+pub mod photon;
+pub mod unidirectional;
+pub mod vcm;
+
+// The machinery they share.
+pub mod density;
+pub mod film;
 pub mod params;
-pub mod photons;
-pub mod pixel;
-pub mod pm;
-pub mod ppm;
-pub mod progressive;
-pub mod pt;
-pub mod pt_bsdf;
-pub mod radius;
 pub mod record;
 pub mod registry;
 pub mod render;
-pub mod splat;
-pub mod sppm;
-pub mod strategy_weight;
-pub mod tally;
-pub mod tally_run;
-pub mod vcm;
-pub mod visible;
-pub mod walk;
+pub mod subpath;
+
+// The paths crates outside this one import (the modules' homes are above).
+pub use bidirectional::{bdpt, lvc_bdpt};
+pub use density::{radius, visible};
+pub use film::{pixel, splat};
+pub use record::{tally, tally_run};
+pub use subpath::connect;
+pub use unidirectional::pt;
+pub use vcm::engine as connect_merge;
 
 pub use params::IntegratorParams;
 pub use registry::{make_integrator, IntegratorInfo, Radius, INTEGRATORS};

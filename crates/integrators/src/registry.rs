@@ -1,17 +1,17 @@
 //! The one table from integrator names to constructors (the CLI, the tests and the experiments
 //! all use it). Tests that loop over `INTEGRATORS` cover a new integrator without new test code.
 
-use crate::bdpt::{Bdpt, BdptParams};
-use crate::bpm::Bpm;
-use crate::eamis::Eamis;
-use crate::light::{LightParams, LightTracer};
-use crate::lvc_bdpt::{LvcBdpt, LvcParams};
+use crate::bidirectional::bdpt::{Bdpt, BdptParams};
+use crate::bidirectional::lvc_bdpt::{LvcBdpt, LvcParams};
 use crate::params::{IntegratorParams, ParamReader};
-use crate::pm::{Pm, PmParams};
-use crate::ppm::Ppm;
-use crate::pt::{Pt, PtParams};
-use crate::pt_bsdf::{PtBsdf, PtBsdfParams};
-use crate::sppm::Sppm;
+use crate::photon::pm::{Pm, PmParams};
+use crate::photon::ppm::Ppm;
+use crate::photon::sppm::Sppm;
+use crate::unidirectional::light::{LightParams, LightTracer};
+use crate::unidirectional::pt::{Pt, PtParams};
+use crate::unidirectional::pt_bsdf::{PtBsdf, PtBsdfParams};
+use crate::vcm::bpm::Bpm;
+use crate::vcm::eamis::Eamis;
 use crate::vcm::Vcm;
 use crate::{Estimator, Kind};
 use lt_core::Scene;
@@ -55,8 +55,8 @@ impl Radius {
         match self {
             Radius::None => None,
             Radius::Fixed => Some(1.0),
-            Radius::KnausZwicker => Some(crate::radius::global_scale2(i, alpha)),
-            Radius::Power => Some(crate::radius::power_scale2(i, alpha)),
+            Radius::KnausZwicker => Some(crate::density::radius::global_scale2(i, alpha)),
+            Radius::Power => Some(crate::density::radius::power_scale2(i, alpha)),
         }
     }
 }
@@ -96,7 +96,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "path tracing with next-event estimation and MIS (power heuristic)",
         kind: Kind::Unbiased,
         weights: Weights::PathTracing,
-        source: include_str!("pt.rs"),
+        source: include_str!("unidirectional/pt.rs"),
         radius: Radius::None,
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(Pt {
@@ -109,7 +109,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "path tracing by BSDF sampling only (the cross-check of pt)",
         kind: Kind::Unbiased,
         weights: Weights::None,
-        source: include_str!("pt_bsdf.rs"),
+        source: include_str!("unidirectional/pt_bsdf.rs"),
         radius: Radius::None,
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(PtBsdf {
@@ -122,7 +122,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "light tracing: light subpaths splatted to the camera at every vertex",
         kind: Kind::Unbiased,
         weights: Weights::None,
-        source: include_str!("light.rs"),
+        source: include_str!("unidirectional/light.rs"),
         radius: Radius::None,
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(LightTracer {
@@ -135,7 +135,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "bidirectional path tracing: every (s,t) strategy under MIS (power heuristic)",
         kind: Kind::Unbiased,
         weights: Weights::Connections,
-        source: include_str!("bdpt.rs"),
+        source: include_str!("bidirectional/bdpt.rs"),
         radius: Radius::None,
         make: |s, r| {
             Ok(Estimator::Unbiased(Box::new(Bdpt {
@@ -148,7 +148,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "bdpt with a light-vertex cache: each camera vertex joins N random cached light vertices",
         kind: Kind::Unbiased,
         weights: Weights::VertexCache,
-        source: include_str!("lvc_bdpt.rs"),
+        source: include_str!("bidirectional/lvc_bdpt.rs"),
         radius: Radius::None,
         make: |s, r| {
             let params = LvcParams::read(s, r)?;
@@ -160,7 +160,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "photon mapping: one photon map per run, gathered at the first non-delta vertex",
         kind: Kind::Consistent,
         weights: Weights::None,
-        source: include_str!("pm.rs"),
+        source: include_str!("photon/pm.rs"),
         radius: Radius::Fixed,
         make: |s, r| {
             Ok(Estimator::Consistent(Box::new(Pm {
@@ -173,7 +173,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "progressive photon mapping: fixed visible points, photon passes pushed into them",
         kind: Kind::Consistent,
         weights: Weights::None,
-        source: include_str!("ppm.rs"),
+        source: include_str!("photon/ppm.rs"),
         radius: Radius::KnausZwicker,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Ppm::read(s, r)?))),
     },
@@ -182,7 +182,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "stochastic progressive photon mapping: new visible points every pass",
         kind: Kind::Consistent,
         weights: Weights::None,
-        source: include_str!("sppm.rs"),
+        source: include_str!("photon/sppm.rs"),
         radius: Radius::KnausZwicker,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Sppm::read(s, r)?))),
     },
@@ -191,7 +191,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "bidirectional photon mapping: merging at every camera vertex under MIS",
         kind: Kind::Consistent,
         weights: Weights::ConnectMerge { connections: false },
-        source: include_str!("bpm.rs"),
+        source: include_str!("vcm/bpm.rs"),
         radius: Radius::Power,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Bpm::read(s, r)?))),
     },
@@ -200,7 +200,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         about: "vertex connection and merging: bdpt's connections and merging under one MIS",
         kind: Kind::Consistent,
         weights: Weights::ConnectMerge { connections: true },
-        source: include_str!("vcm.rs"),
+        source: include_str!("vcm/mod.rs"),
         radius: Radius::Power,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Vcm::read(s, r)?))),
     },
@@ -210,7 +210,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
                 vertex connections and per-pixel merging",
         kind: Kind::Consistent,
         weights: Weights::EfficiencyAware,
-        source: include_str!("eamis.rs"),
+        source: include_str!("vcm/eamis.rs"),
         radius: Radius::Power,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Eamis::read(s, r)?))),
     },

@@ -4,7 +4,7 @@
 //! estimate. `render_runs` repeats a render over independent seeds: the only honest error bars of
 //! a consistent estimator, and a cross-check of the per-pass ones of an unbiased estimator.
 
-use crate::cpu_clock::pool_cpu_time;
+use crate::record::cpu_clock::pool_cpu_time;
 use crate::{Estimator, Integrator, Kind, ProgressLog, Progressive, ProgressiveRun};
 use lt_core::Scene;
 use lt_estimators::running::RunningImage;

@@ -25,7 +25,7 @@ use lt_core::scene::{LightDesc, RenderSettings, SceneBuilder, ShapeGeometry, Tri
 use lt_core::Scene;
 use lt_estimators::agreement::sidak_threshold;
 use lt_integrators::params::documented_keys;
-use lt_integrators::photons::{trace_photons, Photon, PhotonOptions};
+use lt_integrators::density::photons::{trace_photons, Photon, PhotonOptions};
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions, INTEGRATORS};
 use std::ops::ControlFlow;
 
@@ -523,7 +523,7 @@ fn a_thin_wall_lit_from_behind_stays_black_in_front() {
 #[test]
 fn photons_behind_rough_glass_are_gathered_through_it() {
     use lt_core::bsdf::{microfacet, Diffuse, Material, RoughDielectric, ShadingFrame};
-    use lt_integrators::photons::{GatherPoint, Photon};
+    use lt_integrators::density::photons::{GatherPoint, Photon};
     let mut b = SceneBuilder::new(camera(), RenderSettings::default());
     let glass = b.add_material(Material::RoughDielectric(RoughDielectric {
         distribution: microfacet::Microfacet::isotropic(microfacet::MicrofacetType::Ggx, 0.3),

@@ -7,8 +7,8 @@ use lt_core::math::Vec2;
 use lt_core::path::{Path, VertexKind};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
-use lt_integrators::connect::connect_to_camera;
-use lt_integrators::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
+use lt_integrators::subpath::connect::connect_to_camera;
+use lt_integrators::subpath::walk::{camera_subpath, light_subpath, Subpath, WalkLimits};
 use lt_scene_io::load_scene;
 use std::path::PathBuf;
 

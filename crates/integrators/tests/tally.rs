@@ -1,10 +1,10 @@
-//! Per-technique tallies (`lt_integrators::tally`): a tallied render is the plain render bit for
+//! Per-technique tallies (`lt_integrators::record::tally`): a tallied render is the plain render bit for
 //! bit, at any thread count, and its techniques' means add up to the image's mean.
 
 use lt_core::Scene;
 use lt_integrators::record::Work;
-use lt_integrators::tally::RunTally;
-use lt_integrators::tally_run::{tally_run, Tallied};
+use lt_integrators::record::tally::RunTally;
+use lt_integrators::record::tally_run::{tally_run, Tallied};
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
 use lt_scene_io::load_scene;
 use std::ops::ControlFlow;

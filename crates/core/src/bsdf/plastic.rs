@@ -36,6 +36,28 @@ pub fn specular_sampling_weight(diffuse_mean: f32, specular_mean: f32) -> f32 {
     specular_mean / (diffuse_mean + specular_mean)
 }
 
+/// The probability of choosing a plastic's specular lobe, sampling weight `w`, when its coating
+/// reflects `reflected` and transmits `transmitted` of the light arriving from outside:
+/// R w / (R w + T (1 − w)) (smooth: R = F, T = 1 − F; rough: the interface's 1 − T(μ), T(μ)).
+#[inline]
+pub fn specular_lobe_probability(w: f32, reflected: f32, transmitted: f32) -> f32 {
+    let (s, d) = (reflected * w, transmitted * (1.0 - w));
+    s / (s + d)
+}
+
+/// The base's reflectance `r` through the coating's internal reflections, the geometric series
+/// R / (1 − F_int · (nonlinear ? R : 1)) with `f_int` the coating's diffuse reflectance from
+/// inside (Weidlich & Wilkie 2007; Mitsuba 3's plastic and roughplastic).
+#[inline]
+pub fn internal_scattering(r: Color, f_int: f32, nonlinear: bool) -> Color {
+    let internal = if nonlinear {
+        r * f_int
+    } else {
+        Color::splat(f_int)
+    };
+    r / (Color::ONE - internal)
+}
+
 /// Mitsuba parameters: `int_ior` (polypropylene, 1.49), `ext_ior` (air, 1.000277),
 /// `diffuse_reflectance` (0.5, texturable), `specular_reflectance` (1, texturable), `nonlinear`
 /// (false).
@@ -86,21 +108,14 @@ impl Plastic {
     /// Probability of choosing the specular lobe when the outer Fresnel reflectance is `f`.
     #[inline]
     fn specular_probability(&self, f: f32) -> f32 {
-        let w = self.specular_sampling_weight;
-        let (s, d) = (f * w, (1.0 - f) * (1.0 - w));
-        s / (s + d)
+        specular_lobe_probability(self.specular_sampling_weight, f, 1.0 - f)
     }
 
     /// The diffuse lobe with the two transmissions left out: R / (π η² (1 − F_dr,int·(R or 1))).
     #[inline]
     fn diffuse_base(&self) -> Color {
-        let r = self.diffuse_reflectance;
-        let internal = if self.nonlinear {
-            r * self.fdr_int
-        } else {
-            Color::splat(self.fdr_int)
-        };
-        r / (Color::ONE - internal) * (INV_PI / (self.eta * self.eta))
+        internal_scattering(self.diffuse_reflectance, self.fdr_int, self.nonlinear)
+            * (INV_PI / (self.eta * self.eta))
     }
 }
 

@@ -27,7 +27,10 @@
 
 use super::fresnel::fresnel_dielectric;
 use super::microfacet::{reflect, reflection_jacobian, Microfacet, MicrofacetType};
-use super::plastic::{channel_mean, specular_sampling_weight, AIR_IOR, POLYPROPYLENE_IOR};
+use super::plastic::{
+    channel_mean, internal_scattering, specular_lobe_probability, specular_sampling_weight,
+    AIR_IOR, POLYPROPYLENE_IOR,
+};
 use super::quadrature::gauss_legendre;
 use super::{LocalBsdf, LocalSample, TransportMode};
 use crate::math::{Color, Vec2, Vec3, INV_PI};
@@ -222,9 +225,7 @@ impl RoughPlastic {
     #[inline]
     fn specular_probability(&self, wo: Vec3) -> f32 {
         let t = self.interface.transmittance_at(wo.z.min(1.0));
-        let w = self.specular_sampling_weight;
-        let (s, d) = ((1.0 - t) * w, t * (1.0 - w));
-        s / (s + d)
+        specular_lobe_probability(self.specular_sampling_weight, 1.0 - t, t)
     }
 }
 
@@ -265,16 +266,11 @@ impl LocalBsdf for RoughPlastic {
         let cos_h = 0.5 * (wo.dot(h) + wi.dot(h));
         let f = fresnel_dielectric(cos_h.clamp(0.0, 1.0), self.eta).0;
         let specular = self.specular_reflectance * (f * dist.d(h) * g / (4.0 * (wo.z * wi.z)));
-        let r = self.diffuse_reflectance;
         let f_int = self.interface.internal_reflectance;
-        let internal = if self.nonlinear {
-            r * f_int
-        } else {
-            Color::splat(f_int)
-        };
+        let diffuse = internal_scattering(self.diffuse_reflectance, f_int, self.nonlinear);
         let t = self.interface.transmittance_at(wo.z.min(1.0))
             * self.interface.transmittance_at(wi.z.min(1.0));
-        specular + r / (Color::ONE - internal) * (t * INV_PI / (self.eta * self.eta))
+        specular + diffuse * (t * INV_PI / (self.eta * self.eta))
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {

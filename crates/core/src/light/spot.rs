@@ -13,6 +13,7 @@
 //! cutoff cone, pdf_ω = 1 / (2π (1 − cos cutoff)), zero outside; `sample_li` is the position's
 //! Dirac (discrete density 1), as for a point light.
 
+use super::point::sample_li_at;
 use super::{LightLeSample, LightLiSample};
 use crate::geometry::Ray;
 use crate::math::{luminance, Color, Vec2, Vec3, PI};
@@ -94,24 +95,7 @@ impl SpotLight {
     }
 
     pub fn sample_li(&self, p: Vec3) -> Option<LightLiSample> {
-        let to = self.position - p;
-        let d2 = to.length_squared();
-        if !(d2 > 0.0) {
-            return None;
-        }
-        let distance = d2.sqrt();
-        let wi = to / distance;
-        Some(LightLiSample {
-            uv: TexPoint::default(),
-            p_err: Vec3::ZERO,
-            wi,
-            p: self.position,
-            n: -wi,
-            distance,
-            radiance: self.intensity_towards(-wi) / d2,
-            pdf_w: 1.0,
-            delta: true,
-        })
+        sample_li_at(self.position, p, |w| self.intensity_towards(w))
     }
 
     pub fn sample_le(&self, u_dir: Vec2) -> LightLeSample {

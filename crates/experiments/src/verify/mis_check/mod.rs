@@ -6,7 +6,9 @@
 //!   technique of the path.
 //! - `vcm_bpm`: vcm's and bpm's (connections and merges), and their recursion replayed.
 //! - `tolerance`: how far a weight may stray from the oracle's.
+//! - `report`: the one report both checkers fill, a row per path length.
 
 pub mod pt_bdpt;
+pub mod report;
 pub mod tolerance;
 pub mod vcm_bpm;

@@ -29,18 +29,14 @@
 //!   exercises the densities the walks filled. Each replayed weight is also compared with the
 //!   oracle's (`replay` column).
 //!
-//! Table columns per length k: paths checked; techniques recorded and techniques the oracle found
-//! valid (non-zero density) on them; max |Σw − 1| and paths failing (b); max relative mismatch,
-//! max absolute mismatch; the median and largest derived tolerance; the largest mismatch over its
-//! path's tolerance; paths over their tolerance; paths over 1e-4, 1e-5, 1e-6 relative; max
-//! |replayed − oracle| weight (bdpt).
+//! The table (`report::Report`, shared with `vcm_bpm`) has one row per path length k.
 
-use super::tolerance::{
-    derived_tolerance, relative, weight_error_bound, DEFAULT_SLACK, STRICT_LEVELS, SUM_TOLERANCE,
-};
+pub use super::report::Report;
+use super::report::Verdict;
+use super::tolerance::{derived_tolerance, relative, weight_error_bound, DEFAULT_SLACK};
 use lt_core::bsdf::TransportMode;
 use lt_core::math::{Color, Vec2};
-use lt_core::path::{oracle_weight, Heuristic, Path, PathVertex, VertexKind};
+use lt_core::path::{oracle_weight, Heuristic, Path, PathVertex, Technique, VertexKind};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
 use lt_integrators::bdpt::{mis_weight, with_chain, Bdpt, BdptParams, EndEvals, Split};
@@ -49,8 +45,6 @@ use lt_integrators::lvc_bdpt::{lvc_weight, LvcBdpt, LvcParams};
 use lt_integrators::pt::{Pt, PtParams, Techniques};
 use lt_integrators::record::{Completed, Recorder};
 use lt_integrators::registry::{self, Weights};
-use std::collections::BTreeSet;
-use std::fmt;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Which {
@@ -294,25 +288,6 @@ pub fn collect(scene: &Scene, opts: &Options) -> (Collector, u32) {
     (c, passes)
 }
 
-/// The verdict on one path.
-#[derive(Clone, Debug)]
-pub struct PathCheck {
-    pub k: usize,
-    pub s: usize,
-    /// The oracle's weight of technique s.
-    pub oracle: f64,
-    /// Relative mismatch of the integrator's weight (check a).
-    pub mismatch: f64,
-    /// The tolerance of (a) derived for this path: `tolerance::derived_tolerance`.
-    pub allowed: f64,
-    /// Σ of the integrator's own weights over the techniques, minus 1 (check b).
-    pub sum_error: f64,
-    /// Largest |replayed weight − oracle weight| over the techniques (bdpt; 0 for pt).
-    pub replay_error: f64,
-    /// Techniques the oracle considers valid with non-zero density.
-    pub valid: Vec<usize>,
-}
-
 fn unit_towards(from: &PathVertex, to: &PathVertex) -> lt_core::Vec3 {
     from.dir_to(to)
 }
@@ -432,13 +407,7 @@ pub fn effective(d: &lt_core::path::Densities, which: Which, n_conn: f64) -> Vec
 }
 
 /// Checks one recorded path (see the module docs).
-pub fn check_record(
-    scene: &Scene,
-    r: &Record,
-    opts: &Options,
-    ratio: f64,
-    n_conn: f64,
-) -> PathCheck {
+pub fn check_record(scene: &Scene, r: &Record, opts: &Options, ratio: f64, n_conn: f64) -> Verdict {
     let path = r.path();
     let k = path.k();
     let mut d = path.densities(scene);
@@ -483,74 +452,16 @@ pub fn check_record(
     } else {
         sum - 1.0
     };
-    PathCheck {
+    Verdict {
         k,
-        s: r.s,
-        allowed: derived_tolerance(bound, opts.slack),
+        technique: Technique::Connect(r.s),
+        weight: r.weight,
         oracle,
         mismatch,
+        allowed: derived_tolerance(bound, opts.slack),
         sum_error,
         replay_error,
-        valid,
-    }
-}
-
-/// One line of the table: paths of k segments.
-#[derive(Clone, Debug, Default)]
-pub struct Row {
-    pub k: usize,
-    pub paths: usize,
-    /// Techniques the recorded paths came from.
-    pub recorded: BTreeSet<usize>,
-    /// Techniques the oracle found valid (non-zero density) on any of them.
-    pub valid: BTreeSet<usize>,
-    pub max_sum_error: f64,
-    pub max_mismatch: f64,
-    pub max_abs_mismatch: f64,
-    pub max_replay_error: f64,
-    /// Paths over their tolerance of (a).
-    pub over: usize,
-    /// Paths over each of `STRICT_LEVELS`.
-    pub over_strict: [usize; 3],
-    /// Paths failing (b).
-    pub sum_fail: usize,
-    /// Largest mismatch / its path's tolerance.
-    pub max_ratio: f64,
-    /// Every path's tolerance, for the median and the largest.
-    pub allowed: Vec<f64>,
-}
-
-/// The outcome of a check.
-#[derive(Clone, Debug)]
-pub struct Report {
-    pub scene: String,
-    pub integrator: Which,
-    pub heuristic: Heuristic,
-    pub slack: f64,
-    pub passes: u32,
-    pub rows: Vec<Row>,
-    /// Paths the integrator reported beyond max_depth.
-    pub too_long: usize,
-    /// A few failing paths, described.
-    pub examples: Vec<String>,
-}
-
-impl Report {
-    pub fn failures(&self) -> usize {
-        self.too_long
-            + self
-                .rows
-                .iter()
-                .map(|r| r.over.max(r.sum_fail))
-                .sum::<usize>()
-    }
-
-    pub fn passed(&self) -> bool {
-        self.failures() == 0
-    }
-
-    pub fn checked(&self) -> usize {
-        self.rows.iter().map(|r| r.paths).sum()
+        valid: valid.into_iter().map(Technique::Connect).collect(),
     }
 }
 
@@ -585,7 +496,7 @@ fn kind_name(scene: &Scene, v: &PathVertex) -> String {
 pub fn describe(
     scene: &Scene,
     r: &Record,
-    c: &PathCheck,
+    c: &Verdict,
     opts: &Options,
     ratio: f64,
     n_conn: f64,
@@ -634,7 +545,7 @@ pub fn describe(
         "k={} s={} path=[{}] weight={:.9e} oracle={:.9e} rel={:.3e} allowed={:.2e} Σw−1={:.3e} alternatives={:?}\n    \
          eff p_s={:?}\n    oracle w_s=[{}]\n    light={:?}\n    camera={:?} nee={:e}\n    stored {}\n    segments {}",
         c.k,
-        c.s,
+        r.s,
         kinds.join(" → "),
         r.weight,
         c.oracle,
@@ -659,57 +570,25 @@ pub fn check_records(
     opts: &Options,
     passes: u32,
     too_long: usize,
-    name: &str,
+    scene_name: &str,
 ) -> Report {
     let ratio = light_tracing_ratio(scene, opts);
     let n_conn = connection_count(scene, opts);
-    let mut rows: Vec<Row> = (0..=opts.max_depth as usize)
-        .map(|k| Row {
-            k,
-            ..Row::default()
-        })
-        .collect();
-    let mut examples = Vec::new();
+    let name = opts.integrator.name().to_string();
+    let mut report = Report::new(scene_name, name, opts.heuristic, opts.max_depth);
+    report.slack = opts.slack;
+    report.passes = passes;
+    report.too_long = too_long;
     for r in records {
         let c = check_record(scene, r, opts, ratio, n_conn);
-        if c.k >= rows.len() {
-            rows.resize_with(c.k + 1, Row::default);
-            rows[c.k].k = c.k;
-        }
-        let row = &mut rows[c.k];
-        row.paths += 1;
-        row.recorded.insert(c.s);
-        row.valid.extend(c.valid.iter().copied());
-        row.max_sum_error = row.max_sum_error.max(c.sum_error.abs());
-        row.max_mismatch = row.max_mismatch.max(c.mismatch);
-        row.max_abs_mismatch = row.max_abs_mismatch.max((r.weight - c.oracle).abs());
-        row.max_ratio = row.max_ratio.max(c.mismatch / c.allowed);
-        row.allowed.push(c.allowed);
-        row.max_replay_error = row.max_replay_error.max(c.replay_error);
-        for (n, &lvl) in row.over_strict.iter_mut().zip(&STRICT_LEVELS) {
-            if c.mismatch > lvl {
-                *n += 1;
-            }
-        }
-        let over = !(c.mismatch <= c.allowed);
-        let sum_fail = !(c.sum_error.abs() <= SUM_TOLERANCE);
-        row.over += over as usize;
-        row.sum_fail += sum_fail as usize;
-        if (over || sum_fail) && examples.len() < 5 {
-            examples.push(describe(scene, r, &c, opts, ratio, n_conn));
+        report.add(&c);
+        if (c.over() || c.sum_fails()) && report.examples.len() < 5 {
+            report
+                .examples
+                .push(describe(scene, r, &c, opts, ratio, n_conn));
         }
     }
-    rows.retain(|r| r.k >= 1);
-    Report {
-        scene: name.to_string(),
-        integrator: opts.integrator,
-        heuristic: opts.heuristic,
-        slack: opts.slack,
-        passes,
-        rows,
-        too_long,
-        examples,
-    }
+    report.finish()
 }
 
 /// Samples and checks; `scene`'s film is set to the check's resolution first.
@@ -717,104 +596,4 @@ pub fn check_scene(scene: &mut Scene, opts: &Options, name: &str) -> Report {
     prepare_scene(scene, opts);
     let (c, passes) = collect(scene, opts);
     check_records(scene, &c.records, opts, passes, c.too_long, name)
-}
-
-/// " × slack" when it is not 1.
-pub fn slack_note(slack: f64) -> String {
-    if slack == 1.0 {
-        String::new()
-    } else {
-        format!(" × {slack}")
-    }
-}
-
-/// Median and largest of the tolerances (0, 0 when none).
-pub fn median_and_max(v: &[f64]) -> (f64, f64) {
-    if v.is_empty() {
-        return (0.0, 0.0);
-    }
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    (s[s.len() / 2], s[s.len() - 1])
-}
-
-fn set_string(s: &BTreeSet<usize>) -> String {
-    if s.is_empty() {
-        return "-".into();
-    }
-    s.iter()
-        .map(|x| x.to_string())
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-impl fmt::Display for Report {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        writeln!(
-            f,
-            "mis-check {} {} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ the path's derived tolerance{}; (b) |Σw−1| ≤ {:e}",
-            self.scene,
-            self.integrator.name(),
-            self.heuristic.name(),
-            self.passes,
-            slack_note(self.slack),
-            SUM_TOLERANCE
-        )?;
-        writeln!(
-            f,
-            "{:>2} {:>6} {:>15} {:>17} {:>9} {:>5} {:>8} {:>8} {:>8} {:>8} {:>7} {:>5} {:>5} {:>5} {:>5} {:>8}",
-            "k",
-            "paths",
-            "recorded s",
-            "valid s",
-            "max|Σw−1|",
-            "Σfail",
-            "max rel",
-            "max abs",
-            "tol med",
-            "tol max",
-            "rel/tol",
-            "over",
-            ">1e-4",
-            ">1e-5",
-            ">1e-6",
-            "replay"
-        )?;
-        for r in &self.rows {
-            let (med, max) = median_and_max(&r.allowed);
-            writeln!(
-                f,
-                "{:>2} {:>6} {:>15} {:>17} {:>9.2e} {:>5} {:>8.2e} {:>8.2e} {:>8.2e} {:>8.2e} {:>7.3} {:>5} {:>5} {:>5} {:>5} {:>8.1e}",
-                r.k,
-                r.paths,
-                set_string(&r.recorded),
-                set_string(&r.valid),
-                r.max_sum_error,
-                r.sum_fail,
-                r.max_mismatch,
-                r.max_abs_mismatch,
-                med,
-                max,
-                r.max_ratio,
-                r.over,
-                r.over_strict[0],
-                r.over_strict[1],
-                r.over_strict[2],
-                r.max_replay_error
-            )?;
-        }
-        if self.too_long > 0 {
-            writeln!(f, "{} paths reported beyond max_depth", self.too_long)?;
-        }
-        for e in &self.examples {
-            writeln!(f, "  FAIL {e}")?;
-        }
-        let verdict = if self.passed() { "ok" } else { "FAILED" };
-        writeln!(
-            f,
-            "{verdict}: {} paths checked, {} failing",
-            self.checked(),
-            self.failures()
-        )
-    }
 }

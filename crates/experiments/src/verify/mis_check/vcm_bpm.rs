@@ -14,10 +14,9 @@
 //! subpaths moved within their rounding boxes: y_i and z separately, since a merge's weight reads
 //! the light vertex's incoming direction through z's BSDF.
 
-use super::pt_bdpt::{median_and_max, slack_note};
-use super::tolerance::{
-    derived_tolerance, relative, weight_error_bound, DEFAULT_SLACK, SUM_TOLERANCE,
-};
+pub use super::report::Report;
+use super::report::Verdict;
+use super::tolerance::{derived_tolerance, relative, weight_error_bound, DEFAULT_SLACK};
 use lt_core::path::{
     camis, Correlation, Densities, Heuristic, Path, PathVertex, SubpathMis, Technique, TechniqueSet,
 };
@@ -30,7 +29,6 @@ use lt_integrators::record::{Completed, Merged, Recorder};
 use lt_integrators::registry::{self, Weights};
 use lt_integrators::splat::{Pass, Splats, Worker};
 use std::collections::BTreeMap;
-use std::fmt;
 
 /// What to sample and how to judge it.
 #[derive(Clone, Copy, Debug)]
@@ -288,22 +286,6 @@ pub fn collect(scene: &Scene, opts: &VcmOptions) -> (VcmCollector, u32) {
     (c, passes)
 }
 
-/// The verdict on one path.
-#[derive(Clone, Debug)]
-pub struct VcmCheck {
-    pub k: usize,
-    pub technique: Technique,
-    pub oracle: f64,
-    pub mismatch: f64,
-    /// The tolerance the mismatch is held to, derived for this path.
-    pub allowed: f64,
-    /// Σ of the replayed weights over the techniques, minus 1.
-    pub sum_error: f64,
-    /// Largest |replayed − oracle| weight over the techniques.
-    pub replay_error: f64,
-    pub techniques: Vec<Technique>,
-}
-
 fn densities(scene: &Scene, path: &Path, ratio: f64) -> Densities {
     let mut d = path.densities(scene);
     d.light_tracing_ratio = ratio;
@@ -326,7 +308,7 @@ pub fn check_record(
     r: &VcmRecord,
     opts: &VcmOptions,
     (ratio, light_paths): (f64, f64),
-) -> VcmCheck {
+) -> Verdict {
     let set = TechniqueSet {
         vertex_connections: opts.connections && opts.vertex_connections,
         ..TechniqueSet::new(opts.connections, r.eta)
@@ -385,9 +367,10 @@ pub fn check_record(
         replay_error = replay_error.max((w - d.vcm_weight_with(set, corr, t, h)).abs());
         sum += w;
     }
-    VcmCheck {
+    Verdict {
         k: path.k(),
         technique: r.technique,
+        weight: r.weight,
         oracle,
         mismatch,
         allowed,
@@ -397,65 +380,12 @@ pub fn check_record(
             sum - 1.0
         },
         replay_error,
-        techniques,
-    }
-}
-
-/// One line per path length.
-#[derive(Clone, Debug, Default)]
-pub struct VcmRow {
-    pub k: usize,
-    pub connections: usize,
-    pub merges: usize,
-    pub max_sum_error: f64,
-    pub max_mismatch_connect: f64,
-    pub max_mismatch_merge: f64,
-    /// Largest mismatch / its path's tolerance.
-    pub max_ratio: f64,
-    /// Every path's tolerance, for the median and the largest.
-    pub allowed: Vec<f64>,
-    pub max_replay_error: f64,
-    /// Techniques seen valid on the recorded paths: connections (s) and merges (i).
-    pub valid_connect: std::collections::BTreeSet<usize>,
-    pub valid_merge: std::collections::BTreeSet<usize>,
-    pub over: usize,
-    pub sum_fail: usize,
-}
-
-pub struct VcmReport {
-    pub scene: String,
-    pub options: VcmOptions,
-    pub passes: u32,
-    pub rows: Vec<VcmRow>,
-    pub too_long: usize,
-    pub examples: Vec<String>,
-}
-
-impl VcmReport {
-    pub fn failures(&self) -> usize {
-        self.too_long
-            + self
-                .rows
-                .iter()
-                .map(|r| r.over.max(r.sum_fail))
-                .sum::<usize>()
-    }
-
-    pub fn passed(&self) -> bool {
-        self.failures() == 0
-    }
-
-    pub fn checked(&self) -> usize {
-        self.rows.iter().map(|r| r.connections + r.merges).sum()
-    }
-
-    pub fn merges(&self) -> usize {
-        self.rows.iter().map(|r| r.merges).sum()
+        valid: techniques,
     }
 }
 
 /// Samples and checks; `scene`'s film is set to the check's resolution first.
-pub fn check_scene(scene: &mut Scene, opts: &VcmOptions, name: &str) -> VcmReport {
+pub fn check_scene(scene: &mut Scene, opts: &VcmOptions, name: &str) -> Report {
     prepare_scene(scene, opts);
     let (c, passes) = collect(scene, opts);
     check_records(scene, &c.records, opts, passes, c.too_long, name)
@@ -468,147 +398,39 @@ pub fn check_records(
     opts: &VcmOptions,
     passes: u32,
     too_long: usize,
-    name: &str,
-) -> VcmReport {
+    scene_name: &str,
+) -> Report {
     let n = scene.camera.pixel_count() as u64;
     let light_paths = opts.light_paths.unwrap_or(n) as f64;
     let ratio = light_paths / n as f64;
-    let mut rows: Vec<VcmRow> = (0..=opts.max_depth as usize)
-        .map(|k| VcmRow {
-            k,
-            ..VcmRow::default()
-        })
-        .collect();
-    let mut examples = Vec::new();
+    let mut name = opts.name().to_string();
+    if opts.correlation_aware {
+        name += " correlation_aware";
+    }
+    let mut report = Report::new(scene_name, name, opts.heuristic, opts.max_depth);
+    report.slack = opts.slack;
+    report.merging = true;
+    report.passes = passes;
+    report.too_long = too_long;
     for r in records {
         let v = check_record(scene, r, opts, (ratio, light_paths));
-        let row = &mut rows[v.k.min(opts.max_depth as usize)];
-        match v.technique {
-            Technique::Connect(_) => {
-                row.connections += 1;
-                row.max_mismatch_connect = row.max_mismatch_connect.max(v.mismatch);
-            }
-            Technique::Merge(_) => {
-                row.merges += 1;
-                row.max_mismatch_merge = row.max_mismatch_merge.max(v.mismatch);
-            }
-        }
-        for t in &v.techniques {
-            match *t {
-                Technique::Connect(s) => row.valid_connect.insert(s),
-                Technique::Merge(i) => row.valid_merge.insert(i),
-            };
-        }
-        row.max_ratio = row.max_ratio.max(v.mismatch / v.allowed);
-        row.allowed.push(v.allowed);
-        row.max_sum_error = row.max_sum_error.max(v.sum_error.abs());
-        row.max_replay_error = row.max_replay_error.max(v.replay_error);
-        let over = !(v.mismatch <= v.allowed);
-        let sum_fail = !(v.sum_error.abs() <= SUM_TOLERANCE);
-        row.over += over as usize;
-        row.sum_fail += sum_fail as usize;
-        let shown = examples
+        report.add(&v);
+        let (over, sum_fail) = (v.over(), v.sum_fails());
+        let shown = report
+            .examples
             .iter()
             .filter(|e: &&String| e.contains("Σw−1 FAIL") == sum_fail)
             .count();
         if (over || sum_fail) && shown < 3 {
-            examples.push(format!(
+            report.examples.push(format!(
                 "k={} {:?} weight={:.9e} oracle={:.9e} rel={:.3e} allowed={:.3e} Σw−1={:.3e}{} techniques={:?}",
                 v.k, v.technique, r.weight, v.oracle, v.mismatch, v.allowed,
-                v.sum_error, if sum_fail { " Σw−1 FAIL" } else { "" }, v.techniques
+                v.sum_error, if sum_fail { " Σw−1 FAIL" } else { "" }, v.valid
             ));
         }
     }
-    rows.retain(|r| r.k >= 1);
-    VcmReport {
-        scene: name.to_string(),
-        options: *opts,
-        passes,
-        rows,
-        too_long,
-        examples,
-    }
+    report.finish()
 }
 
-fn set_string(s: &std::collections::BTreeSet<usize>) -> String {
-    if s.is_empty() {
-        return "-".into();
-    }
-    s.iter()
-        .map(|x| x.to_string())
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-impl fmt::Display for VcmReport {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        writeln!(
-            f,
-            "mis-check {} {}{} mis={} passes={}: (a) |w−w°|/max(w,w°) ≤ the path's derived tolerance{}; (b) |Σw−1| ≤ {:e} over connections and merges",
-            self.scene,
-            self.options.name(),
-            if self.options.correlation_aware {
-                " correlation_aware"
-            } else {
-                ""
-            },
-            self.options.heuristic.name(),
-            self.passes,
-            slack_note(self.options.slack),
-            SUM_TOLERANCE
-        )?;
-        writeln!(
-            f,
-            "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9} {:>9} {:>9} {:>8} {:>8} {:>7} {:>8} {:>5} {:>5}",
-            "k",
-            "conn",
-            "merges",
-            "valid s",
-            "valid merge i",
-            "max|Σw−1|",
-            "rel conn",
-            "rel merge",
-            "tol med",
-            "tol max",
-            "rel/tol",
-            "replay",
-            "over",
-            "Σfail"
-        )?;
-        for r in &self.rows {
-            let (med, max) = median_and_max(&r.allowed);
-            writeln!(
-                f,
-                "{:>2} {:>6} {:>6} {:>17} {:>13} {:>9.2e} {:>9.2e} {:>9.2e} {:>8.2e} {:>8.2e} {:>7.3} {:>8.1e} {:>5} {:>5}",
-                r.k,
-                r.connections,
-                r.merges,
-                set_string(&r.valid_connect),
-                set_string(&r.valid_merge),
-                r.max_sum_error,
-                r.max_mismatch_connect,
-                r.max_mismatch_merge,
-                med,
-                max,
-                r.max_ratio,
-                r.max_replay_error,
-                r.over,
-                r.sum_fail
-            )?;
-        }
-        if self.too_long > 0 {
-            writeln!(f, "{} paths reported beyond max_depth", self.too_long)?;
-        }
-        for e in &self.examples {
-            writeln!(f, "  FAIL {e}")?;
-        }
-        let verdict = if self.passed() { "ok" } else { "FAILED" };
-        writeln!(
-            f,
-            "{verdict}: {} paths checked ({} merged), {} failing",
-            self.checked(),
-            self.merges(),
-            self.failures()
-        )
-    }
-}
+/// The report under the name the tests import (`Report`, shared with `pt_bdpt`).
+pub type VcmReport = Report;

@@ -20,14 +20,16 @@
 //! | `mis` | power/balance/none | power | heuristic over the strategies (none: uniform weights) |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
 
-use crate::camera_loop::{camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight};
-use crate::connect::{nee_density, splat_light_subpath};
+use crate::film::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::params::ParamReader;
+use crate::record::tally::{tallied_pass, ItemTally, PassClock, PassTally, Tally};
 use crate::record::{NoRecord, Recorder, Work};
-use crate::splat::{splat_pass_with, Pass, Splats, Worker};
-pub use crate::strategy_weight::{mis_weight, with_chain, EndEvals, Split};
-use crate::tally::{tallied_pass, ItemTally, PassClock, PassTally, Tally};
-use crate::walk::{light_subpath, Subpath, WalkLimits};
+use crate::subpath::camera_loop::{
+    camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight,
+};
+use crate::subpath::connect::{nee_density, splat_light_subpath};
+pub use crate::subpath::strategy_weight::{mis_weight, with_chain, EndEvals, Split};
+use crate::subpath::walk::{light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
@@ -258,7 +260,7 @@ impl Bdpt {
 const CHUNK: u64 = 256;
 
 impl Bdpt {
-    /// `render_pass` with every technique's contributions and time tallied (`crate::tally`):
+    /// `render_pass` with every technique's contributions and time tallied (`crate::record::tally`):
     /// the same image, bit for bit.
     pub fn tally_pass(
         &self,

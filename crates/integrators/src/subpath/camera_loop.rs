@@ -22,11 +22,11 @@
 //! `connect` draws (lvc-bdpt's cache picks). Contributions are summed in technique order, so an
 //! estimator's image does not depend on which code path formed it.
 
-use crate::connect::{join, next_event, Joined, NextEvent};
-use crate::pixel::{pixel_sample, weighted};
+use crate::film::pixel::{pixel_sample, weighted};
+use crate::film::splat::Pass;
 use crate::record::{Completed, Recorder, Work};
-use crate::splat::Pass;
-use crate::walk::{camera_subpath, Subpath, WalkLimits};
+use crate::subpath::connect::{join, next_event, Joined, NextEvent};
+use crate::subpath::walk::{camera_subpath, Subpath, WalkLimits};
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
 use lt_core::path::camis::Mixture;

@@ -20,11 +20,11 @@
 //! | `kernel` | disk/epanechnikov | disk | density-estimation kernel, normalised over the disk |
 //! | `direct` | nee/photons | nee | direct light by next-event estimation (first photon hits not stored) or from photons |
 
+use crate::density::photons::{trace_photons, Gather, Kernel, PhotonMap, PhotonOptions};
+use crate::density::radius::InitialRadius;
+use crate::density::visible::{trace_visible_point, Direct};
+use crate::film::pixel::pixel_pass;
 use crate::params::ParamReader;
-use crate::photons::{trace_photons, Gather, Kernel, PhotonMap, PhotonOptions};
-use crate::pixel::pixel_pass;
-use crate::radius::InitialRadius;
-use crate::visible::{trace_visible_point, Direct};
 use crate::{ProgressLog, Progressive, ProgressiveRun};
 use lt_core::Scene;
 use lt_estimators::running::RunningImage;

@@ -4,9 +4,9 @@
 //! two integrators read it — `bdpt` and `lvc_bdpt`, whose connection counts differ — and
 //! integrator files import no other integrator file.
 
-use crate::camera_loop::Connection;
-use crate::connect::{emission_densities, nee_density};
-use crate::walk::reverse_density;
+use crate::subpath::camera_loop::Connection;
+use crate::subpath::connect::{emission_densities, nee_density};
+use crate::subpath::walk::reverse_density;
 use lt_core::bsdf::BsdfEval;
 use lt_core::path::scatter::{connectable, connectable_inside};
 use lt_core::path::{Chain, Heuristic, PathVertex, VertexKind};

@@ -16,8 +16,8 @@
 //! | `alpha` | f64 | 0.75 | radius reduction α: rᵢ = r₀ i^((α−1)/2) |
 //! | `correlation_aware` | true/false | false | correlation-aware MIS for merging (Grittmann et al. 2021, `lt_core::path::camis`): merging at x_i counts η ρ_i; weights from the full path's densities (slower) |
 
-use crate::connect_merge::{Run, Techniques, VcmParams};
 use crate::params::ParamReader;
+use crate::vcm::engine::{Run, Techniques, VcmParams};
 use crate::{Progressive, ProgressiveRun};
 use lt_core::Scene;
 

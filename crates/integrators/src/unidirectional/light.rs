@@ -16,10 +16,10 @@
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
 
-use crate::connect::connect_to_camera;
+use crate::film::splat::splat_pass_with;
 use crate::params::ParamReader;
-use crate::splat::splat_pass_with;
-use crate::walk::{light_subpath, Subpath, WalkLimits};
+use crate::subpath::connect::connect_to_camera;
+use crate::subpath::walk::{light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::path::scatter::connectable;
 use lt_core::sampling::{Domain, Sampler};

@@ -12,10 +12,10 @@
 //! estimation). With the local update, Hachisuka et al.'s flux τ ← (τ + Φ) r²_new / r² and the
 //! pixel's estimate is D̄ + τ / (N_e π r²), N_e the photon paths traced so far.
 
+use crate::density::photons::{trace_photons, Kernel, Photon, PhotonOptions};
+use crate::density::radius::{global_scale2, power_scale2, read_alpha, InitialRadius, Update};
+use crate::density::visible::{CameraPrefix, Direct};
 use crate::params::ParamReader;
-use crate::photons::{trace_photons, Kernel, Photon, PhotonOptions};
-use crate::radius::{global_scale2, power_scale2, read_alpha, InitialRadius, Update};
-use crate::visible::{CameraPrefix, Direct};
 use crate::ProgressLog;
 use lt_core::math::{is_valid_color, Color, Vec3, PI};
 use lt_core::spatial::PointGrid;

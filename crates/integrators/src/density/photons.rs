@@ -10,7 +10,7 @@
 //! normalised over the disk of radius r. The cosine ratio is the shading-normal correction: the
 //! photon density is flux per unit of true surface area.
 
-use crate::walk::{light_subpath, Subpath, WalkLimits};
+use crate::subpath::walk::{light_subpath, Subpath, WalkLimits};
 use lt_core::bsdf::{ShadingFrame, TransportMode};
 use lt_core::math::{Color, Vec3, PI};
 use lt_core::path::scatter::connectable;

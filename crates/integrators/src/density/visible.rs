@@ -4,8 +4,8 @@
 //! or through delta bounces, and, when direct light is not left to photons, next-event estimation
 //! at the visible point.
 
-use crate::photons::GatherPoint;
-use crate::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
+use crate::density::photons::GatherPoint;
+use crate::subpath::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
 use lt_core::bsdf::{ShadingFrame, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::sampling::Sampler;

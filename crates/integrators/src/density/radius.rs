@@ -10,8 +10,8 @@
 //! gathered M photons. With r² ∝ N^(α−1), variance falls as N^−α and bias as N^(α−1): MSE ∝
 //! N^−min(α, 2−2α), best at α = 2/3 (Knaus & Zwicker 2011; Kaplanyan & Dachsbacher 2013).
 
+use crate::density::visible::VisiblePoint;
 use crate::params::ParamReader;
-use crate::visible::VisiblePoint;
 use lt_core::Scene;
 
 /// Where r₀ comes from.

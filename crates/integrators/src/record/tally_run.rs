@@ -1,12 +1,12 @@
 //! Tallied runs of the integrators `tally` covers: the one place that names them, so the tally
 //! machinery (`tally.rs`), which the integrators themselves import, imports none of them.
 
-use crate::bdpt::{Bdpt, BdptParams};
-use crate::bpm::Bpm;
-use crate::connect_merge::{Run, VcmParams};
-use crate::lvc_bdpt::{LvcBdpt, LvcParams};
+use crate::bidirectional::bdpt::{Bdpt, BdptParams};
+use crate::bidirectional::lvc_bdpt::{LvcBdpt, LvcParams};
 use crate::params::{IntegratorParams, ParamReader};
-use crate::tally::RunTally;
+use crate::record::tally::RunTally;
+use crate::vcm::bpm::Bpm;
+use crate::vcm::engine::{Run, VcmParams};
 use crate::vcm::Vcm;
 use crate::ProgressiveRun;
 use lt_core::Scene;

@@ -3,8 +3,8 @@
 //! towards another vertex. Visibility is always `Scene::connection_visible`, which offsets both
 //! ends by their error bounds.
 
+use crate::film::splat::Splats;
 use crate::record::{Completed, Recorder, Work};
-use crate::splat::Splats;
 use lt_core::bsdf::{BsdfEval, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::path::camis::Mixture;

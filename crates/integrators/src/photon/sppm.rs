@@ -17,10 +17,10 @@
 //! | `kernel` | disk/epanechnikov | disk | density-estimation kernel, normalised over the disk |
 //! | `direct` | nee/photons | nee | direct light by next-event estimation or from photons |
 
+use crate::density::progressive::{ProgressiveParams, ProgressiveState};
+use crate::density::visible::{trace_visible_point, CameraPrefix};
+use crate::film::pixel::pixel_sample;
 use crate::params::ParamReader;
-use crate::pixel::pixel_sample;
-use crate::progressive::{ProgressiveParams, ProgressiveState};
-use crate::visible::{trace_visible_point, CameraPrefix};
 use crate::{ProgressLog, Progressive, ProgressiveRun};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;

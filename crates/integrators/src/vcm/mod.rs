@@ -20,8 +20,16 @@
 //! | `merging` | true/false | true | false: connections only (BDPT) |
 //! | `vertex_connections` | true/false | true | false: no connections s ≥ 2, t ≥ 2 (next-event estimation and light tracing stay); weights from the full path's densities |
 
-use crate::connect_merge::{Run, Techniques, VcmParams};
+//!
+//! This folder holds the VCM family: the engine `vcm`, `bpm` and `eamis` share (`engine`), and
+//! the two estimators besides `vcm` built on it (`bpm`, `eamis`).
+
+pub mod bpm;
+pub mod eamis;
+pub mod engine;
+
 use crate::params::ParamReader;
+use crate::vcm::engine::{Run, Techniques, VcmParams};
 use crate::{Progressive, ProgressiveRun};
 use lt_core::Scene;
 

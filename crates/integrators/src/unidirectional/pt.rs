@@ -17,10 +17,10 @@
 //! | `mis` | power/balance | power | heuristic combining NEE and BSDF sampling |
 //! | `techniques` | both/light/bsdf | both | NEE and BSDF sampling, NEE only, or BSDF sampling only |
 
+use crate::film::pixel::pixel_pass;
 use crate::params::ParamReader;
-use crate::pixel::pixel_pass;
 use crate::record::{Completed, NoRecord, Recorder};
-use crate::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
+use crate::subpath::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
 use crate::Integrator;
 use lt_core::bsdf::TransportMode;
 use lt_core::math::Color;

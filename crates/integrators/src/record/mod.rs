@@ -1,6 +1,11 @@
 //! What an integrator can report about the paths it completes, for `lt mis-check`: the path's
 //! vertices and the MIS weight it gave the technique that made it. Rendering passes `NoRecord`,
-//! which compiles to nothing.
+//! which compiles to nothing. The recorders that tally each technique's contributions and time
+//! live beside it: `tally` (per pass), `tally_run` (a run), `cpu_clock` (the time-stamp counter).
+
+pub mod cpu_clock;
+pub mod tally;
+pub mod tally_run;
 
 use lt_core::math::{Color, Vec2};
 use lt_core::path::camis::Mixture;
@@ -44,7 +49,7 @@ pub struct Merged<'a> {
     pub radius: f32,
 }
 
-/// What one stretch of a work item's time went to, for `crate::tally` (per-technique cost): the
+/// What one stretch of a work item's time went to, for `crate::record::tally` (per-technique cost): the
 /// code since the previous lap. Connections are keyed as `Completed` paths are — s light
 /// vertices, t camera vertices, k = s + t − 1 segments (s = 0 at a camera walk of k + 1 vertices
 /// whose end is the emitter) — merges by the camera vertex count t (every light length at once,
@@ -74,7 +79,7 @@ pub trait Recorder {
     /// `merged`), where its weight was computed from the full path (`lt_core::path::camis`).
     #[inline]
     fn mixture(&mut self, _m: Mixture) {}
-    /// Work item `item` starts (`crate::tally` decides here whether it times this item).
+    /// Work item `item` starts (`crate::record::tally` decides here whether it times this item).
     #[inline]
     fn begin_item(&mut self, _item: u64) {}
     /// The camera sample of `pixel` starts; its t ≥ 2 estimate is multiplied by `film_weight`.

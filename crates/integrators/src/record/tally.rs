@@ -34,8 +34,8 @@
 //! stretch of wall time, microseconds long, and a lap in which the thread was descheduled is
 //! dropped with its item (`VOID_LAP`).
 
+use crate::film::splat::{splat_pass_with, Splats};
 use crate::record::{Completed, Merged, Recorder, Work};
-use crate::splat::{splat_pass_with, Splats};
 use lt_core::camera::FilmFilter;
 use lt_core::math::is_valid_color;
 use lt_core::{Color, Scene};
@@ -65,7 +65,7 @@ fn ticks() -> u64 {
 /// CPU seconds of every thread of the current pool, summed (`cpu_clock`): what a pass or phase
 /// costs on a machine shared with other work (wall seconds would count the other work too).
 pub fn pool_cpu_seconds() -> f64 {
-    crate::cpu_clock::current_pool_cpu_time().as_secs_f64()
+    crate::record::cpu_clock::current_pool_cpu_time().as_secs_f64()
 }
 
 /// A 64-bit mix (SplitMix64's finaliser): which items are timed.

@@ -15,18 +15,18 @@
 //! rate, as in SmallVCM, α = 0.75); r₀ is pixel-footprint relative by default (at the mean
 //! primary-hit distance: one radius for the whole pass, which η needs) or scene relative.
 
-use crate::camera_loop::{
+use crate::density::radius::InitialRadius;
+pub use crate::film::splat::pixel_of;
+use crate::film::splat::{splat_pass_with, Pass, Splats, Worker};
+use crate::params::ParamReader;
+use crate::record::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
+use crate::record::{Merged, NoRecord, Recorder, Work};
+use crate::subpath::camera_loop::{
     camera_sample, CameraPolicy, CameraScratch, Connection, Depths, Joins, SampleCtx, Weight,
 };
-use crate::connect::{emission_densities, nee_density, splat_light_subpath, Joined};
-use crate::params::ParamReader;
-use crate::radius::InitialRadius;
-use crate::record::{Merged, NoRecord, Recorder, Work};
-pub use crate::splat::pixel_of;
-use crate::splat::{splat_pass_with, Pass, Splats, Worker};
-use crate::strategy_weight::{with_chain, EndEvals, Split};
-use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
-use crate::walk::{light_subpath, reverse_density, Subpath, WalkLimits};
+use crate::subpath::connect::{emission_densities, nee_density, splat_light_subpath, Joined};
+use crate::subpath::strategy_weight::{with_chain, EndEvals, Split};
+use crate::subpath::walk::{light_subpath, reverse_density, Subpath, WalkLimits};
 use crate::{ProgressLog, ProgressiveRun};
 use lt_core::bsdf::{BsdfEval, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3, PI};
@@ -1149,7 +1149,7 @@ impl Run<'_> {
         (&self.sum, self.passes)
     }
 
-    /// `pass` with every technique's contributions and time tallied (`crate::tally`): the same
+    /// `pass` with every technique's contributions and time tallied (`crate::record::tally`): the same
     /// state and estimate, bit for bit. The light subpaths, their MIS records and the merge grid
     /// are one phase (`Work::LightWalk`).
     pub fn tally_pass(&mut self, pass: u32, every: u64) -> (u64, PassTally) {

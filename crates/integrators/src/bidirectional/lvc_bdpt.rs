@@ -34,14 +34,16 @@
 //! | `light_paths` | u64 | the pixel count | light subpaths traced into the cache per pass |
 //! | `connections` | u32 | 1 | cache vertices each camera vertex connects to (N) |
 
-use crate::camera_loop::{camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight};
-use crate::connect::{nee_density, splat_light_subpath};
+use crate::film::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::params::ParamReader;
+use crate::record::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
 use crate::record::{NoRecord, Recorder, Work};
-use crate::splat::{splat_pass_with, Pass, Splats, Worker};
-use crate::strategy_weight::{with_chain, EndEvals, Split};
-use crate::tally::{pool_cpu_seconds, tallied_pass, PassClock, PassTally, Tally};
-use crate::walk::{light_subpath, Subpath, WalkLimits};
+use crate::subpath::camera_loop::{
+    camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight,
+};
+use crate::subpath::connect::{nee_density, splat_light_subpath};
+use crate::subpath::strategy_weight::{with_chain, EndEvals, Split};
+use crate::subpath::walk::{light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
@@ -441,7 +443,7 @@ impl CameraPolicy for Policy<'_> {
 const CHUNK: u64 = 256;
 
 impl LvcBdpt {
-    /// `render_pass` with every technique's contributions and time tallied (`crate::tally`):
+    /// `render_pass` with every technique's contributions and time tallied (`crate::record::tally`):
     /// the same image, bit for bit. The cache's light walks are one phase (`Work::LightWalk`).
     pub fn tally_pass(
         &self,

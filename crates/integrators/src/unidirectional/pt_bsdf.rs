@@ -9,9 +9,9 @@
 //! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 
+use crate::film::pixel::pixel_pass;
 use crate::params::ParamReader;
-use crate::pixel::pixel_pass;
-use crate::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
+use crate::subpath::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
 use crate::Integrator;
 use lt_core::math::Color;
 use lt_core::sampling::Sampler;

@@ -94,9 +94,9 @@
 //! The light subpath count and vertex connections are the choice's, so they are not keys;
 //! correlation-aware weights are not offered (the prediction counts merges from η weights).
 
-use crate::connect_merge::{pixel_of, MergeMask, Run, VcmParams};
 use crate::params::ParamReader;
 use crate::record::{Completed, Merged, Recorder, Work};
+use crate::vcm::engine::{pixel_of, MergeMask, Run, VcmParams};
 use crate::{ProgressLog, Progressive, ProgressiveRun};
 use lt_core::math::Color;
 use lt_core::path::camis::Mixture;
@@ -295,7 +295,7 @@ impl ProgressiveRun for EamisRun<'_> {
         if let Some(render) = &mut self.render {
             return render.pass(pass);
         }
-        let cpu0 = crate::tally::pool_cpu_seconds();
+        let cpu0 = crate::record::tally::pool_cpu_seconds();
         self.probe.bias_scale = 1.0 / self.eamis.params.radius_scale(pass).powi(2);
         let invalid = self.pilot.recorded_pass(pass, &mut self.probe);
         self.probe.flush();
@@ -310,7 +310,7 @@ impl ProgressiveRun for EamisRun<'_> {
             self.start_render(choice);
         }
         // The choice is overhead too: it is counted with the pilot.
-        self.pilot_cpu += crate::tally::pool_cpu_seconds() - cpu0;
+        self.pilot_cpu += crate::record::tally::pool_cpu_seconds() - cpu0;
         invalid
     }
 

@@ -23,10 +23,10 @@
 //! | `direct` | nee/photons | nee | direct light by next-event estimation or from photons |
 //! | `visible_seed` | u64 | the run's seed | seed of the one camera pass: runs that share it share their visible points and differ in photons only, so their spread is the variance at fixed points that Knaus & Zwicker's rates describe |
 
+use crate::density::progressive::{ProgressiveParams, ProgressiveState};
+use crate::density::visible::{next_event, trace_visible_point, CameraPrefix, Direct};
+use crate::film::pixel::pixel_sample;
 use crate::params::ParamReader;
-use crate::pixel::pixel_sample;
-use crate::progressive::{ProgressiveParams, ProgressiveState};
-use crate::visible::{next_event, trace_visible_point, CameraPrefix, Direct};
 use crate::{ProgressLog, Progressive, ProgressiveRun};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;

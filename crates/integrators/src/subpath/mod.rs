@@ -1,0 +1,9 @@
+//! Subpaths and their joins, owned by no integrator: the walks (`walk`), a light vertex joined to
+//! the lens, next-event estimation and shadow-ray joins (`connect`), the one bidirectional camera
+//! loop (`camera_loop`) and the MIS weight of a strategy from stored densities
+//! (`strategy_weight`).
+
+pub mod camera_loop;
+pub mod connect;
+pub mod strategy_weight;
+pub mod walk;
