@@ -2,9 +2,12 @@
 //! t-corrected z over blocks × channels; `lt_estimators::agreement`):
 //!
 //! 1. Per path length: `light` and `bdpt` (MIS power, balance and none) against `pt` at every
-//!    max_depth 1…5 on `cornell-box`, `cornell-mesh-light`, `cornell-env`, `sun-room` and
-//!    `cornell-directional`. A bias in paths of exactly k segments first shows at max_depth = k,
-//!    so the failing depth names the path length. None of these scenes has a delta surface
+//!    max_depth 1…5 on `cornell-box`, `cornell-mesh-light`, `cornell-env`, `sun-room`,
+//!    `cornell-directional` and more. A bias in paths of exactly k segments first shows at
+//!    max_depth = k, so the failing depth names the path length. Each estimator renders once at
+//!    max_depth 5 and every max_depth's image is taken from its passes split by path length
+//!    (`lt_tests::per_length`); Šidák runs over every depth, estimator, block and channel a test
+//!    compares. None of these scenes has a delta surface
 //!    (mirror, glass), so light tracing, which cannot join the pinhole to a delta vertex, renders
 //!    every path the camera can see, and all five estimators estimate the same image. The only
 //!    delta light among them, `cornell-directional`'s, is never seen directly by any estimator.
@@ -20,11 +23,15 @@ use lt_core::{Scene, Vec2, Vec3};
 use lt_estimators::agreement::{agreement_t, sidak_threshold, Agreement};
 use lt_estimators::blocks::RunningBlocks;
 use lt_integrators::IntegratorParams;
-use lt_tests::{render_blocks, shipped_scene, Rendered};
+use lt_tests::per_length::{render_per_length, PerLength};
+use lt_tests::{render_blocks, shared, shipped_scene, Rendered};
+use std::sync::Arc;
 
 /// Family-wise false-alarm rate of every comparison here.
 const ALPHA: f64 = 1e-3;
 const BLOCK: usize = 8;
+/// The longest path length compared, and the max_depth of the reference's render.
+const LENGTHS: u32 = 5;
 
 /// One estimator configuration: a label, an integrator, its MIS key (if any) and its passes.
 #[derive(Clone, Copy)]
@@ -60,6 +67,33 @@ impl Config {
         assert_eq!(r.invalid_samples, 0, "{}: invalid samples", self.label);
         (r, b)
     }
+
+    /// Per-length statistics of one render at `max_depth` of `scene` (named `scene_name`:
+    /// renders of one name, configuration and depth are made once per test binary).
+    fn per_length(&self, scene_name: &str, scene: &Scene, max_depth: u32) -> Arc<PerLength> {
+        let key = format!(
+            "agreement {scene_name} {} max_depth {max_depth} passes {} seed {}",
+            self.label, self.passes, self.seed
+        );
+        shared(&key, || {
+            let r = render_per_length(
+                scene,
+                self.integrator,
+                &self.params(Some(max_depth)),
+                self.passes,
+                self.seed,
+                BLOCK,
+            );
+            assert_eq!(r.invalid_samples, 0, "{}: invalid samples", self.label);
+            r
+        })
+    }
+}
+
+/// The per-comparison false-alarm rate that keeps `ALPHA` over `comparisons` of them (Šidák;
+/// `agreement_t` then corrects over the blocks × channels of each).
+fn per_comparison(comparisons: usize) -> f64 {
+    -(((-ALPHA).ln_1p()) / comparisons.max(1) as f64).exp_m1()
 }
 
 /// The reference: path tracing with NEE and MIS, with more passes than the others (it is cheap).
@@ -168,9 +202,9 @@ fn worst_ratio(a: &Agreement, other: &RunningBlocks, reference: &RunningBlocks) 
     o.mean[a.worst_region][a.worst_channel] / r.mean[a.worst_region][a.worst_channel]
 }
 
-/// Max |z| over a subset of blocks, with the Šidák threshold for that subset:
-/// (max |z|, worst block, worst channel, threshold).
-fn over_blocks(a: &Agreement, blocks: &[usize]) -> (f64, usize, usize, f64) {
+/// Max |z| over a subset of blocks, with the Šidák threshold for that subset in each of
+/// `comparisons` images: (max |z|, worst block, worst channel, threshold).
+fn over_blocks(a: &Agreement, blocks: &[usize], comparisons: usize) -> (f64, usize, usize, f64) {
     let (mut max, mut worst, mut channel) = (0.0f64, 0, 0);
     for &i in blocks {
         for c in 0..3 {
@@ -184,7 +218,7 @@ fn over_blocks(a: &Agreement, blocks: &[usize]) -> (f64, usize, usize, f64) {
         max,
         worst,
         channel,
-        sidak_threshold(ALPHA, blocks.len() * 3),
+        sidak_threshold(ALPHA, comparisons * blocks.len() * 3),
     )
 }
 
@@ -192,53 +226,57 @@ fn block_name(a: &Agreement, i: usize) -> String {
     format!("({},{})", i % a.blocks_x, i / a.blocks_x)
 }
 
-/// Every configuration of `OTHERS` against `PT` at every max_depth in `depths`.
-fn per_depth(scene_name: &str, depths: std::ops::RangeInclusive<u32>) {
-    per_depth_on(
+/// Every configuration of `OTHERS` against `PT` at every max_depth 1…`LENGTHS`.
+fn per_depth(scene_name: &str) {
+    per_length_on(
         scene_name,
-        shipped_scene(scene_name, Some((32, 32))),
-        depths,
+        &shipped_scene(scene_name, Some((32, 32))),
+        LENGTHS,
         &OTHERS,
     );
 }
 
-/// `per_depth` on a scene given in code (`scene_name` names it in reports and in `EXCLUDED`).
-fn per_depth_on(
-    scene_name: &str,
-    scene: Scene,
-    depths: std::ops::RangeInclusive<u32>,
-    others: &[Config],
-) {
+/// `others` against `PT` on `scene` (named `scene_name` in reports and in `EXCLUDED`) at every
+/// max_depth 1…`lengths`: each rendered once at max_depth `lengths` (`PT` at `LENGTHS`, its
+/// render shared with every test of the same scene) and split by path length.
+fn per_length_on(scene_name: &str, scene: &Scene, lengths: u32, others: &[Config]) {
+    let excluded = |other: &Config| {
+        EXCLUDED
+            .iter()
+            .find(|(s, l, _)| *s == scene_name && *l == other.label)
+            .map(|(_, _, why)| *why)
+    };
+    for other in others {
+        if let Some(why) = excluded(other) {
+            println!("{scene_name} {}: excluded ({why})", other.label);
+        }
+    }
+    let compared: Vec<&Config> = others.iter().filter(|o| excluded(o).is_none()).collect();
+    let alpha = per_comparison(compared.len() * lengths as usize);
+    let reference = PT.per_length(scene_name, scene, LENGTHS.max(lengths));
     let mut failures = Vec::new();
-    for depth in depths {
-        let (_, reference) = PT.render(&scene, Some(depth));
-        for &other in others {
-            if let Some((_, _, why)) = EXCLUDED
-                .iter()
-                .find(|(s, l, _)| *s == scene_name && *l == other.label)
-            {
-                println!(
-                    "{scene_name} max_depth={depth} {}: excluded ({why})",
-                    other.label
-                );
-                continue;
-            }
-            let (_, blocks) = other.render(&scene, Some(depth));
-            let a = agreement_t(&blocks, &reference, ALPHA);
+    for other in compared {
+        let rendered = other.per_length(scene_name, scene, lengths);
+        for k in 1..=lengths {
+            let (blocks, reference) = (
+                &rendered.up_to[k as usize - 1],
+                &reference.up_to[k as usize - 1],
+            );
+            let a = agreement_t(blocks, reference, alpha);
             let line = format!(
-                "{scene_name} max_depth={depth} {} vs pt: max |z| {:.2} (threshold {:.2}) at block \
-                 {} channel {}, mean ratio there {:.4}; mean z² {:.2}",
+                "{scene_name} max_depth={k} {} vs pt: max |z| {:.2} (threshold {:.2}) at block {} \
+                 channel {}, mean ratio there {:.4}; mean z² {:.2}",
                 other.label,
                 a.max_abs_z,
                 a.threshold,
                 block_name(&a, a.worst_region),
                 ["R", "G", "B"][a.worst_channel],
-                worst_ratio(&a, &blocks, &reference),
+                worst_ratio(&a, blocks, reference),
                 a.mean_z2
             );
             let known = KNOWN_FAILURES
                 .iter()
-                .find(|(s, l, d, _)| *s == scene_name && *l == other.label && *d == depth)
+                .find(|(s, l, d, _)| *s == scene_name && *l == other.label && *d == k)
                 .map(|(_, _, _, why)| *why);
             match (a.passed(), known) {
                 (true, None) => println!("{line}"),
@@ -258,7 +296,7 @@ fn per_depth_on(
 
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_box() {
-    per_depth("cornell-box", 1..=5);
+    per_depth("cornell-box");
 }
 
 /// A thin lens, a tent filter and a card blocking part of the aperture: camera rays sample the
@@ -267,18 +305,20 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_box() {
 /// the test's units are 8×8 block means of each pass image (independent across passes).
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_thinlens_tent() {
-    per_depth("cornell-thinlens-tent", 1..=5);
+    per_depth("cornell-thinlens-tent");
 }
 
 /// `bdpt mis=none` on the thin-lens scene with the passes its heavy tails need (see `EXCLUDED`).
 #[test]
 fn bdpt_without_mis_agrees_with_pt_on_cornell_thinlens_tent_with_more_passes() {
+    // Its own label: `EXCLUDED` leaves out the 512-pass configuration on this scene, not this.
     let none = Config {
+        label: "bdpt mis=none, 8192 passes",
         passes: 8192,
         ..OTHERS[3]
     };
     let scene = shipped_scene("cornell-thinlens-tent", Some((32, 32)));
-    per_depth_on("cornell-thinlens-tent (long)", scene, 2..=3, &[none]);
+    per_length_on("cornell-thinlens-tent", &scene, 3, &[none]);
 }
 
 /// Mitsuba's default filter (Gaussian, stddev 0.5, truncated at 4σ) on the pinhole Cornell box.
@@ -287,7 +327,7 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_box_gaussian() {
     let mut scene = shipped_scene("cornell-box", Some((32, 32)));
     let gaussian = PixelFilter::new(FilterShape::Gaussian { stddev: 0.5 }).unwrap();
     scene.camera = scene.camera.with_filter(gaussian);
-    per_depth_on("cornell-box gaussian", scene, 1..=5, &OTHERS);
+    per_length_on("cornell-box gaussian", &scene, LENGTHS, &OTHERS);
 }
 
 /// An orthographic camera (a delta in direction) with a tent filter: `bdpt` without its t = 1
@@ -301,17 +341,17 @@ fn bdpt_agrees_with_pt_per_depth_through_an_orthographic_camera() {
         lt_integrators::make_integrator("light", &scene, &IntegratorParams::new()).is_err(),
         "light tracing must refuse an orthographic camera"
     );
-    per_depth_on("cornell-box orthographic", scene, 1..=4, &OTHERS[1..3]);
+    per_length_on("cornell-box orthographic", &scene, 4, &OTHERS[1..3]);
 }
 
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_mesh_light() {
-    per_depth("cornell-mesh-light", 1..=5);
+    per_depth("cornell-mesh-light");
 }
 
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_env() {
-    per_depth("cornell-env", 1..=5);
+    per_depth("cornell-env");
 }
 
 /// Mitsuba's conductors: a rough (Beckmann) gold sphere, a nearly smooth one-sided copper sphere
@@ -319,7 +359,7 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_env() {
 /// transport modes.
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_conductors() {
-    per_depth("cornell-conductors", 1..=5);
+    per_depth("cornell-conductors");
 }
 
 /// Textures (checkerboard floor, bitmap wall, a rough conductor whose colour and α vary): every
@@ -329,19 +369,19 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_conductors() {
 /// an interface, importance not) and delta pass-through reached by light walks and BSDF samples.
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_rough_glass() {
-    per_depth("cornell-rough-glass", 1..=5);
+    per_depth("cornell-rough-glass");
 }
 
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_textured() {
-    per_depth("cornell-textured", 1..=5);
+    per_depth("cornell-textured");
 }
 
 /// At max_depth 1 the camera does not see the sun (it is not in view), so every estimator's image
 /// is exactly black there (z = 0 by definition); the sunlit floor patch appears at depth 2.
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_sun_room() {
-    per_depth("sun-room", 1..=5);
+    per_depth("sun-room");
 }
 
 /// A directional light (a delta in direction) through a skylight: reached only by next-event
@@ -349,7 +389,7 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_sun_room() {
 /// s = 0 and light tracing's x0 get none. At max_depth 1 every image is exactly black.
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_directional() {
-    per_depth("cornell-directional", 1..=5);
+    per_depth("cornell-directional");
 }
 
 /// Blocks any of whose pixels (sampled at 4×4 positions each, edges included) see the sphere
@@ -414,7 +454,7 @@ fn light_and_bdpt_agree_through_glass_on_cornell_point_caustic() {
     let ball = blocks_seeing_sphere(&scene.camera, Vec3::new(0.375, -0.5, 0.375), 0.25);
     let kept: Vec<usize> = (0..ball.len()).filter(|&i| !ball[i]).collect();
     let a = agreement_t(&l, &b, ALPHA);
-    let (z, worst, c, thr) = over_blocks(&a, &kept);
+    let (z, worst, c, thr) = over_blocks(&a, &kept, 1);
     let (le, be) = (l.estimate(), b.estimate());
     println!(
         "cornell-point-caustic light vs bdpt over {} of {} blocks (the ball's {} left out): \
@@ -541,7 +581,7 @@ fn light_agrees_with_pt_off_axis() {
     let bx = a.blocks_x;
     let (corner, centre) = (0, (bx / 2) * bx + bx / 2);
     let blocks = [corner, centre];
-    let (z, worst, c, thr) = over_blocks(&a, &blocks);
+    let (z, worst, c, thr) = over_blocks(&a, &blocks, 1);
     let (le, pe) = (l.estimate(), p.estimate());
     let pixels = pr.estimate.clone();
     let cam = &scene.camera;
@@ -600,7 +640,7 @@ fn light_agrees_with_pt_off_axis() {
 /// flip and shadowing must be the same function of (camera side, light side) in both modes.
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_bumped() {
-    per_depth("cornell-bumped", 1..=5);
+    per_depth("cornell-bumped");
 }
 
 /// An environment map with a small, very bright sun (scenes/textures/sky-sun.hdr): NEE by the
@@ -608,7 +648,7 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_bumped() {
 /// must estimate the same image per path length.
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_envmap_spheres() {
-    per_depth("envmap-spheres", 1..=5);
+    per_depth("envmap-spheres");
 }
 
 /// Lights delta in position that aim (a textured spot light and a projector, no area light):
@@ -617,38 +657,39 @@ fn light_and_bdpt_agree_with_pt_per_depth_on_envmap_spheres() {
 /// vertex (falloff, texture, 1/cos³) must be the same function in all of them.
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_spot() {
-    per_depth("cornell-spot", 1..=5);
+    per_depth("cornell-spot");
 }
 
 /// Mitsuba's principled BSDFs from TOML: four to five lobes per material, each chosen per sample
 /// with its own probability, must sum to the same pdf and the same f in both transport modes.
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_principled() {
-    per_depth("cornell-principled", 1..=5);
+    per_depth("cornell-principled");
 }
 
 #[test]
 fn light_and_bdpt_agree_with_pt_per_depth_on_cornell_plastic() {
-    per_depth("cornell-plastic", 1..=5);
+    per_depth("cornell-plastic");
 }
 
-/// `cornell-plastic`: light tracing agrees with pt per depth on every block that does not see the
-/// smooth ball (left out by geometry: there the camera sees the coating's delta reflection, which
-/// light tracing cannot join to the pinhole). The rough ball and the rough back wall are in.
+/// `cornell-plastic`: light tracing agrees with pt at every max_depth on every block that does not
+/// see the smooth ball (left out by geometry: there the camera sees the coating's delta reflection,
+/// which light tracing cannot join to the pinhole). The rough ball and the rough back wall are in.
+/// pt's render is the one `light_and_bdpt_agree_with_pt_per_depth_on_cornell_plastic` uses.
 #[test]
 fn light_agrees_with_pt_off_the_smooth_ball_on_cornell_plastic() {
     let scene = shipped_scene("cornell-plastic", Some((32, 32)));
     let (centre, radius) = SMOOTH_PLASTIC_BALL;
     let ball = blocks_seeing_sphere(&scene.camera, centre, radius);
     let kept: Vec<usize> = (0..ball.len()).filter(|&i| !ball[i]).collect();
+    let reference = PT.per_length("cornell-plastic", &scene, LENGTHS);
+    let light = OTHERS[0].per_length("cornell-plastic", &scene, LENGTHS);
     let mut failures = Vec::new();
-    for depth in 1..=5 {
-        let (_, reference) = PT.render(&scene, Some(depth));
-        let (_, blocks) = OTHERS[0].render(&scene, Some(depth));
-        let a = agreement_t(&blocks, &reference, ALPHA);
-        let (z, worst, c, thr) = over_blocks(&a, &kept);
+    for k in 1..=LENGTHS as usize {
+        let a = agreement_t(&light.up_to[k - 1], &reference.up_to[k - 1], ALPHA);
+        let (z, worst, c, thr) = over_blocks(&a, &kept, LENGTHS as usize);
         let line = format!(
-            "cornell-plastic max_depth={depth} light vs pt over {} of {} blocks: max |z| {z:.2} \
+            "cornell-plastic max_depth={k} light vs pt over {} of {} blocks: max |z| {z:.2} \
              (threshold {thr:.2}) at block {} channel {}",
             kept.len(),
             ball.len(),

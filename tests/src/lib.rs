@@ -6,8 +6,13 @@ use lt_estimators::running::{RunningImage, RunningStat};
 use lt_estimators::Image;
 use lt_integrators::{make_integrator, render, IntegratorParams, Kind, RenderOptions};
 use lt_scene_io::load_scene;
+use std::any::Any;
+use std::collections::HashMap;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
+use std::sync::{Arc, Mutex, OnceLock};
+
+pub mod per_length;
 
 /// The repository's `scenes/` folder.
 pub fn scenes_dir() -> PathBuf {
@@ -22,6 +27,26 @@ pub fn shipped_scene(name: &str, resolution: Option<(u32, u32)>) -> Scene {
         scene.camera = scene.camera.with_resolution(w, h);
     }
     scene
+}
+
+/// What `make` returns, made once per test binary for each `key` and shared by every test that
+/// asks for the same key (tests run on parallel threads: a second asker waits for the first).
+/// The key must name everything the value depends on (scene and its changes, integrator,
+/// parameters, passes, seed); asking for one key with two types panics.
+pub fn shared<T: Send + Sync + 'static>(key: &str, make: impl FnOnce() -> T) -> Arc<T> {
+    type Cell = Arc<OnceLock<Arc<dyn Any + Send + Sync>>>;
+    static CELLS: OnceLock<Mutex<HashMap<String, Cell>>> = OnceLock::new();
+    let cell = CELLS
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .entry(key.to_string())
+        .or_default()
+        .clone();
+    let value = cell.get_or_init(|| Arc::new(make())).clone();
+    value
+        .downcast::<T>()
+        .unwrap_or_else(|_| panic!("shared value '{key}' asked for with another type"))
 }
 
 /// Every shipped scene's name.
