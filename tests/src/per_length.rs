@@ -177,13 +177,12 @@ fn hold_to_integrator(
     let terms = 2.0 * p.lengths.len() as f64;
     let bound = (4.0 * terms + terms) * f32::EPSILON as f64;
     for (i, whole) in p.whole.data.iter().enumerate() {
-        for c in 0..3 {
+        for (c, &image) in whole.iter().enumerate() {
             let sum: f64 = p.lengths.iter().map(|l| l.data[i][c]).sum();
             let size: f64 = p.lengths.iter().map(|l| l.data[i][c].abs()).sum();
             assert!(
-                (sum - whole[c]).abs() <= bound * size.max(whole[c].abs()),
-                "{integrator}: pixel {i} channel {c}: lengths sum to {sum}, the image has {}",
-                whole[c]
+                (sum - image).abs() <= bound * size.max(image.abs()),
+                "{integrator}: pixel {i} channel {c}: lengths sum to {sum}, the image has {image}"
             );
         }
     }
@@ -207,11 +206,14 @@ impl Recorder for LengthSums {
     }
 }
 
+/// One image row of a pt pass: the whole row, each length's row, invalid samples.
+type PtRow = (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, u64);
+
 /// `pixel_pass` with `Pt::radiance_recorded`: the same streams, positions and filter weights.
 fn pt_pass(pt: &Pt, scene: &Scene, seed: u64, pass: u32) -> LengthPass {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let lengths = pt.params.max_depth as usize;
-    let rows: Vec<(Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, u64)> = (0..h)
+    let rows: Vec<PtRow> = (0..h)
         .into_par_iter()
         .map(|y| {
             let mut whole = vec![[0.0; 3]; w];
