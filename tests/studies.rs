@@ -82,7 +82,7 @@ fn every_study_writes_its_files() {
         }
         for g in &m.galleries {
             for i in std::iter::once(&g.reference).chain(&g.items) {
-                assert!(d.join(&i.png).is_file(), "{s}: {}", i.png);
+                assert!(d.join(&i.image).is_file(), "{s}: {}", i.image);
             }
         }
     }

@@ -61,8 +61,10 @@ pub struct Gallery {
 #[serde(deny_unknown_fields)]
 pub struct GalleryImage {
     pub label: String,
-    /// sRGB PNG, relative to the study folder.
-    pub png: String,
+    /// The sRGB image the page shows (a JPEG preview, `gallery::write_gallery`; a PNG in
+    /// manifests written before it), relative to the study folder.
+    #[serde(alias = "png")]
+    pub image: String,
     /// A short line under the image, e.g. "MSE 1.2e-3, 30 s".
     pub note: String,
 }
@@ -168,12 +170,12 @@ mod tests {
             caption: String::new(),
             reference: GalleryImage {
                 label: "reference".into(),
-                png: "ref.png".into(),
+                image: "ref.jpg".into(),
                 note: String::new(),
             },
             items: vec![GalleryImage {
                 label: "pt".into(),
-                png: "pt.png".into(),
+                image: "pt.jpg".into(),
                 note: "MSE 1e-3".into(),
             }],
             crop: Some(Crop {
@@ -195,6 +197,13 @@ mod tests {
         assert_eq!(path, dir.join(MANIFEST_FILE));
         assert_eq!(Manifest::read(&dir).unwrap(), m);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn manifests_written_before_the_previews_still_read() {
+        let old = r#"{"label": "pt", "png": "g/pt.png", "note": ""}"#;
+        let i: GalleryImage = serde_json::from_str(old).unwrap();
+        assert_eq!(i.image, "g/pt.png");
     }
 
     #[test]

@@ -13,6 +13,7 @@
 pub mod findings;
 mod html;
 mod markdown;
+pub mod slim;
 
 use crate::image_io::write_atomic;
 use crate::manifest::{Manifest, MANIFEST_FILE};

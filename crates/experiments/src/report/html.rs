@@ -36,8 +36,8 @@ pub fn files_named(m: &Manifest) -> Vec<&str> {
         }
     }
     for g in &m.galleries {
-        out.push(&g.reference.png);
-        out.extend(g.items.iter().map(|i| i.png.as_str()));
+        out.push(&g.reference.image);
+        out.extend(g.items.iter().map(|i| i.image.as_str()));
     }
     out
 }
@@ -280,10 +280,10 @@ fn table(h: &mut String, folder: &str, t: &Table) {
 }
 
 fn gallery(h: &mut String, folder: &str, id: &str, g: &Gallery) {
-    let reference = url(folder, &g.reference.png);
+    let reference = url(folder, &g.reference.image);
     // With no items the reference stands in for the estimate.
     let first: &GalleryImage = g.items.first().unwrap_or(&g.reference);
-    let first_src = url(folder, &first.png);
+    let first_src = url(folder, &first.image);
     let crop = g
         .crop
         .map(|Crop { x, y, w, h }| format!(" data-crop=\"{x},{y},{w},{h}\""))
@@ -347,7 +347,7 @@ fn gallery(h: &mut String, folder: &str, id: &str, g: &Gallery) {
         esc(&g.reference.note)
     );
     for (i, item) in g.items.iter().enumerate() {
-        let src = url(folder, &item.png);
+        let src = url(folder, &item.image);
         let on = if i == 0 { " on" } else { "" };
         let _ = writeln!(
             h,
