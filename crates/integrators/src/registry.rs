@@ -210,7 +210,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
                 vertex connections and per-pixel merging",
         kind: Kind::Consistent,
         weights: Weights::EfficiencyAware,
-        source: include_str!("vcm/eamis.rs"),
+        source: include_str!("vcm/eamis/mod.rs"),
         radius: Radius::Power,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Eamis::read(s, r)?))),
     },

@@ -21,13 +21,13 @@ use lt_core::path::{
     camis, Correlation, Densities, Heuristic, Path, PathVertex, SubpathMis, Technique, TechniqueSet,
 };
 use lt_core::Scene;
-use lt_integrators::connect_merge::{
-    initial_radius, pixel_of, Engine, MergeMask, PassInputs, VcmParams,
-};
 use lt_integrators::radius::InitialRadius;
 use lt_integrators::record::{Completed, Merged, Recorder};
 use lt_integrators::registry::{self, Weights};
 use lt_integrators::splat::{Pass, Splats, Worker};
+use lt_integrators::vcm::engine::{
+    initial_radius, pixel_of, Engine, MergeMask, PassInputs, VcmParams,
+};
 use std::collections::BTreeMap;
 
 /// What to sample and how to judge it.
@@ -103,7 +103,7 @@ impl VcmOptions {
             mis: self.heuristic,
             light_paths: self.light_paths,
             radius: self.radius,
-            alpha: lt_integrators::connect_merge::DEFAULT_ALPHA,
+            alpha: lt_integrators::vcm::engine::DEFAULT_ALPHA,
             connections: self.connections,
             merging: true,
             correlation_aware: self.correlation_aware,
