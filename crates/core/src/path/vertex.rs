@@ -371,17 +371,16 @@ impl PathVertex {
         if next.is_infinite() {
             return pdf;
         }
-        if next.in_medium() {
-            let from = if self.is_infinite() {
-                // A parallel ray from the disk of a light at infinity: no 1/d² (`perpendicular`).
-                return pdf;
-            } else {
-                self.p
-            };
-            return measure::solid_angle_to_volume(pdf, 1.0, from, next.p);
-        }
+        // Surfaces first: the medium test sits on the branch without a normal, so a scene
+        // without media pays nothing for it.
         let n = if next.on_surface() {
             next.ng
+        } else if next.in_medium() {
+            if self.is_infinite() {
+                // A parallel ray from the disk of a light at infinity: no 1/d² (`perpendicular`).
+                return pdf;
+            }
+            return measure::solid_angle_to_volume(pdf, 1.0, self.p, next.p);
         } else {
             self.dir_to(next)
         };

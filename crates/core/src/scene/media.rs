@@ -225,12 +225,17 @@ impl Scene {
         medium: Option<MediumId>,
     ) -> Color {
         let mut t = Color::ONE;
-        self.for_each_medium_piece(a, b, medium, Crossing::Everything, |piece| {
+        let walked = self.for_each_medium_piece(a, b, medium, Crossing::Everything, |piece| {
             if let Some(m) = piece.medium {
                 t *= self.media[m as usize].transmittance(piece.a, piece.b);
             }
         });
-        t
+        // A segment caught in a degenerate spot (no end to its crossings) carries nothing.
+        if walked {
+            t
+        } else {
+            Color::ZERO
+        }
     }
 
     /// The density with which free-flight sampling from `a` towards `b`, restarted in each medium
@@ -246,7 +251,12 @@ impl Scene {
         scattered_at_b: bool,
     ) -> f32 {
         let mut pieces = Vec::new();
-        self.for_each_medium_piece(a, b, medium, Crossing::Everything, |p| pieces.push(p));
+        let walked =
+            self.for_each_medium_piece(a, b, medium, Crossing::Everything, |p| pieces.push(p));
+        // A segment caught in a degenerate spot (no end to its crossings) has no density.
+        if !walked {
+            return 0.0;
+        }
         let last = pieces.len() - 1;
         let mut p = 1.0;
         for (i, piece) in pieces.iter().enumerate() {
