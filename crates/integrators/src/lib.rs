@@ -10,6 +10,7 @@ pub mod cpu_clock;
 pub mod eamis;
 pub mod light;
 pub mod lvc_bdpt;
+pub mod media;
 pub mod params;
 pub mod photons;
 pub mod pixel;
