@@ -12,6 +12,7 @@ mod directional;
 mod furnace;
 mod light_paths;
 mod material_grid;
+mod media;
 mod mis_check;
 mod mis_check_vcm;
 mod partial_merge;

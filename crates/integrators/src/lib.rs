@@ -14,6 +14,8 @@ pub mod vcm;
 // The machinery they share.
 pub mod density;
 pub mod film;
+// Participating media: pt, pt-bsdf and light through volumes (entered when a scene has media).
+pub mod media;
 pub mod params;
 pub mod record;
 pub mod registry;

@@ -243,10 +243,26 @@ pub fn make_integrator(
     params: &IntegratorParams,
 ) -> Result<Estimator, String> {
     let info = find(name)?;
+    refuse_media(info.name, scene)?;
     let reader = ParamReader::new(info.name, params);
     let integrator = (info.make)(scene, &reader)?;
     reader.finish()?;
     Ok(integrator)
+}
+
+/// The integrators that walk participating media (`media/`); every other refuses a scene with
+/// media rather than render it silently wrong (issue 43, item 4).
+pub const HANDLES_MEDIA: &[&str] = &["pt", "pt-bsdf", "light"];
+
+/// One clear line for an integrator that cannot render the scene's media.
+fn refuse_media(name: &str, scene: &Scene) -> Result<(), String> {
+    if !scene.has_media || HANDLES_MEDIA.contains(&name) {
+        return Ok(());
+    }
+    Err(format!(
+        "integrator {name} does not handle participating media yet; the scene has {} media",
+        scene.media.len()
+    ))
 }
 
 #[cfg(test)]

@@ -73,6 +73,24 @@ impl Integrator for LightTracer {
         };
         let scale = 1.0 / m as f32;
         let (w, h) = (cam.width as usize, cam.height as usize);
+        if scene.has_media {
+            let walk = crate::media::light::LightWalk {
+                max_depth: self.params.max_depth,
+                rr_depth: self.params.rr_depth,
+                scale,
+            };
+            return splat_pass_with(
+                w,
+                h,
+                m,
+                CHUNK,
+                || (),
+                |i, splats, _| {
+                    let mut sampler = Sampler::for_item(Domain::Light, seed, i, pass as u64);
+                    crate::media::light::trace(scene, walk, &mut sampler, splats);
+                },
+            );
+        }
         let scratch = || Subpath::with_capacity(limits.max_vertices);
         splat_pass_with(w, h, m, CHUNK, scratch, |i, splats, sub| {
             let mut sampler = Sampler::for_item(Domain::Light, seed, i, pass as u64);

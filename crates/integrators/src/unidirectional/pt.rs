@@ -94,7 +94,7 @@ pub struct Pt {
 impl Pt {
     /// The weight of technique a against b (solid-angle densities at one vertex).
     #[inline]
-    fn weight(&self, a: f32, b: f32) -> f32 {
+    pub(crate) fn weight(&self, a: f32, b: f32) -> f32 {
         match self.params.mis {
             Heuristic::Balance => {
                 if a.is_infinite() {
@@ -112,7 +112,12 @@ impl Pt {
     /// The weight of a BSDF-sampled emitter hit, with `light_pdf` the NEE density of the same
     /// direction; `(this, the NEE weight of the same path)`.
     #[inline]
-    fn hit_weights(&self, prev_delta: bool, prev_pdf_w: f32, light_pdf: f32) -> (f32, f32) {
+    pub(crate) fn hit_weights(
+        &self,
+        prev_delta: bool,
+        prev_pdf_w: f32,
+        light_pdf: f32,
+    ) -> (f32, f32) {
         match self.params.techniques {
             _ if prev_delta => (1.0, 0.0),
             Techniques::Both => (
@@ -303,6 +308,11 @@ impl Integrator for Pt {
     }
 
     fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
+        if scene.has_media {
+            return pixel_pass(scene, seed, pass, |s, raster| {
+                crate::media::pt::radiance(self, scene, raster, s)
+            });
+        }
         pixel_pass(scene, seed, pass, |s, raster| {
             self.radiance(scene, raster, s)
         })

@@ -38,6 +38,18 @@ pub struct PtBsdf {
 }
 
 impl PtBsdf {
+    /// `pt` with BSDF (and phase) sampling alone: the walk `pt-bsdf` runs through media.
+    fn as_bsdf_only_pt(&self) -> crate::pt::Pt {
+        crate::pt::Pt {
+            params: crate::pt::PtParams {
+                max_depth: self.params.max_depth,
+                rr_depth: self.params.rr_depth,
+                mis: lt_core::path::Heuristic::Power,
+                techniques: crate::pt::Techniques::Bsdf,
+            },
+        }
+    }
+
     pub fn radiance(&self, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> Color {
         let mut ray = scene.camera.sample_ray(raster, sampler);
         let mut beta = Color::ONE;
@@ -75,6 +87,12 @@ impl Integrator for PtBsdf {
     }
 
     fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
+        if scene.has_media {
+            let pt = self.as_bsdf_only_pt();
+            return pixel_pass(scene, seed, pass, |s, raster| {
+                crate::media::pt::radiance(&pt, scene, raster, s)
+            });
+        }
         pixel_pass(scene, seed, pass, |s, raster| {
             self.radiance(scene, raster, s)
         })

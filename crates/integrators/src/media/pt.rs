@@ -1,0 +1,245 @@
+//! `pt` and `pt-bsdf` through participating media: Mitsuba 3's `volpath` on lt's walk (see the
+//! module above). A medium vertex is born where free-flight sampling in the ray's medium scatters;
+//! there next-event estimation samples a light, evaluates the phase function towards it and
+//! estimates the transmittance to it through null boundaries, and the walk continues by sampling
+//! the phase function. At surfaces the walk is `pt`'s, with the shadow ray's transmittance and
+//! the medium tracked across every surface the walk leaves.
+//!
+//! `pt-bsdf` runs the same walk with `Techniques::Bsdf` (no next-event estimation, every emitter
+//! hit at full weight), so `pt` against `pt-bsdf` checks next-event estimation, transmittance
+//! estimates and MIS in media against plain free-flight and phase sampling.
+
+use super::{is_null, light_end, point_end, shadow_transmittance, surface_end};
+use crate::pt::{Pt, Techniques};
+use crate::subpath::walk::{
+    continue_path, escaped_radiance, russian_roulette, WalkPoint, WalkRules,
+};
+use lt_core::bsdf::TransportMode;
+use lt_core::geometry::Ray;
+use lt_core::math::{Color, Vec3};
+use lt_core::medium::{FreeFlight, MediumId, PhaseFunction};
+use lt_core::sampling::Sampler;
+use lt_core::scene::ConnectionEnd;
+use lt_core::{Scene, Vec2};
+
+/// More null crossings than this on one segment is a ray caught in a degenerate spot: it ends.
+const MAX_NULL_CROSSINGS: u32 = 1024;
+
+/// The last real vertex, as MIS and the light pdf of an emitter hit read it.
+#[derive(Clone, Copy)]
+struct Previous {
+    /// Solid-angle density of the direction sampled there (BSDF or phase function).
+    pdf_w: f32,
+    /// A delta lobe or the camera: emitters hit next get full weight.
+    delta: bool,
+    p: Vec3,
+}
+
+/// What scatters light at a vertex towards a sampled light direction: its value (with the cosine
+/// at a surface) and its solid-angle density of sampling that direction.
+struct Scatter {
+    f: Color,
+    pdf_w: f32,
+}
+
+/// The radiance estimate of one camera sample at `raster` through media.
+pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> Color {
+    let params = pt.params;
+    let nee = params.techniques != Techniques::Bsdf;
+    let rules = WalkRules::camera(params.rr_depth);
+    let mut ray = scene.camera.sample_ray(raster, sampler);
+    let mut medium = scene.camera_medium;
+    let mut beta = Color::ONE;
+    let mut l = Color::ZERO;
+    let mut prev = Previous {
+        pdf_w: 0.0,
+        delta: true,
+        p: ray.o,
+    };
+    let mut depth = 1;
+    let mut crossings = 0;
+    loop {
+        let hit = scene.intersect(&ray);
+        if let Some(m) = medium {
+            let t_max = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
+            let mm = &scene.media[m as usize];
+            match mm.sample_free_flight(ray.o, ray.d, t_max, sampler) {
+                FreeFlight::Scattered { t, weight } => {
+                    beta *= weight;
+                    if beta == Color::ZERO || depth == params.max_depth {
+                        break;
+                    }
+                    let x = ray.o + ray.d * t;
+                    let wo = -ray.d;
+                    let phase = mm.phase();
+                    if nee {
+                        l += beta * nee_in_medium(pt, scene, x, wo, phase, m, sampler);
+                    }
+                    let Some(ps) = phase.sample(wo, sampler.next_2d()) else {
+                        break;
+                    };
+                    beta *= ps.value / ps.pdf;
+                    if !russian_roulette(&mut beta, Color::ONE, depth, params.rr_depth, sampler) {
+                        break;
+                    }
+                    prev = Previous {
+                        pdf_w: ps.pdf,
+                        delta: false,
+                        p: x,
+                    };
+                    ray = Ray::new(x, ps.wi);
+                    depth += 1;
+                    crossings = 0;
+                    continue;
+                }
+                FreeFlight::Passed { weight } => {
+                    beta *= weight;
+                    if beta == Color::ZERO {
+                        break;
+                    }
+                }
+            }
+        }
+        let Some(hit) = hit else {
+            l += beta
+                * escaped_radiance(scene, ray.d, |i| {
+                    let light_pdf = scene.light_sampler.pmf(i as usize)
+                        * scene.lights[i as usize].pdf_li(prev.p, ray.d, ray.d, -ray.d);
+                    pt.hit_weights(prev.delta, prev.pdf_w, light_pdf).0
+                });
+            break;
+        };
+        if is_null(scene, &hit) {
+            crossings += 1;
+            if crossings > MAX_NULL_CROSSINGS {
+                break;
+            }
+            medium = scene.medium_across(hit.interface, hit.ng, ray.d);
+            ray = hit.spawn_ray(ray.d);
+            continue;
+        }
+        crossings = 0;
+        let wo = -ray.d;
+        if let Some(li) = hit.light {
+            let light = &scene.lights[li as usize];
+            let le = light.emitted(hit.ng, wo, hit.uv);
+            if le != Color::ZERO {
+                let light_pdf = scene.light_sampler.pmf(li as usize)
+                    * light.pdf_li(prev.p, ray.d, hit.p, hit.ng);
+                l += beta * le * pt.hit_weights(prev.delta, prev.pdf_w, light_pdf).0;
+            }
+        }
+        if depth == params.max_depth {
+            break;
+        }
+        let sf = hit.shading_frame();
+        let at = WalkPoint {
+            hit: &hit,
+            sf: &sf,
+            wo,
+        };
+        if nee && !scene.material_is_delta(hit.material) {
+            l += beta * nee_at_surface(pt, scene, &at, sampler);
+        }
+        let Some(bs) = continue_path(scene, &at, &rules, &mut beta, depth, sampler) else {
+            break;
+        };
+        medium = scene.medium_across(hit.interface, hit.ng, bs.wi);
+        prev = Previous {
+            pdf_w: bs.pdf_w,
+            delta: bs.delta,
+            p: hit.p,
+        };
+        ray = hit.spawn_ray(bs.wi);
+        depth += 1;
+    }
+    l
+}
+
+/// Next-event estimation from a surface vertex: `pt`'s, times the transmittance to the light.
+fn nee_at_surface(pt: &Pt, scene: &Scene, at: &WalkPoint, sampler: &mut Sampler) -> Color {
+    let hit = at.hit;
+    let material = scene.material(hit.material);
+    next_event(
+        pt,
+        scene,
+        hit.p,
+        surface_end(hit),
+        sampler,
+        |wi| {
+            let ev = material.eval(at.sf, at.wo, wi, TransportMode::Radiance);
+            Scatter {
+                f: ev.f_cos,
+                pdf_w: ev.pdf_w,
+            }
+        },
+        |wi| scene.medium_across(hit.interface, hit.ng, wi),
+    )
+}
+
+/// Next-event estimation from a medium vertex at `x` in medium `m`: the phase function towards
+/// the light (no cosine) and the transmittance to it.
+fn nee_in_medium(
+    pt: &Pt,
+    scene: &Scene,
+    x: Vec3,
+    wo: Vec3,
+    phase: PhaseFunction,
+    m: MediumId,
+    sampler: &mut Sampler,
+) -> Color {
+    next_event(
+        pt,
+        scene,
+        x,
+        point_end(x),
+        sampler,
+        |wi| {
+            let value = phase.eval(wo, wi);
+            Scatter {
+                f: Color::splat(value),
+                pdf_w: phase.pdf(wo, wi),
+            }
+        },
+        |_| Some(m),
+    )
+}
+
+/// One light chosen by power and sampled towards `p`; `scatter(wi)` is the vertex's value and
+/// density towards it, `medium_towards(wi)` the medium the shadow ray starts in. Weighted against
+/// the vertex's own sampling by `pt`'s heuristic over the two solid-angle densities.
+fn next_event(
+    pt: &Pt,
+    scene: &Scene,
+    p: Vec3,
+    from: ConnectionEnd,
+    sampler: &mut Sampler,
+    scatter: impl Fn(Vec3) -> Scatter,
+    medium_towards: impl Fn(Vec3) -> Option<MediumId>,
+) -> Color {
+    let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
+        return Color::ZERO;
+    };
+    let u = sampler.next_2d();
+    let Some(ls) = scene.lights[li].sample_li(p, u) else {
+        return Color::ZERO;
+    };
+    if ls.radiance == Color::ZERO || ls.pdf_w == 0.0 {
+        return Color::ZERO;
+    }
+    let s = scatter(ls.wi);
+    if s.f == Color::ZERO {
+        return Color::ZERO;
+    }
+    let tr = shadow_transmittance(scene, from, light_end(&ls), medium_towards(ls.wi), sampler);
+    if tr == Color::ZERO {
+        return Color::ZERO;
+    }
+    let light_pdf = pmf * ls.pdf_w;
+    let w = if ls.delta || pt.params.techniques == Techniques::Light {
+        1.0
+    } else {
+        pt.weight(light_pdf, s.pdf_w)
+    };
+    s.f * ls.radiance * tr * (w / light_pdf)
+}
