@@ -24,8 +24,8 @@ use lt_core::math::{luminance, Color, Mat4, Vec3, PI};
 use lt_core::scene::{LightDesc, RenderSettings, SceneBuilder, ShapeGeometry, TriangleMesh};
 use lt_core::Scene;
 use lt_estimators::agreement::sidak_threshold;
-use lt_integrators::params::documented_keys;
 use lt_integrators::density::photons::{trace_photons, Photon, PhotonOptions};
+use lt_integrators::params::documented_keys;
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions, INTEGRATORS};
 use std::ops::ControlFlow;
 

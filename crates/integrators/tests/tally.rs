@@ -2,9 +2,9 @@
 //! bit, at any thread count, and its techniques' means add up to the image's mean.
 
 use lt_core::Scene;
-use lt_integrators::record::Work;
 use lt_integrators::record::tally::RunTally;
 use lt_integrators::record::tally_run::{tally_run, Tallied};
+use lt_integrators::record::Work;
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
 use lt_scene_io::load_scene;
 use std::ops::ControlFlow;
