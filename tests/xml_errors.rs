@@ -213,12 +213,12 @@ fn xml_bad_files_give_one_clear_error() {
         line_of(&text, "name=\"radius\""),
         &["must be a <float>"],
     );
-    let text = scene_xml("    <medium type=\"homogeneous\"/>");
+    let text = scene_xml("    <medium type=\"homogeneous\"><float name=\"density\" value=\"1\"/></medium>");
     fails(
         &d,
         &text,
-        line_of(&text, "medium"),
-        &["participating media are not supported"],
+        line_of(&text, "density"),
+        &["parameter `density` of medium `homogeneous` is not supported"],
     );
 
     // Emitters: a textured area emitter whose bitmap names no file, a spot whose textured cone

@@ -11,7 +11,10 @@ use lt_core::bsdf::Material;
 use lt_core::camera::{Camera, FovAxis};
 use lt_core::light::LightDesc;
 use lt_core::math::Vec3;
-use lt_core::scene::{RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh};
+use lt_core::medium::{Medium, MediumId};
+use lt_core::scene::{
+    MediumInterface, RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh,
+};
 use lt_core::shape::Affine;
 use lt_core::texture::Texture;
 
@@ -138,7 +141,12 @@ struct WorldShape {
     /// The emitted radiance (a constant or a texture over the shape's uv) when it is a light.
     radiance: Option<Texture>,
     flip_normals: bool,
+    media: MediumInterface,
 }
+
+/// A medium made once the origin is known (a grid's `to_world` is recentred); the error names the
+/// medium's place in the file.
+pub type MediumAt = Box<dyn Fn(DVec3) -> Result<Medium, SceneError>>;
 
 /// The scene as the loaders describe it, before the one rounding. Mirrors `SceneBuilder`.
 pub struct WorldBuilder {
@@ -146,7 +154,9 @@ pub struct WorldBuilder {
     materials: Vec<Material>,
     shapes: Vec<WorldShape>,
     /// Lights not made of shapes, each with its world position in f64 when it has one.
-    lights: Vec<(LightDesc, Option<DVec3>)>,
+    lights: Vec<(LightDesc, Option<DVec3>, Option<MediumId>)>,
+    media: Vec<MediumAt>,
+    camera_medium: Option<MediumId>,
 }
 
 impl WorldBuilder {
@@ -156,6 +166,32 @@ impl WorldBuilder {
             materials: Vec::new(),
             shapes: Vec::new(),
             lights: Vec::new(),
+            media: Vec::new(),
+            camera_medium: None,
+        }
+    }
+
+    /// A medium, made by `make` from the scene's origin at `build`; returns its id.
+    pub fn add_medium(&mut self, make: MediumAt) -> MediumId {
+        self.media.push(make);
+        (self.media.len() - 1) as MediumId
+    }
+
+    pub fn set_camera_medium(&mut self, medium: Option<MediumId>) {
+        self.camera_medium = medium;
+    }
+
+    /// The media inside and outside the shape added last.
+    pub fn set_last_shape_media(&mut self, media: MediumInterface) {
+        if let Some(s) = self.shapes.last_mut() {
+            s.media = media;
+        }
+    }
+
+    /// The medium the light added last sits in.
+    pub fn set_last_light_medium(&mut self, medium: Option<MediumId>) {
+        if let Some(l) = self.lights.last_mut() {
+            l.2 = medium;
         }
     }
 
@@ -182,18 +218,19 @@ impl WorldBuilder {
             material,
             radiance,
             flip_normals,
+            media: MediumInterface::default(),
         });
     }
 
     /// A light without a position (sun, directional, environment).
     pub fn add_light(&mut self, light: LightDesc) {
-        self.lights.push((light, None));
+        self.lights.push((light, None, None));
     }
 
     /// A light with a position (point, spot, projector: `LightDesc::position_mut`) placed at a
     /// world position given in f64; the position in `light` is replaced.
     pub fn add_light_at(&mut self, light: LightDesc, position: DVec3) {
-        self.lights.push((light, Some(position)));
+        self.lights.push((light, Some(position), None));
     }
 
     /// The scene's origin, rounded once per position, indexed. `camera` makes the camera from its
@@ -210,6 +247,10 @@ impl WorldBuilder {
         for m in self.materials {
             b.add_material(m);
         }
+        for make in &self.media {
+            b.add_medium(make(origin)?);
+        }
+        b.set_camera_medium(self.camera_medium);
         let local = |p: DVec3| (p - origin).as_vec3();
         for s in self.shapes {
             let geometry = match s.geometry {
@@ -249,12 +290,15 @@ impl WorldBuilder {
                 },
             };
             b.add_emitting_shape(geometry, s.material, s.radiance, s.flip_normals);
+            if s.media != MediumInterface::default() {
+                b.set_last_shape_media(s.media);
+            }
         }
-        for (mut light, at) in self.lights {
+        for (mut light, at, medium) in self.lights {
             if let (Some(position), Some(p)) = (light.position_mut(), at) {
                 *position = local(p);
             }
-            b.add_light(light);
+            b.add_light_in_medium(light, medium);
         }
         Ok(b.build())
     }

@@ -6,3 +6,4 @@
 mod scene_files;
 mod shipped_scenes;
 mod smallvcm_twins;
+mod xml_media;

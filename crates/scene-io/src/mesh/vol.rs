@@ -27,9 +27,7 @@ pub(crate) fn load_sdf_grid(
     })
 }
 
-/// The grid of `file` for a `gridvolume` (1 or 3 channels). Read by the `<volume>` plugin when
-/// the scene formats' media land.
-#[allow(dead_code)]
+/// The grid of `file` for a `gridvolume` (1 or 3 channels).
 pub(crate) fn load_volume_grid(ctx: &Ctx, file: &S<String>) -> Result<VolumeGrid, SceneError> {
     let (path, bytes) = ctx.read_mesh(file)?;
     parse_volume(&bytes).map_err(|msg| {

@@ -86,7 +86,8 @@ impl<'a> Plugin<'a> {
                     params.push((name, target, Cell::new(false)));
                     continue;
                 }
-                if let Some(name) = c.attr("name") {
+                // A medium's `name` (interior, exterior, medium) is read by `named_all`.
+                if let Some(name) = c.attr("name").filter(|_| target.tag != "medium") {
                     report.ignored.push(format!(
                         "{}: the `name` (\"{name}\") of a <ref> to `{id}` accepted and ignored",
                         doc.place(c)
@@ -361,6 +362,36 @@ impl<'a> Plugin<'a> {
                 *e
             })
             .collect()
+    }
+
+    /// Every nested object of these tags with its `name` (on the `<ref>` when referenced), the
+    /// element as written and the one it resolves to (marked as taken).
+    pub fn named_all(&self, tags: &[&str]) -> Vec<(Option<&'a str>, &'a Elem, &'a Elem)> {
+        self.nested
+            .iter()
+            .filter(|(_, e, _)| tags.contains(&e.tag.as_str()))
+            .map(|(written, e, used)| {
+                used.set(true);
+                (written.attr("name"), *written, *e)
+            })
+            .collect()
+    }
+
+    /// The one nested object of these tags named `name` (marked as taken), if any.
+    pub fn named_nested(&self, tags: &[&str], name: &str) -> Result<Option<&'a Elem>, SceneError> {
+        let mut found = None;
+        for (written, e, used) in &self.nested {
+            if tags.contains(&e.tag.as_str()) && written.attr("name") == Some(name) {
+                if found.is_some() {
+                    return Err(
+                        self.err(written, format!("`{name}` of {} is given twice", self.what))
+                    );
+                }
+                used.set(true);
+                found = Some(*e);
+            }
+        }
+        Ok(found)
     }
 
     /// At most one nested object of these tags.

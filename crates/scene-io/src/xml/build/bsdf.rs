@@ -112,7 +112,24 @@ pub(super) const BSDFS: &[(&str, BsdfBuilder)] = &[
     ("bumpmap", perturbed),
     ("mask", mask),
     ("blendbsdf", blend),
+    ("null", null),
 ];
+
+/// Mitsuba's `null`: a boundary between media that light passes straight through.
+fn null<'a>(
+    _: &mut Loader<'a>,
+    p: &Plugin<'a>,
+    in_twosided: bool,
+    _: &mut Slots,
+) -> Result<Material, SceneError> {
+    if in_twosided {
+        return Err(p.err(
+            p.elem,
+            "a `null` BSDF inside `twosided`: give it to the shape alone",
+        ));
+    }
+    Ok(Material::Null(lt_core::bsdf::Null))
+}
 
 fn diffuse<'a>(
     l: &mut Loader<'a>,

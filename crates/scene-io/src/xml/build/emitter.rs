@@ -30,6 +30,7 @@ impl<'a> Loader<'a> {
         e: &'a Elem,
     ) -> Result<Option<(LightDesc, Option<DVec3>)>, SceneError> {
         let p = self.plugin(e)?;
+        self.emitter_medium = self.media_of(&p, &["medium"])?.first().map(|&(_, m)| m);
         let opts = self.opts;
         let desc = match p.kind {
             "point" => {

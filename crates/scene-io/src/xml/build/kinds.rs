@@ -1,10 +1,10 @@
 //! The plugin kinds lt reads, each with the types it knows, and the checks made on the whole tree
 //! before any plugin is built, so that what a user needs first comes first: every unknown type
-//! (with the known ones of its kind), every reference to an undefined id, every medium (refused
-//! until media land) and every element lt does not read at the top level, listed together.
+//! (with the known ones of its kind), every reference to an undefined id (a medium's too) and
+//! every element lt does not read at the top level, listed together.
 //!
-//! Adding a plugin kind (media will: `medium`, `phase`, `volume`) is one row of `KINDS` with the
-//! builder file that owns its types, and a call to that builder where the kind is met.
+//! Adding a plugin kind (as media added `medium`, `phase`, `volume`) is one row of `KINDS` with
+//! the builder file that owns its types, and a call to that builder where the kind is met.
 
 use crate::xml::doc::{Doc, Elem};
 use crate::xml::props::Ids;
@@ -77,10 +77,25 @@ pub(super) const KINDS: &[Kind] = &[
         types: || super::emitter::EMITTERS.to_vec(),
         hint: "",
     },
+    Kind {
+        tag: "medium",
+        what: "medium",
+        types: || super::medium::MEDIA.to_vec(),
+        hint: "",
+    },
+    Kind {
+        tag: "phase",
+        what: "phase function",
+        types: || super::medium::PHASES.to_vec(),
+        hint: "",
+    },
+    Kind {
+        tag: "volume",
+        what: "volume",
+        types: || super::medium::VOLUMES.to_vec(),
+        hint: "",
+    },
 ];
-
-/// Kinds lt knows of but does not read yet.
-const MEDIA: [&str; 3] = ["medium", "phase", "volume"];
 
 /// Elements that may stand at the top level of a scene.
 const TOP_LEVEL: [&str; 8] = [
@@ -139,17 +154,6 @@ fn walk<'a>(
             found.push(doc.err(
                 c,
                 format!("<{}> is not supported at the top level of a scene", c.tag),
-            ));
-            continue;
-        }
-        if MEDIA.contains(&c.tag.as_str()) {
-            found.push(doc.err(
-                c,
-                format!(
-                    "participating media are not supported: <{} type=\"{}\">",
-                    c.tag,
-                    c.attr("type").unwrap_or("")
-                ),
             ));
             continue;
         }
@@ -221,6 +225,7 @@ mod tests {
             let label = match k.tag {
                 "rfilter" => "film",
                 "bsdf" => "BSDF",
+                "phase" | "volume" => "medium",
                 tag => tag,
             };
             let row = docs

@@ -1,11 +1,12 @@
 //! The plugin subset: the XML's sensor, integrator, BSDFs, shapes and emitters turned into a
 //! `Scene` through `SceneBuilder`, each value checked on the way (reference: docs/xml.md).
 
-use crate::world::WorldBuilder;
+use crate::world::{MediumAt, WorldBuilder};
 use crate::xml::doc::{Doc, Elem};
 use crate::xml::props::{Ids, Plugin};
 use crate::SceneError;
 use crate::{LoadOptions, LoadReport};
+use lt_core::medium::MediumId;
 use lt_core::scene::{RenderSettings, Scene};
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
@@ -15,6 +16,7 @@ mod bsdf_params;
 mod emitter;
 mod integrator;
 mod kinds;
+mod medium;
 mod sensor;
 mod shape;
 mod texture;
@@ -33,6 +35,13 @@ pub(super) struct Loader<'a> {
     default_emitter_material: Option<u32>,
     /// Mesh files read, in order.
     pub meshes: Vec<PathBuf>,
+    /// Medium ids of medium elements already built (by element address).
+    media: HashMap<*const Elem, MediumId>,
+    /// The media built, in id order, handed to the builder at the end.
+    media_made: Vec<MediumAt>,
+    camera_medium: Option<MediumId>,
+    /// The medium of the emitter read last.
+    emitter_medium: Option<MediumId>,
 }
 
 fn collect_ids<'a>(doc: &'a Doc, e: &'a Elem, ids: &mut Ids<'a>) -> Result<(), SceneError> {
@@ -70,6 +79,10 @@ pub(super) fn load(
         default_material: None,
         default_emitter_material: None,
         meshes: Vec::new(),
+        media: HashMap::new(),
+        media_made: Vec::new(),
+        camera_medium: None,
+        emitter_medium: None,
     };
     let root = &doc.root;
     let by_tag = |t: &'static str| root.children.iter().filter(move |c| c.tag == t);
@@ -100,6 +113,13 @@ pub(super) fn load(
     for c in by_tag("bsdf") {
         l.material(c, &mut b)?;
     }
+    // Top-level media and phase functions likewise, referenced or not.
+    for c in by_tag("phase") {
+        l.phase(c)?;
+    }
+    for c in by_tag("medium") {
+        l.medium(c)?;
+    }
     let mut emitters = 0;
     for c in &root.children {
         match c.tag.as_str() {
@@ -115,6 +135,7 @@ pub(super) fn load(
                     Some((desc, None)) => b.add_light(desc),
                     None => continue,
                 }
+                b.set_last_light_medium(l.emitter_medium.take());
                 emitters += 1;
             }
             _ => {}
@@ -126,7 +147,17 @@ pub(super) fn load(
             "the scene has no light: no emitter with a non-zero value",
         ));
     }
-    let Loader { report, meshes, .. } = l;
+    let Loader {
+        report,
+        meshes,
+        media_made,
+        camera_medium,
+        ..
+    } = l;
+    for make in media_made {
+        b.add_medium(make);
+    }
+    b.set_camera_medium(camera_medium);
     let (camera, optics) = camera;
     let scene = b.build(|origin| {
         camera

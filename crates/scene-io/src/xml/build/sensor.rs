@@ -46,6 +46,7 @@ impl<'a> Loader<'a> {
         if !SENSORS.contains(&p.kind) {
             return Err(super::kinds::unknown_type(self.doc, e));
         }
+        self.camera_medium = self.media_of(&p, &["medium"])?.first().map(|&(_, m)| m);
         let principal = Vec2::new(
             p.float("principal_point_offset_x")?.unwrap_or(0.0) as f32,
             p.float("principal_point_offset_y")?.unwrap_or(0.0) as f32,

@@ -143,6 +143,7 @@ impl<'a> Loader<'a> {
                 }
             },
         };
+        let media = self.shape_media(&p, &geometry)?;
         let emission = match p.one_nested(&["emitter"], "emitter")? {
             None => None,
             Some(em) => {
@@ -167,7 +168,10 @@ impl<'a> Loader<'a> {
                         ));
                     }
                     ep.finish(&["sampling_weight"], &mut self.report)?;
-                    return self.finish_shape(&p, b, geometry, material, Some(texture), flip);
+                    let emits =
+                        self.finish_shape(&p, b, geometry, material, Some(texture), flip)?;
+                    b.set_last_shape_media(media);
+                    return Ok(emits);
                 }
                 let r = ep
                     .color("radiance", ColorUse::Emission, self.opts, &mut self.report)?
@@ -176,7 +180,9 @@ impl<'a> Loader<'a> {
                 (r.max_element() > 0.0).then_some(Texture::Constant(r))
             }
         };
-        self.finish_shape(&p, b, geometry, material, emission, flip)
+        let emits = self.finish_shape(&p, b, geometry, material, emission, flip)?;
+        b.set_last_shape_media(media);
+        Ok(emits)
     }
 
     /// The shape's last step: its remaining parameters checked, then added (emitting when
