@@ -263,7 +263,10 @@ impl GridMedium {
         sampler: &mut Sampler,
     ) -> Color {
         let len = a.distance(b);
-        if len == 0.0 {
+        // A far end whose distance overflows (a light at infinity) comes only from a point on the
+        // medium's boundary heading out (seen on the suite's null-bounded grid): nothing is left
+        // to attenuate. Before this, tracking with a NaN direction never ended.
+        if len == 0.0 || !len.is_finite() {
             return Color::ONE;
         }
         let d = (b - a) / len;
@@ -275,10 +278,13 @@ impl GridMedium {
             }
             let mut t = t0;
             loop {
-                t -= (1.0 - sampler.next_f32()).ln() / m;
-                if t >= t1 {
+                let step = -(1.0 - sampler.next_f32()).ln() / m;
+                let next = t + step;
+                // A positive step below t's ulp would track forever.
+                if next >= t1 || (step > 0.0 && next <= t) {
                     return true;
                 }
+                t = next;
                 let ratio = self.sigma_t(a + d * t) / m;
                 match estimator {
                     TransmittanceEstimator::Ratio => tr *= Color::ONE - ratio,
