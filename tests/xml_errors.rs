@@ -213,7 +213,9 @@ fn xml_bad_files_give_one_clear_error() {
         line_of(&text, "name=\"radius\""),
         &["must be a <float>"],
     );
-    let text = scene_xml("    <medium type=\"homogeneous\"><float name=\"density\" value=\"1\"/></medium>");
+    let text = scene_xml(
+        "    <medium type=\"homogeneous\"><float name=\"density\" value=\"1\"/></medium>",
+    );
     fails(
         &d,
         &text,
