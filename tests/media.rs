@@ -1,15 +1,16 @@
-//! `pt`, `pt-bsdf` and `light` through participating media (scenes built in code: the scene files
-//! cannot describe media yet). A white furnace inside a null-bounded medium of albedo 1 under a
-//! uniform environment of radiance 1 must return 1; the three estimators agree per block within
-//! Šidák-corrected standard errors on a medium sphere under an area light (null boundary, and
-//! inside glass for pt against pt-bsdf); no NaN or negative pixel; the same bits at 1 and 2
-//! threads.
+//! The integrators that walk participating media (`registry::HANDLES_MEDIA`: `pt`, `pt-bsdf`,
+//! `light`, `bdpt`; scenes built in code: the scene files cannot describe media yet). A white
+//! furnace inside a null-bounded medium of albedo 1 under a uniform environment of radiance 1 must
+//! return 1; the estimators agree with `pt` per block within Šidák-corrected standard errors on a
+//! medium sphere under an area light (null boundary, inside glass, and a heterogeneous grid for
+//! bdpt); no NaN or negative pixel; the same bits at 1 and 2 threads.
 
 use lt_core::bsdf::{Dielectric, Diffuse, Material, Null};
 use lt_core::camera::{Camera, FovAxis};
 use lt_core::light::LightDesc;
 use lt_core::math::Mat4;
-use lt_core::medium::{Homogeneous, Medium, PhaseFunction};
+use lt_core::medium::{GridMedium, GridVolume, Homogeneous, Medium, PhaseFunction};
+use lt_core::medium::{Volume, VolumeGrid, WrapMode};
 use lt_core::scene::{MediumInterface, RenderSettings, SceneBuilder, ShapeGeometry, TriangleMesh};
 use lt_core::{Color, Scene, Vec3};
 use lt_estimators::agreement::{agreement_t, agreement_with_reference_t};
@@ -19,7 +20,7 @@ use std::ops::ControlFlow;
 
 const ALPHA: f64 = 1e-3;
 
-fn homogeneous(sigma_t: Color, albedo: f32, phase: PhaseFunction) -> Medium {
+pub(crate) fn homogeneous(sigma_t: Color, albedo: f32, phase: PhaseFunction) -> Medium {
     Medium::Homogeneous(Homogeneous::new(sigma_t, Color::splat(albedo), 1.0, phase).unwrap())
 }
 
@@ -91,8 +92,22 @@ fn check_furnace(integrator: &str, medium: Medium, passes: u32) {
 #[test]
 fn furnace_isotropic_chromatic() {
     let m = || homogeneous(Color::new(0.5, 1.0, 2.0), 1.0, PhaseFunction::Isotropic);
-    for (integrator, passes) in [("pt", 64), ("pt-bsdf", 64), ("light", 65536)] {
+    for (integrator, passes) in FURNACE_PASSES {
         check_furnace(integrator, m(), passes);
+    }
+}
+
+/// Passes per integrator of the furnaces (light tracing reaches the unit sphere rarely).
+const FURNACE_PASSES: [(&str, u32); 4] =
+    [("pt", 64), ("pt-bsdf", 64), ("light", 65536), ("bdpt", 32)];
+
+#[test]
+fn every_media_integrator_has_a_furnace() {
+    for name in lt_integrators::registry::HANDLES_MEDIA {
+        assert!(
+            FURNACE_PASSES.iter().any(|(n, _)| n == name),
+            "{name} walks media but no furnace runs it"
+        );
     }
 }
 
@@ -100,7 +115,7 @@ fn furnace_isotropic_chromatic() {
 fn furnace_hg_forward() {
     let hg = PhaseFunction::henyey_greenstein(0.7).unwrap();
     let m = || homogeneous(Color::new(1.5, 1.0, 0.7), 1.0, hg);
-    for (integrator, passes) in [("pt", 64), ("pt-bsdf", 64), ("light", 65536)] {
+    for (integrator, passes) in FURNACE_PASSES {
         check_furnace(integrator, m(), passes);
     }
 }
@@ -114,7 +129,39 @@ fn quad(c: Vec3, u: Vec3, v: Vec3) -> ShapeGeometry {
 
 /// A medium sphere (chromatic σt, albedo 0.8, HG g = 0.5) on a diffuse floor under a square area
 /// light, behind a `null` boundary or inside glass (IOR 1.33); the camera in vacuum.
-fn medium_sphere(glass: bool) -> Scene {
+pub(crate) fn medium_sphere(glass: bool) -> Scene {
+    let hg = PhaseFunction::henyey_greenstein(0.5).unwrap();
+    medium_sphere_with(glass, homogeneous(Color::new(2.0, 1.2, 0.6), 0.8, hg))
+}
+
+/// The sphere's centre and radius.
+const SPHERE: (Vec3, f32) = (Vec3::new(0.0, -0.2, 0.0), 0.8);
+
+/// The medium sphere filled with a heterogeneous grid instead: σt on 4³ samples between 0.3 and
+/// 3.3 (chromatic, three channels), albedo 0.8, HG g = −0.3, over the sphere's bounding box.
+pub(crate) fn grid_sphere() -> Scene {
+    let n = 4;
+    let mut data = Vec::with_capacity(n * n * n * 3);
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let f = ((i * 7 + j * 3 + k * 5) % 11) as f32 / 10.0;
+                data.extend([0.3 + 3.0 * f, 0.3 + 2.0 * (1.0 - f), 1.0 + f]);
+            }
+        }
+    }
+    let grid = VolumeGrid::new([n, n, n], 3, data, [Vec3::ZERO, Vec3::ONE]).unwrap();
+    let (c, r) = SPHERE;
+    let to_world =
+        Mat4::from_translation(c - Vec3::splat(r)) * Mat4::from_scale(Vec3::splat(2.0 * r));
+    let vol = GridVolume::new(std::sync::Arc::new(grid), to_world, false, WrapMode::Clamp).unwrap();
+    let hg = PhaseFunction::henyey_greenstein(-0.3).unwrap();
+    let albedo = Volume::Constant(Color::splat(0.8));
+    let m = GridMedium::new(Volume::Grid(vol), 1.0, albedo, hg).unwrap();
+    medium_sphere_with(false, Medium::Grid(Box::new(m)))
+}
+
+fn medium_sphere_with(glass: bool, medium: Medium) -> Scene {
     let camera = Camera::look_at(
         Vec3::new(0.0, 0.6, 4.0),
         Vec3::new(0.0, -0.3, 0.0),
@@ -131,8 +178,7 @@ fn medium_sphere(glass: bool) -> Scene {
         spp: 1,
     };
     let mut b = SceneBuilder::new(camera, settings);
-    let hg = PhaseFunction::henyey_greenstein(0.5).unwrap();
-    let m = b.add_medium(homogeneous(Color::new(2.0, 1.2, 0.6), 0.8, hg));
+    let m = b.add_medium(medium);
     let floor = b.add_material(Material::Diffuse(Diffuse {
         albedo: Color::splat(0.6),
     }));
@@ -153,8 +199,8 @@ fn medium_sphere(glass: bool) -> Scene {
         false,
     );
     let sphere = ShapeGeometry::Sphere {
-        center: Vec3::new(0.0, -0.2, 0.0),
-        radius: 0.8,
+        center: SPHERE.0,
+        radius: SPHERE.1,
     };
     b.add_shape(sphere, boundary, None, false);
     b.set_last_shape_media(MediumInterface {
@@ -187,23 +233,54 @@ fn agree(scene: &Scene, a: (&str, u32), b: (&str, u32)) {
     assert!(result.passed(), "{} vs {}: {result}", a.0, b.0);
 }
 
-#[test]
-fn pt_pt_bsdf_and_light_agree_on_a_null_bounded_medium() {
-    let scene = medium_sphere(false);
-    agree(&scene, ("pt", 64), ("pt-bsdf", 512));
-    agree(&scene, ("pt", 64), ("light", 128));
+/// Passes per integrator when held to `pt` on the medium sphere, in the order the registry lists
+/// `HANDLES_MEDIA`; `None`: the integrator cannot see the scene (light tracing through glass,
+/// which the camera sees only through the delta refraction).
+fn agreement_passes(name: &str, glass: bool) -> Option<u32> {
+    match name {
+        "pt" => None,
+        "pt-bsdf" => Some(512),
+        "light" if glass => None,
+        "light" => Some(128),
+        "bdpt" => Some(32),
+        _ => panic!("{name} walks media: give it agreement passes here"),
+    }
 }
 
 #[test]
-fn pt_and_pt_bsdf_agree_on_a_medium_inside_glass() {
+fn media_integrators_agree_with_pt_on_a_null_bounded_medium() {
+    let scene = medium_sphere(false);
+    for name in lt_integrators::registry::HANDLES_MEDIA {
+        if let Some(passes) = agreement_passes(name, false) {
+            agree(&scene, ("pt", 64), (name, passes));
+        }
+    }
+}
+
+#[test]
+fn media_integrators_agree_with_pt_on_a_medium_inside_glass() {
     let scene = medium_sphere(true);
-    agree(&scene, ("pt", 64), ("pt-bsdf", 512));
+    for name in lt_integrators::registry::HANDLES_MEDIA {
+        if let Some(passes) = agreement_passes(name, true) {
+            agree(&scene, ("pt", 64), (name, passes));
+        }
+    }
+}
+
+#[test]
+fn bdpt_agrees_with_pt_on_a_heterogeneous_grid() {
+    // Ratio tracking on every connection and the grid's free-flight densities in the weights.
+    let scene = grid_sphere();
+    agree(&scene, ("pt", 64), ("bdpt", 32));
 }
 
 #[test]
 fn media_walks_are_deterministic_across_thread_counts() {
-    let scene = medium_sphere(false);
-    for name in ["pt", "pt-bsdf", "light"] {
+    for (scene, name) in [medium_sphere(false), grid_sphere()].iter().flat_map(|s| {
+        lt_integrators::registry::HANDLES_MEDIA
+            .iter()
+            .map(move |n| (s, *n))
+    }) {
         let integ = make_integrator(name, &scene, &IntegratorParams::default()).unwrap();
         let image = |threads| {
             let opts = RenderOptions {

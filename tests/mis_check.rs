@@ -1,6 +1,8 @@
 //! `lt mis-check` as a test: on every shipped scene, pt's and bdpt's MIS weights (power and
 //! balance) agree with the from-scratch oracle of `lt_core::path`, and the weights each integrator's
-//! own code gives a path's techniques sum to one. Plus proof that the check can fail.
+//! own code gives a path's techniques sum to one; bdpt's also through participating media (the
+//! scenes of `media.rs`: homogeneous behind a null boundary and inside glass, a heterogeneous
+//! grid). Plus proof that the check can fail, media errors included.
 
 use lt_core::path::Heuristic;
 use lt_experiments::verify::mis_check::pt_bdpt::{
@@ -235,4 +237,150 @@ fn an_lvc_connection_count_without_n_fails() {
         report.rows.iter().any(|r| r.k >= 3 && r.over > 0),
         "{report}"
     );
+}
+
+/// The media scenes bdpt's weights are held to the oracle on (built in `media.rs`; no shipped
+/// scene has media yet).
+fn media_scenes() -> Vec<(&'static str, lt_core::Scene)> {
+    vec![
+        ("medium-sphere", crate::media::medium_sphere(false)),
+        ("medium-in-glass", crate::media::medium_sphere(true)),
+        ("grid-sphere", crate::media::grid_sphere()),
+    ]
+}
+
+/// bdpt's check options on a media scene: paths of up to 5 segments, fewer paths than on the
+/// shipped scenes (every oracle density through media traces its segments).
+fn media_options(scene: &lt_core::Scene, h: Heuristic) -> Options {
+    let mut o = options(scene, Which::Bdpt, h);
+    o.max_depth = 5;
+    o.paths = 40;
+    o
+}
+
+fn has_medium_vertex(r: &Record) -> bool {
+    r.light.iter().chain(&r.camera).any(|v| v.in_medium())
+}
+
+#[test]
+fn bdpt_weights_match_the_oracle_through_media() {
+    let mut failed = Vec::new();
+    for h in [Heuristic::Power, Heuristic::Balance] {
+        for (name, mut scene) in media_scenes() {
+            let opts = media_options(&scene, h);
+            prepare_scene(&mut scene, &opts);
+            let (c, passes) = collect(&scene, &opts);
+            let in_media = c.records.iter().filter(|r| has_medium_vertex(r)).count();
+            let report = check_records(&scene, &c.records, &opts, passes, c.too_long, name);
+            println!("{name} {h:?}: {in_media} paths with medium vertices\n{report}");
+            assert!(
+                in_media > 100,
+                "{name}: {in_media} paths through the medium\n{report}"
+            );
+            if !report.passed() {
+                failed.push(format!("{report}"));
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+type Record = lt_experiments::verify::mis_check::pt_bdpt::Record;
+
+/// An error planted in the densities a bdpt walk stores at medium vertices, or in the weight's
+/// arithmetic through media.
+#[derive(Clone, Copy, Debug)]
+enum MediaPlant {
+    /// Every medium vertex's reverse density (phase pdf reversed × free flight) 1 % high.
+    ReverseDensity,
+    /// A cosine left in a medium vertex's forward density, as if it had a surface (normal +y).
+    Cosine,
+    /// The connection's own densities without their free flights (the surface weights).
+    FreeFlight,
+}
+
+/// bdpt's weight of record `r` recomputed by its own code (`mis_weight_in`) from the vertices
+/// the walks stored — `MEDIA` false drops the join's free flights.
+fn reweigh<const MEDIA: bool>(scene: &lt_core::Scene, r: &Record, h: Heuristic) -> f64 {
+    use lt_core::bsdf::TransportMode::{Importance, Radiance};
+    use lt_integrators::bdpt::{mis_weight_in, EndEvals, Split};
+    use lt_integrators::connect::{eval_towards, nee_density};
+    let (y, z) = (&r.light[..], &r.camera[..]);
+    if r.s == 0 {
+        let path: Vec<_> = z.iter().chain(y).copied().collect();
+        let (split, evals) = Split::reached(&path);
+        return mis_weight_in::<MEDIA>(scene, split, evals, h, 1.0);
+    }
+    let (yv, zv) = (&y[y.len() - 1], &z[z.len() - 1]);
+    let evals = EndEvals {
+        light_end: (r.s >= 2)
+            .then(|| eval_towards(scene, yv, yv.dir_to(zv), Importance))
+            .flatten(),
+        camera_end: (z.len() >= 2)
+            .then(|| eval_towards(scene, zv, zv.dir_to(yv), Radiance))
+            .flatten(),
+    };
+    let light_nee = if r.s >= 2 {
+        nee_density(scene, &y[0], &y[1])
+    } else {
+        0.0
+    };
+    let split = Split {
+        light: y,
+        camera: z,
+        light_nee,
+    };
+    mis_weight_in::<MEDIA>(scene, split, evals, h, 1.0)
+}
+
+fn plant(scene: &lt_core::Scene, r: &mut Record, what: MediaPlant, h: Heuristic) {
+    for v in r.light.iter_mut().chain(r.camera.iter_mut()) {
+        if !v.in_medium() {
+            continue;
+        }
+        match what {
+            MediaPlant::ReverseDensity => v.pdf_rev *= 1.01,
+            MediaPlant::Cosine => v.pdf_fwd *= v.wo.y.abs(),
+            MediaPlant::FreeFlight => {}
+        }
+    }
+    r.weight = match what {
+        MediaPlant::FreeFlight => reweigh::<false>(scene, r, h),
+        _ => reweigh::<true>(scene, r, h),
+    };
+}
+
+#[test]
+fn planted_media_errors_fail() {
+    let (name, mut scene) = media_scenes().swap_remove(0);
+    let mut opts = media_options(&scene, Heuristic::Power);
+    opts.paths = 20;
+    prepare_scene(&mut scene, &opts);
+    let (c, _) = collect(&scene, &opts);
+    let through: Vec<Record> = c.records.into_iter().filter(has_medium_vertex).collect();
+    // The weights recomputed from the stored vertices without a plant pass: the failures below
+    // are the plants'.
+    let mut clean = through.clone();
+    for r in &mut clean {
+        r.weight = reweigh::<true>(&scene, r, opts.heuristic);
+    }
+    let report = check_records(&scene, &clean, &opts, 0, 0, name);
+    assert!(report.passed(), "{report}");
+    for what in [
+        MediaPlant::ReverseDensity,
+        MediaPlant::Cosine,
+        MediaPlant::FreeFlight,
+    ] {
+        let mut planted = through.clone();
+        for r in &mut planted {
+            plant(&scene, r, what, opts.heuristic);
+        }
+        let report = check_records(&scene, &planted, &opts, 0, 0, name);
+        println!(
+            "{what:?}: {} of {} paths fail",
+            report.failures(),
+            report.checked()
+        );
+        assert!(!report.passed(), "{what:?} planted, yet\n{report}");
+    }
 }

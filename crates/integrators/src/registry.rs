@@ -252,7 +252,7 @@ pub fn make_integrator(
 
 /// The integrators that walk participating media (`media/`); every other refuses a scene with
 /// media rather than render it silently wrong (issue 43, item 4).
-pub const HANDLES_MEDIA: &[&str] = &["pt", "pt-bsdf", "light"];
+pub const HANDLES_MEDIA: &[&str] = &["pt", "pt-bsdf", "light", "bdpt"];
 
 /// One clear line for an integrator that cannot render the scene's media.
 fn refuse_media(name: &str, scene: &Scene) -> Result<(), String> {

@@ -78,6 +78,7 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
         }
     };
     let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    crate::verify::mis_check::refuse_media(&scene, &args.integrator)?;
     let mut opts = Options::new(&scene, integrator);
     if let Some(m) = &args.mis {
         opts.heuristic = Heuristic::parse(m)?;
@@ -126,6 +127,7 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
 /// `lt mis-check --integrator vcm|bpm`: vcm has connections, bpm has merges only.
 fn run_vcm_bpm(args: &MisCheckArgs, connections: bool) -> Result<String, String> {
     let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    crate::verify::mis_check::refuse_media(&scene, &args.integrator)?;
     let mut opts = VcmOptions::new(&scene, connections);
     if let Some(m) = &args.mis {
         opts.heuristic = Heuristic::parse(m)?;

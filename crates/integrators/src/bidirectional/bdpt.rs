@@ -27,9 +27,10 @@ use crate::record::{NoRecord, Recorder, Work};
 use crate::subpath::camera_loop::{
     camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight,
 };
-use crate::subpath::connect::{nee_density, splat_light_subpath};
-pub use crate::subpath::strategy_weight::{mis_weight, with_chain, EndEvals, Split};
-use crate::subpath::walk::{light_subpath, Subpath, WalkLimits};
+use crate::subpath::connect::{nee_density, splat_light_subpath_in};
+pub use crate::subpath::strategy_weight::{mis_weight, mis_weight_in, with_chain, with_chain_in};
+pub use crate::subpath::strategy_weight::{EndEvals, Split};
+use crate::subpath::walk::{light_subpath_in, Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
@@ -82,7 +83,8 @@ struct Pairing {
 
 /// bdpt's policy in the camera loop: every camera vertex joins every vertex of the one light
 /// subpath `y` it is paired with; weights from the stored densities (`strategy_weight`).
-struct Policy<'a> {
+/// `MEDIA`: the scene has participating media (chosen once per pass: `Bdpt::item_in`).
+struct Policy<'a, const MEDIA: bool> {
     y: &'a [PathVertex],
     /// Next-event estimation's density of y_0 from y_1.
     light_nee: f64,
@@ -91,10 +93,13 @@ struct Policy<'a> {
     ratio: f64,
 }
 
-impl CameraPolicy for Policy<'_> {
+impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
+    const MEDIA: bool = MEDIA;
+
     fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], _: Vec2) -> Weight {
         let (split, evals) = Split::reached(path);
-        (mis_weight(scene, split, evals, self.h, self.ratio), None)
+        let w = mis_weight_in::<MEDIA>(scene, split, evals, self.h, self.ratio);
+        (w, None)
     }
 
     fn next_event_weight(
@@ -106,13 +111,15 @@ impl CameraPolicy for Policy<'_> {
         _: Vec2,
     ) -> Weight {
         let (split, evals) = Split::next_event(z, x0, camera_end);
-        (mis_weight(scene, split, evals, self.h, self.ratio), None)
+        let w = mis_weight_in::<MEDIA>(scene, split, evals, self.h, self.ratio);
+        (w, None)
     }
 
     fn connect<R: Recorder>(&mut self, scene: &Scene, joins: &mut Joins<'_, R>, _: &mut Sampler) {
-        joins.join_subpath(scene, self.y, |c| {
+        joins.join_subpath_in::<MEDIA>(scene, self.y, |c| {
             let (split, evals) = Split::connection(c, self.light_nee);
-            (mis_weight(scene, split, evals, self.h, self.ratio), None)
+            let w = mis_weight_in::<MEDIA>(scene, split, evals, self.h, self.ratio);
+            (w, None)
         });
     }
 }
@@ -129,7 +136,7 @@ impl Bdpt {
     }
 
     /// One camera sample as `pair` says; returns the pixel's own estimate (strategies t ≥ 2).
-    fn sample<R: Recorder>(
+    fn sample<const MEDIA: bool, R: Recorder>(
         &self,
         scene: &Scene,
         pass: Pass,
@@ -151,7 +158,7 @@ impl Bdpt {
         let h = self.params.mis;
         let max_k = self.params.max_depth as usize;
         let mut ls = Sampler::for_item(Domain::Light, seed, light_index, pass as u64);
-        light_subpath(
+        light_subpath_in::<MEDIA>(
             scene,
             &mut ls,
             WalkLimits::light(self.params.max_depth, self.params.rr_depth),
@@ -171,24 +178,34 @@ impl Bdpt {
             // A thin lens draws its lens points from the light path's own lens stream (as vcm
             // does, so vcm without merging takes bdpt's paths).
             let mut lens = Sampler::for_item(Domain::Lens, seed, light_index, pass as u64);
-            splat_light_subpath(scene, y, max_k, scale, &mut lens, splats, *rec, |s, c| {
-                let camera_only = [c.camera];
-                let split = Split {
-                    light: &y[..s],
-                    camera: &camera_only,
-                    light_nee,
-                };
-                let evals = EndEvals {
-                    light_end: c.eval,
-                    camera_end: None,
-                };
-                (mis_weight(scene, split, evals, h, ratio), None)
-            });
+            let rec = &mut **rec;
+            splat_light_subpath_in::<MEDIA, R>(
+                scene,
+                y,
+                max_k,
+                scale,
+                &mut lens,
+                splats,
+                rec,
+                |s, c| {
+                    let camera_only = [c.camera];
+                    let split = Split {
+                        light: &y[..s],
+                        camera: &camera_only,
+                        light_nee,
+                    };
+                    let evals = EndEvals {
+                        light_end: c.eval,
+                        camera_end: None,
+                    };
+                    (mis_weight_in::<MEDIA>(scene, split, evals, h, ratio), None)
+                },
+            );
         }
         let Some(pixel) = pixel else {
             return Color::ZERO;
         };
-        let mut policy = Policy {
+        let mut policy = Policy::<MEDIA> {
             y,
             light_nee,
             h,
@@ -233,8 +250,24 @@ impl Bdpt {
     }
 
     /// Work item i of a pass (0 … max(N, M)−1): pixel i (when i < N) with light subpath i mod M, splatting that
-    /// light subpath when i < M; items N … M−1 (M > N) splat their light subpath only.
+    /// light subpath when i < M; items N … M−1 (M > N) splat their light subpath only. Through
+    /// media when the scene has them (callers outside the pass loop: the pyramid, tests).
     pub fn item<R: Recorder>(
+        &self,
+        scene: &Scene,
+        pass: Pass,
+        i: u64,
+        worker: &mut Worker<'_, Scratch, R>,
+    ) {
+        if scene.has_media {
+            self.item_in::<true, R>(scene, pass, i, worker)
+        } else {
+            self.item_in::<false, R>(scene, pass, i, worker)
+        }
+    }
+
+    /// `item` with the walks and joins through media or not (`MEDIA`), as a pass picks once.
+    pub fn item_in<const MEDIA: bool, R: Recorder>(
         &self,
         scene: &Scene,
         pass: Pass,
@@ -249,7 +282,7 @@ impl Bdpt {
             splat_light: i < m,
         };
         worker.rec.begin_item(i);
-        let l = self.sample(scene, pass, pair, worker);
+        let l = self.sample::<MEDIA, R>(scene, pass, pair, worker);
         if let Some(p) = pair.pixel {
             worker.splats.add_to_pixel(p as u32, l);
         }
@@ -296,6 +329,17 @@ impl Integrator for Bdpt {
     }
 
     fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
+        // Media or not, chosen once per pass: each is its own monomorphised loop.
+        if scene.has_media {
+            self.pass::<true>(scene, seed, pass)
+        } else {
+            self.pass::<false>(scene, seed, pass)
+        }
+    }
+}
+
+impl Bdpt {
+    fn pass<const MEDIA: bool>(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
         let cam = &scene.camera;
         let n = cam.pixel_count() as u64;
         let items = n.max(self.light_paths(scene));
@@ -312,7 +356,7 @@ impl Integrator for Bdpt {
                     scratch,
                     rec: &mut NoRecord,
                 };
-                self.item(scene, Pass { seed, pass }, i, &mut worker)
+                self.item_in::<MEDIA, NoRecord>(scene, Pass { seed, pass }, i, &mut worker)
             },
         )
     }

@@ -25,8 +25,8 @@
 use crate::film::pixel::{pixel_sample, weighted};
 use crate::film::splat::Pass;
 use crate::record::{Completed, Recorder, Work};
-use crate::subpath::connect::{join, next_event, Joined, NextEvent};
-use crate::subpath::walk::{camera_subpath, Subpath, WalkLimits};
+use crate::subpath::connect::{join_in, next_event_in, Joined, NextEvent};
+use crate::subpath::walk::{camera_subpath_in, Subpath, WalkLimits};
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
 use lt_core::path::camis::Mixture;
@@ -42,6 +42,11 @@ pub type Weight = (f64, Option<Mixture>);
 /// What a bidirectional estimator does at the camera vertices the loop visits. `z` is always the
 /// camera prefix z_0 … z_{t−1}, camera first, its last vertex the one being visited.
 pub trait CameraPolicy {
+    /// The estimator walks participating media (`walk::camera_subpath_in`, next-event estimation
+    /// and joins with transmittance estimates). A constant of the policy's type, chosen once per
+    /// pass from `Scene::has_media`, so the loop without media is the surface loop alone.
+    const MEDIA: bool = false;
+
     /// The camera walk `z` is done, before any technique runs: per-sample state (the VCM
     /// engine's MIS records of the walk, whether the pixel at `raster` merges).
     #[inline]
@@ -146,6 +151,9 @@ pub struct Joins<'a, R> {
     raster: Vec2,
     rec: &'a mut R,
     l: &'a mut Color,
+    /// Through media: the stream the joins' transmittance estimates draw from (the pixel's
+    /// auxiliary stream, so the camera stream's order is the surface loop's).
+    transmittance: Option<&'a mut Sampler>,
 }
 
 impl<R: Recorder> Joins<'_, R> {
@@ -175,13 +183,31 @@ impl<R: Recorder> Joins<'_, R> {
         scale: f32,
         weight: impl FnOnce(Connection) -> Weight,
     ) {
+        self.join_in::<false>(scene, y, scale, weight)
+    }
+
+    /// `join`, through media when `MEDIA` (the policy's `CameraPolicy::MEDIA`): the value
+    /// carries the edge's transmittance estimate.
+    #[inline]
+    pub fn join_in<const MEDIA: bool>(
+        &mut self,
+        scene: &Scene,
+        y: &[PathVertex],
+        scale: f32,
+        weight: impl FnOnce(Connection) -> Weight,
+    ) {
         let (s, t) = (y.len(), self.z.len());
         'attempt: {
             let yv = &y[s - 1];
             if !connectable(scene, yv) {
                 break 'attempt;
             }
-            let Some(joined) = join(scene, yv, &self.z[t - 1]) else {
+            let tr = if MEDIA {
+                self.transmittance.as_deref_mut()
+            } else {
+                None
+            };
+            let Some(joined) = join_in::<MEDIA>(scene, yv, &self.z[t - 1], tr) else {
                 break 'attempt;
             };
             let value = joined.value * scale;
@@ -220,10 +246,21 @@ impl<R: Recorder> Joins<'_, R> {
         &mut self,
         scene: &Scene,
         y: &[PathVertex],
+        weight: impl FnMut(Connection) -> Weight,
+    ) {
+        self.join_subpath_in::<false>(scene, y, weight)
+    }
+
+    /// `join_subpath`, through media when `MEDIA`.
+    #[inline]
+    pub fn join_subpath_in<const MEDIA: bool>(
+        &mut self,
+        scene: &Scene,
+        y: &[PathVertex],
         mut weight: impl FnMut(Connection) -> Weight,
     ) {
         for s in 2..=y.len().min(self.max_k + 1 - self.z.len()) {
-            self.join(scene, &y[..s], 1.0, &mut weight);
+            self.join_in::<MEDIA>(scene, &y[..s], 1.0, &mut weight);
         }
     }
 }
@@ -251,7 +288,13 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
     };
     let raster = film.raster;
     let limits = WalkLimits::camera(depths.max_depth, depths.rr_depth);
-    camera_subpath(scene, raster, &mut cs, limits, &mut scratch.camera);
+    if P::MEDIA {
+        camera_subpath_in::<true>(scene, raster, &mut cs, limits, &mut scratch.camera);
+    } else {
+        camera_subpath_in::<false>(scene, raster, &mut cs, limits, &mut scratch.camera);
+    }
+    let mut transmittance =
+        P::MEDIA.then(|| Sampler::for_item(Domain::Aux, pass.seed, pixel, pass.pass as u64));
     let z = &scratch.camera.vertices;
     policy.walked(scene, z, raster);
     rec.begin_sample(pixel, film.weight);
@@ -290,6 +333,7 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
                 raster,
                 rec: &mut *ctx.rec,
                 l: &mut l,
+                transmittance: transmittance.as_mut(),
             };
             policy.connect(scene, &mut joins, &mut cs);
         }
@@ -360,7 +404,11 @@ fn next_event_weighted<P: CameraPolicy, R: Recorder>(
         x0,
         camera_end,
         value,
-    }) = next_event(scene, &z[z.len() - 1], sampler)
+    }) = (if P::MEDIA {
+        next_event_in::<true>(scene, &z[z.len() - 1], sampler)
+    } else {
+        next_event_in::<false>(scene, &z[z.len() - 1], sampler)
+    })
     else {
         return Color::ZERO;
     };

@@ -7,6 +7,7 @@ use crate::film::splat::Splats;
 use crate::record::{Completed, Recorder, Work};
 use lt_core::bsdf::{BsdfEval, TransportMode};
 use lt_core::math::{Color, Vec2, Vec3};
+use lt_core::medium::MediumId;
 use lt_core::path::camis::Mixture;
 use lt_core::path::scatter::connectable;
 use lt_core::path::{PathVertex, VertexKind};
@@ -28,7 +29,7 @@ pub struct CameraConnection {
 }
 
 /// The BSDF of surface vertex `v` between its stored incoming direction `v.wo` and the direction
-/// towards `to`, in `mode`. `None` for non-surfaces.
+/// `wi`, in `mode`; at a medium vertex its phase function (`in_medium`). `None` for endpoints.
 #[inline]
 pub fn eval_towards(
     scene: &Scene,
@@ -36,11 +37,52 @@ pub fn eval_towards(
     wi: Vec3,
     mode: TransportMode,
 ) -> Option<BsdfEval> {
-    let VertexKind::Surface { material } = v.kind else {
-        return None;
+    let material = match v.kind {
+        VertexKind::Surface { material } => material,
+        VertexKind::Medium { medium } => return Some(in_medium(scene, medium, v.wo, wi)),
+        _ => return None,
     };
     let sf = v.shading_frame();
     Some(scene.material(material).eval(&sf, v.wo, wi, mode))
+}
+
+/// A medium vertex's scattering towards `wi` as a connection uses it: the phase function alone
+/// (no cosine; σs is already in the vertex's β, from the free flight's weight σs T / p), its
+/// solid-angle density that of sampling it, and the reverse density the same (reciprocal).
+/// Transport mode does not enter (`lt_core::medium`).
+fn in_medium(scene: &Scene, medium: MediumId, wo: Vec3, wi: Vec3) -> BsdfEval {
+    let phase = scene.media[medium as usize].phase();
+    let value = phase.eval(wo, wi);
+    BsdfEval {
+        f_cos: Color::splat(value),
+        pdf_w: phase.pdf(wo, wi),
+        pdf_rev_w: phase.pdf(wi, wo),
+    }
+}
+
+/// What the edge between two subpath vertices lets through: visibility alone without media;
+/// through media (`MEDIA`) an unbiased transmittance estimate through null boundaries and every
+/// medium on the way (`Scene::transmittance_estimate`, ratio tracking in grids, exact in
+/// homogeneous media), zero where an opaque surface blocks. The estimate enters the contribution
+/// only: no density of any technique depends on it.
+#[inline]
+pub fn edge_throughput<const MEDIA: bool>(
+    scene: &Scene,
+    a: &PathVertex,
+    b: &PathVertex,
+    sampler: &mut Sampler,
+) -> Color {
+    if !MEDIA {
+        return if scene.connection_visible(a, b) {
+            Color::ONE
+        } else {
+            Color::ZERO
+        };
+    }
+    let medium = a.medium_towards(scene, a.dir_to(b));
+    scene
+        .transmittance_estimate(a.into(), b.into(), medium, sampler)
+        .unwrap_or(Color::ZERO)
 }
 
 /// Joins light-subpath vertex `y` (x0 on a light, or a non-delta surface) to a point of the lens
@@ -51,6 +93,17 @@ pub fn eval_towards(
 /// (delta direction: `escaped` is zero towards any camera ray, and `scatter::connectable` already
 /// refuses its x0), and so does every vertex for an orthographic camera (a delta in direction).
 pub fn connect_to_camera(
+    scene: &Scene,
+    y: &PathVertex,
+    sampler: &mut Sampler,
+) -> Option<CameraConnection> {
+    connect_to_camera_in::<false>(scene, y, sampler)
+}
+
+/// `connect_to_camera`, through media when `MEDIA`: a medium vertex joins too (its phase
+/// function towards the lens), and the value carries the edge's transmittance estimate (drawn
+/// from `sampler` after the lens point).
+pub fn connect_to_camera_in<const MEDIA: bool>(
     scene: &Scene,
     y: &PathVertex,
     sampler: &mut Sampler,
@@ -74,21 +127,22 @@ pub fn connect_to_camera(
                 (lens, le / y.pdf_fwd, None)
             }
         }
-        VertexKind::Surface { .. } => {
+        VertexKind::Surface { .. } | VertexKind::Medium { .. } => {
             let lens = cam.connect(y.p, sampler)?;
             let ev = eval_towards(scene, y, -lens.dir, TransportMode::Importance)?;
             (lens, y.beta * ev.f_cos, Some(ev))
         }
-        // Medium vertices: no integrator walks media yet (issue 43, item 4).
-        VertexKind::Camera | VertexKind::Medium { .. } => return None,
+        VertexKind::Camera => return None,
     };
     if value == Color::ZERO {
         return None;
     }
     let camera = PathVertex::camera_at(cam, lens.origin, Color::ONE);
-    if !scene.connection_visible(y, &camera) {
+    let tr = edge_throughput::<MEDIA>(scene, y, &camera, sampler);
+    if tr == Color::ZERO {
         return None;
     }
+    let value = if MEDIA { value * tr } else { value };
     Some(CameraConnection {
         raster: lens.raster,
         dir: lens.dir,
@@ -112,6 +166,21 @@ pub fn splat_light_subpath<R: Recorder>(
     lens: &mut Sampler,
     splats: &mut Splats,
     rec: &mut R,
+    weight: impl FnMut(usize, &CameraConnection) -> (f64, Option<Mixture>),
+) {
+    splat_light_subpath_in::<false, R>(scene, y, max_k, scale, lens, splats, rec, weight)
+}
+
+/// `splat_light_subpath`, through media when `MEDIA` (`connect_to_camera_in`).
+#[allow(clippy::too_many_arguments)]
+pub fn splat_light_subpath_in<const MEDIA: bool, R: Recorder>(
+    scene: &Scene,
+    y: &[PathVertex],
+    max_k: usize,
+    scale: f32,
+    lens: &mut Sampler,
+    splats: &mut Splats,
+    rec: &mut R,
     mut weight: impl FnMut(usize, &CameraConnection) -> (f64, Option<Mixture>),
 ) {
     for s in 1..=y.len().min(max_k) {
@@ -120,7 +189,7 @@ pub fn splat_light_subpath<R: Recorder>(
             if !connectable(scene, yv) {
                 break 'attempt;
             }
-            let Some(c) = connect_to_camera(scene, yv, lens) else {
+            let Some(c) = connect_to_camera_in::<MEDIA>(scene, yv, lens) else {
                 break 'attempt;
             };
             let (w, mixture) = weight(s, &c);
@@ -195,6 +264,19 @@ pub struct Joined {
 }
 
 pub fn join(scene: &Scene, y: &PathVertex, z: &PathVertex) -> Option<Joined> {
+    join_in::<false>(scene, y, z, None)
+}
+
+/// `join`, through media when `MEDIA`: either end may be a medium vertex (its phase function),
+/// and the value carries the edge's transmittance estimate, drawn from `sampler` (`Some` exactly
+/// when `MEDIA`).
+#[inline]
+pub fn join_in<const MEDIA: bool>(
+    scene: &Scene,
+    y: &PathVertex,
+    z: &PathVertex,
+    sampler: Option<&mut Sampler>,
+) -> Option<Joined> {
     let d = y.p - z.p;
     let d2 = d.length_squared();
     if !(d2 > 0.0) {
@@ -204,10 +286,22 @@ pub fn join(scene: &Scene, y: &PathVertex, z: &PathVertex) -> Option<Joined> {
     let light_end = eval_towards(scene, y, -dir, TransportMode::Importance)?;
     let camera_end = eval_towards(scene, z, dir, TransportMode::Radiance)?;
     let value = y.beta * light_end.f_cos * camera_end.f_cos * z.beta / d2;
-    (value != Color::ZERO && scene.connection_visible(y, z)).then_some(Joined {
+    if !MEDIA {
+        return (value != Color::ZERO && scene.connection_visible(y, z)).then_some(Joined {
+            light_end,
+            camera_end,
+            value,
+        });
+    }
+    if value == Color::ZERO {
+        return None;
+    }
+    let sampler = sampler.expect("a join through media draws its transmittance estimate");
+    let tr = edge_throughput::<true>(scene, y, z, sampler);
+    (tr != Color::ZERO).then_some(Joined {
         light_end,
         camera_end,
-        value,
+        value: value * tr,
     })
 }
 
@@ -223,6 +317,17 @@ pub struct NextEvent {
 }
 
 pub fn next_event(scene: &Scene, z: &PathVertex, sampler: &mut Sampler) -> Option<NextEvent> {
+    next_event_in::<false>(scene, z, sampler)
+}
+
+/// `next_event`, through media when `MEDIA`: from a medium vertex too (its phase function), the
+/// value times the shadow ray's transmittance estimate (drawn from `sampler` after the three
+/// numbers of the light sample).
+pub fn next_event_in<const MEDIA: bool>(
+    scene: &Scene,
+    z: &PathVertex,
+    sampler: &mut Sampler,
+) -> Option<NextEvent> {
     let (li, pmf, _) = scene.light_sampler.sample(sampler.next_f32())?;
     let u = sampler.next_2d();
     let ls = scene.lights[li].sample_li(z.p, u)?;
@@ -234,10 +339,18 @@ pub fn next_event(scene: &Scene, z: &PathVertex, sampler: &mut Sampler) -> Optio
         return None;
     }
     let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, z);
-    if !scene.connection_visible(&x0, z) {
+    // Without media the shadow ray runs from x0, as it always has (same bits); through media
+    // from z, whose side of a surface names the medium the ray starts in.
+    let tr = if MEDIA {
+        edge_throughput::<true>(scene, z, &x0, sampler)
+    } else {
+        edge_throughput::<false>(scene, &x0, z, sampler)
+    };
+    if tr == Color::ZERO {
         return None;
     }
     let value = z.beta * camera_end.f_cos * ls.radiance / (pmf * ls.pdf_w);
+    let value = if MEDIA { value * tr } else { value };
     Some(NextEvent {
         x0,
         camera_end,

@@ -5,5 +5,6 @@
 
 pub mod camera_loop;
 pub mod connect;
+pub mod media_walk;
 pub mod strategy_weight;
 pub mod walk;

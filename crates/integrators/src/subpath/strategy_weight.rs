@@ -85,13 +85,39 @@ const STACK_K: usize = 23;
 /// The MIS weight of strategy (s, t) for the path `split` forms (Veach 1997, eq. 10.9 with the
 /// ratios of §10.2), under `h`, with `ratio` = M/N light subpaths per camera sample.
 pub fn mis_weight(scene: &Scene, split: Split, evals: EndEvals, h: Heuristic, ratio: f64) -> f64 {
-    with_chain(scene, split, evals, ratio, |chain, s| chain.weight(s, h))
+    mis_weight_in::<false>(scene, split, evals, h, ratio)
+}
+
+/// `mis_weight` of a path through media when `MEDIA` (see `with_chain_in`).
+pub fn mis_weight_in<const MEDIA: bool>(
+    scene: &Scene,
+    split: Split,
+    evals: EndEvals,
+    h: Heuristic,
+    ratio: f64,
+) -> f64 {
+    with_chain_in::<MEDIA, _>(scene, split, evals, ratio, |chain, s| chain.weight(s, h))
 }
 
 /// Builds the `Chain` of the path `split` forms (stored densities, the ≤ 4 entries the join
 /// changes patched) and hands it, with the technique s, to `f` — `mis_weight`, or an integrator
 /// whose sample counts differ from bdpt's (`lvc_bdpt`).
 pub fn with_chain<T>(
+    scene: &Scene,
+    split: Split,
+    evals: EndEvals,
+    ratio: f64,
+    f: impl FnOnce(&Chain, usize) -> T,
+) -> T {
+    with_chain_in::<false, T>(scene, split, evals, ratio, f)
+}
+
+/// `with_chain`, for a path that may pass through media when `MEDIA`: every density the join
+/// patches is a walk's that was never walked (the connecting edge in either direction, and the
+/// two end vertices' arriving edges walked backwards), so each takes its free-flight density
+/// (`free_flight`) beside the converted direction density, as the walks' stored ones do. No
+/// transmittance estimate enters: the weights read densities only.
+pub fn with_chain_in<const MEDIA: bool, T>(
     scene: &Scene,
     split: Split,
     evals: EndEvals,
@@ -162,8 +188,12 @@ pub fn with_chain<T>(
             let (l0, l1) = emission_densities(scene, x0, x1);
             light[0] = l0;
             if k >= 2 {
+                let x1 = x1.unwrap();
                 light[1] = l1;
-                nee = nee_density(scene, x0, x1.unwrap());
+                if MEDIA {
+                    light[1] *= free_flight(scene, x0, x1);
+                }
+                nee = nee_density(scene, x0, x1);
             }
         }
         (_, 1) => {
@@ -172,28 +202,47 @@ pub fn with_chain<T>(
             let cam = &z[0];
             let dir = cam.dir_to(yv);
             camera[k - 1] = reverse_density(yv, cam, scene.camera.pdf_dir(cam.p, dir)) as f64;
+            if MEDIA {
+                camera[k - 1] *= free_flight(scene, cam, yv);
+            }
             if s >= 2 {
                 let ev = evals.light_end.expect("a surface connected to the camera");
                 camera[k - 2] = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
+                if MEDIA {
+                    camera[k - 2] *= free_flight(scene, yv, &y[s - 2]);
+                }
             }
         }
         _ => {
             let (yv, zv) = (&y[s - 1], &z[t - 1]);
             let ev_z = evals.camera_end.expect("the camera end is a surface");
             camera[s - 1] = reverse_density(yv, zv, ev_z.pdf_w) as f64;
+            if MEDIA {
+                camera[s - 1] *= free_flight(scene, zv, yv);
+            }
             if s + 1 < k {
                 light[s + 1] = reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64;
+                if MEDIA {
+                    light[s + 1] *= free_flight(scene, zv, &z[t - 2]);
+                }
             }
             if s == 1 {
                 // x0 came from next-event estimation: its light-walk densities are emission's.
                 let (l0, l1) = emission_densities(scene, yv, Some(zv));
                 light[0] = l0;
                 light[1] = l1;
+                if MEDIA {
+                    light[1] *= free_flight(scene, yv, zv);
+                }
                 nee = yv.pdf_fwd as f64;
             } else {
                 let ev_y = evals.light_end.expect("the light end is a surface");
                 light[s] = yv.convert_density(ev_y.pdf_w, zv) as f64;
                 camera[s - 2] = reverse_density(&y[s - 2], yv, ev_y.pdf_rev_w) as f64;
+                if MEDIA {
+                    light[s] *= free_flight(scene, yv, zv);
+                    camera[s - 2] *= free_flight(scene, yv, &y[s - 2]);
+                }
             }
         }
     }
@@ -205,4 +254,14 @@ pub fn with_chain<T>(
         light_tracing_ratio: ratio,
     };
     f(&chain, s)
+}
+
+/// The free-flight density of a walk from `from` reaching `to` (`Scene::free_flight_density`:
+/// per unit length when `to` lies in a medium, the probability of passing every medium when it
+/// is a surface or a light), starting in the medium `from` leaves into towards `to`: the factor
+/// of a walk's density that the direction's conversion (`PathVertex::convert_density`) leaves
+/// out. The oracle computes it the same way (`Path::densities`).
+fn free_flight(scene: &Scene, from: &PathVertex, to: &PathVertex) -> f64 {
+    let medium = from.medium_towards(scene, from.dir_to(to));
+    scene.free_flight_density(from.into(), to.into(), medium, to.in_medium()) as f64
 }

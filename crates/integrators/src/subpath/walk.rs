@@ -139,7 +139,8 @@ pub struct Escape {
     pub dir: Vec3,
     /// Throughput up to the escape.
     pub beta: Color,
-    /// Solid-angle density with which the last vertex chose `dir`.
+    /// Solid-angle density with which the last vertex chose `dir` (through media, times the
+    /// probability of passing every medium on the way out).
     pub pdf_w: f32,
 }
 
@@ -179,6 +180,19 @@ pub fn camera_subpath(
     limits: WalkLimits,
     out: &mut Subpath,
 ) {
+    camera_subpath_in::<false>(scene, raster, sampler, limits, out)
+}
+
+/// `camera_subpath`, through participating media when `MEDIA` (`media_walk`: medium vertices
+/// where free flights scatter, null surfaces crossed). The estimator picks `MEDIA` once per pass
+/// from `Scene::has_media`, so a scene without media runs the surface walk's code alone.
+pub fn camera_subpath_in<const MEDIA: bool>(
+    scene: &Scene,
+    raster: Vec2,
+    sampler: &mut Sampler,
+    limits: WalkLimits,
+    out: &mut Subpath,
+) {
     out.vertices.clear();
     out.escape = None;
     let ray = scene.camera.sample_ray(raster, sampler);
@@ -194,13 +208,39 @@ pub fn camera_subpath(
         pdf,
         mode: TransportMode::Radiance,
     };
-    random_walk(scene, start, sampler, limits, out);
+    walk::<MEDIA>(scene, start, sampler, limits, out);
+}
+
+/// The surface walk, or the walk through media (`MEDIA`, a constant of the instantiation).
+#[inline(always)]
+fn walk<const MEDIA: bool>(
+    scene: &Scene,
+    start: WalkStart,
+    sampler: &mut Sampler,
+    limits: WalkLimits,
+    out: &mut Subpath,
+) {
+    if MEDIA {
+        super::media_walk::random_walk(scene, start, sampler, limits, out)
+    } else {
+        random_walk(scene, start, sampler, limits, out)
+    }
 }
 
 /// Traces a light subpath: y0 on a light chosen by power (`Light::sample_le`), then the surfaces
 /// the emitted ray meets (importance mode). β of y0 is Le / pdf_fwd; the emitted direction's
 /// cosine and density enter β at y1.
 pub fn light_subpath(scene: &Scene, sampler: &mut Sampler, limits: WalkLimits, out: &mut Subpath) {
+    light_subpath_in::<false>(scene, sampler, limits, out)
+}
+
+/// `light_subpath`, through participating media when `MEDIA` (see `camera_subpath_in`).
+pub fn light_subpath_in<const MEDIA: bool>(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    limits: WalkLimits,
+    out: &mut Subpath,
+) {
     out.vertices.clear();
     out.escape = None;
     let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
@@ -238,16 +278,16 @@ pub fn light_subpath(scene: &Scene, sampler: &mut Sampler, limits: WalkLimits, o
         pdf,
         mode: TransportMode::Importance,
     };
-    random_walk(scene, start, sampler, limits, out);
+    walk::<MEDIA>(scene, start, sampler, limits, out);
 }
 
 /// The first ray of a subpath's walk, leaving its endpoint: the throughput it carries, the
 /// density with which the endpoint chose it (see `PathVertex::surface`) and the transport mode.
-struct WalkStart {
-    ray: Ray,
-    beta: Color,
-    pdf: f32,
-    mode: TransportMode,
+pub(super) struct WalkStart {
+    pub ray: Ray,
+    pub beta: Color,
+    pub pdf: f32,
+    pub mode: TransportMode,
 }
 
 /// Extends `out` (which holds at least its endpoint) along `start.ray` until the walk ends or

@@ -8,7 +8,34 @@
 //! - `tolerance`: how far a weight may stray from the oracle's.
 //! - `report`: the one report both checkers fill, a row per path length.
 
+use lt_core::Scene;
+
 pub mod pt_bdpt;
 pub mod report;
 pub mod tolerance;
 pub mod vcm_bpm;
+
+/// One clear line when `integrator`'s weights cannot be held to the oracle on `scene` because
+/// of its media. bdpt's can (its walks, joins and weights take media, and the oracle covers
+/// medium vertices). pt's through media are Mitsuba volpath's, next-event estimation against
+/// phase or BSDF sampling by the two direction densities alone: a partition of unity, so
+/// unbiased, but not the path-space weights, whose BSDF-sampling density also carries the
+/// probability of passing the media to the light. The others refuse media scenes outright.
+pub fn refuse_media(scene: &Scene, integrator: &str) -> Result<(), String> {
+    if !scene.has_media || integrator == "bdpt" {
+        return Ok(());
+    }
+    if integrator == "pt" {
+        return Err(
+            "mis-check: pt through media weighs by direction densities alone (Mitsuba's \
+                    volpath), not by the path-space densities the oracle holds; check bdpt on \
+                    this scene"
+                .into(),
+        );
+    }
+    Err(format!(
+        "mis-check: integrator {integrator} does not handle participating media yet; the scene \
+         has {} media",
+        scene.media.len()
+    ))
+}

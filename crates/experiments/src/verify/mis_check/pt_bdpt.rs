@@ -39,7 +39,7 @@ use lt_core::math::{Color, Vec2};
 use lt_core::path::{oracle_weight, Heuristic, Path, PathVertex, Technique, VertexKind};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
-use lt_integrators::bdpt::{mis_weight, with_chain, Bdpt, BdptParams, EndEvals, Split};
+use lt_integrators::bdpt::{mis_weight_in, with_chain_in, Bdpt, BdptParams, EndEvals, Split};
 use lt_integrators::connect::eval_towards;
 use lt_integrators::lvc_bdpt::{lvc_weight, LvcBdpt, LvcParams};
 use lt_integrators::pt::{Pt, PtParams, Techniques};
@@ -379,12 +379,18 @@ fn replay_bdpt(
         light_end: light_end.flatten(),
         camera_end: camera_end.flatten(),
     };
-    if n_conn == 1.0 {
-        mis_weight(scene, split, evals, h, ratio)
-    } else {
-        with_chain(scene, split, evals, ratio, |c, s| {
-            lvc_weight(c, s, h, n_conn)
-        })
+    // Through media the join's patched densities take their free flights (`with_chain_in`).
+    match (n_conn == 1.0, scene.has_media) {
+        (true, false) => mis_weight_in::<false>(scene, split, evals, h, ratio),
+        (true, true) => mis_weight_in::<true>(scene, split, evals, h, ratio),
+        (false, media) => {
+            let lvc = |c: &lt_core::path::Chain, s| lvc_weight(c, s, h, n_conn);
+            if media {
+                with_chain_in::<true, _>(scene, split, evals, ratio, lvc)
+            } else {
+                with_chain_in::<false, _>(scene, split, evals, ratio, lvc)
+            }
+        }
     }
 }
 
