@@ -28,7 +28,7 @@ pub(crate) fn homogeneous(sigma_t: Color, albedo: f32, phase: PhaseFunction) -> 
 /// radiance 1 outside: with albedo 1 nothing is absorbed, so every pixel is 1. Light tracing
 /// reaches the unit sphere from the scene's bounding disk rarely, hence its many passes; the
 /// spread bound (5 %) keeps each case able to see a bias of a few per cent.
-fn furnace(medium: Medium) -> Scene {
+pub(crate) fn furnace(medium: Medium) -> Scene {
     let camera = Camera::look_at(
         Vec3::new(0.1, 0.05, 0.0),
         Vec3::new(0.2, -0.1, -1.0),
@@ -99,7 +99,7 @@ fn furnace_isotropic_chromatic() {
 
 /// Passes per integrator of the furnaces (light tracing reaches the unit sphere rarely).
 const FURNACE_PASSES: [(&str, u32); 4] =
-    [("pt", 64), ("pt-bsdf", 64), ("light", 65536), ("bdpt", 32)];
+    [("pt", 64), ("pt-bsdf", 64), ("light", 65536), ("bdpt", 64)];
 
 #[test]
 fn every_media_integrator_has_a_furnace() {

@@ -240,12 +240,22 @@ fn an_lvc_connection_count_without_n_fails() {
 }
 
 /// The media scenes bdpt's weights are held to the oracle on (built in `media.rs`; no shipped
-/// scene has media yet).
+/// scene has media yet): an area light over a medium behind a null boundary, inside glass, a
+/// heterogeneous grid, and the camera inside a medium under an environment.
 fn media_scenes() -> Vec<(&'static str, lt_core::Scene)> {
     vec![
         ("medium-sphere", crate::media::medium_sphere(false)),
         ("medium-in-glass", crate::media::medium_sphere(true)),
         ("grid-sphere", crate::media::grid_sphere()),
+        // The camera inside the medium, lit from infinity through a null boundary.
+        (
+            "furnace",
+            crate::media::furnace(crate::media::homogeneous(
+                lt_core::Color::new(0.5, 1.0, 2.0),
+                0.8,
+                lt_core::medium::PhaseFunction::henyey_greenstein(0.4).unwrap(),
+            )),
+        ),
     ]
 }
 
