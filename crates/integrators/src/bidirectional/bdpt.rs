@@ -13,6 +13,12 @@
 //! With `light_paths` = M ≠ N, camera sample j pairs with light subpath j mod M, every light
 //! subpath is splatted once, and light tracing's weight carries n_k/n_s = M/N.
 //!
+//! Through participating media (a scene with `has_media`, chosen once per pass: `pass::<true>`)
+//! both subpaths are walked by `subpath::media_walk` (medium vertices where free flights scatter,
+//! null boundaries crossed), every join of (s, t) carries the edge's transmittance estimate, and
+//! the weights read the walks' volume-measure densities with the join's patched densities taking
+//! their free flights (`strategy_weight::with_chain_in::<true>`); never the estimate.
+//!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
 //! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |

@@ -18,8 +18,10 @@
 //! camera sample: `connect::splat_light_subpath`.
 //!
 //! The random numbers are drawn from the pixel's camera stream in this order: film position,
-//! camera walk, then per vertex next-event estimation's three numbers and whatever the policy's
-//! `connect` draws (lvc-bdpt's cache picks). Contributions are summed in technique order, so an
+//! camera walk, then per vertex next-event estimation's three numbers (and, through media, its
+//! shadow ray's transmittance estimate) and whatever the policy's `connect` draws (lvc-bdpt's
+//! cache picks). Through media (`CameraPolicy::MEDIA`) the joins s, t ≥ 2 draw their
+//! transmittance estimates from the pixel's own `Domain::Aux` stream. Contributions are summed in technique order, so an
 //! estimator's image does not depend on which code path formed it.
 
 use crate::film::pixel::{pixel_sample, weighted};
