@@ -17,6 +17,9 @@
 //! 3. Off axis: `light` against `pt` on a corner block of a wide-angle view, where a wrong power
 //!    of cos θ in the camera's importance changes the answer by tens of per cent, and at the
 //!    centre.
+//! 4. Through media: on every media scene (`scenes/media/`), every integrator of
+//!    `registry::HANDLES_MEDIA` (so bdpt joins when it walks media) against `pt` at the scene's
+//!    max_depth, whole images: the media walks have no per-length recorder yet.
 
 use lt_core::camera::{Camera, FilterShape, FovAxis, PixelFilter};
 use lt_core::{Scene, Vec2, Vec3};
@@ -24,7 +27,9 @@ use lt_estimators::agreement::{agreement_t, sidak_threshold, Agreement};
 use lt_estimators::blocks::RunningBlocks;
 use lt_integrators::IntegratorParams;
 use lt_tests::per_length::{render_per_length, PerLength};
-use lt_tests::{render_blocks, shared, shipped_scene, Rendered};
+use lt_tests::{
+    handles_media, render_blocks, shared, shipped_media_scene_names, shipped_scene, Rendered,
+};
 use std::sync::Arc;
 
 /// Family-wise false-alarm rate of every comparison here.
@@ -699,6 +704,124 @@ fn light_agrees_with_pt_off_the_smooth_ball_on_cornell_plastic() {
         println!("{line}");
         if z >= thr {
             failures.push(line);
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+}
+
+/// Media scenes are compared at this resolution (9 blocks of 8×8).
+const MEDIA_RESOLUTION: u32 = 24;
+
+/// Passes per media integrator (the reference `pt` first); one that joins `HANDLES_MEDIA`
+/// without a row here renders `MEDIA_DEFAULT_PASSES`.
+const MEDIA_PASSES: [(&str, u32); 4] = [
+    ("pt", 1024),
+    ("pt-bsdf", 1024),
+    ("light", 512),
+    ("bdpt", 256),
+];
+const MEDIA_DEFAULT_PASSES: u32 = 256;
+
+/// (scene, integrator, reason) pairs on media scenes not compared; reported, never silently.
+const MEDIA_EXCLUDED: &[(&str, &str, &str)] = &[(
+    "media/hg-spot",
+    "pt-bsdf",
+    "the only light is a spot light (a delta in position): BSDF and phase sampling never hit \
+     it, so pt-bsdf's image is exactly black (robustness.rs holds it so)",
+)];
+
+/// (scene, integrator, sphere centre, radius, reason): compared on the blocks that do not see the
+/// sphere only.
+const MEDIA_OFF_SPHERE: &[(&str, &str, Vec3, f32, &str)] = &[(
+    "media/glass-sphere-medium",
+    "light",
+    Vec3::new(0.0, -0.49, 0.0),
+    0.5,
+    "the camera sees the medium only through the smooth glass: E S … paths have no light \
+     tracing technique (the pinhole cannot be joined through a delta surface)",
+)];
+
+fn media_passes(integrator: &str) -> u32 {
+    MEDIA_PASSES
+        .iter()
+        .find(|(i, _)| *i == integrator)
+        .map_or(MEDIA_DEFAULT_PASSES, |(_, p)| *p)
+}
+
+/// Every integrator of `HANDLES_MEDIA` against `pt` on every media scene, each at the scene's
+/// max_depth, per 8×8 block, Šidák over every comparison of the test.
+#[test]
+fn media_integrators_agree_with_pt_on_every_media_scene() {
+    let names = shipped_media_scene_names();
+    let others: Vec<&'static str> = lt_integrators::INTEGRATORS
+        .iter()
+        .map(|i| i.name)
+        .filter(|n| handles_media(n) && *n != "pt")
+        .collect();
+    assert!(!others.is_empty(), "no integrator but pt handles media");
+    let excluded = |scene: &str, integrator: &str| {
+        MEDIA_EXCLUDED
+            .iter()
+            .find(|(s, i, _)| *s == scene && *i == integrator)
+            .map(|(_, _, why)| *why)
+    };
+    let comparisons = names
+        .iter()
+        .flat_map(|n| others.iter().map(move |o| (n, o)))
+        .filter(|(n, o)| excluded(n, o).is_none())
+        .count();
+    let mut failures = Vec::new();
+    for (k, name) in names.iter().enumerate() {
+        let scene = shipped_scene(name, Some((MEDIA_RESOLUTION, MEDIA_RESOLUTION)));
+        let config = |integrator: &'static str, j: u64| Config {
+            label: integrator,
+            integrator,
+            mis: None,
+            passes: media_passes(integrator),
+            seed: 501 + 10 * k as u64 + j,
+        };
+        let (_, reference) = config("pt", 0).render(&scene, None);
+        for (j, other) in others.iter().enumerate() {
+            if let Some(why) = excluded(name, other) {
+                println!("{name} {other}: excluded ({why})");
+                continue;
+            }
+            let (_, blocks) = config(other, 1 + j as u64).render(&scene, None);
+            let a = agreement_t(&blocks, &reference, per_comparison(comparisons));
+            let off_sphere = MEDIA_OFF_SPHERE
+                .iter()
+                .find(|(s, i, ..)| s == name && i == other);
+            let (z, worst, c, threshold, kept) = match off_sphere {
+                Some((_, _, centre, radius, why)) => {
+                    let seen = blocks_seeing_sphere(&scene.camera, *centre, *radius);
+                    let kept: Vec<usize> = (0..seen.len()).filter(|&i| !seen[i]).collect();
+                    println!(
+                        "{name} {other}: {} of {} blocks left out ({why})",
+                        seen.len() - kept.len(),
+                        seen.len()
+                    );
+                    let (z, w, c, t) = over_blocks(&a, &kept, comparisons);
+                    (z, w, c, t, kept.len())
+                }
+                None => (
+                    a.max_abs_z,
+                    a.worst_region,
+                    a.worst_channel,
+                    a.threshold,
+                    a.z.len(),
+                ),
+            };
+            let line = format!(
+                "{name} {other} vs pt over {kept} blocks: max |z| {z:.2} (threshold {threshold:.2}) \
+                 at block {} channel {}, mean ratio there {:.4}",
+                block_name(&a, worst),
+                ["R", "G", "B"][c],
+                blocks.estimate().mean[worst][c] / reference.estimate().mean[worst][c],
+            );
+            println!("{line}");
+            if !(z < threshold) {
+                failures.push(line);
+            }
         }
     }
     assert!(failures.is_empty(), "\n{}", failures.join("\n"));

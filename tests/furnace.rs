@@ -5,14 +5,23 @@
 //! triangle-mesh cube, at small and at extreme scene scales. The walls are both the emitter and
 //! the reflector, so light tracing and BDPT start their light subpaths on the very surfaces they
 //! bounce on (x0 on a wall is splatted too).
+//!
+//! With a ball of medium of albedo 1 inside (any σt, any phase function) the answer is the same:
+//! the uniform field L = Le / (1 − ρ) is in equilibrium with a medium that only scatters (what it
+//! scatters out of a ray it scatters back in), and the walls give Le + ρL = L. Every integrator
+//! of `registry::HANDLES_MEDIA` must reproduce it; every other one must refuse the scene in one
+//! line. The camera stays outside the ball: in a medium around the pinhole, light tracing's
+//! splats from medium vertices grow as 1/d² with no cosine to tame them, an estimator of infinite
+//! variance that no z-test can hold (tests/media.rs checks that case with many passes).
 
-use lt_core::bsdf::{Diffuse, Material};
+use lt_core::bsdf::{Diffuse, Material, Null};
 use lt_core::camera::{Camera, FovAxis};
-use lt_core::scene::{RenderSettings, SceneBuilder, ShapeGeometry, TriangleMesh};
+use lt_core::medium::{Homogeneous, Medium, PhaseFunction};
+use lt_core::scene::{MediumInterface, RenderSettings, SceneBuilder, ShapeGeometry, TriangleMesh};
 use lt_core::{Color, Scene, Vec3};
 use lt_estimators::agreement::agreement_with_reference_t;
 use lt_integrators::{IntegratorParams, INTEGRATORS};
-use lt_tests::render_blocks;
+use lt_tests::{handles_media, media_refusal, render_blocks};
 
 const RHO: f32 = 0.6;
 const LE: f32 = 0.5;
@@ -36,6 +45,13 @@ fn excluded(integrator: &str, case: &str) -> Option<&'static str> {
 }
 
 fn furnace(sphere: bool, scale: f32) -> Scene {
+    furnace_filled(sphere, scale, None)
+}
+
+/// The furnace, with a ball of `medium` (centre (0.45, 0.1, −0.3), radius 0.35, times the
+/// scale; in view, 0.155 from the eye, inside both enclosures) behind a `null` boundary when
+/// given.
+fn furnace_filled(sphere: bool, scale: f32, medium: Option<Medium>) -> Scene {
     let camera = Camera::look_at(
         Vec3::new(0.1, 0.2, 0.05) * scale,
         Vec3::new(0.5, 0.1, -0.3) * scale,
@@ -69,6 +85,19 @@ fn furnace(sphere: bool, scale: f32) -> Scene {
     };
     // Normals flipped to face inwards: that is the side that emits and is seen.
     b.add_shape(geometry, m, Some(Color::splat(LE)), true);
+    if let Some(medium) = medium {
+        let id = b.add_medium(medium);
+        let null = b.add_material(Material::Null(Null));
+        let ball = ShapeGeometry::Sphere {
+            center: Vec3::new(0.45, 0.1, -0.3) * scale,
+            radius: 0.35 * scale,
+        };
+        b.add_shape(ball, null, None, false);
+        b.set_last_shape_media(MediumInterface {
+            interior: Some(id),
+            exterior: None,
+        });
+    }
     b.build()
 }
 
@@ -82,9 +111,19 @@ fn run(
 ) -> Result<String, String> {
     let case = if sphere { "sphere" } else { "cube" };
     let name = format!("{integrator} {case} scale={scale:e}");
-    let scene = furnace(sphere, scale);
+    run_on(&name, &furnace(sphere, scale), integrator, params, passes)
+}
+
+/// Renders furnace `scene` (called `name` in messages) and holds it to Le / (1 − ρ).
+fn run_on(
+    name: &str,
+    scene: &Scene,
+    integrator: &str,
+    params: IntegratorParams,
+    passes: u32,
+) -> Result<String, String> {
     let rendered = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        render_blocks(&scene, integrator, params, passes, 7, 16)
+        render_blocks(scene, integrator, params, passes, 7, 16)
     }));
     let (result, blocks) = rendered.map_err(|e| {
         let msg = e
@@ -191,4 +230,59 @@ fn pt_next_event_only_sphere_furnace() {
         Ok(summary) => println!("{summary}"),
         Err(e) => panic!("{e}"),
     }
+}
+
+/// Passes per media integrator in the medium furnace (light tracing's splats from medium
+/// vertices near the eye are its noisiest; 1024 passes put its standard error near 1 %); one
+/// that joins `HANDLES_MEDIA` without a row here renders 256.
+const MEDIUM_FURNACE_PASSES: [(&str, u32); 3] = [("pt", 64), ("pt-bsdf", 64), ("light", 1024)];
+
+/// The sphere holding a ball of chromatic forward-scattering medium (HG g = 0.7), the cube one of
+/// chromatic isotropic medium, both of albedo 1 and optical radius 0.35–1.4, so many paths
+/// scatter in the ball, some many times. Every scattering counts toward max_depth 64; the ball
+/// fills a few per cent of the enclosure, so a path of 64 vertices has had tens of wall bounces
+/// and the truncated tail (≈ ρ^20 ≈ 4e-5 or less) is far below the standard error.
+#[test]
+fn media_integrators_furnace_with_a_white_medium_ball() {
+    let medium = |sphere: bool| {
+        let (sigma_t, phase) = if sphere {
+            let hg = PhaseFunction::henyey_greenstein(0.7).unwrap();
+            (Color::new(1.0, 2.0, 4.0), hg)
+        } else {
+            (Color::new(4.0, 2.0, 1.0), PhaseFunction::Isotropic)
+        };
+        Medium::Homogeneous(Homogeneous::new(sigma_t, Color::ONE, 1.0, phase).unwrap())
+    };
+    let mut failures = Vec::new();
+    for info in INTEGRATORS {
+        for sphere in [true, false] {
+            let case = if sphere {
+                "sphere, HG 0.7"
+            } else {
+                "cube, isotropic"
+            };
+            let name = format!("{} {case} medium furnace", info.name);
+            let scene = furnace_filled(sphere, 1.0, Some(medium(sphere)));
+            if !handles_media(info.name) {
+                let refusal = media_refusal(info.name, &scene, &name);
+                println!("{name}: refused ({refusal})");
+                continue;
+            }
+            let passes = MEDIUM_FURNACE_PASSES
+                .iter()
+                .find(|(i, _)| *i == info.name)
+                .map_or(256, |(_, p)| *p);
+            match run_on(
+                &name,
+                &scene,
+                info.name,
+                IntegratorParams::default(),
+                passes,
+            ) {
+                Ok(summary) => println!("{summary}"),
+                Err(e) => failures.push(e),
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -1,9 +1,14 @@
 //! Every registered integrator (`lt_integrators::INTEGRATORS`, so a new one is covered with no new
 //! test code) renders every shipped scene without NaN, infinite or negative pixels and without
-//! invalid samples, and gives the same image bit for bit with one thread or two.
+//! invalid samples, and gives the same image bit for bit with one thread or two. On the media
+//! scenes (`scenes/media/`) the integrators of `registry::HANDLES_MEDIA` render and every other
+//! one is held to its one-line refusal.
 
+use lt_core::Scene;
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions, INTEGRATORS};
-use lt_tests::{shipped_scene, shipped_scene_names};
+use lt_tests::{
+    handles_media, media_refusal, shipped_media_scene_names, shipped_scene, shipped_scene_names,
+};
 use std::ops::ControlFlow;
 
 /// Why an integrator's image of a scene may legitimately be black at this test's sample count.
@@ -69,6 +74,12 @@ const BLACK: &[(&str, &str, Black, &str)] = &[
          never hits",
     ),
     (
+        "pt-bsdf",
+        "media/hg-spot",
+        Black::Exact,
+        "its only light is a spot light, a delta in position no BSDF or phase sample hits",
+    ),
+    (
         "light",
         "caustic-sds",
         Black::Exact,
@@ -118,28 +129,63 @@ fn every_integrator_gives_finite_non_negative_pixels_on_every_shipped_scene() {
                 );
                 continue;
             }
-            let (result, _) =
-                lt_tests::render_blocks(&scene, info.name, IntegratorParams::default(), 16, 3, 32);
-            let who = format!("{} on {name}", info.name);
-            assert_eq!(
-                result.invalid_samples, 0,
-                "{who}: integrator produced invalid samples"
-            );
-            let mean = &result.estimate;
-            assert!(
-                mean.data
-                    .iter()
-                    .flatten()
-                    .all(|v| v.is_finite() && *v >= 0.0),
-                "{who}: invalid pixel"
-            );
-            let lit = mean.data.iter().flatten().any(|v| *v > 0.0);
-            match black(info.name, name) {
-                None => assert!(lit, "{who}: image is black"),
-                Some((Black::Exact, why)) => {
-                    assert!(!lit, "{who}: expected black ({why}), found light")
-                }
-                Some((Black::Likely, why)) => println!("{who}: black allowed ({why}); lit: {lit}"),
+            finite_non_negative_and_lit(&scene, name, info.name, 16);
+        }
+    }
+}
+
+/// `integrator` renders `passes` passes of `scene` (named `name`) with no invalid sample, no NaN,
+/// infinite or negative pixel, and lit unless `BLACK` says otherwise.
+fn finite_non_negative_and_lit(scene: &Scene, name: &str, integrator: &str, passes: u32) {
+    let (result, _) = lt_tests::render_blocks(
+        scene,
+        integrator,
+        IntegratorParams::default(),
+        passes,
+        3,
+        32,
+    );
+    let who = format!("{integrator} on {name}");
+    assert_eq!(
+        result.invalid_samples, 0,
+        "{who}: integrator produced invalid samples"
+    );
+    let mean = &result.estimate;
+    assert!(
+        mean.data
+            .iter()
+            .flatten()
+            .all(|v| v.is_finite() && *v >= 0.0),
+        "{who}: invalid pixel"
+    );
+    let lit = mean.data.iter().flatten().any(|v| *v > 0.0);
+    match black(integrator, name) {
+        None => assert!(lit, "{who}: image is black"),
+        Some((Black::Exact, why)) => {
+            assert!(!lit, "{who}: expected black ({why}), found light")
+        }
+        Some((Black::Likely, why)) => println!("{who}: black allowed ({why}); lit: {lit}"),
+    }
+}
+
+/// The media scenes at 24², 8 passes: every integrator of `HANDLES_MEDIA` as above, every other
+/// one refuses in one line (checked, and said, never skipped silently).
+#[test]
+fn media_integrators_give_finite_non_negative_pixels_on_every_media_scene() {
+    let names = shipped_media_scene_names();
+    assert!(
+        names.len() >= 5,
+        "expected the five media scenes, found {names:?}"
+    );
+    for name in &names {
+        let scene = shipped_scene(name, Some((24, 24)));
+        assert!(scene.has_media, "{name}: a media scene without media");
+        for info in INTEGRATORS {
+            if handles_media(info.name) {
+                finite_non_negative_and_lit(&scene, name, info.name, 8);
+            } else {
+                let refusal = media_refusal(info.name, &scene, name);
+                println!("{} on {name}: refused ({refusal})", info.name);
             }
         }
     }
@@ -154,30 +200,51 @@ fn same_seed_gives_identical_images_for_one_and_two_threads() {
             "cornell-glass-light",
             "cornell-rough-glass",
         ] {
-            let who = format!("{} on {name}", info.name);
             let scene = shipped_scene(name, Some((32, 32)));
-            let integ = make_integrator(info.name, &scene, &IntegratorParams::default()).unwrap();
-            let run = |threads, seed| {
-                let opts = RenderOptions {
-                    passes: 4,
-                    time_limit: None,
-                    seed,
-                    threads,
-                };
-                render(&scene, &integ, &opts, |_| ControlFlow::Continue(()))
-                    .unwrap()
-                    .estimate
-            };
-            let one = run(1, 99);
-            let two = run(2, 99);
-            let same = one
-                .data
-                .iter()
-                .flatten()
-                .zip(two.data.iter().flatten())
-                .all(|(a, b)| a.to_bits() == b.to_bits());
-            assert!(same, "{who}: images differ between 1 and 2 threads");
-            assert_ne!(one, run(2, 100), "{who}: the seed must matter");
+            same_bits_at_one_and_two_threads(&scene, name, info.name, 4);
         }
+    }
+}
+
+/// Every integrator of `HANDLES_MEDIA` on every media scene (24², 2 passes); the others refuse
+/// them (`media_integrators_give_finite_non_negative_pixels_on_every_media_scene` checks how).
+#[test]
+fn same_seed_gives_identical_images_for_one_and_two_threads_on_media_scenes() {
+    for name in &shipped_media_scene_names() {
+        let scene = shipped_scene(name, Some((24, 24)));
+        for info in INTEGRATORS.iter().filter(|i| handles_media(i.name)) {
+            same_bits_at_one_and_two_threads(&scene, name, info.name, 2);
+        }
+    }
+}
+
+/// `integrator`'s image of `scene` after `passes` passes is the same bit for bit at 1 and 2
+/// threads, and another seed changes it.
+fn same_bits_at_one_and_two_threads(scene: &Scene, name: &str, integrator: &str, passes: u32) {
+    let who = format!("{integrator} on {name}");
+    let integ = make_integrator(integrator, scene, &IntegratorParams::default()).unwrap();
+    let run = |threads, seed| {
+        let opts = RenderOptions {
+            passes,
+            time_limit: None,
+            seed,
+            threads,
+        };
+        render(scene, &integ, &opts, |_| ControlFlow::Continue(()))
+            .unwrap()
+            .estimate
+    };
+    let one = run(1, 99);
+    let two = run(2, 99);
+    let same = one
+        .data
+        .iter()
+        .flatten()
+        .zip(two.data.iter().flatten())
+        .all(|(a, b)| a.to_bits() == b.to_bits());
+    assert!(same, "{who}: images differ between 1 and 2 threads");
+    // A black image (`BLACK`) is black under every seed.
+    if black(integrator, name).is_none() {
+        assert_ne!(one, run(2, 100), "{who}: the seed must matter");
     }
 }

@@ -19,10 +19,19 @@ pub fn scenes_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes")
 }
 
-/// Loads `scenes/NAME.toml`, optionally at a smaller resolution.
+/// The file of shipped scene `name`: `scenes/NAME.toml`, or `scenes/NAME.xml` for the media
+/// scenes (`media/…`, Mitsuba XML: TOML has no media yet).
+pub fn shipped_scene_path(name: &str) -> PathBuf {
+    let toml = scenes_dir().join(format!("{name}.toml"));
+    if toml.exists() {
+        return toml;
+    }
+    scenes_dir().join(format!("{name}.xml"))
+}
+
+/// Loads shipped scene `name` (`shipped_scene_path`), optionally at a smaller resolution.
 pub fn shipped_scene(name: &str, resolution: Option<(u32, u32)>) -> Scene {
-    let mut scene =
-        load_scene(&scenes_dir().join(format!("{name}.toml"))).unwrap_or_else(|e| panic!("{e}"));
+    let mut scene = load_scene(&shipped_scene_path(name)).unwrap_or_else(|e| panic!("{e}"));
     if let Some((w, h)) = resolution {
         scene.camera = scene.camera.with_resolution(w, h);
     }
@@ -49,7 +58,9 @@ pub fn shared<T: Send + Sync + 'static>(key: &str, make: impl FnOnce() -> T) -> 
         .unwrap_or_else(|_| panic!("shared value '{key}' asked for with another type"))
 }
 
-/// Every shipped scene's name.
+/// Every shipped scene without media: the `scenes/*.toml` files' names. The media scenes are
+/// [`shipped_media_scene_names`], kept apart because only `registry::HANDLES_MEDIA` renders them:
+/// a loop over these names may build any integrator on any of them.
 pub fn shipped_scene_names() -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(scenes_dir())
         .expect("scenes/ exists")
@@ -63,6 +74,44 @@ pub fn shipped_scene_names() -> Vec<String> {
         .collect();
     names.sort();
     names
+}
+
+/// Every shipped scene with participating media: `media/NAME` for each `scenes/media/NAME.xml`,
+/// sorted. Loops over them render with the integrators of `registry::HANDLES_MEDIA` and hold
+/// every other integrator to its refusal ([`media_refusal`]).
+pub fn shipped_media_scene_names() -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(scenes_dir().join("media"))
+        .expect("scenes/media/ exists")
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            e.file_name()
+                .to_str()
+                .and_then(|n| n.strip_suffix(".xml"))
+                .map(|n| format!("media/{n}"))
+        })
+        .collect();
+    names.sort();
+    names
+}
+
+/// Whether `integrator` renders scenes with media (`registry::HANDLES_MEDIA`).
+pub fn handles_media(integrator: &str) -> bool {
+    lt_integrators::registry::HANDLES_MEDIA.contains(&integrator)
+}
+
+/// For an integrator outside `HANDLES_MEDIA`, checks that it refuses `scene` (which has media) in
+/// one line naming itself and participating media, and returns that line; panics if it builds
+/// or says anything else (tests/media.rs holds the exact wording).
+pub fn media_refusal(integrator: &str, scene: &Scene, scene_name: &str) -> String {
+    let made = make_integrator(integrator, scene, &IntegratorParams::default());
+    let Err(e) = made else {
+        panic!("{integrator} on {scene_name}: built for a scene with media, outside HANDLES_MEDIA");
+    };
+    assert!(
+        !e.contains('\n') && e.contains(integrator) && e.contains("participating media"),
+        "{integrator} on {scene_name}: not a one-line media refusal: {e}"
+    );
+    e
 }
 
 /// Independent runs a consistent estimator's block statistics are taken over (its passes are

@@ -61,33 +61,54 @@ pub struct Scale {
 
 pub const ALL_ALPHAS: [f64; 6] = [0.3, 0.5, 2.0 / 3.0, 0.75, 0.9, 1.0];
 
-/// The shipped scenes (every `.toml` in the folder), sorted by name.
+/// The shipped scenes, sorted by name: every `.toml` in the folder, then the media scenes (every
+/// `.xml` in its `media/` subfolder, Mitsuba XML: TOML has no media yet).
 pub fn shipped_scenes(dir: &Path) -> Result<Vec<PathBuf>, String> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| format!("cannot list the scenes in {}: {e}", dir.display()))?
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    v.sort();
+    let mut v = files_with_extension(dir, "toml")?;
     if v.is_empty() {
         return Err(format!("{} holds no .toml scenes", dir.display()));
+    }
+    let media = dir.join("media");
+    if media.is_dir() {
+        v.extend(files_with_extension(&media, "xml")?);
     }
     Ok(v)
 }
 
+fn files_with_extension(dir: &Path, ext: &str) -> Result<Vec<PathBuf>, String> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| format!("cannot list the scenes in {}: {e}", dir.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == ext))
+        .collect();
+    v.sort();
+    Ok(v)
+}
+
 /// The scenes every registered integrator accepts. A scene one of them refuses — `point-plane`'s
-/// orthographic camera, which light tracing, bpm and vcm cannot connect to — belongs to the study
-/// written for it (radius-shrinkage-plane), not to the comparisons of every estimator. A scene
-/// that does not load stays: its render reports the file, place and problem.
+/// orthographic camera, which light tracing, bpm and vcm cannot connect to; the media scenes,
+/// which only `registry::HANDLES_MEDIA` renders — belongs to the study written for it
+/// (radius-shrinkage-plane; the media tests), not to the comparisons of every estimator; each
+/// is named on stderr with the first refusal. A scene that does not load stays: its render
+/// reports the file, place and problem.
 fn every_integrator_renders(scenes: Vec<PathBuf>) -> Vec<PathBuf> {
     let params = lt_integrators::IntegratorParams::new();
     scenes
         .into_iter()
         .filter(|p| match lt_scene_io::load_scene(p) {
-            Ok(scene) => lt_integrators::INTEGRATORS
-                .iter()
-                .all(|i| lt_integrators::make_integrator(i.name, &scene, &params).is_ok()),
+            Ok(scene) => {
+                let refusal = lt_integrators::INTEGRATORS
+                    .iter()
+                    .find_map(|i| lt_integrators::make_integrator(i.name, &scene, &params).err());
+                if let Some(why) = &refusal {
+                    eprintln!(
+                        "note: {} is left out of the studies that compare every integrator: {why}",
+                        p.display()
+                    );
+                }
+                refusal.is_none()
+            }
             Err(_) => true,
         })
         .collect()
