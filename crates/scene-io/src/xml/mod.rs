@@ -19,6 +19,7 @@
 pub(crate) mod build;
 mod cie_table;
 pub(crate) mod doc;
+mod print;
 mod props;
 pub(crate) mod resolve;
 mod spectrum;
