@@ -1,11 +1,10 @@
 //! The TOML scene format (docs/scene-format.md): text → `SceneFile` (`schema`, serde's view of
 //! the file) → `Scene` (`assemble` here). Materials and media go through the plugin tree the
-//! XML reader builds from (`tree`: TOML's keys renamed, then `xml/build`); the camera, shapes
-//! and lights are still built here, one file per table (`camera`, `shape`, `light`, with
-//! `texture` for their textures).
+//! XML reader builds from (`tree`: TOML's keys renamed, then `xml/build`), and so do the
+//! lights; the camera and shapes are still built here (`camera`, `shape`, with `texture` for an
+//! emitting shape's texture).
 
 mod camera;
-mod light;
 pub(crate) mod schema;
 mod shape;
 pub(crate) mod texture;
@@ -16,7 +15,6 @@ use crate::world::WorldBuilder;
 use crate::SceneError;
 use camera::{camera, render};
 use glam::DVec3;
-use light::{light, Placed};
 use lt_core::medium::MediumId;
 use lt_core::Scene;
 use schema::SceneFile;
@@ -104,6 +102,13 @@ fn assemble(
     for (name, def) in media {
         plugins.push(tree::medium(ctx, name, def)?);
     }
+    let media_names: HashMap<String, MediumId> =
+        file.media.keys().map(|k| (k.clone(), 0)).collect();
+    for def in &file.lights {
+        // The name checked here, in TOML's words, before the tree refers to it by id.
+        medium_named(ctx, &def.get_ref().medium, &media_names)?;
+        plugins.push(tree::with_medium(tree::light(ctx, def)?, def.get_ref()));
+    }
     let doc = tree::document(path, ctx.text, plugins);
     let defined = crate::xml::build::define(&doc, &mut b)?;
     let ids: HashMap<&str, u32> = defined
@@ -112,19 +117,9 @@ fn assemble(
         .map(|(k, &v)| (k.as_str(), v))
         .collect();
     let media = |name: &Option<schema::S<String>>| medium_named(ctx, name, &defined.media);
-    let mut emitters = 0;
+    let mut emitters = defined.emitters;
     for def in &file.shapes {
         emitters += shape(ctx, def, &ids, &defined.media, &mut b)? as usize;
-    }
-    for def in &file.lights {
-        let medium = media(&def.get_ref().medium)?;
-        match light(ctx, def)? {
-            Some(Placed::At(position, l)) => b.add_light_at(l, position),
-            Some(Placed::Anywhere(l)) => b.add_light(l),
-            None => continue,
-        }
-        b.set_last_light_medium(medium);
-        emitters += 1;
     }
     if emitters == 0 {
         return Err(ctx.whole(

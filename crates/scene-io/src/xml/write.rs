@@ -1,10 +1,12 @@
 //! One of our TOML scenes as Mitsuba 3 XML (`lt convert`), wherever Mitsuba can express it: the
 //! scene is loaded (so everything is checked as for rendering), then written from its file's own
-//! description — rectangles and cubes as `rectangle`/`cube` with the exact f32 `to_world` the
-//! loader built, meshes as `obj` files referenced relative to the output, spheres as `sphere`.
-//! Our materials reflect alike on both sides, so the one-sided Mitsuba BSDFs are wrapped in
-//! `twosided`. Numbers are written as the shortest decimal that reads back to the same f32, so
-//! toml → xml → load gives the same scene bit for bit.
+//! description. Materials, media, lights and textures are printed from the plugin tree the
+//! loader builds them from (`toml_scene::tree`, `print`), so this file knows none of their
+//! parameters; the integrator, the sensor and the shapes are written here — rectangles and cubes
+//! as `rectangle`/`cube` with the exact `to_world` the loader built, meshes as `obj` files
+//! referenced relative to the output, spheres as `sphere`. Numbers are written as the shortest
+//! decimal that reads back to the same value, so toml → xml → load gives the same scene bit for
+//! bit.
 //!
 //! Refused: the `sun` light (Mitsuba 3 has no distant light of finite solid angle; a
 //! directional light or an environment map would change the image, so nothing is approximated).
@@ -12,7 +14,7 @@
 use super::doc::Elem;
 use super::print::{escape, map_filenames, print};
 use crate::error::Ctx;
-use crate::toml_scene::schema::{ColorDef, SceneFile, ShapeDef, TextureDef, S};
+use crate::toml_scene::schema::{SceneFile, ShapeDef, TextureDef, S};
 use crate::toml_scene::tree;
 use crate::transform::shape_matrix;
 use crate::SceneError;
@@ -175,161 +177,10 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
         let d = def.get_ref();
         x.push_str(&shape(&ctx, d, out_dir, &v)?);
     }
+    // Lights printed from the tree the loader builds them from (a sun was refused above).
     for l in &file.lights {
-        let d = l.get_ref();
-        let start = x.len();
-        let col = |c: &Option<toml::Spanned<ColorDef>>| {
-            c.as_ref().map(|c| c.get_ref().0).unwrap_or([0.0; 3])
-        };
-        let zero = |c: [f64; 3]| c.iter().all(|&x| x as f32 == 0.0);
-        match d.kind.get_ref().as_str() {
-            "point" => {
-                let i = col(&d.intensity);
-                if zero(i) {
-                    continue;
-                }
-                let p = d
-                    .position
-                    .as_ref()
-                    .map(|p| *p.get_ref())
-                    .unwrap_or_default();
-                let _ = writeln!(
-                    x,
-                    "    <emitter type=\"point\">\n        <point name=\"position\" value=\"{}\"/>\n        <rgb name=\"intensity\" value=\"{}\"/>\n    </emitter>",
-                    v(&p),
-                    v(&i)
-                );
-            }
-            "directional" => {
-                let e = col(&d.irradiance);
-                if zero(e) {
-                    continue;
-                }
-                // Ours points towards the light, Mitsuba's along the light's travel: the f32
-                // direction as the TOML gives it, negated (exact; both loaders normalise it).
-                let dir = d
-                    .direction
-                    .as_ref()
-                    .map(|p| *p.get_ref())
-                    .unwrap_or_default();
-                let u = glam::Vec3::from_array(dir.map(|x| x as f32));
-                let _ = writeln!(
-                    x,
-                    "    <emitter type=\"directional\">\n        <vector name=\"direction\" value=\"{}, {}, {}\"/>\n        <rgb name=\"irradiance\" value=\"{}\"/>\n    </emitter>",
-                    -u.x,
-                    -u.y,
-                    -u.z,
-                    v(&e)
-                );
-            }
-            "envmap" => {
-                let file = d
-                    .file
-                    .as_ref()
-                    .map(|f| f.get_ref().as_str())
-                    .unwrap_or_default();
-                let rel = relative(&ctx.base_dir.join(file), out_dir);
-                let _ = write!(
-                    x,
-                    "    <emitter type=\"envmap\">\n        <string name=\"filename\" value=\"{}\"/>\n        <float name=\"scale\" value=\"{}\"/>\n",
-                    esc(&rel.to_string_lossy()),
-                    d.scale.as_ref().map_or(1.0, |s| *s.get_ref() as f32)
-                );
-                if let Some(r) = &d.rotate {
-                    let (a, deg) = (r.get_ref().axis, r.get_ref().angle);
-                    let _ = writeln!(
-                        x,
-                        "        <transform name=\"to_world\">\n            <rotate x=\"{}\" y=\"{}\" z=\"{}\" angle=\"{deg}\"/>\n        </transform>",
-                        a[0], a[1], a[2]
-                    );
-                }
-                let _ = writeln!(x, "    </emitter>");
-            }
-            "spot" | "projector" => {
-                let spot = d.kind.get_ref() == "spot";
-                let get = |p: &Option<toml::Spanned<[f64; 3]>>| {
-                    p.as_ref().map(|p| *p.get_ref()).unwrap_or_default()
-                };
-                let (o, t) = (get(&d.position), get(&d.target));
-                // The loader's default `up`, written out so that Mitsuba builds the same frame.
-                let up = d.up.as_ref().map(|u| *u.get_ref()).unwrap_or_else(|| {
-                    let dir = glam::DVec3::from_array(t) - glam::DVec3::from_array(o);
-                    crate::transform::default_up(dir).to_array()
-                });
-                let _ = writeln!(
-                    x,
-                    "    <emitter type=\"{}\">\n        <transform name=\"to_world\">\n            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>\n        </transform>",
-                    d.kind.get_ref(),
-                    v(&o),
-                    v(&t),
-                    v(&up)
-                );
-                if spot {
-                    let cutoff = d
-                        .cutoff_angle
-                        .as_ref()
-                        .map_or(20.0, |c| *c.get_ref() as f32);
-                    let beam = d
-                        .beam_width
-                        .as_ref()
-                        .map_or(0.75 * cutoff, |b| *b.get_ref() as f32);
-                    let _ = writeln!(
-                        x,
-                        "        <rgb name=\"intensity\" value=\"{}\"/>\n        <float name=\"cutoff_angle\" value=\"{cutoff}\"/>\n        <float name=\"beam_width\" value=\"{beam}\"/>",
-                        v(&col(&d.intensity))
-                    );
-                    if let Some(tex) = &d.texture {
-                        x.push_str(&texture_xml(&ctx, tex, "texture", out_dir, 2)?);
-                    }
-                } else {
-                    let _ = writeln!(
-                        x,
-                        "        <float name=\"fov\" value=\"{}\"/>\n        <float name=\"scale\" value=\"{}\"/>",
-                        d.fov.as_ref().map_or(0.0, |f| *f.get_ref()),
-                        d.scale.as_ref().map_or(1.0, |s| *s.get_ref() as f32)
-                    );
-                    match &d.texture {
-                        Some(tex) => x.push_str(&texture_xml(&ctx, tex, "irradiance", out_dir, 2)?),
-                        None => {
-                            let _ = writeln!(
-                                x,
-                                "        <rgb name=\"irradiance\" value=\"{}\"/>",
-                                v(&col(&d.irradiance))
-                            );
-                        }
-                    }
-                }
-                let _ = writeln!(x, "    </emitter>");
-            }
-            "environment" => {
-                let r = col(&d.radiance);
-                if zero(r) {
-                    continue;
-                }
-                let _ = writeln!(
-                    x,
-                    "    <emitter type=\"constant\">\n        <rgb name=\"radiance\" value=\"{}\"/>\n    </emitter>",
-                    v(&r)
-                );
-            }
-            other => {
-                return Err(ctx.at(
-                    d.kind.span(),
-                    format!("light type `{other}` has no Mitsuba counterpart"),
-                ))
-            }
-        }
-        // The light's medium, inside the emitter just written (if one was).
-        if let (Some(m), true) = (&d.medium, x.len() > start) {
-            let close = x.rfind("    </emitter>").expect("an emitter was written");
-            let r = printed(
-                &ctx,
-                tree::reference("medium", m.get_ref(), m.span()),
-                2,
-                out_dir,
-            );
-            x.insert_str(close, &r);
-        }
+        let e = tree::with_medium(tree::light(&ctx, l)?, l.get_ref());
+        x.push_str(&printed(&ctx, e, 1, out_dir));
     }
     x.push_str("</scene>\n");
     Ok(x)

@@ -8,10 +8,12 @@
 //! Each element's `range` is the byte span of the TOML value it comes from (of the table for a
 //! plugin), and `src` is 0, the TOML file: a builder's error names the TOML line.
 
+mod light;
 mod material;
 mod medium;
 mod texture;
 
+pub(crate) use light::{light, with_medium};
 pub(crate) use material::material;
 pub(crate) use medium::medium;
 pub(crate) use texture::texture;

@@ -176,10 +176,12 @@ pub(crate) struct Defined {
     pub materials: HashMap<String, u32>,
     pub media: HashMap<String, MediumId>,
     pub files: Vec<PathBuf>,
+    /// Emitters that emit (those that emit nothing are dropped, as in an XML scene).
+    pub emitters: usize,
 }
 
-/// Builds the top-level `<bsdf>` and `<medium>` elements of `doc` into `b`, in document order,
-/// with the builders an XML scene's go through.
+/// Builds the top-level `<bsdf>`, `<medium>` and `<emitter>` elements of `doc` into `b`, in
+/// document order, with the builders an XML scene's go through.
 pub(crate) fn define(doc: &Doc, b: &mut WorldBuilder) -> Result<Defined, SceneError> {
     let mut ids = Ids::new();
     collect_ids(doc, &doc.root, &mut ids)?;
@@ -209,6 +211,15 @@ pub(crate) fn define(doc: &Doc, b: &mut WorldBuilder) -> Result<Defined, SceneEr
             "medium" => {
                 let m = l.medium(c)?;
                 out.media.insert(id, m);
+            }
+            "emitter" => {
+                match l.emitter(c)? {
+                    Some((desc, Some(position))) => b.add_light_at(desc, position),
+                    Some((desc, None)) => b.add_light(desc),
+                    None => continue,
+                }
+                b.set_last_light_medium(l.emitter_medium.take());
+                out.emitters += 1;
             }
             _ => {}
         }
