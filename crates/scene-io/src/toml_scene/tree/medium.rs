@@ -1,7 +1,8 @@
 //! A TOML `[media.NAME]` table as a `<medium id=NAME>`: the keys are Mitsuba's, except that a
 //! grid is `sigma_t_volume` / `albedo_volume` (a `<volume type="gridvolume" name=…>`, whose
 //! `file` is its `filename` and `wrap` its `wrap_mode`) and the phase function is a `phase`
-//! table. Values are checked by the medium's builder (`xml/build/medium.rs`), at the TOML line.
+//! table. A new medium type needs nothing here. Values are checked by the medium's builder
+//! (`xml/build/medium.rs`), at the TOML line.
 
 use super::texture::color;
 use super::{boolean, float, matrix, plugin, string};
@@ -14,41 +15,18 @@ use crate::SceneError;
 pub(crate) fn medium(ctx: &Ctx, name: &str, def: &S<MediumDef>) -> Result<Elem, SceneError> {
     let d = def.get_ref();
     let kind = d.kind.get_ref().as_str();
-    let what = format!("medium `{name}` of type {kind}");
-    let given = [
-        ("sigma_t", d.sigma_t.as_ref().map(S::span)),
-        ("albedo", d.albedo.as_ref().map(S::span)),
-        ("sigma_a", d.sigma_a.as_ref().map(S::span)),
-        ("sigma_s", d.sigma_s.as_ref().map(S::span)),
-        ("scale", d.scale.as_ref().map(S::span)),
-        ("sigma_t_volume", d.sigma_t_volume.as_ref().map(S::span)),
-        ("albedo_volume", d.albedo_volume.as_ref().map(S::span)),
-        ("phase", d.phase.as_ref().map(S::span)),
-    ];
-    match kind {
-        "homogeneous" => ctx.only(
-            &given,
-            &["sigma_t", "albedo", "sigma_a", "sigma_s", "scale", "phase"],
-            &what,
-        )?,
-        "heterogeneous" => ctx.only(
-            &given,
-            &[
-                "sigma_t",
-                "albedo",
-                "sigma_t_volume",
-                "albedo_volume",
-                "scale",
-                "phase",
-            ],
-            &what,
-        )?,
-        other => {
-            return Err(ctx.at(
-                d.kind.span(),
-                format!("unknown medium type `{other}` (expected homogeneous or heterogeneous)"),
-            ))
-        }
+    // The types are the builder's (`xml/build/medium.rs`); so are the keys a type takes: one it
+    // does not take is refused there, at its TOML line, in the same (Mitsuba's) words.
+    let types = crate::xml::build::MEDIA;
+    if !types.contains(&kind) {
+        let (last, rest) = types.split_last().expect("MEDIA is not empty");
+        return Err(ctx.at(
+            d.kind.span(),
+            format!(
+                "unknown medium type `{kind}` (expected {} or {last})",
+                rest.join(", ")
+            ),
+        ));
     }
     let mut m = plugin("medium", kind, def.span());
     m.attrs.push(("id".into(), name.into()));

@@ -19,7 +19,7 @@ use lt_core::scene::MediumInterface;
 use std::collections::HashMap;
 use std::sync::Arc;
 
-pub(super) const MEDIA: [&str; 2] = ["homogeneous", "heterogeneous"];
+pub(crate) const MEDIA: [&str; 2] = ["homogeneous", "heterogeneous"];
 pub(super) const PHASES: [&str; 2] = ["isotropic", "hg"];
 pub(super) const VOLUMES: [&str; 2] = ["gridvolume", "constvolume"];
 

@@ -22,7 +22,7 @@ mod shape;
 mod texture;
 
 pub use integrator::UNBOUNDED_DEPTH_SUBSTITUTE;
-pub(crate) use medium::open_surface;
+pub(crate) use medium::{open_surface, MEDIA};
 
 pub(super) struct Loader<'a> {
     doc: &'a Doc,
