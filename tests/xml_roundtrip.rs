@@ -216,6 +216,7 @@ const MEDIA_XML: &str = r#"<scene version="3.0.0">
         <string name="fov_axis" value="x"/>
         <transform name="to_world"><lookat origin="0, 1, 4" target="0, 1, 0" up="0, 1, 0"/></transform>
         <ref name="medium" id="fog"/>
+        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
         <film type="hdrfilm">
             <integer name="width" value="32"/>
             <integer name="height" value="24"/>
