@@ -115,3 +115,166 @@ fn xml_every_expressible_shipped_scene_round_trips() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// A `.vol` grid: header (version 3, f32), resolution, channels, unit bounding box, values.
+fn vol_bytes(res: [i32; 3], values: &[f32]) -> Vec<u8> {
+    let mut b = b"VOL\x03".to_vec();
+    for v in [1, res[0], res[1], res[2], 1] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in values {
+        b.extend(v.to_le_bytes());
+    }
+    b
+}
+
+/// Media in TOML (`[media]`, shapes' interior/exterior, the camera's and a light's medium, a
+/// `null` material, a grid, an HG phase) build the same scene as the same media written by hand
+/// in Mitsuba XML, and as the XML `lt convert` writes from the TOML.
+const MEDIA_TOML: &str = r#"
+[camera]
+eye = [0.0, 1.0, 4.0]
+target = [0.0, 1.0, 0.0]
+fov = 40.0
+resolution = [32, 24]
+medium = "fog"
+
+[render]
+max_depth = 6
+
+[materials.white]
+type = "diffuse"
+albedo = 0.7
+
+[materials.boundary]
+type = "null"
+
+[media.fog]
+type = "homogeneous"
+sigma_a = [0.01, 0.02, 0.03]
+sigma_s = 0.05
+phase = { type = "isotropic" }
+
+[media.smoke]
+type = "heterogeneous"
+sigma_t_volume = { file = "density.vol", to_world = [[2.0, 0.0, 0.0, -1.0], [0.0, 2.0, 0.0, 0.0], [0.0, 0.0, 2.0, -1.0], [0.0, 0.0, 0.0, 1.0]] }
+albedo = [0.9, 0.8, 0.7]
+scale = 3.0
+phase = { type = "hg", g = 0.7 }
+
+[[shapes]]
+type = "quad"
+material = "white"
+to_world = [[4.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, -4.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
+exterior = "fog"
+
+[[shapes]]
+type = "sphere"
+center = [0.0, 1.0, 0.0]
+radius = 0.75
+material = "boundary"
+interior = "smoke"
+exterior = "fog"
+
+[[lights]]
+type = "point"
+position = [0.0, 3.0, 1.0]
+intensity = 10.0
+medium = "fog"
+"#;
+
+const MEDIA_XML: &str = r#"<scene version="3.0.0">
+    <integrator type="volpath">
+        <integer name="max_depth" value="6"/>
+    </integrator>
+    <bsdf type="twosided" id="white">
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf>
+    </bsdf>
+    <bsdf type="null" id="boundary"/>
+    <medium type="homogeneous" id="fog">
+        <rgb name="sigma_a" value="0.01, 0.02, 0.03"/>
+        <rgb name="sigma_s" value="0.05"/>
+        <phase type="isotropic"/>
+    </medium>
+    <medium type="heterogeneous" id="smoke">
+        <volume type="gridvolume" name="sigma_t">
+            <string name="filename" value="density.vol"/>
+            <transform name="to_world">
+                <scale value="2"/>
+                <translate x="-1" y="0" z="-1"/>
+            </transform>
+        </volume>
+        <rgb name="albedo" value="0.9, 0.8, 0.7"/>
+        <float name="scale" value="3"/>
+        <phase type="hg"><float name="g" value="0.7"/></phase>
+    </medium>
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <string name="fov_axis" value="x"/>
+        <transform name="to_world"><lookat origin="0, 1, 4" target="0, 1, 0" up="0, 1, 0"/></transform>
+        <ref name="medium" id="fog"/>
+        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="32"/>
+            <integer name="height" value="24"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <matrix value="4 0 0 0  0 0 1 0  0 -4 0 0  0 0 0 1"/>
+        </transform>
+        <ref id="white"/>
+        <ref name="exterior" id="fog"/>
+    </shape>
+    <shape type="sphere">
+        <point name="center" value="0, 1, 0"/>
+        <float name="radius" value="0.75"/>
+        <ref id="boundary"/>
+        <ref name="interior" id="smoke"/>
+        <ref name="exterior" id="fog"/>
+    </shape>
+    <emitter type="point">
+        <point name="position" value="0, 3, 1"/>
+        <rgb name="intensity" value="10"/>
+        <ref name="medium" id="fog"/>
+    </emitter>
+</scene>
+"#;
+
+#[test]
+fn xml_toml_media_scene_builds_as_its_xml_twin() {
+    let dir = std::env::temp_dir().join(format!("lt-toml-media-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let density: Vec<f32> = (0..27).map(|i| 0.1 + 0.05 * i as f32).collect();
+    std::fs::write(dir.join("density.vol"), vol_bytes([3, 3, 3], &density)).unwrap();
+    let toml = dir.join("media.toml");
+    std::fs::write(&toml, MEDIA_TOML).unwrap();
+    let twin = dir.join("media.xml");
+    std::fs::write(&twin, MEDIA_XML).unwrap();
+    let converted = dir.join("converted.xml");
+    lt_experiments::commands::convert::run(&lt_experiments::commands::convert::ConvertArgs {
+        scene: toml.clone(),
+        output: converted.clone(),
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    let a = load_scene(&toml).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(a.media.len(), 2);
+    assert!(a.camera_medium.is_some() && a.light_media == [a.camera_medium]);
+    for (what, xml) in [("the XML twin", &twin), ("the converted XML", &converted)] {
+        let (b, _) =
+            load_scene_with(xml, &LoadOptions::default()).unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert_same(what, &a, &b);
+        assert_eq!(a.media, b.media, "{what}: media");
+        assert_eq!(a.interfaces, b.interfaces, "{what}: interfaces");
+        assert_eq!(
+            (a.camera_medium, &a.light_media),
+            (b.camera_medium, &b.light_media),
+            "{what}: camera and light media"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -340,12 +340,16 @@ fn filters() -> Vec<String> {
     )
 }
 
-/// Media: none is read yet (the XML reader refuses `<medium>` outright, naming no types); when
-/// media land, the loader's answer lists them and README must follow.
+/// Media: both loaders read them (TOML's `[media.NAME]` through the XML reader's builder), and
+/// each answers an unknown type with the types it knows.
 fn media() -> Vec<String> {
     let medium = "<medium type=\"nosuch\" id=\"docs-probe\"/>\n</scene>";
     loader_names(
-        None,
+        Some(probe(
+            "scenes/cornell-box.toml",
+            "[camera]\n",
+            "[media.probe]\ntype = \"nosuch\"\n\n[camera]\n",
+        )),
         Some(probe("scenes/xml/cornell-box.xml", "</scene>", medium)),
         true,
     )

@@ -1,24 +1,22 @@
 //! The TOML scene format (docs/scene-format.md): text → `SceneFile` (`schema`, serde's view of
-//! the file) → `Scene` (`assemble` here, with one file per table: `camera`, `material` with
-//! `material_params`, `principled` and `texture`, `shape`, `light`).
+//! the file) → `Scene` (`assemble` here). Materials and media go through the plugin tree the
+//! XML reader builds from (`tree`: TOML's keys renamed, then `xml/build`), and so do the
+//! lights; the camera and shapes are still built here (`camera`, `shape`, with `texture` for an
+//! emitting shape's texture).
 
 mod camera;
-mod light;
-mod material;
-mod material_params;
-pub(crate) mod principled;
 pub(crate) mod schema;
 mod shape;
 pub(crate) mod texture;
+pub(crate) mod tree;
 
 use crate::error::Ctx;
 use crate::world::WorldBuilder;
 use crate::SceneError;
 use camera::{camera, render};
 use glam::DVec3;
-use light::{light, Placed};
+use lt_core::medium::MediumId;
 use lt_core::Scene;
-use material::material;
 use schema::SceneFile;
 use shape::shape;
 use std::collections::HashMap;
@@ -46,7 +44,7 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
         Some(span) => ctx.at(span, e.message().trim_end().to_string()),
         None => ctx.whole(e.message().trim_end().to_string()),
     })?;
-    let mut scene = assemble(&ctx, &file)?;
+    let (mut scene, volumes) = assemble(&ctx, path, &file)?;
     let meshes = file.shapes.iter().filter_map(|s| s.get_ref().file.as_ref());
     // Texture files in material order (as the XML loader meets them: BSDFs before shapes).
     let mut materials: Vec<_> = file.materials.values().collect();
@@ -74,41 +72,91 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
     });
     scene.source_files = std::iter::once(path.to_path_buf())
         .chain(textures.map(|f| ctx.base_dir.join(f.get_ref())))
+        .chain(volumes)
         .chain(meshes.map(|f| ctx.base_dir.join(f.get_ref())))
         .chain(envmaps.map(|f| ctx.base_dir.join(f.get_ref())))
         .collect();
     Ok(scene)
 }
 
-/// The parsed file as a scene, built in file order so that ids and the first error follow it.
-fn assemble(ctx: &Ctx, file: &SceneFile) -> Result<Scene, SceneError> {
+/// The parsed file as a scene, built in file order so that ids and the first error follow it;
+/// with the volume files its media read.
+fn assemble(
+    ctx: &Ctx,
+    path: &Path,
+    file: &SceneFile,
+) -> Result<(Scene, Vec<std::path::PathBuf>), SceneError> {
     // Checked here, at the origin, so that a degenerate camera is the error reported first.
     camera(ctx, &file.camera, DVec3::ZERO)?;
     let settings = render(ctx, file)?;
     let mut b = WorldBuilder::new(settings);
-    let mut ids = HashMap::new();
-    // In file order, so ids and the first error reported follow the file.
+    // Materials, then media, each in file order, as the plugin tree the XML builders read.
     let mut materials: Vec<_> = file.materials.iter().collect();
     materials.sort_by_key(|(_, def)| def.span().start);
+    let mut media: Vec<_> = file.media.iter().collect();
+    media.sort_by_key(|(_, def)| def.span().start);
+    let mut plugins = Vec::new();
     for (name, def) in materials {
-        ids.insert(name.as_str(), b.add_material(material(ctx, name, def)?));
+        plugins.push(tree::material(ctx, name, def)?);
     }
-    let mut emitters = 0;
-    for def in &file.shapes {
-        emitters += shape(ctx, def, &ids, &mut b)? as usize;
+    for (name, def) in media {
+        plugins.push(tree::medium(ctx, name, def)?);
     }
+    let media_names: HashMap<String, MediumId> =
+        file.media.keys().map(|k| (k.clone(), 0)).collect();
     for def in &file.lights {
-        match light(ctx, def)? {
-            Some(Placed::At(position, l)) => b.add_light_at(l, position),
-            Some(Placed::Anywhere(l)) => b.add_light(l),
-            None => continue,
-        }
-        emitters += 1;
+        // The name checked here, in TOML's words, before the tree refers to it by id.
+        medium_named(ctx, &def.get_ref().medium, &media_names)?;
+        plugins.push(tree::with_medium(tree::light(ctx, def)?, def.get_ref()));
+    }
+    let doc = tree::document(path, ctx.text, plugins);
+    let defined = crate::xml::build::define(&doc, &mut b)?;
+    let ids: HashMap<&str, u32> = defined
+        .materials
+        .iter()
+        .map(|(k, &v)| (k.as_str(), v))
+        .collect();
+    let media = |name: &Option<schema::S<String>>| medium_named(ctx, name, &defined.media);
+    let mut emitters = defined.emitters;
+    for def in &file.shapes {
+        emitters += shape(ctx, def, &ids, &defined.media, &mut b)? as usize;
     }
     if emitters == 0 {
         return Err(ctx.whole(
             "the scene has no light: give a shape a non-zero `emission` or add a [[lights]] entry",
         ));
     }
-    b.build(|origin| camera(ctx, &file.camera, origin))
+    b.set_camera_medium(media(&file.camera.get_ref().medium)?);
+    let scene = b.build(|origin| camera(ctx, &file.camera, origin))?;
+    Ok((scene, defined.files.into_iter().filter(is_volume).collect()))
+}
+
+/// The files a medium read (its grids), as opposed to a material's textures.
+fn is_volume(p: &std::path::PathBuf) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vol"))
+}
+
+/// The id of the medium a `medium`, `interior` or `exterior` key names.
+pub(super) fn medium_named(
+    ctx: &Ctx,
+    name: &Option<schema::S<String>>,
+    media: &HashMap<String, MediumId>,
+) -> Result<Option<MediumId>, SceneError> {
+    let Some(name) = name else { return Ok(None) };
+    match media.get(name.get_ref()) {
+        Some(&id) => Ok(Some(id)),
+        None => {
+            let mut defined: Vec<&str> = media.keys().map(String::as_str).collect();
+            defined.sort_unstable();
+            let list = if defined.is_empty() {
+                "no [media] are defined".to_string()
+            } else {
+                format!("defined: {}", defined.join(", "))
+            };
+            Err(ctx.at(
+                name.span(),
+                format!("medium `{}` is not defined ({list})", name.get_ref()),
+            ))
+        }
+    }
 }

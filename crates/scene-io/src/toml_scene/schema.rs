@@ -24,6 +24,48 @@ pub struct SceneFile {
     pub shapes: Vec<S<ShapeDef>>,
     #[serde(default)]
     pub lights: Vec<S<LightDef>>,
+    /// Participating media by name, referenced by shapes' `interior`/`exterior` and by the
+    /// camera's and lights' `medium`.
+    #[serde(default)]
+    pub media: BTreeMap<String, S<MediumDef>>,
+}
+
+/// `[media.NAME]`: Mitsuba's `homogeneous` (`sigma_t` and `albedo`, or `sigma_a` and `sigma_s`)
+/// and `heterogeneous` (`sigma_t` and `albedo` as colours or as `*_volume` grids) media, both
+/// with `scale` and a `phase` function.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MediumDef {
+    #[serde(rename = "type")]
+    pub kind: S<String>,
+    pub sigma_t: Option<S<ColorDef>>,
+    pub albedo: Option<S<ColorDef>>,
+    pub sigma_a: Option<S<ColorDef>>,
+    pub sigma_s: Option<S<ColorDef>>,
+    pub scale: Option<S<f64>>,
+    pub sigma_t_volume: Option<S<VolumeDef>>,
+    pub albedo_volume: Option<S<VolumeDef>>,
+    pub phase: Option<S<PhaseDef>>,
+}
+
+/// `phase = { type = "isotropic" }` or `{ type = "hg", g = 0.7 }`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhaseDef {
+    #[serde(rename = "type")]
+    pub kind: S<String>,
+    pub g: Option<S<f64>>,
+}
+
+/// A grid volume (Mitsuba's `gridvolume`): a `.vol` `file` (relative to the scene file), its
+/// `to_world` (row by row), `use_grid_bbox` and `wrap` ("clamp", "repeat" or "mirror").
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VolumeDef {
+    pub file: S<String>,
+    pub to_world: Option<S<[[f64; 4]; 4]>>,
+    pub use_grid_bbox: Option<S<bool>>,
+    pub wrap: Option<S<String>>,
 }
 
 /// `fov_axis` as the file spells it (the core's `FovAxis` knows no file format).
@@ -70,6 +112,8 @@ pub struct CameraDef {
     pub principal_point_offset: Option<S<[f64; 2]>>,
     /// The pixel filter (Mitsuba's `<rfilter>`); the box of one pixel when absent.
     pub filter: Option<S<FilterDef>>,
+    /// The medium the camera sits in (a `[media]` name).
+    pub medium: Option<S<String>>,
 }
 
 /// `[camera.filter]`: Mitsuba's reconstruction filters and their parameters.
@@ -142,7 +186,7 @@ pub struct MaterialDef {
     /// through with probability 1 − α), a number in [0, 1] or a texture (its luminance).
     pub opacity: Option<S<f64>>,
     pub opacity_texture: Option<S<TextureDef>>,
-    /// `principled` and `principledthin` (Mitsuba's names, `principled.rs`): `base_color`
+    /// `principled` and `principledthin` (Mitsuba's names, `tree/material.rs`): `base_color`
     /// or `base_color_texture`, `roughness` and `ior` as above, and these scalars.
     pub base_color: Option<S<ColorDef>>,
     pub base_color_texture: Option<S<TextureDef>>,
@@ -198,6 +242,10 @@ pub struct ShapeDef {
     pub translate: Option<S<V3>>,
     pub rotate: Option<S<RotateDef>>,
     pub scale: Option<S<ScaleDef>>,
+    /// The media inside and outside the surface (`[media]` names; an interior needs a closed
+    /// surface).
+    pub interior: Option<S<String>>,
+    pub exterior: Option<S<String>>,
 }
 
 #[derive(Deserialize)]
@@ -236,6 +284,8 @@ pub struct LightDef {
     /// of view across the image's width in degrees.
     pub texture: Option<S<TextureDef>>,
     pub fov: Option<S<f64>>,
+    /// The medium the light sits in (a `[media]` name).
+    pub medium: Option<S<String>>,
 }
 
 /// An RGB triple written as `[r, g, b]` or as one number for grey.

@@ -14,6 +14,7 @@ pub(super) fn shape(
     ctx: &Ctx,
     def: &S<ShapeDef>,
     ids: &HashMap<&str, u32>,
+    media: &HashMap<String, lt_core::medium::MediumId>,
     b: &mut WorldBuilder,
 ) -> Result<bool, SceneError> {
     let d = def.get_ref();
@@ -108,8 +109,25 @@ pub(super) fn shape(
         }
         (None, None) => None,
     };
+    let interface = lt_core::scene::MediumInterface {
+        interior: super::medium_named(ctx, &d.interior, media)?,
+        exterior: super::medium_named(ctx, &d.exterior, media)?,
+    };
+    if let (Some(_), Some(why)) = (
+        interface.interior,
+        crate::xml::build::open_surface(&geometry),
+    ) {
+        return Err(ctx.at(
+            def.span(),
+            format!(
+                "{what} has an interior medium but is not closed ({why}): a medium needs a \
+                 surface that bounds it"
+            ),
+        ));
+    }
     let emits = radiance.is_some();
     b.add_shape(geometry, material, radiance, d.flip_normals);
+    b.set_last_shape_media(interface);
     Ok(emits)
 }
 

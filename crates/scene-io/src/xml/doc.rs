@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 const MAX_INCLUDE_DEPTH: usize = 16;
 
 /// One file read: the scene file first, then every included file.
-pub(super) struct Source {
+pub(crate) struct Source {
     pub path: PathBuf,
     pub shown: String,
     pub text: String,
@@ -26,7 +26,7 @@ pub(super) struct Source {
 }
 
 #[derive(Debug)]
-pub(super) struct Elem {
+pub(crate) struct Elem {
     pub tag: String,
     /// Attributes after substitution (and the 0.6 upgrade of `name`), in document order.
     pub attrs: Vec<(String, String)>,
@@ -45,7 +45,7 @@ impl Elem {
     }
 }
 
-pub(super) struct Doc {
+pub(crate) struct Doc {
     pub sources: Vec<Source>,
     /// The `<scene>` element of the scene file, includes spliced in.
     pub root: Elem,

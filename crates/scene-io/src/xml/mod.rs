@@ -16,11 +16,12 @@
 //! in the `LoadReport`. Parameters Mitsuba writes by default that change nothing lt renders
 //! (`near_clip`, a film's `pixel_format`, a `ref`'s `name`, …) are accepted and listed too.
 
-mod build;
+pub(crate) mod build;
 mod cie_table;
-mod doc;
+pub(crate) mod doc;
+mod print;
 mod props;
-mod resolve;
+pub(crate) mod resolve;
 mod spectrum;
 mod values;
 pub mod write;

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 #[derive(Clone, Debug)]
-pub(super) struct Resolver {
+pub(crate) struct Resolver {
     /// The scene file's folder, then every `<path>` folder.
     dirs: Vec<PathBuf>,
 }

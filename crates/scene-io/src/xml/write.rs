@@ -1,19 +1,23 @@
 //! One of our TOML scenes as Mitsuba 3 XML (`lt convert`), wherever Mitsuba can express it: the
 //! scene is loaded (so everything is checked as for rendering), then written from its file's own
-//! description — rectangles and cubes as `rectangle`/`cube` with the exact f32 `to_world` the
-//! loader built, meshes as `obj` files referenced relative to the output, spheres as `sphere`.
-//! Our materials reflect alike on both sides, so the one-sided Mitsuba BSDFs are wrapped in
-//! `twosided`. Numbers are written as the shortest decimal that reads back to the same f32, so
-//! toml → xml → load gives the same scene bit for bit.
+//! description. Materials, media, lights and textures are printed from the plugin tree the
+//! loader builds them from (`toml_scene::tree`, `print`), so this file knows none of their
+//! parameters; the integrator, the sensor and the shapes are written here — rectangles and cubes
+//! as `rectangle`/`cube` with the exact `to_world` the loader built, meshes as `obj` files
+//! referenced relative to the output, spheres as `sphere`. Numbers are written as the shortest
+//! decimal that reads back to the same value, so toml → xml → load gives the same scene bit for
+//! bit.
 //!
 //! Refused: the `sun` light (Mitsuba 3 has no distant light of finite solid angle; a
 //! directional light or an environment map would change the image, so nothing is approximated).
 
+use super::doc::Elem;
+use super::print::{escape, map_filenames, print};
 use crate::error::Ctx;
-use crate::toml_scene::schema::{ColorDef, MaterialDef, SceneFile, ShapeDef, S};
+use crate::toml_scene::schema::{SceneFile, ShapeDef, TextureDef, S};
+use crate::toml_scene::tree;
 use crate::transform::shape_matrix;
 use crate::SceneError;
-use lt_core::bsdf::plastic::{AIR_IOR, POLYPROPYLENE_IOR};
 use lt_core::camera::{FilterShape, Lens};
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
@@ -99,7 +103,20 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
         Lens::ThinLens { .. } => "thinlens",
         Lens::Orthographic { .. } => "orthographic",
     };
+    let mut media: Vec<_> = file.media.iter().collect();
+    media.sort_by_key(|(_, d)| d.span().start);
+    for (name, def) in media {
+        x.push_str(&printed(&ctx, tree::medium(&ctx, name, def)?, 1, out_dir));
+    }
     let _ = writeln!(x, "    <sensor type=\"{kind}\">");
+    if let Some(m) = &c.medium {
+        x.push_str(&printed(
+            &ctx,
+            tree::reference("medium", m.get_ref(), m.span()),
+            2,
+            out_dir,
+        ));
+    }
     if let Some(fov) = &c.fov {
         let _ = writeln!(
             x,
@@ -149,331 +166,21 @@ pub fn to_mitsuba_xml(scene: &Path, out_dir: &Path) -> Result<String, SceneError
         "        <film type=\"hdrfilm\">\n            <integer name=\"width\" value=\"{w}\"/>\n            <integer name=\"height\" value=\"{h}\"/>\n            {}\n        </film>\n    </sensor>",
         rfilter_xml(cam.filter().shape())
     );
-    // Materials, in file order, by name.
-    let mut mats: Vec<_> = file.materials.iter().collect();
-    mats.sort_by_key(|(_, d)| d.span().start);
-    for (mname, def) in mats {
-        let d = def.get_ref();
-        let rgb = |c: &Option<toml::Spanned<ColorDef>>, default: f64| {
-            let a = c.as_ref().map(|c| c.get_ref().0).unwrap_or([default; 3]);
-            v(&a)
-        };
-        let id = esc(mname);
-        let body = match d.kind.get_ref().as_str() {
-            "diffuse" => format!(
-                "<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"diffuse\">\n            <rgb name=\"reflectance\" value=\"{}\"/>\n        </bsdf>\n    </bsdf>",
-                rgb(&d.albedo, 0.0)
-            ),
-            "mirror" => format!(
-                "<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"conductor\">\n            <string name=\"material\" value=\"none\"/>\n            <rgb name=\"specular_reflectance\" value=\"{}\"/>\n        </bsdf>\n    </bsdf>",
-                rgb(&d.reflectance, 1.0)
-            ),
-            "glossy" => format!(
-                "<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"roughconductor\">\n            <string name=\"material\" value=\"none\"/>\n            <string name=\"distribution\" value=\"ggx\"/>\n            <float name=\"alpha\" value=\"{}\"/>\n            <rgb name=\"specular_reflectance\" value=\"{}\"/>\n        </bsdf>\n    </bsdf>",
-                d.roughness.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(0.0),
-                rgb(&d.reflectance, 1.0)
-            ),
-            "conductor" | "roughconductor" => {
-                let kind = d.kind.get_ref();
-                let mut inner = String::new();
-                match (&d.material, &d.eta, &d.k) {
-                    (Some(m), _, _) => {
-                        let _ = write!(inner, "\n            <string name=\"material\" value=\"{}\"/>", esc(m.get_ref()));
-                    }
-                    (None, Some(_), Some(_)) => {
-                        let _ = write!(inner, "\n            <rgb name=\"eta\" value=\"{}\"/>\n            <rgb name=\"k\" value=\"{}\"/>", rgb(&d.eta, 0.0), rgb(&d.k, 0.0));
-                    }
-                    _ => {}
-                }
-                if kind == "roughconductor" {
-                    let dist = d.distribution.as_ref().map_or("beckmann", |s| s.get_ref().as_str());
-                    let _ = write!(inner, "\n            <string name=\"distribution\" value=\"{}\"/>{}", esc(dist), roughness_xml(d, "\n            "));
-                }
-                let _ = write!(inner, "\n            <rgb name=\"specular_reflectance\" value=\"{}\"/>", rgb(&d.reflectance, 1.0));
-                if d.twosided.as_ref().is_some_and(|t| *t.get_ref()) {
-                    format!("<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"{kind}\">{inner}\n        </bsdf>\n    </bsdf>")
-                } else {
-                    format!("<bsdf type=\"{kind}\" id=\"{id}\">{}\n    </bsdf>", inner.replace("\n            ", "\n        "))
-                }
-            }
-            "plastic" | "roughplastic" => {
-                let kind = d.kind.get_ref();
-                let ior = d.ior.as_ref().map_or(POLYPROPYLENE_IOR / AIR_IOR, |r| *r.get_ref() as f32);
-                let mut inner = format!("\n            <float name=\"int_ior\" value=\"{ior}\"/>\n            <float name=\"ext_ior\" value=\"1\"/>\n            <rgb name=\"diffuse_reflectance\" value=\"{}\"/>\n            <rgb name=\"specular_reflectance\" value=\"{}\"/>", rgb(&d.albedo, 0.5), rgb(&d.reflectance, 1.0));
-                if d.nonlinear.as_ref().is_some_and(|n| *n.get_ref()) {
-                    inner.push_str("\n            <boolean name=\"nonlinear\" value=\"true\"/>");
-                }
-                if kind == "roughplastic" {
-                    let dist = d.distribution.as_ref().map_or("beckmann", |s| s.get_ref().as_str());
-                    let alpha = d.alpha.as_ref().map_or(0.1, |a| *a.get_ref() as f32);
-                    let _ = write!(inner, "\n            <string name=\"distribution\" value=\"{}\"/>\n            <float name=\"alpha\" value=\"{alpha}\"/>", esc(dist));
-                }
-                if d.twosided.as_ref().is_some_and(|t| *t.get_ref()) {
-                    format!("<bsdf type=\"twosided\" id=\"{id}\">\n        <bsdf type=\"{kind}\">{inner}\n        </bsdf>\n    </bsdf>")
-                } else {
-                    format!("<bsdf type=\"{kind}\" id=\"{id}\">{}\n    </bsdf>", inner.replace("\n            ", "\n        "))
-                }
-            }
-            "roughdielectric" | "thindielectric" => {
-                let kind = d.kind.get_ref();
-                let mut inner = format!(
-                    "\n        <float name=\"int_ior\" value=\"{}\"/>\n        <float name=\"ext_ior\" value=\"1\"/>",
-                    d.ior.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(1.0)
-                );
-                if kind == "roughdielectric" {
-                    let dist = d.distribution.as_ref().map_or("beckmann", |s| s.get_ref().as_str());
-                    let _ = write!(inner, "\n        <string name=\"distribution\" value=\"{}\"/>{}", esc(dist), roughness_xml(d, "\n        "));
-                }
-                let _ = write!(
-                    inner,
-                    "\n        <rgb name=\"specular_reflectance\" value=\"{}\"/>\n        <rgb name=\"specular_transmittance\" value=\"{}\"/>",
-                    rgb(&d.reflectance, 1.0),
-                    rgb(&d.transmittance, 1.0)
-                );
-                format!("<bsdf type=\"{kind}\" id=\"{id}\">{inner}\n    </bsdf>")
-            }
-            "dielectric" => format!(
-                "<bsdf type=\"dielectric\" id=\"{id}\">\n        <float name=\"int_ior\" value=\"{}\"/>\n        <float name=\"ext_ior\" value=\"1\"/>\n    </bsdf>",
-                d.ior.as_ref().map(|r| *r.get_ref() as f32).unwrap_or(1.0)
-            ),
-            "principled" | "principledthin" => {
-                let kind = d.kind.get_ref();
-                let mut inner = format!("\n        <rgb name=\"base_color\" value=\"{}\"/>", rgb(&d.base_color, 0.5));
-                // Only the scalars the file gives: Mitsuba's defaults are lt's.
-                for (v, name) in [
-                    (&d.roughness, "roughness"),
-                    (&d.anisotropic, "anisotropic"),
-                    (&d.metallic, "metallic"),
-                    (&d.spec_trans, "spec_trans"),
-                    (&d.specular, "specular"),
-                    (&d.spec_tint, "spec_tint"),
-                    (&d.sheen, "sheen"),
-                    (&d.sheen_tint, "sheen_tint"),
-                    (&d.flatness, "flatness"),
-                    (&d.clearcoat, "clearcoat"),
-                    (&d.clearcoat_gloss, "clearcoat_gloss"),
-                    (&d.diff_trans, "diff_trans"),
-                    (&d.ior, "eta"),
-                ] {
-                    if let Some(v) = v {
-                        let _ = write!(inner, "\n        <float name=\"{name}\" value=\"{}\"/>", *v.get_ref() as f32);
-                    }
-                }
-                format!("<bsdf type=\"{kind}\" id=\"{id}\">{inner}\n    </bsdf>")
-            }
-            other => {
-                return Err(ctx.at(d.kind.span(), format!("material type `{other}` has no Mitsuba counterpart here")))
-            }
-        };
-        // Textured parameters become nested <texture>s of the innermost BSDF.
-        let plastic = matches!(d.kind.get_ref().as_str(), "plastic" | "roughplastic");
-        let albedo = if plastic {
-            "diffuse_reflectance"
-        } else {
-            "reflectance"
-        };
-        let mut textures = String::new();
-        for (t, name) in [
-            (&d.albedo_texture, albedo),
-            (&d.reflectance_texture, "specular_reflectance"),
-            (&d.alpha_texture, "alpha"),
-            (&d.alpha_u_texture, "alpha_u"),
-            (&d.alpha_v_texture, "alpha_v"),
-            (&d.base_color_texture, "base_color"),
-        ] {
-            if let Some(t) = t {
-                textures.push_str(&texture_xml(&ctx, t.get_ref(), name, out_dir));
-            }
-        }
-        // A textured parameter's plain value (the default the writer filled in) goes.
-        let body: String = body
-            .split_inclusive('\n')
-            .filter(|line| {
-                ![
-                    (
-                        &d.albedo_texture,
-                        if plastic {
-                            "name=\"diffuse_reflectance\""
-                        } else {
-                            "name=\"reflectance\""
-                        },
-                    ),
-                    (&d.reflectance_texture, "name=\"specular_reflectance\""),
-                    (&d.alpha_texture, "name=\"alpha\""),
-                    (&d.alpha_u_texture, "name=\"alpha_u\""),
-                    (&d.alpha_v_texture, "name=\"alpha_v\""),
-                    (&d.base_color_texture, "name=\"base_color\""),
-                ]
-                .iter()
-                .any(|(t, key)| t.is_some() && line.contains(key) && !line.contains("<texture"))
-            })
-            .collect();
-        // The innermost BSDF closes first: its textures go on the lines before that.
-        let body = match body.find("</bsdf>") {
-            Some(close) if !textures.is_empty() => {
-                let line_start = body[..close].rfind('\n').map_or(0, |n| n + 1);
-                let (a, b) = body.split_at(line_start);
-                format!("{a}{textures}{b}")
-            }
-            _ => body,
-        };
-        let body = perturbation_xml(&ctx, d, &id, body, out_dir);
-        let body = mask_xml(&ctx, d, &id, body, out_dir);
-        let _ = writeln!(x, "    {body}");
+    // Materials and media, in file order, printed from the plugin tree the loader builds them
+    // from (so the writer knows no material's or medium's parameters).
+    let mut materials: Vec<_> = file.materials.iter().collect();
+    materials.sort_by_key(|(_, d)| d.span().start);
+    for (name, def) in materials {
+        x.push_str(&printed(&ctx, tree::material(&ctx, name, def)?, 1, out_dir));
     }
     for def in &file.shapes {
         let d = def.get_ref();
         x.push_str(&shape(&ctx, d, out_dir, &v)?);
     }
+    // Lights printed from the tree the loader builds them from (a sun was refused above).
     for l in &file.lights {
-        let d = l.get_ref();
-        let col = |c: &Option<toml::Spanned<ColorDef>>| {
-            c.as_ref().map(|c| c.get_ref().0).unwrap_or([0.0; 3])
-        };
-        let zero = |c: [f64; 3]| c.iter().all(|&x| x as f32 == 0.0);
-        match d.kind.get_ref().as_str() {
-            "point" => {
-                let i = col(&d.intensity);
-                if zero(i) {
-                    continue;
-                }
-                let p = d
-                    .position
-                    .as_ref()
-                    .map(|p| *p.get_ref())
-                    .unwrap_or_default();
-                let _ = writeln!(
-                    x,
-                    "    <emitter type=\"point\">\n        <point name=\"position\" value=\"{}\"/>\n        <rgb name=\"intensity\" value=\"{}\"/>\n    </emitter>",
-                    v(&p),
-                    v(&i)
-                );
-            }
-            "directional" => {
-                let e = col(&d.irradiance);
-                if zero(e) {
-                    continue;
-                }
-                // Ours points towards the light, Mitsuba's along the light's travel: the f32
-                // direction as the TOML gives it, negated (exact; both loaders normalise it).
-                let dir = d
-                    .direction
-                    .as_ref()
-                    .map(|p| *p.get_ref())
-                    .unwrap_or_default();
-                let u = glam::Vec3::from_array(dir.map(|x| x as f32));
-                let _ = writeln!(
-                    x,
-                    "    <emitter type=\"directional\">\n        <vector name=\"direction\" value=\"{}, {}, {}\"/>\n        <rgb name=\"irradiance\" value=\"{}\"/>\n    </emitter>",
-                    -u.x,
-                    -u.y,
-                    -u.z,
-                    v(&e)
-                );
-            }
-            "envmap" => {
-                let file = d
-                    .file
-                    .as_ref()
-                    .map(|f| f.get_ref().as_str())
-                    .unwrap_or_default();
-                let rel = relative(&ctx.base_dir.join(file), out_dir);
-                let _ = write!(
-                    x,
-                    "    <emitter type=\"envmap\">\n        <string name=\"filename\" value=\"{}\"/>\n        <float name=\"scale\" value=\"{}\"/>\n",
-                    esc(&rel.to_string_lossy()),
-                    d.scale.as_ref().map_or(1.0, |s| *s.get_ref() as f32)
-                );
-                if let Some(r) = &d.rotate {
-                    let (a, deg) = (r.get_ref().axis, r.get_ref().angle);
-                    let _ = writeln!(
-                        x,
-                        "        <transform name=\"to_world\">\n            <rotate x=\"{}\" y=\"{}\" z=\"{}\" angle=\"{deg}\"/>\n        </transform>",
-                        a[0], a[1], a[2]
-                    );
-                }
-                let _ = writeln!(x, "    </emitter>");
-            }
-            "spot" | "projector" => {
-                let spot = d.kind.get_ref() == "spot";
-                let get = |p: &Option<toml::Spanned<[f64; 3]>>| {
-                    p.as_ref().map(|p| *p.get_ref()).unwrap_or_default()
-                };
-                let (o, t) = (get(&d.position), get(&d.target));
-                // The loader's default `up`, written out so that Mitsuba builds the same frame.
-                let up = d.up.as_ref().map(|u| *u.get_ref()).unwrap_or_else(|| {
-                    let dir = glam::DVec3::from_array(t) - glam::DVec3::from_array(o);
-                    crate::transform::default_up(dir).to_array()
-                });
-                let _ = writeln!(
-                    x,
-                    "    <emitter type=\"{}\">\n        <transform name=\"to_world\">\n            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>\n        </transform>",
-                    d.kind.get_ref(),
-                    v(&o),
-                    v(&t),
-                    v(&up)
-                );
-                if spot {
-                    let cutoff = d
-                        .cutoff_angle
-                        .as_ref()
-                        .map_or(20.0, |c| *c.get_ref() as f32);
-                    let beam = d
-                        .beam_width
-                        .as_ref()
-                        .map_or(0.75 * cutoff, |b| *b.get_ref() as f32);
-                    let _ = writeln!(
-                        x,
-                        "        <rgb name=\"intensity\" value=\"{}\"/>\n        <float name=\"cutoff_angle\" value=\"{cutoff}\"/>\n        <float name=\"beam_width\" value=\"{beam}\"/>",
-                        v(&col(&d.intensity))
-                    );
-                    if let Some(tex) = &d.texture {
-                        x.push_str(
-                            &texture_xml(&ctx, tex.get_ref(), "texture", out_dir)
-                                .replace("\n    ", "\n"),
-                        );
-                    }
-                } else {
-                    let _ = writeln!(
-                        x,
-                        "        <float name=\"fov\" value=\"{}\"/>\n        <float name=\"scale\" value=\"{}\"/>",
-                        d.fov.as_ref().map_or(0.0, |f| *f.get_ref()),
-                        d.scale.as_ref().map_or(1.0, |s| *s.get_ref() as f32)
-                    );
-                    match &d.texture {
-                        Some(tex) => x.push_str(
-                            &texture_xml(&ctx, tex.get_ref(), "irradiance", out_dir)
-                                .replace("\n    ", "\n"),
-                        ),
-                        None => {
-                            let _ = writeln!(
-                                x,
-                                "        <rgb name=\"irradiance\" value=\"{}\"/>",
-                                v(&col(&d.irradiance))
-                            );
-                        }
-                    }
-                }
-                let _ = writeln!(x, "    </emitter>");
-            }
-            "environment" => {
-                let r = col(&d.radiance);
-                if zero(r) {
-                    continue;
-                }
-                let _ = writeln!(
-                    x,
-                    "    <emitter type=\"constant\">\n        <rgb name=\"radiance\" value=\"{}\"/>\n    </emitter>",
-                    v(&r)
-                );
-            }
-            other => {
-                return Err(ctx.at(
-                    d.kind.span(),
-                    format!("light type `{other}` has no Mitsuba counterpart"),
-                ))
-            }
-        }
+        let e = tree::with_medium(tree::light(&ctx, l)?, l.get_ref());
+        x.push_str(&printed(&ctx, e, 1, out_dir));
     }
     x.push_str("</scene>\n");
     Ok(x)
@@ -566,8 +273,18 @@ fn shape(
         let _ = write!(
             x,
             "        <emitter type=\"area\">\n{}        </emitter>\n",
-            texture_xml(ctx, t.get_ref(), "radiance", out_dir)
+            texture_xml(ctx, t, "radiance", out_dir, 3)?
         );
+    }
+    for (m, side) in [(&d.interior, "interior"), (&d.exterior, "exterior")] {
+        if let Some(m) = m {
+            x.push_str(&printed(
+                ctx,
+                tree::reference(side, m.get_ref(), m.span()),
+                2,
+                out_dir,
+            ));
+        }
     }
     x.push_str("    </shape>\n");
     Ok(x)
@@ -591,135 +308,32 @@ fn relative(path: &Path, dir: &Path) -> PathBuf {
     out
 }
 
-/// Escapes text for an XML attribute value.
-/// A TOML texture as Mitsuba's `<texture name=…>` (uv scale as `to_uv`).
-/// `body` (a BSDF with `id`) inside Mitsuba's `normalmap` or `bumpmap` when the material has one;
-/// the wrapper takes the id.
-fn perturbation_xml(
-    ctx: &Ctx,
-    d: &crate::toml_scene::schema::MaterialDef,
-    id: &str,
-    body: String,
-    out_dir: &Path,
-) -> String {
-    let (kind, texture, mut params) = match (&d.normal_map, &d.bump_map) {
-        (Some(t), _) => (
-            "normalmap",
-            texture_xml(ctx, t.get_ref(), "normalmap", out_dir),
-            String::new(),
-        ),
-        (None, Some(t)) => (
-            "bumpmap",
-            texture_xml(ctx, t.get_ref(), "height", out_dir),
-            format!(
-                "        <float name=\"scale\" value=\"{}\"/>\n",
-                d.bump_scale.as_ref().map_or(1.0, |s| *s.get_ref() as f32)
-            ),
-        ),
-        (None, None) => return body,
-    };
-    for (flag, key) in [
-        (&d.flip_invalid_normals, "flip_invalid_normals"),
-        (&d.bump_shadowing, "use_shadowing_function"),
-    ] {
-        if let Some(f) = flag {
-            let _ = writeln!(
-                params,
-                "        <boolean name=\"{key}\" value=\"{}\"/>",
-                f.get_ref()
-            );
-        }
-    }
-    let inner = body.replacen(&format!(" id=\"{id}\""), "", 1);
-    let texture = texture.replace("\n            ", "\n        ");
-    format!(
-        "<bsdf type=\"{kind}\" id=\"{id}\">\n{}{params}    {inner}\n    </bsdf>",
-        texture.trim_start_matches("    ")
-    )
+fn esc(s: &str) -> String {
+    escape(s)
 }
 
-/// `body` inside Mitsuba's `mask` when the material has an `opacity` or `opacity_texture`.
-fn mask_xml(
-    ctx: &Ctx,
-    d: &crate::toml_scene::schema::MaterialDef,
-    id: &str,
-    body: String,
-    out_dir: &Path,
-) -> String {
-    let opacity = match (&d.opacity, &d.opacity_texture) {
-        (_, Some(t)) => texture_xml(ctx, t.get_ref(), "opacity", out_dir)
-            .replace("\n            ", "\n        ")
-            .trim_start_matches("    ")
-            .to_string(),
-        (Some(a), None) => format!(
-            "        <float name=\"opacity\" value=\"{}\"/>\n",
-            *a.get_ref() as f32
-        ),
-        (None, None) => return body,
-    };
-    let inner = body.replacen(&format!(" id=\"{id}\""), "", 1);
-    format!("<bsdf type=\"mask\" id=\"{id}\">\n{opacity}    {inner}\n    </bsdf>")
-}
-
-fn texture_xml(
-    ctx: &Ctx,
-    t: &crate::toml_scene::schema::TextureDef,
-    name: &str,
-    out_dir: &Path,
-) -> String {
-    let mut x = format!(
-        "            <texture type=\"{}\" name=\"{name}\">\n",
-        esc(t.kind.get_ref())
-    );
-    if let Some(s) = &t.scale {
-        let _ = writeln!(
-            x,
-            "                <transform name=\"to_uv\"><scale value=\"{}\"/></transform>",
-            *s.get_ref() as f32
-        );
-    }
-    if let Some(f) = &t.file {
-        let rel = relative(&ctx.base_dir.join(f.get_ref()), out_dir);
-        let _ = writeln!(
-            x,
-            "                <string name=\"filename\" value=\"{}\"/>",
-            esc(&rel.to_string_lossy())
-        );
-    }
-    for (key, xml_key) in [(&t.filter, "filter_type"), (&t.wrap, "wrap_mode")] {
-        if let Some(k) = key {
-            let _ = writeln!(
-                x,
-                "                <string name=\"{xml_key}\" value=\"{}\"/>",
-                esc(k.get_ref())
-            );
-        }
-    }
-    if let Some(r) = &t.raw {
-        let _ = writeln!(
-            x,
-            "                <boolean name=\"raw\" value=\"{}\"/>",
-            r.get_ref()
-        );
-    }
-    for (c, key) in [(&t.color0, "color0"), (&t.color1, "color1")] {
-        if let Some(c) = c {
-            let [r, g, b] = c.get_ref().0;
-            let _ = writeln!(
-                x,
-                "                <rgb name=\"{key}\" value=\"{r}, {g}, {b}\"/>"
-            );
-        }
-    }
-    x.push_str("            </texture>\n");
+/// A tree element as XML text at `depth`, its file names relative to `out_dir`.
+fn printed(ctx: &Ctx, mut e: Elem, depth: usize, out_dir: &Path) -> String {
+    let base = ctx.base_dir.clone();
+    map_filenames(&mut e, &|f| {
+        relative(&base.join(f), out_dir)
+            .to_string_lossy()
+            .into_owned()
+    });
+    let mut x = String::new();
+    print(&e, depth, &mut x);
     x
 }
 
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
+/// A TOML texture as Mitsuba's `<texture name=…>` (through the tree).
+fn texture_xml(
+    ctx: &Ctx,
+    t: &S<TextureDef>,
+    name: &str,
+    out_dir: &Path,
+    depth: usize,
+) -> Result<String, SceneError> {
+    Ok(printed(ctx, tree::texture(ctx, t, name)?, depth, out_dir))
 }
 
 /// Mitsuba's `<rfilter>` of a pixel filter, with its parameters.
@@ -741,25 +355,4 @@ fn rfilter_xml(shape: FilterShape) -> String {
         return "<rfilter type=\"box\"/>".into();
     }
     format!("<rfilter type=\"{kind}\">{params}\n            </rfilter>")
-}
-
-/// A microfacet material's roughness lines: `alpha`, or `alpha_u` and `alpha_v` when either is
-/// given (as a number or a texture; a textured one's placeholder line is dropped later).
-fn roughness_xml(d: &MaterialDef, indent: &str) -> String {
-    let value =
-        |a: &Option<S<f64>>, default: f32| a.as_ref().map_or(default, |a| *a.get_ref() as f32);
-    let alpha = value(&d.alpha, 0.1);
-    let anisotropic = d.alpha_u.is_some()
-        || d.alpha_v.is_some()
-        || d.alpha_u_texture.is_some()
-        || d.alpha_v_texture.is_some();
-    if anisotropic {
-        format!(
-            "{indent}<float name=\"alpha_u\" value=\"{}\"/>{indent}<float name=\"alpha_v\" value=\"{}\"/>",
-            value(&d.alpha_u, alpha),
-            value(&d.alpha_v, alpha)
-        )
-    } else {
-        format!("{indent}<float name=\"alpha\" value=\"{alpha}\"/>")
-    }
 }

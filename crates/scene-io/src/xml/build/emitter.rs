@@ -1,4 +1,5 @@
-//! `<emitter>` at the top level: point, constant, directional, envmap, spot, projector.
+//! `<emitter>` at the top level: point, constant, directional, envmap, spot, projector, and lt's
+//! own `sun` (a distant disk of finite solid angle, which Mitsuba 3 lacks: TOML's `sun` light).
 
 use super::Loader;
 use crate::image_file::read_environment_map;
@@ -13,7 +14,7 @@ use lt_core::scene::LightDesc;
 use lt_core::texture::Texture;
 
 /// The emitters lt reads (`area` only inside a shape, or referenced from one by id).
-pub(super) const EMITTERS: [&str; 7] = [
+pub(super) const EMITTERS: [&str; 8] = [
     "area",
     "point",
     "spot",
@@ -21,6 +22,7 @@ pub(super) const EMITTERS: [&str; 7] = [
     "constant",
     "directional",
     "envmap",
+    "sun",
 ];
 
 impl<'a> Loader<'a> {
@@ -94,6 +96,7 @@ impl<'a> Loader<'a> {
                     irradiance,
                 }
             }
+            "sun" => sun(&p, &mut self.report)?,
             "area" => return Err(p.err(e, "an area emitter must be nested in a shape")),
             "envmap" => {
                 let Some((file, fe)) = p.string("filename")? else {
@@ -233,6 +236,49 @@ impl<'a> Loader<'a> {
             position,
         )))
     }
+}
+
+/// lt's `sun`: `direction` (the light's travel, as Mitsuba's `directional`), `solid_angle` (sr,
+/// in (0, 2π)), and `radiance` or `irradiance` (what a surface facing it receives, turned into
+/// radiance by `SunLight::radiance_from_irradiance`).
+fn sun(p: &Plugin, report: &mut crate::LoadReport) -> Result<LightDesc, SceneError> {
+    let e = p.elem;
+    let opts = crate::LoadOptions::default();
+    let Some(travel) = p.vec3("direction")? else {
+        return Err(p.err(e, "a sun needs a `direction`"));
+    };
+    let towards = -DVec3::from_array(travel).as_vec3();
+    if !(towards.length() > 0.0) || !towards.is_finite() {
+        return Err(p.err(e, "the sun's `direction` is the zero vector"));
+    }
+    let Some(solid_angle) = p.float("solid_angle")? else {
+        return Err(p.err(e, "a sun needs a `solid_angle`"));
+    };
+    let solid_angle = solid_angle as f32;
+    if !(solid_angle > 0.0 && solid_angle < 2.0 * lt_core::math::PI) {
+        return Err(p.err(
+            e,
+            format!("a sun's `solid_angle` must lie in (0, 2π) sr, got {solid_angle}"),
+        ));
+    }
+    let radiance = p.color("radiance", ColorUse::Emission, &opts, report)?;
+    let irradiance = p.color("irradiance", ColorUse::Emission, &opts, report)?;
+    let radiance = match (radiance, irradiance) {
+        (Some(r), None) => r,
+        (None, Some(i)) => {
+            let l = lt_core::light::SunLight::radiance_from_irradiance(i, solid_angle);
+            if !l.is_finite() {
+                return Err(p.err(e, format!("a sun's `solid_angle` {solid_angle} is too small to turn the irradiance into a finite radiance")));
+            }
+            l
+        }
+        _ => return Err(p.err(e, "a sun takes `radiance` or `irradiance` (one of them)")),
+    };
+    Ok(LightDesc::Sun {
+        direction: towards.normalize(),
+        solid_angle,
+        radiance,
+    })
 }
 
 /// The rotation and the translation of a light's `to_world` (identity when absent), which must

@@ -19,7 +19,7 @@ use lt_core::scene::MediumInterface;
 use std::collections::HashMap;
 use std::sync::Arc;
 
-pub(super) const MEDIA: [&str; 2] = ["homogeneous", "heterogeneous"];
+pub(crate) const MEDIA: [&str; 2] = ["homogeneous", "heterogeneous"];
 pub(super) const PHASES: [&str; 2] = ["isotropic", "hg"];
 pub(super) const VOLUMES: [&str; 2] = ["gridvolume", "constvolume"];
 
@@ -300,7 +300,7 @@ impl<'a> Loader<'a> {
 /// Why a shape bounds no volume, or None when it is closed: a sphere or an sdfgrid is; a disk or
 /// an open cylinder is not; a mesh is when every edge, its vertices welded by position, is shared
 /// by exactly two triangles.
-fn open_surface(geometry: &WorldGeometry) -> Option<String> {
+pub(crate) fn open_surface(geometry: &WorldGeometry) -> Option<String> {
     let m = match geometry {
         WorldGeometry::Sphere { .. } | WorldGeometry::SdfGrid { .. } => return None,
         WorldGeometry::Disk { .. } => return Some("a disk".into()),

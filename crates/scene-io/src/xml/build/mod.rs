@@ -22,6 +22,7 @@ mod shape;
 mod texture;
 
 pub use integrator::UNBOUNDED_DEPTH_SUBSTITUTE;
+pub(crate) use medium::{open_surface, MEDIA};
 
 pub(super) struct Loader<'a> {
     doc: &'a Doc,
@@ -166,6 +167,68 @@ pub(super) fn load(
             .map_err(|m| doc.err(sensor, format!("degenerate camera: {m}")))
     })?;
     Ok((scene, report, meshes))
+}
+
+/// What a tree made from another format (TOML's `toml_scene::tree`) defines at its top level:
+/// each BSDF's material id and each medium's id, by the element's `id`, and the files read.
+#[derive(Default)]
+pub(crate) struct Defined {
+    pub materials: HashMap<String, u32>,
+    pub media: HashMap<String, MediumId>,
+    pub files: Vec<PathBuf>,
+    /// Emitters that emit (those that emit nothing are dropped, as in an XML scene).
+    pub emitters: usize,
+}
+
+/// Builds the top-level `<bsdf>`, `<medium>` and `<emitter>` elements of `doc` into `b`, in
+/// document order, with the builders an XML scene's go through.
+pub(crate) fn define(doc: &Doc, b: &mut WorldBuilder) -> Result<Defined, SceneError> {
+    let mut ids = Ids::new();
+    collect_ids(doc, &doc.root, &mut ids)?;
+    let opts = LoadOptions::default();
+    let mut l = Loader {
+        doc,
+        opts: &opts,
+        report: LoadReport::default(),
+        ids,
+        materials: HashMap::new(),
+        default_material: None,
+        default_emitter_material: None,
+        meshes: Vec::new(),
+        media: HashMap::new(),
+        media_made: Vec::new(),
+        camera_medium: None,
+        emitter_medium: None,
+    };
+    let mut out = Defined::default();
+    for c in &doc.root.children {
+        let id = c.attr("id").unwrap_or_default().to_string();
+        match c.tag.as_str() {
+            "bsdf" => {
+                let m = l.material(c, b)?;
+                out.materials.insert(id, m);
+            }
+            "medium" => {
+                let m = l.medium(c)?;
+                out.media.insert(id, m);
+            }
+            "emitter" => {
+                match l.emitter(c)? {
+                    Some((desc, Some(position))) => b.add_light_at(desc, position),
+                    Some((desc, None)) => b.add_light(desc),
+                    None => continue,
+                }
+                b.set_last_light_medium(l.emitter_medium.take());
+                out.emitters += 1;
+            }
+            _ => {}
+        }
+    }
+    for make in l.media_made {
+        b.add_medium(make);
+    }
+    out.files = l.meshes;
+    Ok(out)
 }
 
 impl<'a> Loader<'a> {

@@ -1,0 +1,595 @@
+//! A TOML `[materials.NAME]` table as a `<bsdf id=NAME>`. The renamed keys:
+//!
+//! | TOML | tree |
+//! |---|---|
+//! | `albedo` (diffuse, plastics) | `reflectance` / `diffuse_reflectance` |
+//! | `reflectance` | `specular_reflectance` |
+//! | `transmittance` | `specular_transmittance` |
+//! | `ior` (dielectrics, plastics) | `int_ior` over `ext_ior` = 1 |
+//! | `ior` (principled) | `eta` |
+//! | `roughness` (glossy) | `alpha` of a GGX `roughconductor` of material `none` |
+//! | `*_texture` | a `<texture>` named after the parameter it sets |
+//! | `normal_map`, `bump_map` (+ `bump_scale`, `flip_invalid_normals`, `bump_shadowing`) | `normalmap` / `bumpmap` around the BSDF (`scale`, `use_shadowing_function`) |
+//! | `opacity`, `opacity_texture` | `mask` around it |
+//! | `twosided = true`, and every diffuse, mirror and glossy | `twosided` around the one-sided BSDF |
+//!
+//! Every other key keeps its name. Which keys each type takes, what it needs and what may not be
+//! given together is checked here, in TOML's words.
+
+use super::texture::{color, texture};
+use super::{boolean, float, float64, plugin, string, wrap};
+use crate::error::Ctx;
+use crate::principled_keys::{principled_eta, scalar_in_range, thin_eta};
+use crate::toml_scene::schema::{MaterialDef, TextureDef, S};
+use crate::xml::doc::Elem;
+use crate::SceneError;
+use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor};
+use lt_core::bsdf::plastic::{AIR_IOR, POLYPROPYLENE_IOR};
+use std::ops::Range;
+
+/// GGX α below this is numerically a mirror; use `mirror` instead.
+const MIN_ROUGHNESS: f32 = 1e-4;
+
+/// The material as a BSDF element with `id` = its name.
+pub(crate) fn material(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Elem, SceneError> {
+    let e = plain(ctx, name, def)?;
+    let e = perturbed(ctx, def, e)?;
+    let mut e = masked(ctx, def, e)?;
+    e.attrs.push(("id".into(), name.into()));
+    Ok(e)
+}
+
+/// `e` inside Mitsuba's `mask` when the material has an `opacity` or `opacity_texture`.
+fn masked(ctx: &Ctx, def: &S<MaterialDef>, e: Elem) -> Result<Elem, SceneError> {
+    let d = def.get_ref();
+    let opacity = match (&d.opacity, &d.opacity_texture) {
+        (None, None) => return Ok(e),
+        (Some(_), Some(t)) => {
+            return Err(ctx.at(t.span(), "give `opacity` or `opacity_texture`, not both"));
+        }
+        (Some(a), None) => {
+            let v: f32 = ctx.num(a, "opacity")?;
+            if !(0.0..=1.0).contains(&v) {
+                return Err(ctx.at(a.span(), format!("`opacity` must lie in [0, 1], got {v}")));
+            }
+            float("opacity", v, a.span())
+        }
+        (None, Some(t)) => texture(ctx, t, "opacity")?,
+    };
+    let mut m = wrap("bsdf", "mask", def.span(), e);
+    m.children.insert(0, opacity);
+    Ok(m)
+}
+
+/// `e` inside Mitsuba's `normalmap` or `bumpmap` when the material has one.
+fn perturbed(ctx: &Ctx, def: &S<MaterialDef>, e: Elem) -> Result<Elem, SceneError> {
+    let d = def.get_ref();
+    let mut m = match (&d.normal_map, &d.bump_map) {
+        (None, None) => {
+            let stray = [
+                ("bump_scale", d.bump_scale.as_ref().map(S::span)),
+                (
+                    "flip_invalid_normals",
+                    d.flip_invalid_normals.as_ref().map(S::span),
+                ),
+                ("bump_shadowing", d.bump_shadowing.as_ref().map(S::span)),
+            ];
+            if let Some((key, Some(span))) = stray.into_iter().find(|(_, s)| s.is_some()) {
+                return Err(ctx.at(span, format!("`{key}` needs a `normal_map` or `bump_map`")));
+            }
+            return Ok(e);
+        }
+        (Some(_), Some(b)) => {
+            return Err(ctx.at(b.span(), "give `normal_map` or `bump_map`, not both"));
+        }
+        (Some(n), None) => {
+            if let Some(s) = &d.bump_scale {
+                return Err(ctx.at(s.span(), "`bump_scale` applies to a `bump_map`"));
+            }
+            let mut m = plugin("bsdf", "normalmap", def.span());
+            m.children.push(texture(ctx, n, "normalmap")?);
+            m
+        }
+        (None, Some(b)) => {
+            let mut m = plugin("bsdf", "bumpmap", def.span());
+            m.children.push(texture(ctx, b, "height")?);
+            if let Some(s) = &d.bump_scale {
+                m.children
+                    .push(float("scale", ctx.num(s, "bump_scale")?, s.span()));
+            }
+            m
+        }
+    };
+    for (flag, key) in [
+        (&d.flip_invalid_normals, "flip_invalid_normals"),
+        (&d.bump_shadowing, "use_shadowing_function"),
+    ] {
+        if let Some(f) = flag {
+            m.children.push(boolean(key, *f.get_ref(), f.span()));
+        }
+    }
+    m.children.push(e);
+    Ok(m)
+}
+
+/// The keys given, with their spans (serde knows only the union of every type's keys).
+fn given(d: &MaterialDef) -> Vec<(&'static str, Option<Range<usize>>)> {
+    vec![
+        ("albedo", d.albedo.as_ref().map(S::span)),
+        ("reflectance", d.reflectance.as_ref().map(S::span)),
+        ("ior", d.ior.as_ref().map(S::span)),
+        ("roughness", d.roughness.as_ref().map(S::span)),
+        ("material", d.material.as_ref().map(S::span)),
+        ("eta", d.eta.as_ref().map(S::span)),
+        ("k", d.k.as_ref().map(S::span)),
+        ("distribution", d.distribution.as_ref().map(S::span)),
+        ("alpha", d.alpha.as_ref().map(S::span)),
+        ("alpha_u", d.alpha_u.as_ref().map(S::span)),
+        ("alpha_v", d.alpha_v.as_ref().map(S::span)),
+        ("transmittance", d.transmittance.as_ref().map(S::span)),
+        ("twosided", d.twosided.as_ref().map(S::span)),
+        ("albedo_texture", d.albedo_texture.as_ref().map(S::span)),
+        (
+            "reflectance_texture",
+            d.reflectance_texture.as_ref().map(S::span),
+        ),
+        ("alpha_texture", d.alpha_texture.as_ref().map(S::span)),
+        ("alpha_u_texture", d.alpha_u_texture.as_ref().map(S::span)),
+        ("alpha_v_texture", d.alpha_v_texture.as_ref().map(S::span)),
+        ("nonlinear", d.nonlinear.as_ref().map(S::span)),
+        ("base_color", d.base_color.as_ref().map(S::span)),
+        (
+            "base_color_texture",
+            d.base_color_texture.as_ref().map(S::span),
+        ),
+        ("anisotropic", d.anisotropic.as_ref().map(S::span)),
+        ("metallic", d.metallic.as_ref().map(S::span)),
+        ("spec_trans", d.spec_trans.as_ref().map(S::span)),
+        ("specular", d.specular.as_ref().map(S::span)),
+        ("spec_tint", d.spec_tint.as_ref().map(S::span)),
+        ("sheen", d.sheen.as_ref().map(S::span)),
+        ("sheen_tint", d.sheen_tint.as_ref().map(S::span)),
+        ("flatness", d.flatness.as_ref().map(S::span)),
+        ("clearcoat", d.clearcoat.as_ref().map(S::span)),
+        ("clearcoat_gloss", d.clearcoat_gloss.as_ref().map(S::span)),
+        ("diff_trans", d.diff_trans.as_ref().map(S::span)),
+    ]
+}
+
+/// The keys each type takes.
+fn allowed(kind: &str) -> &'static [&'static str] {
+    match kind {
+        "diffuse" => &["albedo", "albedo_texture"],
+        "mirror" => &["reflectance"],
+        "dielectric" => &["ior"],
+        "glossy" => &["reflectance", "roughness"],
+        "thindielectric" => &["ior", "reflectance", "transmittance", "reflectance_texture"],
+        "roughdielectric" => &[
+            "ior",
+            "reflectance",
+            "transmittance",
+            "distribution",
+            "alpha",
+            "reflectance_texture",
+            "alpha_texture",
+            "alpha_u",
+            "alpha_v",
+            "alpha_u_texture",
+            "alpha_v_texture",
+        ],
+        "conductor" => &[
+            "reflectance",
+            "material",
+            "eta",
+            "k",
+            "twosided",
+            "reflectance_texture",
+        ],
+        "roughconductor" => &[
+            "reflectance",
+            "material",
+            "eta",
+            "k",
+            "twosided",
+            "distribution",
+            "alpha",
+            "reflectance_texture",
+            "alpha_texture",
+            "alpha_u",
+            "alpha_v",
+            "alpha_u_texture",
+            "alpha_v_texture",
+        ],
+        "plastic" => &[
+            "albedo",
+            "albedo_texture",
+            "reflectance",
+            "reflectance_texture",
+            "ior",
+            "nonlinear",
+            "twosided",
+        ],
+        "roughplastic" => &[
+            "albedo",
+            "albedo_texture",
+            "reflectance",
+            "reflectance_texture",
+            "ior",
+            "nonlinear",
+            "twosided",
+            "distribution",
+            "alpha",
+        ],
+        "principled" => &[
+            "base_color",
+            "base_color_texture",
+            "roughness",
+            "anisotropic",
+            "spec_trans",
+            "spec_tint",
+            "sheen",
+            "sheen_tint",
+            "flatness",
+            "ior",
+            "metallic",
+            "clearcoat",
+            "clearcoat_gloss",
+            "specular",
+        ],
+        "principledthin" => &[
+            "base_color",
+            "base_color_texture",
+            "roughness",
+            "anisotropic",
+            "spec_trans",
+            "spec_tint",
+            "sheen",
+            "sheen_tint",
+            "flatness",
+            "ior",
+            "diff_trans",
+        ],
+        _ => &[],
+    }
+}
+
+/// The TOML material types, for the unknown type's message.
+const TYPES: &str = "diffuse, mirror, dielectric, roughdielectric, thindielectric, glossy, \
+                     conductor, roughconductor, plastic, roughplastic, principled, principledthin \
+                     or null";
+
+/// The BSDF with its untextured and textured parameters, inside `twosided` where ours reflect on
+/// both sides.
+fn plain(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Elem, SceneError> {
+    let d = def.get_ref();
+    let kind = d.kind.get_ref().as_str();
+    let what = format!("material `{name}` of type {kind}");
+    let span = def.span();
+    let given = given(d);
+    if kind != "null" && allowed(kind).is_empty() {
+        return Err(ctx.at(
+            d.kind.span(),
+            format!("unknown material type `{kind}` (expected {TYPES})"),
+        ));
+    }
+    ctx.only(&given, allowed(kind), &what)?;
+    let twosided = d.twosided.as_ref().is_some_and(|t| *t.get_ref());
+    let mut b;
+    match kind {
+        "null" => return Ok(plugin("bsdf", "null", span)),
+        "diffuse" => {
+            b = plugin("bsdf", "diffuse", span.clone());
+            match (&d.albedo, &d.albedo_texture) {
+                (Some(a), None) => b
+                    .children
+                    .push(color(ctx, a, "albedo", "reflectance", true)?),
+                (None, Some(t)) => b.children.push(texture(ctx, t, "reflectance")?),
+                (Some(_), Some(t)) => {
+                    return Err(ctx.at(t.span(), "give `albedo` or `albedo_texture`, not both"))
+                }
+                (None, None) => {
+                    return Err(ctx.at(
+                        span,
+                        format!("missing required key `albedo` (or `albedo_texture`) for {what}"),
+                    ))
+                }
+            }
+            return Ok(wrap("bsdf", "twosided", span, b));
+        }
+        "mirror" => {
+            b = plugin("bsdf", "conductor", span.clone());
+            b.children.push(string("material", "none", span.clone()));
+            specular_reflectance(ctx, d, &mut b)?;
+            return Ok(wrap("bsdf", "twosided", span, b));
+        }
+        "glossy" => {
+            b = plugin("bsdf", "roughconductor", span.clone());
+            b.children.push(string("material", "none", span.clone()));
+            b.children.push(string("distribution", "ggx", span.clone()));
+            let r = ctx.need(&d.roughness, "roughness", &span, &what)?;
+            let roughness = ctx.num(r, "roughness")?;
+            if !(roughness >= MIN_ROUGHNESS) {
+                return Err(ctx.at(r.span(), format!("`roughness` (GGX α) must be at least {MIN_ROUGHNESS}, got {roughness} (use a mirror for a perfectly smooth surface)")));
+            }
+            b.children.push(float("alpha", roughness, r.span()));
+            specular_reflectance(ctx, d, &mut b)?;
+            return Ok(wrap("bsdf", "twosided", span, b));
+        }
+        "dielectric" => {
+            b = plugin("bsdf", "dielectric", span.clone());
+            ior(ctx, d, &span, &what, Some(&mut b))?;
+        }
+        "roughdielectric" | "thindielectric" => {
+            b = plugin("bsdf", kind, span.clone());
+            ior(ctx, d, &span, &what, Some(&mut b))?;
+            if kind == "roughdielectric" {
+                microfacet(ctx, d, &span, &mut b)?;
+            }
+            specular_reflectance(ctx, d, &mut b)?;
+            if let Some(t) = &d.transmittance {
+                b.children.push(color(
+                    ctx,
+                    t,
+                    "transmittance",
+                    "specular_transmittance",
+                    true,
+                )?);
+            }
+        }
+        "conductor" | "roughconductor" => {
+            b = plugin("bsdf", kind, span.clone());
+            complex_ior(ctx, d, &span, &mut b)?;
+            if kind == "roughconductor" {
+                microfacet(ctx, d, &span, &mut b)?;
+            }
+            specular_reflectance(ctx, d, &mut b)?;
+        }
+        "plastic" | "roughplastic" => {
+            b = plugin("bsdf", kind, span.clone());
+            plastic(ctx, d, kind, &mut b)?;
+        }
+        _ => {
+            b = plugin("bsdf", kind, span.clone());
+            principled(ctx, d, &mut b)?;
+        }
+    }
+    Ok(if twosided {
+        wrap("bsdf", "twosided", span, b)
+    } else {
+        b
+    })
+}
+
+/// `reflectance` (or `reflectance_texture`) as `specular_reflectance`.
+fn specular_reflectance(ctx: &Ctx, d: &MaterialDef, b: &mut Elem) -> Result<(), SceneError> {
+    match (&d.reflectance, &d.reflectance_texture) {
+        (Some(_), Some(t)) => Err(ctx.at(
+            t.span(),
+            "give `reflectance` or `reflectance_texture`, not both",
+        )),
+        (Some(r), None) => {
+            let e = color(ctx, r, "reflectance", "specular_reflectance", true)?;
+            b.children.push(e);
+            Ok(())
+        }
+        (None, Some(t)) => {
+            b.children.push(texture(ctx, t, "specular_reflectance")?);
+            Ok(())
+        }
+        (None, None) => Ok(()),
+    }
+}
+
+/// A dielectric's `ior` as `int_ior` in a vacuum (`ext_ior` = 1).
+fn ior(
+    ctx: &Ctx,
+    d: &MaterialDef,
+    span: &Range<usize>,
+    what: &str,
+    b: Option<&mut Elem>,
+) -> Result<f32, SceneError> {
+    let i = ctx.need(&d.ior, "ior", span, what)?;
+    let ior = ctx.positive(i, "ior")?;
+    if let Some(b) = b {
+        b.children.push(float("int_ior", ior, i.span()));
+        b.children.push(float("ext_ior", 1.0, span.clone()));
+    }
+    Ok(ior)
+}
+
+/// Mitsuba's `plastic` / `roughplastic`: `albedo` (its `diffuse_reflectance`), `reflectance`
+/// (`specular_reflectance`), `ior` (default polypropylene in air), `nonlinear`; the rough one
+/// adds `distribution` and `alpha`.
+fn plastic(ctx: &Ctx, d: &MaterialDef, kind: &str, b: &mut Elem) -> Result<(), SceneError> {
+    let span = d.kind.span();
+    let ior = match &d.ior {
+        None => POLYPROPYLENE_IOR / AIR_IOR,
+        Some(i) => ctx.positive(i, "ior")?,
+    };
+    if kind == "roughplastic" && ior == 1.0 {
+        return Err(ctx.at(
+            d.ior.as_ref().map_or(span.clone(), S::span),
+            "a roughplastic needs `ior` ≠ 1 (as Mitsuba)",
+        ));
+    }
+    let at = d.ior.as_ref().map_or(span.clone(), S::span);
+    b.children.push(float("int_ior", ior, at));
+    b.children.push(float("ext_ior", 1.0, span.clone()));
+    match (&d.albedo, &d.albedo_texture) {
+        (Some(_), Some(t)) => {
+            return Err(ctx.at(t.span(), "give `albedo` or `albedo_texture`, not both"))
+        }
+        (Some(a), None) => b
+            .children
+            .push(color(ctx, a, "albedo", "diffuse_reflectance", true)?),
+        (None, Some(t)) => b.children.push(texture(ctx, t, "diffuse_reflectance")?),
+        (None, None) => {}
+    }
+    specular_reflectance(ctx, d, b)?;
+    if let Some(n) = &d.nonlinear {
+        b.children
+            .push(boolean("nonlinear", *n.get_ref(), n.span()));
+    }
+    if kind == "roughplastic" {
+        microfacet(ctx, d, &span, b)?;
+    }
+    Ok(())
+}
+
+/// A conductor's complex IOR: a `material` name Mitsuba knows (default "none": a perfect mirror)
+/// or `eta` and `k` together.
+fn complex_ior(
+    ctx: &Ctx,
+    d: &MaterialDef,
+    span: &Range<usize>,
+    b: &mut Elem,
+) -> Result<(), SceneError> {
+    match (&d.material, &d.eta, &d.k) {
+        (None, None, None) => Ok(()),
+        (Some(name), None, None) => {
+            if named_conductor(name.get_ref()).is_none() {
+                let names: Vec<&str> = conductor_names().collect();
+                return Err(ctx.at(
+                    name.span(),
+                    format!(
+                        "conductor material `{}` is not one Mitsuba knows (known: {})",
+                        name.get_ref(),
+                        names.join(", ")
+                    ),
+                ));
+            }
+            b.children
+                .push(string("material", name.get_ref(), name.span()));
+            Ok(())
+        }
+        (None, Some(eta), Some(k)) => {
+            b.children.push(color(ctx, eta, "eta", "eta", false)?);
+            b.children.push(color(ctx, k, "k", "k", false)?);
+            Ok(())
+        }
+        (Some(name), _, _) => Err(ctx.at(
+            name.span(),
+            "give a conductor `material` or `eta` and `k`, not both",
+        )),
+        _ => Err(ctx.at(
+            span.clone(),
+            "a conductor's `eta` and `k` go together: give both",
+        )),
+    }
+}
+
+/// A microfacet distribution: `distribution` (beckmann, the default, or ggx) and `alpha`
+/// (default 0.1, at least 1e-4) or `alpha_u` and `alpha_v`, each a number or a texture.
+fn microfacet(
+    ctx: &Ctx,
+    d: &MaterialDef,
+    at: &Range<usize>,
+    b: &mut Elem,
+) -> Result<(), SceneError> {
+    if let Some(s) = &d.distribution {
+        if !matches!(s.get_ref().as_str(), "beckmann" | "ggx") {
+            return Err(ctx.at(
+                s.span(),
+                format!(
+                    "`distribution` must be beckmann or ggx, got `{}`",
+                    s.get_ref()
+                ),
+            ));
+        }
+        b.children
+            .push(string("distribution", s.get_ref(), s.span()));
+    }
+    let given = |a: &Option<S<f64>>, t: &Option<S<TextureDef>>| a.is_some() || t.is_some();
+    let (u_given, v_given) = (
+        given(&d.alpha_u, &d.alpha_u_texture),
+        given(&d.alpha_v, &d.alpha_v_texture),
+    );
+    if u_given != v_given || (u_given && given(&d.alpha, &d.alpha_texture)) {
+        return Err(ctx.at(
+            at.clone(),
+            "give `alpha` (or `alpha_texture`), or both `alpha_u` and `alpha_v` (or their textures)",
+        ));
+    }
+    for (a, t, key) in [
+        (&d.alpha, &d.alpha_texture, "alpha"),
+        (&d.alpha_u, &d.alpha_u_texture, "alpha_u"),
+        (&d.alpha_v, &d.alpha_v_texture, "alpha_v"),
+    ] {
+        match (a, t) {
+            (Some(_), Some(t)) => {
+                return Err(ctx.at(
+                    t.span(),
+                    format!("give `{key}` or `{key}_texture`, not both"),
+                ))
+            }
+            (Some(a), None) => {
+                let x = ctx.num(a, key)?;
+                if !(x >= MIN_ROUGHNESS) {
+                    return Err(ctx.at(a.span(), format!("`{key}` must be at least {MIN_ROUGHNESS}, got {x} (use a conductor for a perfectly smooth surface)")));
+                }
+                b.children.push(float(key, x, a.span()));
+            }
+            (None, Some(t)) => b.children.push(texture(ctx, t, key)?),
+            (None, None) => {}
+        }
+    }
+    Ok(())
+}
+
+/// `principled` and `principledthin`: Mitsuba's names and defaults, except `ior` for its `eta`;
+/// scalars are numbers here (Mitsuba XML also takes textures for them). η and `specular` go
+/// into the tree in f64, as given: η = 1 exactly is moved off the index-matched interface.
+fn principled(ctx: &Ctx, d: &MaterialDef, b: &mut Elem) -> Result<(), SceneError> {
+    let thin = d.kind.get_ref() == "principledthin";
+    match (&d.base_color, &d.base_color_texture) {
+        (Some(_), Some(t)) => {
+            return Err(ctx.at(
+                t.span(),
+                "give `base_color` or `base_color_texture`, not both",
+            ))
+        }
+        (Some(c), None) => b
+            .children
+            .push(color(ctx, c, "base_color", "base_color", true)?),
+        (None, Some(t)) => b.children.push(texture(ctx, t, "base_color")?),
+        (None, None) => {}
+    }
+    let mut spec_trans = 0.0;
+    let scalars = [
+        (&d.roughness, "roughness", 1.0),
+        (&d.anisotropic, "anisotropic", 1.0),
+        (&d.spec_trans, "spec_trans", 1.0),
+        (&d.spec_tint, "spec_tint", 1.0),
+        (&d.sheen, "sheen", 1.0),
+        (&d.sheen_tint, "sheen_tint", 1.0),
+        (&d.flatness, "flatness", 1.0),
+        (&d.metallic, "metallic", 1.0),
+        (&d.clearcoat, "clearcoat", 1.0),
+        (&d.clearcoat_gloss, "clearcoat_gloss", 1.0),
+        (&d.diff_trans, "diff_trans", 2.0),
+    ];
+    for (v, name, max) in scalars {
+        let Some(x) = v else { continue };
+        let value = scalar_in_range(name, *x.get_ref(), max).map_err(|e| ctx.at(x.span(), e))?;
+        if name == "spec_trans" {
+            spec_trans = value;
+        }
+        b.children.push(float(name, value, x.span()));
+    }
+    let ior = d.ior.as_ref().map(|i| *i.get_ref());
+    let ior_span = || d.ior.as_ref().map_or(d.kind.span(), |i| i.span());
+    if thin {
+        thin_eta(ior, "ior").map_err(|e| ctx.at(ior_span(), e))?;
+    } else {
+        let specular = d.specular.as_ref().map(|s| *s.get_ref());
+        let eta_span = d.specular.as_ref().map_or_else(ior_span, |s| s.span());
+        principled_eta(ior, specular, spec_trans != 0.0, "ior").map_err(|e| ctx.at(eta_span, e))?;
+        if let Some(s) = &d.specular {
+            b.children.push(float64("specular", *s.get_ref(), s.span()));
+        }
+    }
+    if let Some(i) = &d.ior {
+        b.children.push(float64("eta", *i.get_ref(), i.span()));
+    }
+    Ok(())
+}
