@@ -84,14 +84,19 @@ if ! ls /usr/lib/x86_64-linux-gnu/libLLVM-1[5-9]*.so* /usr/lib/llvm-1[5-9]/lib/l
     echo "bench_peers.sh: apt-get install libllvm19 failed (llvm_ad_rgb will not load)" >&2
 fi
 # "### SCENE: Mitsuba VARIANT `peer` vs lt `ours`, …" then a table ending in the median row: one
-# row per (scene, variant, pair) with the issue's target; the equal-error efficiency (the row's
-# last figure) where the scene had a reference.
+# row per (scene, variant, pair) with the issue's target: the wall-time ratio, the CPU-time ratio
+# and, where the scene had a reference, the efficiency at equal error (columns found by header).
 mitsuba_rows() { # FILE.md TARGET
   awk -v target="$2" '
+    function cell(i,   v) { v = c[i]; gsub(/^ +| +$/, "", v); return v }
     /^### / { split($0, a, "`"); scene = $2; sub(":", "", scene); variant = $4
       pair = "lt `" a[4] "` / Mitsuba " variant " `" a[2] "` (" scene ")" }
-    /^\| \*\*median/ { n = split($0, c, "|"); r = c[10]; gsub(/^ +| +$/, "", r); e = c[n - 1]; gsub(/^ +| +$/, "", e)
-      if (e != "" && e !~ /%/) r = r " time at equal spp; " e " efficiency at equal error"
+    /^\| round/ { n = split($0, c, "|"); wall = cpu = eff = 0
+      for (i = 1; i <= n; i++) { h = cell(i)
+        if (h == "**lt/Mitsuba**") wall = i; if (h ~ /by CPU time/) cpu = i; if (h ~ /efficiency/) eff = i } }
+    /^\| \*\*median/ { n = split($0, c, "|"); r = cell(wall)
+      if (cpu) r = r " wall; " cell(cpu) " CPU time"
+      if (eff && cell(eff) != "") r = r "; " cell(eff) " efficiency at equal error"
       print "| " pair " | " r " | " target " |" }
   ' "$1"
 }

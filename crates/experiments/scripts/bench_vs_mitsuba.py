@@ -196,6 +196,8 @@ def lt_render(lt, scene, integrator, spp, threads, seed, out_exr, extra=()):
     return {
         "seconds": secs,
         "spp_per_s": spp / secs,
+        # CPU seconds of the pass loop's threads (lt's own record).
+        "cpu_seconds": float(rec.get("cpu_seconds", float("nan"))),
         "process_wall": wall,
         # The whole process's CPU time over its wall time (the pass loop cannot be told apart from
         # outside): near `threads` on an idle machine when the pass loop dominates, lower when a
@@ -269,6 +271,7 @@ class Mitsuba:
         return {
             "seconds": secs,
             "spp_per_s": spp / secs,
+            "cpu_seconds": cpu,
             "cpu": cpu / max(secs, 1e-9),
             "load1": before,
             "compiled": self._compiles(),
@@ -454,7 +457,9 @@ def main():
         "mi.render after a warm-up). cpu = CPU seconds / wall seconds (Mitsuba: of the render; lt: "
         "of its whole process, scene load included); near the thread count on an idle machine. "
         "load = 1-min load average just before the render. "
-        "Δmean = mean pixel of lt / Mitsuba − 1 (a few % is noise at few spp).",
+        "Δmean = mean pixel of lt / Mitsuba − 1 (a few % is noise at few spp). lt/Mitsuba by CPU time = "
+        "Mitsuba's CPU seconds over lt's (lt: its pass loop's threads; Mitsuba: this process during "
+        "mi.render) at equal spp, which a machine shared with other work disturbs less than wall time.",
         "",
     ])
     print("\n".join(out), flush=True)
@@ -502,12 +507,12 @@ def main():
                             f"Mitsuba scene load {load_secs:.2f} s; warm-up render (incl. JIT) {warm:.2f} s.",
                             "",
                             "| round | first | lt spp/s | lt cpu | lt load | Mitsuba spp/s | Mitsuba cpu | Mitsuba load "
-                            "| **lt/Mitsuba** | mean lt | mean Mitsuba | Δmean |"
+                            "| **lt/Mitsuba** | mean lt | mean Mitsuba | Δmean | lt/Mitsuba by CPU time |"
                             + (" MSE* lt | MSE* Mitsuba | **efficiency lt/Mitsuba** |" if ref else ""),
-                            "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+                            "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
                             + ("---:|---:|---:|" if ref else "")]
                     print("\n".join(rows), flush=True)
-                    ratios, diffs, effs = [], [], []
+                    ratios, diffs, effs, cpu_ratios = [], [], [], []
                     for r in range(rounds):
                         seed = r + 1
                         exr = os.path.join(work, f"{name}-{lt_int}.exr")
@@ -528,6 +533,9 @@ def main():
                             eff = (mse_mi * mir["seconds"]) / (mse_lt * ltr["seconds"])
                             effs.append(eff)
                         ratio = ltr["spp_per_s"] / mir["spp_per_s"]
+                        # On a shared machine the CPU seconds each spent, Mitsuba's over lt's.
+                        cpu_ratio = mir["cpu_seconds"] / ltr["cpu_seconds"]
+                        cpu_ratios.append(cpu_ratio)
                         d = mean_diff(lt_mean, mi_mean)
                         ratios.append(ratio)
                         diffs.append(d)
@@ -535,29 +543,30 @@ def main():
                         row = (f"| {r + 1} | {'lt' if lt_first else 'Mitsuba'} | {ltr['spp_per_s']:.2f} | "
                                f"{ltr['cpu']:.2f} | {ltr['load1']:.2f} | {mir['spp_per_s']:.2f}{flag} | "
                                f"{mir['cpu']:.2f} | {mir['load1']:.2f} | **{ratio:.2f}** | {lt_mean:.4f} | "
-                               f"{mi_mean:.4f} | {100 * d:+.1f} % |")
+                               f"{mi_mean:.4f} | {100 * d:+.1f} % | {cpu_ratio:.2f} |")
                         if ref:
                             row += (f" {fmt_mse(mse_lt)} | {fmt_mse(mse_mi)} | "
                                     + (f"**{eff:.2f}** |" if eff is not None else "— |"))
                         print(row, flush=True)
                         rows.append(row)
                     tail = [f"| **median [min, max]** | | | | | | | | {fmt_ratio_summary(ratios)} | | | "
-                            f"{100 * statistics.median(diffs):+.1f} % |"
+                            f"{100 * statistics.median(diffs):+.1f} % | {fmt_ratio_summary(cpu_ratios)} |"
                             + (f" | | {fmt_ratio_summary(effs)} |" if effs else (" | | |" if ref else "")), ""]
                     print("\n".join(tail), flush=True)
                     rows.extend(tail)
                     out.extend(rows)
-                    summary.append((name, variant, n, f"{m_int} / {lt_int}", ratios, diffs, effs))
+                    summary.append((name, variant, n, f"{m_int} / {lt_int}", ratios, diffs, effs, cpu_ratios))
 
     s = ["## Summary: lt throughput / Mitsuba throughput (median over rounds [min, max])", "",
          "| scene | Mitsuba variant | threads | Mitsuba / lt integrator | lt/Mitsuba | Δmean (median) | rounds "
-         "| efficiency lt/Mitsuba at equal error |",
-         "|---|---|---:|---|---:|---:|---:|---:|"]
+         "| lt/Mitsuba by CPU time | efficiency lt/Mitsuba at equal error |",
+         "|---|---|---:|---|---:|---:|---:|---:|---:|"]
     warn = []
-    for name, variant, n, pair, ratios, diffs, effs in summary:
+    for name, variant, n, pair, ratios, diffs, effs, cpu_ratios in summary:
         md = statistics.median(diffs)
         s.append(f"| {name} | {variant} | {n} | {pair} | {fmt_ratio_summary(ratios)} | {100 * md:+.1f} % | "
-                 f"{len(ratios)} | {fmt_ratio_summary(effs) if effs else '— (no reference)'} |")
+                 f"{len(ratios)} | {fmt_ratio_summary(cpu_ratios)} | "
+                 f"{fmt_ratio_summary(effs) if effs else '— (no reference)'} |")
         if abs(md) > 0.05:
             warn.append(f"- **image check**: {name} {pair} ({variant}): mean pixel differs by "
                         f"{100 * md:+.1f} % — check the conversion before trusting the ratio.")
