@@ -77,8 +77,12 @@ if ! python3 -c "import mitsuba, numpy" 2>/dev/null; then
   echo "bench_peers.sh: installing Mitsuba 3 (pip install mitsuba numpy)" >&2
   python3 -m pip install --quiet mitsuba numpy >&2 || echo "bench_peers.sh: pip install mitsuba failed" >&2
 fi
-if ! ls /usr/lib/x86_64-linux-gnu/libLLVM-1[5-9]*.so* /usr/lib/llvm-1[5-9]/lib/libLLVM* >/dev/null 2>&1 &&
-  [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+have_llvm=0
+for f in /usr/lib/x86_64-linux-gnu/libLLVM-1[5-9]*.so* /usr/lib/x86_64-linux-gnu/libLLVM-[2-9][0-9]*.so* \
+  /usr/lib/llvm-1[5-9]/lib/libLLVM* /usr/lib/llvm-[2-9][0-9]/lib/libLLVM*; do
+  [ -e "$f" ] && have_llvm=1
+done
+if [ "$have_llvm" = 0 ] && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
   echo "bench_peers.sh: installing libllvm19 for Mitsuba's llvm_ad_rgb" >&2
   { apt-get install -y -q libllvm19 || { apt-get update -q && apt-get install -y -q libllvm19; }; } >/dev/null 2>&1 ||
     echo "bench_peers.sh: apt-get install libllvm19 failed (llvm_ad_rgb will not load)" >&2
