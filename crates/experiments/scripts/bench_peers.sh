@@ -10,8 +10,14 @@
 # Tungsten's reference, ≈ 4 min, then cached); --quick ≈ 3 min.
 #
 # Peers, each skipped with a line saying so when absent (nothing of them is committed):
-# - Mitsuba 3 (`pip install mitsuba numpy`; `llvm_ad_rgb` needs Debian's libllvm): `path` against
-#   `pt` and `ptracer` against `light`, through bench_vs_mitsuba.py (its header says how it times).
+# - Mitsuba 3 (`pip install mitsuba numpy`, done here when `import mitsuba` fails; `llvm_ad_rgb`
+#   needs Debian's libllvm 15 or later, `apt-get install libllvm19`, also done here as root when
+#   none is found): `path` against `pt` and `ptracer` against `light`, through
+#   bench_vs_mitsuba.py (its header says how it times); and with participating media (issue 43),
+#   its `volpath` against `pt` on three scenes of Mitsuba's own render-test suite
+#   ($SUITE/participating_media, default ../shared/mitsuba-render-tests/tests/scenes beside the
+#   repository), in `scalar_rgb` and `llvm_ad_rgb`, at the suite's size (48 x 48) and max depth
+#   (6), with time at equal spp and efficiency at equal error against the suite's references.
 # - SmallVCM, built from its public source outside the repository:
 #     git clone https://github.com/SmallVCM/SmallVCM && cd SmallVCM &&
 #     g++ -o smallvcm ./src/smallvcm.cxx -O3 -std=c++0x -fopenmp
@@ -62,11 +68,42 @@ REPORT="$WORK/report.md"
   echo
   echo "lt: $LT_FROM"
   echo
-  echo "| pair | ratio (median [min, max] over rounds) | target (issue 28) |"
+  echo "| pair | ratio (median [min, max] over rounds) | target (issue) |"
   echo "|---|---|---|"
 } >"$REPORT"
 
-# Mitsuba 3: median ratio rows of bench_vs_mitsuba.py's Markdown, one per (scene, pair).
+# Mitsuba 3 from PyPI when absent; Dr.Jit's LLVM backend wants libLLVM ≥ 15 (Debian's libllvm19).
+if ! python3 -c "import mitsuba, numpy" 2>/dev/null; then
+  echo "bench_peers.sh: installing Mitsuba 3 (pip install mitsuba numpy)" >&2
+  python3 -m pip install --quiet mitsuba numpy >&2 || echo "bench_peers.sh: pip install mitsuba failed" >&2
+fi
+have_llvm=0
+for f in /usr/lib/x86_64-linux-gnu/libLLVM-1[5-9]*.so* /usr/lib/x86_64-linux-gnu/libLLVM-[2-9][0-9]*.so* \
+  /usr/lib/llvm-1[5-9]/lib/libLLVM* /usr/lib/llvm-[2-9][0-9]/lib/libLLVM*; do
+  [ -e "$f" ] && have_llvm=1
+done
+if [ "$have_llvm" = 0 ] && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+  echo "bench_peers.sh: installing libllvm19 for Mitsuba's llvm_ad_rgb" >&2
+  { apt-get install -y -q libllvm19 || { apt-get update -q && apt-get install -y -q libllvm19; }; } >/dev/null 2>&1 ||
+    echo "bench_peers.sh: apt-get install libllvm19 failed (llvm_ad_rgb will not load)" >&2
+fi
+# "### SCENE: Mitsuba VARIANT `peer` vs lt `ours`, …" then a table ending in the median row: one
+# row per (scene, variant, pair) with the issue's target: the wall-time ratio, the CPU-time ratio
+# and, where the scene had a reference, the efficiency at equal error (columns found by header).
+mitsuba_rows() { # FILE.md TARGET
+  awk -v target="$2" '
+    function cell(i,   v) { v = c[i]; gsub(/^ +| +$/, "", v); return v }
+    /^### / { split($0, a, "`"); scene = $2; sub(":", "", scene); variant = $4
+      pair = "lt `" a[4] "` / Mitsuba " variant " `" a[2] "` (" scene ")" }
+    /^\| round/ { n = split($0, c, "|"); wall = cpu = eff = 0
+      for (i = 1; i <= n; i++) { h = cell(i)
+        if (h == "**lt/Mitsuba**") wall = i; if (h ~ /by CPU time/) cpu = i; if (h ~ /efficiency/) eff = i } }
+    /^\| \*\*median/ { n = split($0, c, "|"); r = cell(wall)
+      if (cpu) r = r " wall; " cell(cpu) " CPU time"
+      if (eff && cell(eff) != "") r = r "; " cell(eff) " efficiency at equal error"
+      print "| " pair " | " r " | " target " |" }
+  ' "$1"
+}
 if python3 -c "import mitsuba" 2>/dev/null; then
   mi_args=(--lt "$LT" --threads 2 --variants llvm_ad_rgb --out "$WORK/mitsuba.md" --work "$WORK/mi")
   if [ "$QUICK" = 1 ]; then mi_args+=(--quick); else mi_args+=(--spp 64 --rounds 5); fi
@@ -75,12 +112,25 @@ if python3 -c "import mitsuba" 2>/dev/null; then
     tail -20 "$WORK/mitsuba.log" >&2
     exit 1
   }
-  # "### SCENE: Mitsuba VARIANT `peer` vs lt `ours`, …" then a table ending in the median row.
-  awk '
-    /^### / { split($0, a, "`"); scene = $2; sub(":", "", scene); pair = "lt `" a[4] "` / Mitsuba `" a[2] "` (" scene ")" }
-    /^\| \*\*median/ { n = split($0, c, "|"); r = c[10]; gsub(/^ +| +$/, "", r);
-      print "| " pair " | " r " | ≥ 1.0 |" }
-  ' "$WORK/mitsuba.md" >>"$REPORT"
+  mitsuba_rows "$WORK/mitsuba.md" "≥ 1.0" >>"$REPORT"
+  # Participating media (issue 43): volpath against pt on three suite scenes, both variants.
+  SUITE=${SUITE:-$REPO/../shared/mitsuba-render-tests/tests/scenes}
+  media="$SUITE/participating_media"
+  media_scenes=(test_homo_null_envmap_volpath test_hetero_sigmat_volpath test_homo_area_light_volpath)
+  if [ -d "$media" ]; then
+    md_args=(--lt "$LT" --threads 2 --variants scalar_rgb llvm_ad_rgb --pairs volpath:pt --max-depth 6
+      --out "$WORK/mitsuba-media.md" --work "$WORK/mi-media" --scenes)
+    for s in "${media_scenes[@]}"; do md_args+=("$media/$s.xml"); done
+    if [ "$QUICK" = 1 ]; then md_args+=(--quick); else md_args+=(--spp 256 --rounds 3); fi
+    python3 "$SCRIPTS/bench_vs_mitsuba.py" "${md_args[@]}" >"$WORK/mitsuba-media.log" 2>&1 || {
+      echo "bench_peers.sh: bench_vs_mitsuba.py (media) failed; its log:" >&2
+      tail -20 "$WORK/mitsuba-media.log" >&2
+      exit 1
+    }
+    mitsuba_rows "$WORK/mitsuba-media.md" "≥ 1.0 scalar (issue 43)" >>"$REPORT"
+  else
+    echo "| Mitsuba 3 \`volpath\` (media) | not run: no suite at \$SUITE ($SUITE) | ≥ 1.0 scalar (issue 43) |" >>"$REPORT"
+  fi
 else
   echo "| Mitsuba 3 | not run: \`import mitsuba\` fails (pip install mitsuba numpy) | |" >>"$REPORT"
 fi
@@ -137,6 +187,9 @@ fi
   echo "seconds of lt over seconds of SmallVCM (< 1: lt faster); Tungsten's are efficiency at equal"
   echo "error (> 1: lt faster) and, for sppm, time to an MSE (< 1: lt faster). Full tables follow."
   if [ -f "$WORK/mitsuba.md" ]; then echo; echo "## Mitsuba 3, every round"; echo; cat "$WORK/mitsuba.md"; fi
+  if [ -f "$WORK/mitsuba-media.md" ]; then
+    echo; echo "## Mitsuba 3 with participating media, every round"; echo; cat "$WORK/mitsuba-media.md"
+  fi
   if [ -f "$WORK/smallvcm.log" ]; then echo; echo "## SmallVCM, every round"; echo; echo '```'; cat "$WORK/smallvcm.log"; echo '```'; fi
   if [ -f "$WORK/tungsten.md" ]; then echo; echo "## Tungsten, every render"; echo; cat "$WORK/tungsten.md"; fi
 } >>"$REPORT"

@@ -13,6 +13,21 @@ idle machine:
 
 Smoke test (a few seconds of rendering): add --quick (4 spp, 1 round).
 
+Mitsuba XML scenes (issue 43: participating media) are rendered as they are, by both renderers,
+with no `lt convert`: e.g. three scenes of Mitsuba's own media suite, `volpath` against lt's `pt`,
+both variants, the suite's max depth 6 and its own resolution (48 x 48):
+
+    python3 crates/experiments/scripts/bench_vs_mitsuba.py --lt /tmp/lt-bench-binary \
+        --scenes $SUITE/participating_media/test_homo_null_envmap_volpath.xml … \
+        --pairs volpath:pt --variants scalar_rgb llvm_ad_rgb --max-depth 6 --spp 256
+
+`-D key=value` sets an XML scene's `$key` for both (e.g. -D res=128). When the scene's folder
+holds Mitsuba's reference `refs/<scene without _volpath>_ref_rgb.exr` of the rendered size, each
+render's MSE against it is shown too, and the efficiency ratio at equal error,
+(MSE_Mitsuba · t_Mitsuba) / (MSE_lt · t_lt) (> 1: lt reaches a given error sooner); MSE* subtracts
+the reference's own noise: the mean of its per-sample variance image `_var` over the 32,000
+samples per pixel the suite's references were rendered with (its README).
+
 What it does, per scene (default scenes/cornell-box.toml and scenes/bench/cornell-glossy-glass.toml):
 `lt convert` writes the scene as Mitsuba XML once; Mitsuba loads it once per variant (in this
 process, so the scene and the JIT kernels are reused). Then, per thread count and round, back to
@@ -70,8 +85,9 @@ from mitsuba_reference import find_libllvm  # noqa: E402
 DEFAULT_SCENES = ["scenes/cornell-box.toml", "scenes/bench/cornell-glossy-glass.toml"]
 # (Mitsuba integrator, lt integrator): the same estimator on both sides.
 PAIRS = [("path", "pt"), ("ptracer", "light")]
-MAX_DEPTH = 8
-RR_DEPTH = 5
+MAX_DEPTH = 8  # --max-depth
+RR_DEPTH = 5  # --rr-depth
+DEFINES = []  # -D key=value: an XML scene's parameters, for both renderers
 
 
 # ---------------------------------------------------------------------------------------------
@@ -163,6 +179,8 @@ def lt_render(lt, scene, integrator, spp, threads, seed, out_exr, extra=()):
     cmd = [lt, "render", scene, "-i", integrator, "--spp", str(spp), "--threads", str(threads),
            "--seed", str(seed), "--max-depth", str(MAX_DEPTH), "--rr-depth", str(RR_DEPTH),
            "--quiet", "-o", out_exr, *extra]
+    for k, v in DEFINES:
+        cmd += ["-D", f"{k}={v}"]
     c0 = cpu_children()
     t0 = time.perf_counter()
     r = subprocess.run(cmd, capture_output=True, text=True)
@@ -178,6 +196,8 @@ def lt_render(lt, scene, integrator, spp, threads, seed, out_exr, extra=()):
     return {
         "seconds": secs,
         "spp_per_s": spp / secs,
+        # CPU seconds of the pass loop's threads (lt's own record).
+        "cpu_seconds": float(rec.get("cpu_seconds", float("nan"))),
         "process_wall": wall,
         # The whole process's CPU time over its wall time (the pass loop cannot be told apart from
         # outside): near `threads` on an idle machine when the pass loop dominates, lower when a
@@ -220,7 +240,7 @@ class Mitsuba:
 
     def load(self, xml):
         t0 = time.perf_counter()
-        scene = self.mi.load_file(xml)
+        scene = self.mi.load_file(xml, **dict(DEFINES))
         return scene, time.perf_counter() - t0
 
     def integrator(self, kind):
@@ -251,6 +271,7 @@ class Mitsuba:
         return {
             "seconds": secs,
             "spp_per_s": spp / secs,
+            "cpu_seconds": cpu,
             "cpu": cpu / max(secs, 1e-9),
             "load1": before,
             "compiled": self._compiles(),
@@ -276,6 +297,9 @@ class Mitsuba:
 def xml_facts(xml):
     """Resolution, filter and max depth as the converted XML states them."""
     root = ET.parse(xml).getroot()
+    if root.find("./sensor/film") is None:
+        # A suite scene: its film sits in an <include>d file, sized by $res.
+        return None
     film = root.find("./sensor/film")
     w = int(film.find("./integer[@name='width']").get("value"))
     h = int(film.find("./integer[@name='height']").get("value"))
@@ -287,6 +311,45 @@ def xml_facts(xml):
         "rfilter": rf.get("type") if rf is not None else "gaussian (hdrfilm default)",
         "max_depth": int(md.get("value")) if md is not None else None,
     }
+
+
+def display_path(path):
+    """A path inside the repository relative to it; any other as it is."""
+    rel = os.path.relpath(path, REPO)
+    return path if rel.startswith("..") else rel
+
+
+# Samples per pixel of the render-test suite's references (its README).
+SUITE_REF_SPP = 32_000
+
+
+def reference_of(mitsuba, scene):
+    """Mitsuba's reference image of a render-test suite scene (`refs/<name without the
+    integrator suffix>_ref_rgb.exr` beside it) as (path, image, its own mean squared error: the
+    mean per-sample variance of `_var` over the reference's spp), or None."""
+    stem = os.path.splitext(os.path.basename(scene))[0]
+    for suffix in ("_volpathmis", "_volpath", "_path"):
+        if stem.endswith(suffix):
+            stem = stem[: -len(suffix)]
+            break
+    path = os.path.join(os.path.dirname(scene), "refs", stem + "_ref_rgb.exr")
+    if not os.path.exists(path):
+        return None
+    var_path = path[: -len(".exr")] + "_var.exr"
+    var = float(mitsuba.read_exr(var_path).mean()) if os.path.exists(var_path) else 0.0
+    return path, mitsuba.read_exr(path), var / SUITE_REF_SPP
+
+
+def mse_star(img, ref):
+    """Mean squared error of `img` against the reference (path, image, noise), its noise
+    subtracted; None when there is no reference or its size differs."""
+    if ref is None or ref[1].shape != img.shape:
+        return None
+    return float(((img - ref[1]) ** 2).mean()) - ref[2]
+
+
+def fmt_mse(x):
+    return "—" if x is None else f"{x:.3e}"
 
 
 def median_range(xs):
@@ -340,6 +403,7 @@ def header_lines(args, lt, mitsuba, extra=()):
 
 
 def main():
+    global MAX_DEPTH, RR_DEPTH
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog="\n".join(__doc__.split("\n")[1:]))
@@ -356,7 +420,16 @@ def main():
     ap.add_argument("--out", default=None, help="also write the Markdown here")
     ap.add_argument("--work", default=None, help="folder for the XML and images (default: a temporary one)")
     ap.add_argument("--quick", action="store_true", help="smoke test: 4 spp, 1 round")
+    ap.add_argument("--max-depth", type=int, default=MAX_DEPTH, help=f"both renderers (default {MAX_DEPTH})")
+    ap.add_argument("--rr-depth", type=int, default=RR_DEPTH, help=f"both renderers (default {RR_DEPTH})")
+    ap.add_argument("-D", dest="define", action="append", default=[], metavar="KEY=VALUE",
+                    help="an XML scene's $KEY for both renderers (repeatable)")
     a = ap.parse_args()
+    MAX_DEPTH, RR_DEPTH = a.max_depth, a.rr_depth
+    for d in a.define:
+        if "=" not in d:
+            sys.exit(f"-D {d}: expected KEY=VALUE")
+        DEFINES.append(tuple(d.split("=", 1)))
     spp = a.spp or (4 if a.quick else 64)
     rounds = a.rounds or (1 if a.quick else 7)
     threads = parse_int_list(a.threads)
@@ -384,7 +457,9 @@ def main():
         "mi.render after a warm-up). cpu = CPU seconds / wall seconds (Mitsuba: of the render; lt: "
         "of its whole process, scene load included); near the thread count on an idle machine. "
         "load = 1-min load average just before the render. "
-        "Δmean = mean pixel of lt / Mitsuba − 1 (a few % is noise at few spp).",
+        "Δmean = mean pixel of lt / Mitsuba − 1 (a few % is noise at few spp). lt/Mitsuba by CPU time = "
+        "Mitsuba's CPU seconds over lt's (lt: its pass loop's threads; Mitsuba: this process during "
+        "mi.render) at equal spp, which a machine shared with other work disturbs less than wall time.",
         "",
     ])
     print("\n".join(out), flush=True)
@@ -392,14 +467,25 @@ def main():
 
     for scene in scenes:
         name = os.path.splitext(os.path.basename(scene))[0]
-        xml = os.path.join(work, name + ".xml")
-        lt_convert(lt, scene, xml)
-        facts = xml_facts(xml)
-        note = (f"## {name}\n\n`{os.path.relpath(scene, REPO)}` → `lt convert` → Mitsuba: "
-                f"{facts['width']}×{facts['height']}, rfilter {facts['rfilter']}, scene max_depth "
-                f"{facts['max_depth']} (both renderers are run at {MAX_DEPTH}).\n")
-        if facts["max_depth"] != MAX_DEPTH:
-            note += f"\n**Note**: the scene says max_depth {facts['max_depth']}; rendered at {MAX_DEPTH}.\n"
+        if scene.endswith(".xml"):
+            # A Mitsuba scene: both renderers read the same file.
+            xml = scene
+            defs = ", ".join(f"{k}={v}" for k, v in DEFINES) or "none"
+            note = (f"## {name}\n\n`{display_path(scene)}`, Mitsuba XML read by both (-D: {defs}); "
+                    f"both renderers are run at max depth {MAX_DEPTH}.\n")
+        else:
+            xml = os.path.join(work, name + ".xml")
+            lt_convert(lt, scene, xml)
+            facts = xml_facts(xml)
+            note = (f"## {name}\n\n`{display_path(scene)}` → `lt convert` → Mitsuba: "
+                    f"{facts['width']}×{facts['height']}, rfilter {facts['rfilter']}, scene max_depth "
+                    f"{facts['max_depth']} (both renderers are run at {MAX_DEPTH}).\n")
+            if facts["max_depth"] != MAX_DEPTH:
+                note += f"\n**Note**: the scene says max_depth {facts['max_depth']}; rendered at {MAX_DEPTH}.\n"
+        ref = reference_of(mitsuba, scene)
+        if ref is not None:
+            note += (f"\nReference: `{display_path(ref[0])}` (its own noise, mean of the `_var` image "
+                     f"/ {SUITE_REF_SPP} spp: {ref[2]:.3g}, subtracted from each MSE: MSE*).\n")
         print(note, flush=True)
         out.append(note)
         # One untimed lt render: checks the scene and warms the page cache.
@@ -421,10 +507,12 @@ def main():
                             f"Mitsuba scene load {load_secs:.2f} s; warm-up render (incl. JIT) {warm:.2f} s.",
                             "",
                             "| round | first | lt spp/s | lt cpu | lt load | Mitsuba spp/s | Mitsuba cpu | Mitsuba load "
-                            "| **lt/Mitsuba** | mean lt | mean Mitsuba | Δmean |",
-                            "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+                            "| **lt/Mitsuba** | mean lt | mean Mitsuba | Δmean | lt/Mitsuba by CPU time |"
+                            + (" MSE* lt | MSE* Mitsuba | **efficiency lt/Mitsuba** |" if ref else ""),
+                            "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+                            + ("---:|---:|---:|" if ref else "")]
                     print("\n".join(rows), flush=True)
-                    ratios, diffs = [], []
+                    ratios, diffs, effs, cpu_ratios = [], [], [], []
                     for r in range(rounds):
                         seed = r + 1
                         exr = os.path.join(work, f"{name}-{lt_int}.exr")
@@ -435,9 +523,19 @@ def main():
                         else:
                             mir, mimg = mitsuba.render(mscene, integrators[m_int], spp, seed)
                             ltr = lt_render(lt, scene, lt_int, spp, n, seed, exr)
-                        lt_mean = float(mitsuba.read_exr(exr).mean())
+                        limg = mitsuba.read_exr(exr)
+                        lt_mean = float(limg.mean())
                         mi_mean = float(mimg.mean())
+                        # Equal error: efficiency 1/(MSE* · seconds), lt over Mitsuba.
+                        mse_lt, mse_mi = mse_star(limg, ref), mse_star(mimg, ref)
+                        eff = None
+                        if mse_lt is not None and mse_lt > 0 and mse_mi > 0:
+                            eff = (mse_mi * mir["seconds"]) / (mse_lt * ltr["seconds"])
+                            effs.append(eff)
                         ratio = ltr["spp_per_s"] / mir["spp_per_s"]
+                        # On a shared machine the CPU seconds each spent, Mitsuba's over lt's.
+                        cpu_ratio = mir["cpu_seconds"] / ltr["cpu_seconds"]
+                        cpu_ratios.append(cpu_ratio)
                         d = mean_diff(lt_mean, mi_mean)
                         ratios.append(ratio)
                         diffs.append(d)
@@ -445,24 +543,30 @@ def main():
                         row = (f"| {r + 1} | {'lt' if lt_first else 'Mitsuba'} | {ltr['spp_per_s']:.2f} | "
                                f"{ltr['cpu']:.2f} | {ltr['load1']:.2f} | {mir['spp_per_s']:.2f}{flag} | "
                                f"{mir['cpu']:.2f} | {mir['load1']:.2f} | **{ratio:.2f}** | {lt_mean:.4f} | "
-                               f"{mi_mean:.4f} | {100 * d:+.1f} % |")
+                               f"{mi_mean:.4f} | {100 * d:+.1f} % | {cpu_ratio:.2f} |")
+                        if ref:
+                            row += (f" {fmt_mse(mse_lt)} | {fmt_mse(mse_mi)} | "
+                                    + (f"**{eff:.2f}** |" if eff is not None else "— |"))
                         print(row, flush=True)
                         rows.append(row)
                     tail = [f"| **median [min, max]** | | | | | | | | {fmt_ratio_summary(ratios)} | | | "
-                            f"{100 * statistics.median(diffs):+.1f} % |", ""]
+                            f"{100 * statistics.median(diffs):+.1f} % | {fmt_ratio_summary(cpu_ratios)} |"
+                            + (f" | | {fmt_ratio_summary(effs)} |" if effs else (" | | |" if ref else "")), ""]
                     print("\n".join(tail), flush=True)
                     rows.extend(tail)
                     out.extend(rows)
-                    summary.append((name, variant, n, f"{m_int} / {lt_int}", ratios, diffs))
+                    summary.append((name, variant, n, f"{m_int} / {lt_int}", ratios, diffs, effs, cpu_ratios))
 
     s = ["## Summary: lt throughput / Mitsuba throughput (median over rounds [min, max])", "",
-         "| scene | Mitsuba variant | threads | Mitsuba / lt integrator | lt/Mitsuba | Δmean (median) | rounds |",
-         "|---|---|---:|---|---:|---:|---:|"]
+         "| scene | Mitsuba variant | threads | Mitsuba / lt integrator | lt/Mitsuba | Δmean (median) | rounds "
+         "| lt/Mitsuba by CPU time | efficiency lt/Mitsuba at equal error |",
+         "|---|---|---:|---|---:|---:|---:|---:|---:|"]
     warn = []
-    for name, variant, n, pair, ratios, diffs in summary:
+    for name, variant, n, pair, ratios, diffs, effs, cpu_ratios in summary:
         md = statistics.median(diffs)
         s.append(f"| {name} | {variant} | {n} | {pair} | {fmt_ratio_summary(ratios)} | {100 * md:+.1f} % | "
-                 f"{len(ratios)} |")
+                 f"{len(ratios)} | {fmt_ratio_summary(cpu_ratios)} | "
+                 f"{fmt_ratio_summary(effs) if effs else '— (no reference)'} |")
         if abs(md) > 0.05:
             warn.append(f"- **image check**: {name} {pair} ({variant}): mean pixel differs by "
                         f"{100 * md:+.1f} % — check the conversion before trusting the ratio.")
