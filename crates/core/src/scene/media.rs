@@ -16,15 +16,33 @@
 //! is outside — is had here by declaring the exterior: a medium nested in another names the outer
 //! medium as its exterior, and a medium inside glass is the dielectric's interior (its exterior the
 //! air or fog around it), which is Mitsuba's convention and so its test scenes'.
+//!
+//! **A shape that declares no media** (interface 0) is no medium transition (Mitsuba's
+//! `is_medium_transition`): a ray leaving it stays in the medium it arrived in
+//! ([`Scene::medium_after`]), so an object placed inside fog without naming the fog reflects in
+//! it (the suite's obj_inside_medium, emitter_inside_medium, and the hetero scenes' floor poking
+//! into the cube). Only there does the rule read the arriving medium: a walk knows it, a vertex on
+//! such a shape has the same medium on both sides.
+//!
+//! **A thin dielectric's pass-through is a null event** in Mitsuba's `volpath` (its transmission
+//! lobe is `BSDFFlags::Null`: the direction is kept), so it does not count toward `max_depth`
+//! ([`Scene::is_null_transmission`]); the media walks follow that count. Shadow rays still stop
+//! at the pane (Mitsuba's pass it with weight 1 − R'); both are unbiased, the walk's MIS treating
+//! the pane as the delta vertex it is.
 
 use super::{ConnectionEnd, Scene};
+use crate::bsdf::Material;
 use crate::geometry::{offset_ray_origin, Ray};
 use crate::math::{gamma, Color, Vec3};
 use crate::medium::MediumId;
 use crate::sampling::Sampler;
 
+/// Distinct (interior, exterior) pairs a scene's shapes may name, (none, none) included: a shape
+/// keeps its pair's index in 16 bits (`Shape::interface`, copied into every hit and vertex).
+pub const MAX_MEDIUM_INTERFACES: usize = u16::MAX as usize + 1;
+
 /// The media on the two sides of a shape (Mitsuba's `interior` and `exterior`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct MediumInterface {
     pub interior: Option<MediumId>,
     pub exterior: Option<MediumId>,
@@ -72,6 +90,42 @@ impl Scene {
     #[inline]
     pub fn medium_across(&self, interface: u16, ng: Vec3, w: Vec3) -> Option<MediumId> {
         self.interfaces[interface as usize].towards(ng, w)
+    }
+
+    /// The medium a ray is in after leaving (or crossing) a surface with interface `interface`
+    /// along `w`, having arrived in `current`: the declared medium on that side, or `current`
+    /// when the shape declares none (module doc).
+    #[inline]
+    pub fn medium_after(
+        &self,
+        interface: u16,
+        ng: Vec3,
+        w: Vec3,
+        current: Option<MediumId>,
+    ) -> Option<MediumId> {
+        if interface == 0 {
+            current
+        } else {
+            self.medium_across(interface, ng, w)
+        }
+    }
+
+    /// True when material `material` has a lobe Mitsuba's `volpath` counts as a null event (a
+    /// `thindielectric`, plain or textured): a sample there may not count toward `max_depth`.
+    pub fn has_null_transmission(&self, material: u32) -> bool {
+        match self.material(material) {
+            Material::ThinDielectric(_) => true,
+            Material::Textured(t) => matches!(t.base, Material::ThinDielectric(_)),
+            _ => false,
+        }
+    }
+
+    /// True when a sample from `wo` to `wi` at a surface of material `material` with shading
+    /// normal `ns` took that null lobe: a thin dielectric's transmission, the one lobe that
+    /// leaves on the other side of the shading plane (its reflection mirrors about `ns`).
+    #[inline]
+    pub fn is_null_transmission(&self, material: u32, ns: Vec3, wo: Vec3, wi: Vec3) -> bool {
+        self.has_null_transmission(material) && ns.dot(wo) * ns.dot(wi) < 0.0
     }
 
     /// The medium light `light` emits into.
@@ -130,7 +184,7 @@ impl Scene {
                 a: here,
                 b: p,
             });
-            current = self.medium_across(s.interface, ng, d);
+            current = self.medium_after(s.interface, ng, d, current);
             here = p;
         }
         visit(MediumPiece {
