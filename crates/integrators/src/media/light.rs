@@ -143,7 +143,7 @@ pub fn trace(scene: &Scene, walk: LightWalk, sampler: &mut Sampler, splats: &mut
             if crossings > MAX_NULL_CROSSINGS {
                 return;
             }
-            medium = scene.medium_across(hit.interface, hit.ng, ray.d);
+            medium = scene.medium_after(hit.interface, hit.ng, ray.d, medium);
             ray = hit.spawn_ray(ray.d);
             continue;
         }
@@ -162,19 +162,28 @@ pub fn trace(scene: &Scene, walk: LightWalk, sampler: &mut Sampler, splats: &mut
                     .eval(&sf, at.wo, wi, TransportMode::Importance)
                     .f_cos
             };
-            let towards = |wi: Vec3| scene.medium_across(hit.interface, hit.ng, wi);
+            let arrived = medium;
+            let towards = |wi: Vec3| scene.medium_after(hit.interface, hit.ng, wi, arrived);
             let from = (hit.p, surface_end(&hit));
             splat(scene, walk, from, towards, sampler, splats, value);
         }
-        if n + 1 >= walk.max_depth {
+        // A pane's pass-through is no bounce (Mitsuba's null event, `pt`'s media walk alike).
+        let pane = scene.has_null_transmission(hit.material);
+        if n + 1 >= walk.max_depth && !pane {
             return;
         }
         let Some(bs) = continue_path(scene, &at, &rules, &mut beta, n, sampler) else {
             return;
         };
-        medium = scene.medium_across(hit.interface, hit.ng, bs.wi);
+        let crossed = pane && scene.is_null_transmission(hit.material, sf.ns(), at.wo, bs.wi);
+        if n + 1 >= walk.max_depth && !crossed {
+            return;
+        }
+        medium = scene.medium_after(hit.interface, hit.ng, bs.wi, medium);
         ray = hit.spawn_ray(bs.wi);
-        n += 1;
+        if !crossed {
+            n += 1;
+        }
     }
 }
 

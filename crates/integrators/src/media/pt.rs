@@ -114,7 +114,7 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
             if crossings > MAX_NULL_CROSSINGS {
                 break;
             }
-            medium = scene.medium_across(hit.interface, hit.ng, ray.d);
+            medium = scene.medium_after(hit.interface, hit.ng, ray.d, medium);
             ray = hit.spawn_ray(ray.d);
             continue;
         }
@@ -129,7 +129,10 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
                 l += beta * le * pt.hit_weights(prev.delta, prev.pdf_w, light_pdf).0;
             }
         }
-        if depth == params.max_depth {
+        // A pane (thin dielectric) may still be passed at the last depth: its pass-through is
+        // Mitsuba's null event, no bounce (`Scene::is_null_transmission`).
+        let pane = scene.has_null_transmission(hit.material);
+        if depth == params.max_depth && !pane {
             break;
         }
         let sf = hit.shading_frame();
@@ -139,25 +142,40 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
             wo,
         };
         if nee && !scene.material_is_delta(hit.material) {
-            l += beta * nee_at_surface(pt, scene, &at, sampler);
+            l += beta * nee_at_surface(pt, scene, &at, medium, sampler);
         }
         let Some(bs) = continue_path(scene, &at, &rules, &mut beta, depth, sampler) else {
             break;
         };
-        medium = scene.medium_across(hit.interface, hit.ng, bs.wi);
+        let crossed = pane && scene.is_null_transmission(hit.material, sf.ns(), wo, bs.wi);
+        if depth == params.max_depth && !crossed {
+            break;
+        }
+        medium = scene.medium_after(hit.interface, hit.ng, bs.wi, medium);
+        // After a pane, too, the previous vertex is a delta one: shadow rays stop at the pane,
+        // so an emitter seen through it is this walk's alone.
         prev = Previous {
             pdf_w: bs.pdf_w,
             delta: bs.delta,
             p: hit.p,
         };
         ray = hit.spawn_ray(bs.wi);
-        depth += 1;
+        if !crossed {
+            depth += 1;
+        }
     }
     l
 }
 
-/// Next-event estimation from a surface vertex: `pt`'s, times the transmittance to the light.
-fn nee_at_surface(pt: &Pt, scene: &Scene, at: &WalkPoint, sampler: &mut Sampler) -> Color {
+/// Next-event estimation from a surface vertex: `pt`'s, times the transmittance to the light;
+/// `medium` is the one the walk arrived in (kept by a shape that declares none).
+fn nee_at_surface(
+    pt: &Pt,
+    scene: &Scene,
+    at: &WalkPoint,
+    medium: Option<MediumId>,
+    sampler: &mut Sampler,
+) -> Color {
     let hit = at.hit;
     let material = scene.material(hit.material);
     next_event(
@@ -173,7 +191,7 @@ fn nee_at_surface(pt: &Pt, scene: &Scene, at: &WalkPoint, sampler: &mut Sampler)
                 pdf_w: ev.pdf_w,
             }
         },
-        |wi| scene.medium_across(hit.interface, hit.ng, wi),
+        |wi| scene.medium_after(hit.interface, hit.ng, wi, medium),
     )
 }
 
