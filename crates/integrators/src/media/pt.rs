@@ -9,7 +9,7 @@
 //! hit at full weight), so `pt` against `pt-bsdf` checks next-event estimation, transmittance
 //! estimates and MIS in media against plain free-flight and phase sampling.
 
-use super::{is_null, light_end, point_end, shadow_transmittance, surface_end};
+use super::{is_null, light_end, point_end, surface_end};
 use crate::pt::{Pt, Techniques};
 use crate::subpath::walk::{
     continue_path, escaped_radiance, russian_roulette, WalkPoint, WalkRules,
@@ -152,17 +152,18 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
             break;
         }
         medium = scene.medium_after(hit.interface, hit.ng, bs.wi, medium);
-        // After a pane, too, the previous vertex is a delta one: shadow rays stop at the pane,
-        // so an emitter seen through it is this walk's alone.
+        ray = hit.spawn_ray(bs.wi);
+        if crossed {
+            // As a null boundary: no vertex, so MIS still weighs from the last real one, whose
+            // shadow rays pass the pane too (`Scene::transmittance_estimate_past_panes`).
+            continue;
+        }
         prev = Previous {
             pdf_w: bs.pdf_w,
             delta: bs.delta,
             p: hit.p,
         };
-        ray = hit.spawn_ray(bs.wi);
-        if !crossed {
-            depth += 1;
-        }
+        depth += 1;
     }
     l
 }
@@ -249,7 +250,9 @@ fn next_event(
     if s.f == Color::ZERO {
         return Color::ZERO;
     }
-    let tr = shadow_transmittance(scene, from, light_end(&ls), medium_towards(ls.wi), sampler);
+    let tr = scene
+        .transmittance_estimate_past_panes(from, light_end(&ls), medium_towards(ls.wi), sampler)
+        .unwrap_or(Color::ZERO);
     if tr == Color::ZERO {
         return Color::ZERO;
     }
