@@ -17,6 +17,7 @@ fn cell(o: Option<&Outcome>) -> String {
             j.mean_ratio
         ),
         Some(Outcome::Error(m)) => format!("error: {}", escape(m)),
+        Some(Outcome::NotJudged(m)) => format!("not judged: {}", escape(m)),
     }
 }
 
