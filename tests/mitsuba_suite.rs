@@ -246,7 +246,15 @@ fn mitsuba_render_suite_keeps_passing() {
             ));
         }
     }
-    // The media scenes, each with every media estimator not exempt, at the same budget.
+    // The media scenes, each with every media estimator not exempt, at 256 spp whatever the
+    // machine's load: the time limit is a safety net, not the budget (seed 0 at any thread count
+    // gives the same image, so the judgement is the one results/mitsuba-suite-media.md records,
+    // every pinned value ≥ 99.85 % there); at 6 s a loaded machine cut them to 56–96 spp, where
+    // their heavy tails fail the rule.
+    let budget = Budget {
+        time_per_estimator: Duration::from_secs(120),
+        ..budget
+    };
     let rows = run_suite_pairs(&dir, &budget, |scene, estimator| {
         MEDIA_SCENES.contains(&scene) && !media_exempt(scene, estimator)
     })
@@ -256,6 +264,9 @@ fn mitsuba_render_suite_keeps_passing() {
         table::markdown(&rows, &budget, "cargo test --test mitsuba_suite")
     );
     for &scene in MEDIA_SCENES {
+        if MEDIA_ESTIMATORS.iter().all(|e| media_exempt(scene, e)) {
+            continue;
+        }
         let Some(row) = rows.iter().find(|r| r.name == scene) else {
             regressions.push(format!("{scene}: missing (refused or renamed?)"));
             continue;
