@@ -362,14 +362,16 @@ fn a_shape_without_media_keeps_the_fog_it_sits_in() {
 
 /// Mitsuba's `volpath` counts a thin dielectric's straight pass-through as a null event, not a
 /// bounce (its `BSDFFlags::Null` lobe): with max_depth 2 (direct light only) a pane of IOR 1
-/// between the light and the floor changes nothing — pt reaches the light through it by BSDF
-/// sampling (its shadow rays stop at the pane), light tracing joins the floor to the camera.
+/// between the light and the floor changes nothing — pt-bsdf reaches the light through it,
+/// light tracing joins the floor to the camera.
 /// Before, the pane took the one bounce and the floor went black.
 #[test]
 fn a_thin_dielectrics_pass_through_is_no_bounce() {
     let open = floor_scene(false, false, false);
     let paned = floor_scene(false, true, false);
-    agree_scenes(&paned, &open, ("pt", 256), ("pt", 64));
+    // pt-bsdf: pt's media walk without next-event estimation, whose shadow rays would pass the
+    // pane anyway (a planted count of the pane as a bounce moved pt by 0.6 % only).
+    agree_scenes(&paned, &open, ("pt-bsdf", 256), ("pt", 64));
     agree_scenes(&paned, &open, ("light", 64), ("light", 64));
 }
 
