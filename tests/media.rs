@@ -322,3 +322,148 @@ fn integrators_without_media_refuse_a_scene_with_media() {
         assert_eq!(e, want);
     }
 }
+
+/// A floor (diffuse 0.6) under a square area light, for Mitsuba's two walk rules below: a
+/// fog-filled null sphere around everything (`fog_around`: the camera and the light declared in
+/// it, the floor too when `floor_named`) or a small one out of view (so that the media walks run);
+/// `pane`, a thin dielectric of IOR 1 (R' = 0: every sample passes straight through) between the
+/// light and the floor.
+fn floor_scene(floor_named: bool, pane: bool, fog_around: bool) -> Scene {
+    let camera = Camera::look_at(
+        Vec3::new(0.0, 0.8, 2.0),
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::Y,
+        50.0,
+        FovAxis::X,
+        16,
+        16,
+    )
+    .unwrap();
+    let settings = RenderSettings {
+        max_depth: 2,
+        rr_depth: 5,
+        spp: 1,
+    };
+    let mut b = SceneBuilder::new(camera, settings);
+    let fog = b.add_medium(homogeneous(
+        Color::new(0.6, 0.4, 0.2),
+        0.0,
+        PhaseFunction::Isotropic,
+    ));
+    let floor = b.add_material(Material::Diffuse(Diffuse {
+        albedo: Color::splat(0.6),
+    }));
+    let black = b.add_material(Material::Diffuse(Diffuse {
+        albedo: Color::ZERO,
+    }));
+    let null = b.add_material(Material::Null(Null));
+    let in_fog = MediumInterface {
+        interior: Some(fog),
+        exterior: Some(fog),
+    };
+    let (x, z) = (Vec3::X, Vec3::Z);
+    b.add_shape(quad(Vec3::ZERO, 3.0 * z, 3.0 * x), floor, None, false);
+    if floor_named {
+        b.set_last_shape_media(in_fog);
+    }
+    b.add_shape(
+        quad(Vec3::new(0.0, 2.0, 0.0), 0.5 * x, 0.5 * z),
+        black,
+        Some(Color::splat(5.0)),
+        false,
+    );
+    if fog_around {
+        // The light emits into the fog (`Scene::light_medium` reads its declared exterior).
+        b.set_last_shape_media(in_fog);
+    }
+    if pane {
+        let glass = b.add_material(Material::ThinDielectric(lt_core::bsdf::ThinDielectric {
+            ior: 1.0,
+            ..Default::default()
+        }));
+        b.add_shape(
+            quad(Vec3::new(0.0, 1.5, 0.0), 3.0 * z, 3.0 * x),
+            glass,
+            None,
+            false,
+        );
+    }
+    // Around everything (radius 10, the camera inside it) or out of view.
+    let (center, radius) = if fog_around {
+        (Vec3::ZERO, 10.0)
+    } else {
+        (Vec3::new(0.0, 0.0, 30.0), 0.1)
+    };
+    b.add_shape(ShapeGeometry::Sphere { center, radius }, null, None, false);
+    b.set_last_shape_media(MediumInterface {
+        interior: Some(fog),
+        exterior: None,
+    });
+    if fog_around {
+        b.set_camera_medium(Some(fog));
+    }
+    b.build()
+}
+
+fn image_bits(scene: &Scene, integrator: &str) -> Vec<[u64; 3]> {
+    let integ = make_integrator(integrator, scene, &IntegratorParams::default()).unwrap();
+    let opts = RenderOptions {
+        passes: 4,
+        time_limit: None,
+        seed: 9,
+        threads: 0,
+    };
+    let image = render(scene, &integ, &opts, |_| ControlFlow::Continue(()))
+        .unwrap()
+        .estimate;
+    image.data.iter().map(|p| p.map(f64::to_bits)).collect()
+}
+
+/// Mitsuba's rule: a shape that declares no media is no medium transition — a path leaving it
+/// stays in the fog it arrived in (`Scene::medium_after`). So a floor inside fog that names no
+/// media renders the same bits as one naming the fog on both sides. Before the rule, the walk
+/// left it into vacuum: shadow rays and camera joins from the floor were not attenuated (the
+/// suite's obj_inside_medium: max |z| 25).
+#[test]
+fn a_shape_without_media_keeps_the_fog_it_sits_in() {
+    let silent = floor_scene(false, false, true);
+    let named = floor_scene(true, false, true);
+    for integrator in ["pt", "light"] {
+        assert!(
+            image_bits(&silent, integrator) == image_bits(&named, integrator),
+            "{integrator}: a floor in fog that names no media renders differently from one \
+             naming the fog"
+        );
+    }
+}
+
+/// Mitsuba's `volpath` counts a thin dielectric's straight pass-through as a null event, not a
+/// bounce (its `BSDFFlags::Null` lobe): with max_depth 2 (direct light only) a pane of IOR 1
+/// between the light and the floor changes nothing — pt-bsdf reaches the light through it,
+/// light tracing joins the floor to the camera.
+/// Before, the pane took the one bounce and the floor went black.
+#[test]
+fn a_thin_dielectrics_pass_through_is_no_bounce() {
+    let open = floor_scene(false, false, false);
+    let paned = floor_scene(false, true, false);
+    // pt-bsdf: pt's media walk without next-event estimation, whose shadow rays would pass the
+    // pane anyway (a planted count of the pane as a bounce moved pt by 0.6 % only).
+    agree_scenes(&paned, &open, ("pt-bsdf", 256), ("pt", 64));
+    agree_scenes(&paned, &open, ("light", 64), ("light", 64));
+}
+
+/// `agree` between two scenes of the same camera.
+fn agree_scenes(sa: &Scene, sb: &Scene, a: (&str, u32), b: (&str, u32)) {
+    let p = IntegratorParams::default;
+    let (ra, ba) = render_blocks(sa, a.0, p(), a.1, 23, 4);
+    let (rb, bb) = render_blocks(sb, b.0, p(), b.1, 24, 4);
+    assert_eq!(ra.invalid_samples + rb.invalid_samples, 0);
+    let result = agreement_t(&ba, &bb, ALPHA);
+    println!("{} (pane) vs {} (open): {result}", a.0, b.0);
+    assert!(
+        result.passed(),
+        "{} (pane) vs {} (open): {result}",
+        a.0,
+        b.0
+    );
+}

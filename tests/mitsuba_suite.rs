@@ -1,9 +1,14 @@
 //! Mitsuba 3's render-test suite as a peer's test suite (`lt mitsuba-suite`), on
 //! `../shared/mitsuba-render-tests` (relative to the repository root): every scene loads or names
-//! its refusal (a token render), and every scene that passes today keeps passing at 256 spp (`EXPECTED_PASSING`: add a scene when your work makes it pass). Without the
+//! its refusal (a token render), every scene that passes today keeps passing at 256 spp
+//! (`EXPECTED_PASSING`: add a scene when your work makes it pass), and the participating-media
+//! scenes pass with every estimator the suite judges on media (`MEDIA_SCENES`). Without the
 //! folder the test says it skipped; `LT_REQUIRE_MITSUBA_SUITE=1` (CI) makes that a failure.
 
-use lt_experiments::verify::mitsuba_suite::{run_suite, run_suite_only, table, Budget};
+use lt_experiments::verify::mitsuba_suite::cases::MEDIA_ESTIMATORS;
+use lt_experiments::verify::mitsuba_suite::{
+    run_suite, run_suite_only, run_suite_pairs, table, Budget, Outcome,
+};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -72,6 +77,100 @@ const EXPECTED_PASSING: &[(&str, &str)] = &[
     ("bsdf_spheres/test_texturedprincipledthin_path", "pt"),
     ("bsdf_spheres/test_texturedprincipledthin_path", "bdpt"),
 ];
+
+/// The participating-media scenes (Mitsuba's `volpath` and `volpathmis` references): each must
+/// pass with every estimator of `cases::MEDIA_ESTIMATORS` (the one list: adding `bdpt` there
+/// judges it here too) but for `MEDIA_EXEMPT`; where the suite does not judge `light` (the
+/// camera sees a delta lobe: `mitsuba_suite::not_judged`) it must say why.
+const MEDIA_SCENES: &[&str] = &[
+    "participating_media/test_hetero_sigmat_albedo_volpath",
+    "participating_media/test_hetero_sigmat_volpath",
+    "participating_media/test_hetero_spectral_sigmat_no_scattering_volpath",
+    "participating_media/test_hetero_spectral_sigmat_volpathmis",
+    "participating_media/test_homo_area_light_volpath",
+    "participating_media/test_homo_dielectric_envmap_volpath",
+    "participating_media/test_homo_emitter_inside_medium_volpath",
+    "participating_media/test_homo_null_envmap_volpath",
+    "participating_media/test_homo_obj_inside_medium_volpath",
+    "participating_media/test_homo_roughdielectric_spot_volpath",
+    "participating_media/test_homo_spectral_sigmat_volpathmis",
+    "participating_media/test_surf_area_light_volpath",
+];
+
+/// (scene, estimator, why) not rendered in CI: unbiased (image means agree) but heavy-tailed at
+/// the CI budget of 256 spp, so the passes' spread underestimates the per-pixel error and the
+/// per-pixel rule fails on a fraction of pixels, all on the dark side; what each does at a larger
+/// budget is in results/mitsuba-suite-media.md.
+const MEDIA_EXEMPT: &[(&str, &str, &str)] = &[
+    (
+        "participating_media/test_homo_area_light_volpath",
+        "pt",
+        "the floor in the sphere's shadow sees the small area light through the medium only: \
+         99.59 % at 256 spp (the line is 99.75 %), every failing value below the reference",
+    ),
+    (
+        "participating_media/test_homo_dielectric_envmap_volpath",
+        "pt",
+        "caustics of the museum envmap through the dielectric spheres: 99.05 % at 256 spp",
+    ),
+    (
+        "participating_media/test_hetero_spectral_sigmat_no_scattering_volpath",
+        "pt",
+        "passes, 99.81 % at 256 spp, too close to the line for CI (albedo 0: a path's free \
+         flight either passes or ends)",
+    ),
+    (
+        "participating_media/test_homo_roughdielectric_spot_volpath",
+        "pt",
+        "a spot light through rough glass (α = 0.3) reaches the floor by BTDF paths only",
+    ),
+    (
+        "participating_media/test_homo_roughdielectric_spot_volpath",
+        "light",
+        "light paths into the medium through rough glass, joined to the camera through it",
+    ),
+    (
+        "participating_media/test_hetero_sigmat_albedo_volpath",
+        "light",
+        ENVMAP_LIGHT,
+    ),
+    (
+        "participating_media/test_hetero_sigmat_volpath",
+        "light",
+        ENVMAP_LIGHT,
+    ),
+    (
+        "participating_media/test_hetero_spectral_sigmat_no_scattering_volpath",
+        "light",
+        ENVMAP_LIGHT,
+    ),
+    (
+        "participating_media/test_hetero_spectral_sigmat_volpathmis",
+        "light",
+        ENVMAP_LIGHT,
+    ),
+    (
+        "participating_media/test_homo_null_envmap_volpath",
+        "light",
+        ENVMAP_LIGHT,
+    ),
+    (
+        "participating_media/test_homo_spectral_sigmat_volpathmis",
+        "light",
+        ENVMAP_LIGHT,
+    ),
+];
+
+/// Why light tracing is exempt on the envmap-lit media scenes.
+const ENVMAP_LIGHT: &str = "light traced from the museum envmap: at 256 spp a pixel gets a few \
+     splats per pass, so the passes' spread underestimates its error (pixels at 0 where the \
+     reference reads 0.07; image means ×0.99–1.00)";
+
+fn media_exempt(scene: &str, estimator: &str) -> bool {
+    MEDIA_EXEMPT
+        .iter()
+        .any(|&(s, e, _)| s == scene && e == estimator)
+}
 
 #[test]
 fn mitsuba_render_suite_keeps_passing() {
@@ -145,6 +244,42 @@ fn mitsuba_render_suite_keeps_passing() {
                 "{scene} with {estimator}: {:?}",
                 row.map(|r| (&r.refusal, &r.outcomes))
             ));
+        }
+    }
+    // The media scenes, each with every media estimator not exempt, at 256 spp whatever the
+    // machine's load: the time limit is a safety net, not the budget (seed 0 at any thread count
+    // gives the same image, so the judgement is the one results/mitsuba-suite-media.md records,
+    // every pinned value ≥ 99.85 % there); at 6 s a loaded machine cut them to 56–96 spp, where
+    // their heavy tails fail the rule.
+    let budget = Budget {
+        time_per_estimator: Duration::from_secs(120),
+        ..budget
+    };
+    let rows = run_suite_pairs(&dir, &budget, |scene, estimator| {
+        MEDIA_SCENES.contains(&scene) && !media_exempt(scene, estimator)
+    })
+    .unwrap();
+    println!(
+        "{}",
+        table::markdown(&rows, &budget, "cargo test --test mitsuba_suite")
+    );
+    for &scene in MEDIA_SCENES {
+        if MEDIA_ESTIMATORS.iter().all(|e| media_exempt(scene, e)) {
+            continue;
+        }
+        let Some(row) = rows.iter().find(|r| r.name == scene) else {
+            regressions.push(format!("{scene}: missing (refused or renamed?)"));
+            continue;
+        };
+        for &estimator in MEDIA_ESTIMATORS {
+            if media_exempt(scene, estimator) {
+                continue;
+            }
+            match row.outcomes.iter().find(|(e, _)| *e == estimator) {
+                Some((_, o)) if o.passes() => {}
+                Some((_, Outcome::NotJudged(why))) if !why.is_empty() => {}
+                other => regressions.push(format!("{scene} with {estimator}: {other:?}")),
+            }
         }
     }
     assert!(

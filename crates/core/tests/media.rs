@@ -61,7 +61,7 @@ fn product_medium(channels: usize, supervoxel: usize) -> (Medium, GridVolume) {
     let m = GridMedium::new(
         Volume::Grid(vol.clone()),
         SCALE,
-        Volume::Constant(Color::new(0.8, 0.4, 0.2)),
+        Volume::constant(Color::new(0.8, 0.4, 0.2)),
         PhaseFunction::Isotropic,
     )
     .unwrap()
@@ -176,7 +176,7 @@ fn bad_volumes_and_grid_media_are_refused() {
         )
     };
     let iso = PhaseFunction::Isotropic;
-    let half = Volume::Constant(Color::splat(0.5));
+    let half = Volume::constant(Color::splat(0.5));
     assert!(GridMedium::new(vol(-1.0), 1.0, half.clone(), iso)
         .unwrap_err()
         .contains("sigma_t"));
@@ -225,15 +225,20 @@ fn majorants_bound_the_field_along_every_segment() {
             let Medium::Grid(g) = &m else { unreachable!() };
             let mut s = Sampler::new(9, supervoxel as u64, 0);
             for _ in 0..300 {
-                // Rays from outside the cube through it (the outside part has the global bound).
+                // Rays from outside the cube through it: the segments tile the part inside it
+                // (outside, σt is zero and nothing is tracked).
                 let o = Vec3::new(-2.0, -0.5, -1.0)
                     + Vec3::new(5.0, 2.5, 2.0) * s.next_2d().extend(s.next_f32());
                 let target = point_in_hull(&vol, &mut s);
                 let d = (target - o).normalize();
                 let t_max = 2.0 * o.distance(target);
-                let mut covered = 0.0;
+                let (t_in, t_out) = g.clip(o, d, t_max).expect("the ray meets the cube");
+                let mut covered = t_in;
                 for (t0, t1, mu) in g.majorant_segments(o, d, t_max) {
-                    assert!(t0 == covered && t1 >= t0, "segments must tile [0, t_max]");
+                    assert!(
+                        t0 == covered && t1 >= t0,
+                        "segments must tile [t_in, t_out]"
+                    );
                     covered = t1;
                     for i in 0..8 {
                         let t = t0 + (t1 - t0) * (i as f32 + 0.5) / 8.0;
@@ -243,7 +248,7 @@ fn majorants_bound_the_field_along_every_segment() {
                         assert!(sigma.cmple(slack).all(), "σt {sigma} > μ̄ {mu} at t {t}");
                     }
                 }
-                assert_eq!(covered, t_max);
+                assert_eq!(covered, t_out);
             }
         }
     }
@@ -501,7 +506,7 @@ fn an_unbounded_walk_through_a_grid_ends() {
     let g = GridMedium::new(
         Volume::Grid(vol),
         1.0,
-        Volume::Constant(Color::ONE),
+        Volume::constant(Color::ONE),
         PhaseFunction::Isotropic,
     )
     .unwrap();
@@ -526,5 +531,112 @@ fn homogeneous_transmittance_over_an_infinite_distance_is_a_number() {
     assert_eq!(
         h.transmittance(1.0),
         Color::new(1.0, (-1.0f32).exp(), (-2.0f32).exp())
+    );
+}
+
+/// Mitsuba's `heterogeneous` medium exists only inside its σt volume's box (`intersect_aabb` on
+/// the volume's bbox, the placed unit cube; a plain value is a `constvolume` on [0, 1]³): the
+/// clamped field does not extend beyond it. σt = 2 on the unit cube moved by −½ (a grid and a
+/// constant): a chord of length 6 through it crosses 1 unit of medium, T = e⁻², and nothing
+/// scatters outside the box. Before, the grid's clamped field and the constant filled all
+/// space (T = e⁻¹², the suite's hetero_sigmat_albedo: max |z| 78).
+#[test]
+fn a_heterogeneous_medium_lives_in_its_sigma_t_box() {
+    let to_world = Mat4::from_translation(Vec3::splat(-0.5));
+    let grid = VolumeGrid::new([2, 2, 2], 1, vec![2.0; 8], [Vec3::ZERO, Vec3::ONE]).unwrap();
+    let volumes = [
+        Volume::Grid(GridVolume::new(Arc::new(grid), to_world, false, WrapMode::Clamp).unwrap()),
+        Volume::placed_constant(Color::splat(2.0), to_world).unwrap(),
+    ];
+    let (a, b) = (Vec3::new(-3.0, 0.1, 0.2), Vec3::new(3.0, 0.1, 0.2));
+    let (t_max, d) = (a.distance(b), (b - a).normalize());
+    let want = (-2.0f64).exp();
+    for sigma_t in volumes {
+        let what = format!("{sigma_t:?}").chars().take(8).collect::<String>();
+        let g = GridMedium::new(
+            sigma_t,
+            1.0,
+            Volume::constant(Color::ONE),
+            PhaseFunction::Isotropic,
+        )
+        .unwrap();
+        let m = Medium::Grid(Box::new(g));
+        assert_eq!(m.sigma_t(Vec3::new(0.7, 0.1, 0.2)), Color::ZERO, "{what}");
+        let t = m.transmittance(a, b).x as f64;
+        assert!(
+            (t - want).abs() <= 1e-5 * want,
+            "{what}: T = {t}, want e⁻² = {want}"
+        );
+        const N: usize = 4000;
+        let (mut est, mut passed) = (MeanEstimate::default(), MeanEstimate::default());
+        let mut s = Sampler::new(81, 0, 0);
+        for _ in 0..N {
+            est.add(m.transmittance_estimate(a, b, &mut s).x as f64);
+            match m.sample_free_flight(a, d, t_max, &mut s) {
+                FreeFlight::Scattered { t, .. } => {
+                    assert!(
+                        (2.5 - 1e-4..=3.5 + 1e-4).contains(&t),
+                        "{what}: scattered at {t}"
+                    );
+                    passed.add(0.0);
+                }
+                FreeFlight::Passed { .. } => passed.add(1.0),
+            }
+        }
+        let failures = z_failures(
+            &[
+                (format!("{what}: T estimate"), est, want),
+                (format!("{what}: pass fraction"), passed, want),
+            ],
+            4,
+        );
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
+    }
+}
+
+/// A shape keeps its (interior, exterior) pair's index in 16 bits: one pair more than that is
+/// one clear error from `try_build` (before: a panic in `build`), and the limit itself builds.
+#[test]
+fn too_many_medium_pairs_is_an_error_not_a_panic() {
+    use lt_core::bsdf::{Material, Null};
+    use lt_core::camera::{Camera, FovAxis};
+    use lt_core::scene::{
+        MediumInterface, RenderSettings, SceneBuilder, ShapeGeometry, MAX_MEDIUM_INTERFACES,
+    };
+    let scene = |pairs: usize| {
+        let camera = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, FovAxis::X, 2, 2).unwrap();
+        let mut b = SceneBuilder::new(camera, RenderSettings::default());
+        let fog = Homogeneous::new(Color::ONE, Color::ONE, 1.0, PhaseFunction::Isotropic).unwrap();
+        for _ in 0..256 {
+            b.add_medium(Medium::Homogeneous(fog));
+        }
+        let null = b.add_material(Material::Null(Null));
+        for k in 0..pairs {
+            let center = Vec3::new((k % 256) as f32, (k / 256) as f32, -10.0);
+            b.add_shape(
+                ShapeGeometry::Sphere {
+                    center,
+                    radius: 0.1,
+                },
+                null,
+                None,
+                false,
+            );
+            b.set_last_shape_media(MediumInterface {
+                interior: Some((k % 256) as u32),
+                exterior: Some((k / 256) as u32),
+            });
+        }
+        b.try_build()
+    };
+    let limit = MAX_MEDIUM_INTERFACES - 1;
+    assert!(scene(limit).is_ok());
+    let Err(e) = scene(limit + 1) else {
+        panic!("{} pairs built", limit + 1);
+    };
+    assert_eq!(
+        e,
+        "the shapes name 65536 distinct (interior, exterior) media pairs; at most 65535 are \
+         supported"
     );
 }

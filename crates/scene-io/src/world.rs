@@ -14,9 +14,11 @@ use lt_core::math::Vec3;
 use lt_core::medium::{Medium, MediumId};
 use lt_core::scene::{
     MediumInterface, RenderSettings, Scene, SceneBuilder, ShapeGeometry, TriangleMesh,
+    MAX_MEDIUM_INTERFACES,
 };
 use lt_core::shape::Affine;
 use lt_core::texture::Texture;
+use std::collections::HashSet;
 
 /// Largest world coordinate a scene may hold. f32 products of two coordinates (squared distances,
 /// cross products for areas and normals) overflow beyond ~1.8e19; keep a margin of ten.
@@ -157,6 +159,8 @@ pub struct WorldBuilder {
     lights: Vec<(LightDesc, Option<DVec3>, Option<MediumId>)>,
     media: Vec<MediumAt>,
     camera_medium: Option<MediumId>,
+    /// The distinct media pairs the shapes name besides (none, none).
+    media_pairs: HashSet<MediumInterface>,
 }
 
 impl WorldBuilder {
@@ -168,6 +172,7 @@ impl WorldBuilder {
             lights: Vec::new(),
             media: Vec::new(),
             camera_medium: None,
+            media_pairs: HashSet::new(),
         }
     }
 
@@ -181,11 +186,24 @@ impl WorldBuilder {
         self.camera_medium = medium;
     }
 
-    /// The media inside and outside the shape added last.
-    pub fn set_last_shape_media(&mut self, media: MediumInterface) {
+    /// The media inside and outside the shape added last; errs when the pair is one more than
+    /// a scene may hold (`MAX_MEDIUM_INTERFACES`), for the loader to place at the shape.
+    pub fn set_last_shape_media(&mut self, media: MediumInterface) -> Result<(), String> {
+        if media != MediumInterface::default()
+            && self.media_pairs.insert(media)
+            && self.media_pairs.len() >= MAX_MEDIUM_INTERFACES
+        {
+            return Err(format!(
+                "this shape's (interior, exterior) media pair is the {}th distinct one; a scene \
+                 holds at most {}",
+                self.media_pairs.len(),
+                MAX_MEDIUM_INTERFACES - 1
+            ));
+        }
         if let Some(s) = self.shapes.last_mut() {
             s.media = media;
         }
+        Ok(())
     }
 
     /// The medium the light added last sits in.
@@ -300,7 +318,13 @@ impl WorldBuilder {
             }
             b.add_light_in_medium(light, medium);
         }
-        Ok(b.build())
+        // The pairs were counted as the shapes were added (`set_last_shape_media`).
+        b.try_build().map_err(|message| SceneError {
+            file: String::new(),
+            line: None,
+            column: None,
+            message,
+        })
     }
 
     /// Per axis, the centre of the geometry's bounding box when it lies more than two box

@@ -1,6 +1,11 @@
 //! Mitsuba's `heterogeneous` medium: σt(x) = scale · σt-volume(x), α(x) from a volume (or a
 //! constant), one phase function.
 //!
+//! - **Support**: σt is zero outside the σt volume's bounding box (`Volume::bounds`), as in
+//!   Mitsuba, whose media sample and attenuate only within `intersect_aabb` — the wrap mode
+//!   extends the field to the box's faces, never beyond. Every segment is clipped to the box
+//!   first ([`GridMedium::clip`]), so tracking and T see only the part inside.
+//!
 //! - **Deterministic T** ([`GridMedium::optical_depth`]): the trilinear field is a cubic in t
 //!   between consecutive sample-plane crossings of the segment, so 2-point Gauss–Legendre on each
 //!   piece integrates it exactly (degree 2·2 − 1 = 3); T = exp(−τ). This T feeds the MIS densities
@@ -51,6 +56,8 @@ pub struct GridMedium {
     pub estimator: TransmittanceEstimator,
     /// Majorants of scale·σt; None when σt is a constant volume (its value is its majorant).
     majorant: Option<MajorantGrid>,
+    /// World box outside which σt is zero (the σt volume's, see the module doc).
+    support: [Vec3; 2],
 }
 
 /// Gauss–Legendre 2-point nodes on [0, 1]: ½ ∓ 1/(2√3), weights ½ each.
@@ -76,8 +83,10 @@ impl GridMedium {
         let majorant = sigma_t
             .as_grid()
             .map(|g| MajorantGrid::new(g, scale, SAMPLES_PER_SUPERVOXEL));
+        let support = sigma_t.bounds();
         Ok(GridMedium {
             sigma_t,
+            support,
             scale,
             albedo,
             phase,
@@ -94,9 +103,34 @@ impl GridMedium {
         self
     }
 
+    /// scale · σt-volume(p) inside the support, zero outside it.
     #[inline]
     pub fn sigma_t(&self, p: Vec3) -> Color {
-        self.sigma_t.eval(p) * self.scale
+        let [lo, hi] = self.support;
+        if p.cmpge(lo).all() && p.cmple(hi).all() {
+            self.sigma_t.eval(p) * self.scale
+        } else {
+            Color::ZERO
+        }
+    }
+
+    /// The part [t0, t1] of [0, t_max] of o + t·d (d ≠ 0) inside the support, or None (slab
+    /// test; t_max may be infinite, the result is then finite).
+    pub fn clip(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, f32)> {
+        let [lo, hi] = self.support;
+        let (mut t0, mut t1) = (0.0f32, t_max);
+        for a in 0..3 {
+            if d[a] == 0.0 {
+                if !(lo[a]..=hi[a]).contains(&o[a]) {
+                    return None;
+                }
+                continue;
+            }
+            let (ta, tb) = ((lo[a] - o[a]) / d[a], (hi[a] - o[a]) / d[a]);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+        (t0 < t1).then_some((t0, t1))
     }
 
     #[inline]
@@ -109,20 +143,24 @@ impl GridMedium {
         self.sigma_t(p) * self.albedo(p)
     }
 
-    /// τ(a, b) = ∫ σt along a → b, exact for the trilinear field (see the module doc).
+    /// τ(a, b) = ∫ σt along a → b, exact for the trilinear field (see the module doc) and zero
+    /// outside the support.
     pub fn optical_depth(&self, a: Vec3, b: Vec3) -> Color {
         let len = a.distance(b);
-        let Some(g) = self.sigma_t.as_grid() else {
-            return self.sigma_t(a) * len;
-        };
-        if len == 0.0 {
+        if len == 0.0 || !len.is_finite() {
             return Color::ZERO;
         }
         let d = (b - a) / len;
+        let Some((t_in, t_out)) = self.clip(a, d, len) else {
+            return Color::ZERO;
+        };
+        let Some(g) = self.sigma_t.as_grid() else {
+            return self.sigma_t.eval(a) * self.scale * (t_out - t_in);
+        };
         let (u0, du) = (g.sample_space(a), g.sample_space_dir(d));
         let mut sum = Color::ZERO;
-        let mut t0 = 0.0f32;
-        for t1 in PlaneCrossings::new(u0, du, len) {
+        let mut t0 = t_in;
+        for t1 in PlaneCrossings::new(u0 + du * t_in, du, t_out - t_in).map(|t| t_in + t) {
             let h = t1 - t0;
             if h > 0.0 {
                 let f = |x: f32| g.eval_sample_space(u0 + du * (t0 + h * x));
@@ -138,7 +176,8 @@ impl GridMedium {
         exp_neg(self.optical_depth(a, b))
     }
 
-    /// The majorant segments (t0, t1, μ̄) covering [0, t_max] of o + t·d, in order.
+    /// The majorant segments (t0, t1, μ̄) covering the part of [0, t_max] of o + t·d inside the
+    /// support (`clip`), in order.
     pub fn majorant_segments(&self, o: Vec3, d: Vec3, t_max: f32) -> Vec<(f32, f32, Color)> {
         let mut v = Vec::new();
         self.for_each_segment(o, d, t_max, |t0, t1, mu| {
@@ -148,8 +187,9 @@ impl GridMedium {
         v
     }
 
-    /// Calls `f` on the majorant segments (t0, t1, μ̄) covering [0, t_max] of o + t·d, in order,
-    /// until it returns false.
+    /// Calls `f` on the majorant segments (t0, t1, μ̄) covering the part of [0, t_max] of
+    /// o + t·d inside the support, in order, until it returns false (outside it σt is zero: no
+    /// segment, no tentative collision).
     fn for_each_segment(
         &self,
         o: Vec3,
@@ -157,16 +197,21 @@ impl GridMedium {
         t_max: f32,
         mut f: impl FnMut(f32, f32, Color) -> bool,
     ) {
+        let Some((t_in, t_out)) = self.clip(o, d, t_max) else {
+            return;
+        };
         match (&self.majorant, self.sigma_t.as_grid()) {
             (Some(m), Some(g)) => {
-                for (t0, t1, mu) in m.segments(g, o, d, t_max) {
-                    if !f(t0, t1, mu) {
+                // Walked from o (the same points as the lookups), trimmed to the support.
+                for (t0, t1, mu) in m.segments(g, o, d, t_out) {
+                    let (t0, t1) = (t0.max(t_in), t1.min(t_out));
+                    if t1 > t0 && !f(t0, t1, mu) {
                         return;
                     }
                 }
             }
             _ => {
-                f(0.0, t_max, self.sigma_t(o));
+                f(t_in, t_out, self.sigma_t.eval(o) * self.scale);
             }
         }
     }
@@ -201,22 +246,13 @@ impl GridMedium {
         hit
     }
 
-    /// `t_max`, or where the ray leaves the grid's placed unit cube when `t_max` is infinite: a
-    /// `heterogeneous` medium sits inside a closed boundary (every walk through it has a finite
-    /// t_max; the loaders refuse one without), and this only keeps an unbounded walk from
-    /// tracking forever through a clamped or periodic field.
+    /// `t_max`, or where the ray leaves the support when `t_max` is infinite (0 when it misses
+    /// it): beyond, σt is zero, and the pass's T is that of the part inside.
     fn reach(&self, o: Vec3, d: Vec3, t_max: f32) -> f32 {
-        let Some(g) = self.sigma_t.as_grid().filter(|_| !t_max.is_finite()) else {
+        if t_max.is_finite() {
             return t_max;
-        };
-        let [lo, hi] = g.world_bounds();
-        let (ta, tb) = ((lo - o) / d, (hi - o) / d);
-        let exit = ta.max(tb).min_element();
-        if exit.is_finite() {
-            exit.max(0.0)
-        } else {
-            0.0
         }
+        self.clip(o, d, t_max).map_or(0.0, |(_, t_out)| t_out)
     }
 
     /// Free-flight sampling (see the module doc for the scheme and its density). For a grid,

@@ -154,14 +154,7 @@ impl GridVolume {
     /// World-space bounding box of the unit cube the grid spans (where it is not extended by the
     /// wrap mode): its eight corners mapped by to_local⁻¹.
     pub fn world_bounds(&self) -> [Vec3; 2] {
-        let to_world = self.to_local.inverse();
-        let mut b = [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)];
-        for i in 0..8 {
-            let c = Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32);
-            let w = to_world.transform_point3(c);
-            b = [b[0].min(w), b[1].max(w)];
-        }
-        b
+        placed_unit_cube(&self.to_local.inverse())
     }
 
     /// Sample-space coordinates u = local·n − ½ of a world point (samples at integer u).
@@ -246,18 +239,53 @@ impl GridVolume {
 }
 
 /// A volume: Mitsuba's `constvolume` or `gridvolume`.
+///
+/// Every Mitsuba volume also has a bounding box, the world box of the unit cube its `to_world`
+/// places (`Volume::update_bbox`; with `use_grid_bbox` the file's box): a `heterogeneous` medium
+/// exists only inside its σt volume's box (`Medium::intersect_aabb`), whatever the wrap mode says
+/// beyond it. A constant has one too: a `constvolume` without `to_world`, and the `constvolume`
+/// Mitsuba makes of a plain value (`Properties::get_volume`), span the unit cube [0, 1]³.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Volume {
-    Constant(Color),
+    Constant { value: Color, bounds: [Vec3; 2] },
     Grid(GridVolume),
 }
 
 impl Volume {
+    /// A `constvolume` with no `to_world` (or a plain value): `value` on the unit cube.
+    pub fn constant(value: Color) -> Volume {
+        Volume::Constant {
+            value,
+            bounds: [Vec3::ZERO, Vec3::ONE],
+        }
+    }
+
+    /// A `constvolume` placed by `to_world` (its box is the placed unit cube); errors on a
+    /// singular or non-finite transform, as a grid's placement does.
+    pub fn placed_constant(value: Color, to_world: Mat4) -> Result<Volume, String> {
+        let det = to_world.determinant();
+        if !(det.is_finite() && det != 0.0 && to_world.is_finite()) {
+            return Err("to_world is singular or not finite".into());
+        }
+        Ok(Volume::Constant {
+            value,
+            bounds: placed_unit_cube(&to_world),
+        })
+    }
+
     #[inline]
     pub fn eval(&self, p: Vec3) -> Color {
         match self {
-            Volume::Constant(c) => *c,
+            Volume::Constant { value, .. } => *value,
             Volume::Grid(g) => g.eval(p),
+        }
+    }
+
+    /// Mitsuba's bounding box of the volume, in world space (see the type's doc).
+    pub fn bounds(&self) -> [Vec3; 2] {
+        match self {
+            Volume::Constant { bounds, .. } => *bounds,
+            Volume::Grid(g) => g.world_bounds(),
         }
     }
 
@@ -265,7 +293,7 @@ impl Volume {
     /// within its samples' range).
     pub fn range(&self) -> (Color, Color) {
         match self {
-            Volume::Constant(c) => (*c, *c),
+            Volume::Constant { value, .. } => (*value, *value),
             Volume::Grid(g) => g.grid.range(),
         }
     }
@@ -273,10 +301,21 @@ impl Volume {
     /// The sample-space map of a grid, for the exact integration along segments.
     pub fn as_grid(&self) -> Option<&GridVolume> {
         match self {
-            Volume::Constant(_) => None,
+            Volume::Constant { .. } => None,
             Volume::Grid(g) => Some(g),
         }
     }
+}
+
+/// World box of the unit cube [0, 1]³ placed by `to_world`: its eight corners' bounds.
+fn placed_unit_cube(to_world: &Mat4) -> [Vec3; 2] {
+    let mut b = [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)];
+    for i in 0..8 {
+        let c = Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32);
+        let w = to_world.transform_point3(c);
+        b = [b[0].min(w), b[1].max(w)];
+    }
+    b
 }
 
 /// Distances along o + t·d, t ∈ (0, t_max), where the sample-space point crosses an integer plane

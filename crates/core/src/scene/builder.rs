@@ -1,7 +1,7 @@
 //! Assembling a scene in code: the loader and the tests both go through this one path, so a scene
 //! built by hand is checked and indexed exactly like one read from a file.
 
-use super::{MediumInterface, RenderSettings, Scene, Shape};
+use super::{MediumInterface, RenderSettings, Scene, Shape, MAX_MEDIUM_INTERFACES};
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::geometry::quad::Parallelogram;
@@ -13,6 +13,7 @@ use crate::math::{Color, Vec3};
 use crate::medium::{Medium, MediumId};
 use crate::shape::{ShapeGeometry, TriangleMesh};
 use crate::texture::Texture;
+use std::collections::{HashMap, HashSet};
 
 /// Triangles of a mesh as BVH primitives; consecutive pairs that split a parallelogram (quads,
 /// cube faces, quads triangulated from OBJ) become one analytic parallelogram.
@@ -194,10 +195,28 @@ impl SceneBuilder {
         self.add_light_in_medium(light, None);
     }
 
+    /// [`SceneBuilder::try_build`] for scenes that cannot fail it (code building a scene within
+    /// its limits); panics with `try_build`'s message otherwise.
+    pub fn build(self) -> Scene {
+        self.try_build()
+            .unwrap_or_else(|m| panic!("SceneBuilder::build: {m}"))
+    }
+
     /// Indexes the scene, recentred on `scene_origin` of its geometry: every shape, positioned light
     /// and the camera eye are stored as world − origin (see `Scene::origin`); directions (sun,
-    /// directional light, environment, shading normals) are unchanged.
-    pub fn build(mut self) -> Scene {
+    /// directional light, environment, shading normals) are unchanged. Errs when the shapes name
+    /// more distinct (interior, exterior) media pairs than [`MAX_MEDIUM_INTERFACES`] allows.
+    pub fn try_build(mut self) -> Result<Scene, String> {
+        // Checked before any work: a refused scene costs nothing.
+        let pairs: HashSet<MediumInterface> = self
+            .shape_media
+            .iter()
+            .copied()
+            .chain([MediumInterface::default()])
+            .collect();
+        if pairs.len() > MAX_MEDIUM_INTERFACES {
+            return Err(too_many_interfaces(pairs.len()));
+        }
         let origin = self.origin.unwrap_or_else(|| scene_origin(&self.shapes));
         if self.origin.is_none() && origin != Vec3::ZERO {
             for (geometry, ..) in &mut self.shapes {
@@ -222,6 +241,7 @@ impl SceneBuilder {
         let mut light_media = Vec::new();
         let mut prims = Vec::new();
         let mut interfaces = vec![MediumInterface::default()];
+        let mut interface_index = HashMap::from([(MediumInterface::default(), 0u16)]);
         for ((geometry, material, emission, flip_normals), media) in
             self.shapes.into_iter().zip(self.shape_media)
         {
@@ -259,13 +279,11 @@ impl SceneBuilder {
                 light_media.push(media.exterior);
                 (lights.len() - 1) as u32
             });
-            let interface = match interfaces.iter().position(|i| *i == media) {
-                Some(i) => i,
-                None => {
-                    interfaces.push(media);
-                    interfaces.len() - 1
-                }
-            };
+            // In order of first use; fits in u16 (checked above).
+            let interface = *interface_index.entry(media).or_insert_with(|| {
+                interfaces.push(media);
+                (interfaces.len() - 1) as u16
+            });
             // A missing attribute reads as zero (the loaders report it first).
             let attribute = match (
                 &geometry,
@@ -283,8 +301,7 @@ impl SceneBuilder {
                 light,
                 flip_normals,
                 attribute,
-                interface: u16::try_from(interface)
-                    .expect("more than 65 535 distinct (interior, exterior) media pairs"),
+                interface,
                 null: matches!(m, Material::Null(_)),
             });
         }
@@ -310,7 +327,7 @@ impl SceneBuilder {
             || interfaces.len() > 1
             || light_media.iter().any(Option::is_some);
         let light_sampler = LightSampler::new(&lights, bounding_sphere);
-        Scene {
+        Ok(Scene {
             origin,
             camera: self.camera,
             settings: self.settings,
@@ -328,8 +345,16 @@ impl SceneBuilder {
             light_media,
             has_media,
             accel,
-        }
+        })
     }
+}
+
+fn too_many_interfaces(pairs: usize) -> String {
+    format!(
+        "the shapes name {} distinct (interior, exterior) media pairs; at most {} are supported",
+        pairs - 1,
+        MAX_MEDIUM_INTERFACES - 1
+    )
 }
 
 /// True when the light pushed last sits at infinity (it emits into no medium).

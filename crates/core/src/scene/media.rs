@@ -16,15 +16,37 @@
 //! is outside — is had here by declaring the exterior: a medium nested in another names the outer
 //! medium as its exterior, and a medium inside glass is the dielectric's interior (its exterior the
 //! air or fog around it), which is Mitsuba's convention and so its test scenes'.
+//!
+//! **A shape that declares no media** (interface 0) is no medium transition (Mitsuba's
+//! `is_medium_transition`): a ray leaving it stays in the medium it arrived in
+//! ([`Scene::medium_after`]), so an object placed inside fog without naming the fog reflects in
+//! it (the suite's obj_inside_medium, emitter_inside_medium, and the hetero scenes' floor poking
+//! into the cube). Only there does the rule read the arriving medium: a walk knows it, a vertex on
+//! such a shape has the same medium on both sides.
+//!
+//! **A thin dielectric's pass-through is a null event** in Mitsuba's `volpath` (its transmission
+//! lobe is `BSDFFlags::Null`: the direction is kept), so the media walks of `pt` and `light` cross
+//! a pane as they cross a null boundary: no vertex, no count toward `max_depth`
+//! ([`Scene::is_null_transmission`]), and their shadow rays pass it with its null transmission
+//! 1 − R' ([`Scene::transmittance_estimate_past_panes`]) — the sampled pass-through has weight 1
+//! and probability 1 − R', so the two techniques estimate the same and MIS pairs them from the
+//! last real vertex. The path-space oracle and `transmittance_estimate` still see a pane as the
+//! delta vertex it is.
 
+use super::SurfaceHit;
 use super::{ConnectionEnd, Scene};
+use crate::bsdf::Material;
 use crate::geometry::{offset_ray_origin, Ray};
 use crate::math::{gamma, Color, Vec3};
 use crate::medium::MediumId;
 use crate::sampling::Sampler;
 
+/// Distinct (interior, exterior) pairs a scene's shapes may name, (none, none) included: a shape
+/// keeps its pair's index in 16 bits (`Shape::interface`, copied into every hit and vertex).
+pub const MAX_MEDIUM_INTERFACES: usize = u16::MAX as usize + 1;
+
 /// The media on the two sides of a shape (Mitsuba's `interior` and `exterior`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct MediumInterface {
     pub interior: Option<MediumId>,
     pub exterior: Option<MediumId>,
@@ -59,11 +81,14 @@ const MAX_CROSSINGS: usize = 1024;
 
 /// Which surfaces a segment walk passes: every one (the oracle, whose f excludes visibility:
 /// an opaque surface is then a boundary like a null one, and V zeroes the edge anyway), or null
-/// ones only (a shadow ray: an opaque surface blocks).
+/// ones only (a shadow ray: an opaque surface blocks), or null ones and thin dielectric panes (the
+/// shadow rays of the media walks, as Mitsuba's `volpath` casts them: a pane passes with its
+/// null transmission 1 − R', `Scene::pane_transmission`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Crossing {
     Everything,
     NullOnly,
+    NullAndPanes,
 }
 
 impl Scene {
@@ -74,6 +99,53 @@ impl Scene {
         self.interfaces[interface as usize].towards(ng, w)
     }
 
+    /// The medium a ray is in after leaving (or crossing) a surface with interface `interface`
+    /// along `w`, having arrived in `current`: the declared medium on that side, or `current`
+    /// when the shape declares none (module doc).
+    #[inline]
+    pub fn medium_after(
+        &self,
+        interface: u16,
+        ng: Vec3,
+        w: Vec3,
+        current: Option<MediumId>,
+    ) -> Option<MediumId> {
+        if interface == 0 {
+            current
+        } else {
+            self.medium_across(interface, ng, w)
+        }
+    }
+
+    /// True when material `material` has a lobe Mitsuba's `volpath` counts as a null event (a
+    /// plain `thindielectric`; a textured one is walked as any delta material): a sample there
+    /// may not count toward `max_depth`, and the media walks' shadow rays pass it.
+    #[inline]
+    pub fn has_null_transmission(&self, material: u32) -> bool {
+        matches!(self.material(material), Material::ThinDielectric(_))
+    }
+
+    /// What a thin dielectric pane at `hit` lets through straight along `d` (Mitsuba's
+    /// `eval_null_transmission`): (1 − R'(cos θ)) · specular_transmittance, θ from the shading
+    /// normal; zero for any other material.
+    pub fn pane_transmission(&self, hit: &SurfaceHit, d: Vec3) -> Color {
+        match self.material(hit.material) {
+            Material::ThinDielectric(t) => {
+                let cos = hit.shading_frame().ns().dot(d);
+                t.specular_transmittance * (1.0 - t.reflectance(cos))
+            }
+            _ => Color::ZERO,
+        }
+    }
+
+    /// True when a sample from `wo` to `wi` at a surface of material `material` with shading
+    /// normal `ns` took that null lobe: a thin dielectric's transmission, the one lobe that
+    /// leaves on the other side of the shading plane (its reflection mirrors about `ns`).
+    #[inline]
+    pub fn is_null_transmission(&self, material: u32, ns: Vec3, wo: Vec3, wi: Vec3) -> bool {
+        self.has_null_transmission(material) && ns.dot(wo) * ns.dot(wi) < 0.0
+    }
+
     /// The medium light `light` emits into.
     #[inline]
     pub fn light_medium(&self, light: u32) -> Option<MediumId> {
@@ -81,8 +153,9 @@ impl Scene {
     }
 
     /// Cuts the segment a → b (either end may be at infinity, not both) into its pieces between
-    /// boundaries, starting in `medium` at `a`, in order from `a`; `visit` sees each. Returns false
-    /// (having visited the pieces before it) when a surface that `crossing` does not pass blocks.
+    /// boundaries, starting in `medium` at `a`, in order from `a`; `visit` sees each. Returns what
+    /// the crossed panes let through (1 unless `crossing` passes panes), or None (having visited
+    /// the pieces before it) when a surface that `crossing` does not pass blocks.
     pub fn for_each_medium_piece(
         &self,
         a: ConnectionEnd,
@@ -90,7 +163,7 @@ impl Scene {
         medium: Option<MediumId>,
         crossing: Crossing,
         mut visit: impl FnMut(MediumPiece),
-    ) -> bool {
+    ) -> Option<Color> {
         // Crossings are found from a finite end; from a light at infinity they are found from the
         // other end and walked backwards.
         let (from, to, reversed) = if a.infinite {
@@ -98,9 +171,8 @@ impl Scene {
         } else {
             (a, b, false)
         };
-        let Some(crossings) = self.crossings(from, to) else {
-            return false;
-        };
+        let panes = crossing == Crossing::NullAndPanes;
+        let crossings = self.crossings(from, to, panes)?;
         let dir = if to.infinite {
             to.p
         } else {
@@ -114,23 +186,28 @@ impl Scene {
         } else {
             (from.p, to.p, dir)
         };
-        let order: Box<dyn Iterator<Item = &(Vec3, u32, Vec3)>> = if reversed {
+        let order: Box<dyn Iterator<Item = &(Vec3, u32, Vec3, Color)>> = if reversed {
             Box::new(crossings.iter().rev())
         } else {
             Box::new(crossings.iter())
         };
-        let (mut current, mut here) = (medium, start);
-        for &(p, shape, ng) in order {
+        let (mut current, mut here, mut through) = (medium, start, Color::ONE);
+        for &(p, shape, ng, pane) in order {
             let s = &self.shapes[shape as usize];
-            if crossing == Crossing::NullOnly && !s.null {
-                return false;
+            match crossing {
+                Crossing::Everything => {}
+                _ if s.null => {}
+                Crossing::NullAndPanes if self.has_null_transmission(s.material) => {
+                    through *= pane;
+                }
+                _ => return None,
             }
             visit(MediumPiece {
                 medium: current,
                 a: here,
                 b: p,
             });
-            current = self.medium_across(s.interface, ng, d);
+            current = self.medium_after(s.interface, ng, d, current);
             here = p;
         }
         visit(MediumPiece {
@@ -138,12 +215,19 @@ impl Scene {
             a: here,
             b: end,
         });
-        true
+        Some(through)
     }
 
     /// The surfaces strictly between `from` (finite) and `to`, in order from `from`: each hit
-    /// point with its shape and its outward geometric normal. `None` when the walk does not end (a degenerate spot).
-    fn crossings(&self, from: ConnectionEnd, to: ConnectionEnd) -> Option<Vec<(Vec3, u32, Vec3)>> {
+    /// point with its shape, its outward geometric normal and (with `panes`, at a thin dielectric)
+    /// what the pane lets through along the walk, else 1. `None` when the walk does not end (a
+    /// degenerate spot).
+    fn crossings(
+        &self,
+        from: ConnectionEnd,
+        to: ConnectionEnd,
+        panes: bool,
+    ) -> Option<Vec<(Vec3, u32, Vec3, Color)>> {
         let a = self.end(from.p, from.p_err, from.ng);
         let target = (!to.infinite).then(|| self.end(to.p, to.p_err, to.ng));
         let dir0 = match &target {
@@ -175,7 +259,13 @@ impl Scene {
             }) else {
                 return Some(found);
             };
-            found.push((hit.p, hit.shape, hit.ng));
+            let pane = if panes && self.has_null_transmission(hit.material) {
+                // Seen along the walk's direction: |cos| is the same both ways.
+                self.pane_transmission(&hit, dir)
+            } else {
+                Color::ONE
+            };
+            found.push((hit.p, hit.shape, hit.ng, pane));
             origin = offset_ray_origin(hit.p, hit.p_err, hit.ng, dir);
         }
         None
@@ -195,7 +285,7 @@ impl Scene {
                 t *= self.media[m as usize].transmittance(piece.a, piece.b);
             }
         });
-        open.then_some(t)
+        open.map(|_| t)
     }
 
     /// An unbiased estimate of T(a, b) through null boundaries (`Medium::transmittance_estimate`
@@ -207,13 +297,37 @@ impl Scene {
         medium: Option<MediumId>,
         sampler: &mut Sampler,
     ) -> Option<Color> {
+        self.estimate_through(a, b, medium, Crossing::NullOnly, sampler)
+    }
+
+    /// `transmittance_estimate` past thin dielectric panes too, times what each lets through
+    /// (`pane_transmission`): the shadow rays of `pt`'s and `light`'s media walks, which cross a
+    /// pane as Mitsuba's `volpath` does — a null event, not a vertex (`is_null_transmission`).
+    pub fn transmittance_estimate_past_panes(
+        &self,
+        a: ConnectionEnd,
+        b: ConnectionEnd,
+        medium: Option<MediumId>,
+        sampler: &mut Sampler,
+    ) -> Option<Color> {
+        self.estimate_through(a, b, medium, Crossing::NullAndPanes, sampler)
+    }
+
+    fn estimate_through(
+        &self,
+        a: ConnectionEnd,
+        b: ConnectionEnd,
+        medium: Option<MediumId>,
+        crossing: Crossing,
+        sampler: &mut Sampler,
+    ) -> Option<Color> {
         let mut t = Color::ONE;
-        let open = self.for_each_medium_piece(a, b, medium, Crossing::NullOnly, |piece| {
+        let through = self.for_each_medium_piece(a, b, medium, crossing, |piece| {
             if let Some(m) = piece.medium {
                 t *= self.media[m as usize].transmittance_estimate(piece.a, piece.b, sampler);
             }
-        });
-        open.then_some(t)
+        })?;
+        Some(t * through)
     }
 
     /// The oracle's T of a path edge: every surface crossed is a boundary (visibility is not
@@ -231,7 +345,7 @@ impl Scene {
             }
         });
         // A segment caught in a degenerate spot (no end to its crossings) carries nothing.
-        if walked {
+        if walked.is_some() {
             t
         } else {
             Color::ZERO
@@ -254,7 +368,7 @@ impl Scene {
         let walked =
             self.for_each_medium_piece(a, b, medium, Crossing::Everything, |p| pieces.push(p));
         // A segment caught in a degenerate spot (no end to its crossings) has no density.
-        if !walked {
+        if walked.is_none() {
             return 0.0;
         }
         let last = pieces.len() - 1;

@@ -4,11 +4,12 @@
 //! `null` surfaces are crossed without a vertex. Every vertex that can be joined (x0 on an area
 //! light, a non-delta surface, a medium vertex) is connected to a lens point (t = 1) and splatted
 //! with β · f · T · We · cos θ_c / d², f the BSDF (with its cosine, importance mode) or the phase
-//! function (no cosine), T an unbiased transmittance estimate through null boundaries. Lights at
+//! function (no cosine), T an unbiased transmittance estimate through null boundaries and thin
+//! dielectric panes (crossed as null events, as `pt`'s walk crosses them). Lights at
 //! infinity are joined at x0 by the camera's direction towards them (`Camera::connect_direction`),
 //! through the camera's medium.
 
-use super::{is_null, point_end, shadow_transmittance, surface_end};
+use super::{is_null, point_end, surface_end};
 use crate::splat::Splats;
 use crate::subpath::walk::{continue_path, russian_roulette, WalkPoint, WalkRules};
 use lt_core::bsdf::TransportMode;
@@ -143,7 +144,7 @@ pub fn trace(scene: &Scene, walk: LightWalk, sampler: &mut Sampler, splats: &mut
             if crossings > MAX_NULL_CROSSINGS {
                 return;
             }
-            medium = scene.medium_across(hit.interface, hit.ng, ray.d);
+            medium = scene.medium_after(hit.interface, hit.ng, ray.d, medium);
             ray = hit.spawn_ray(ray.d);
             continue;
         }
@@ -162,19 +163,28 @@ pub fn trace(scene: &Scene, walk: LightWalk, sampler: &mut Sampler, splats: &mut
                     .eval(&sf, at.wo, wi, TransportMode::Importance)
                     .f_cos
             };
-            let towards = |wi: Vec3| scene.medium_across(hit.interface, hit.ng, wi);
+            let arrived = medium;
+            let towards = |wi: Vec3| scene.medium_after(hit.interface, hit.ng, wi, arrived);
             let from = (hit.p, surface_end(&hit));
             splat(scene, walk, from, towards, sampler, splats, value);
         }
-        if n + 1 >= walk.max_depth {
+        // A pane's pass-through is no bounce (Mitsuba's null event, `pt`'s media walk alike).
+        let pane = scene.has_null_transmission(hit.material);
+        if n + 1 >= walk.max_depth && !pane {
             return;
         }
         let Some(bs) = continue_path(scene, &at, &rules, &mut beta, n, sampler) else {
             return;
         };
-        medium = scene.medium_across(hit.interface, hit.ng, bs.wi);
+        let crossed = pane && scene.is_null_transmission(hit.material, sf.ns(), at.wo, bs.wi);
+        if n + 1 >= walk.max_depth && !crossed {
+            return;
+        }
+        medium = scene.medium_after(hit.interface, hit.ng, bs.wi, medium);
         ray = hit.spawn_ray(bs.wi);
-        n += 1;
+        if !crossed {
+            n += 1;
+        }
     }
 }
 
@@ -199,7 +209,9 @@ fn splat(
         return;
     }
     let medium = medium_towards(-lens.dir);
-    let tr = shadow_transmittance(scene, from, point_end(lens.origin), medium, sampler);
+    let tr = scene
+        .transmittance_estimate_past_panes(from, point_end(lens.origin), medium, sampler)
+        .unwrap_or(Color::ZERO);
     if tr == Color::ZERO {
         return;
     }
@@ -231,7 +243,9 @@ fn splat_at_infinity(
         infinite: true,
     };
     let from = point_end(lens.origin);
-    let tr = shadow_transmittance(scene, from, far, scene.camera_medium, sampler);
+    let tr = scene
+        .transmittance_estimate_past_panes(from, far, scene.camera_medium, sampler)
+        .unwrap_or(Color::ZERO);
     if tr == Color::ZERO {
         return;
     }

@@ -9,7 +9,7 @@
 //! hit at full weight), so `pt` against `pt-bsdf` checks next-event estimation, transmittance
 //! estimates and MIS in media against plain free-flight and phase sampling.
 
-use super::{is_null, light_end, point_end, shadow_transmittance, surface_end};
+use super::{is_null, light_end, point_end, surface_end};
 use crate::pt::{Pt, Techniques};
 use crate::subpath::walk::{
     continue_path, escaped_radiance, russian_roulette, WalkPoint, WalkRules,
@@ -114,7 +114,7 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
             if crossings > MAX_NULL_CROSSINGS {
                 break;
             }
-            medium = scene.medium_across(hit.interface, hit.ng, ray.d);
+            medium = scene.medium_after(hit.interface, hit.ng, ray.d, medium);
             ray = hit.spawn_ray(ray.d);
             continue;
         }
@@ -129,7 +129,10 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
                 l += beta * le * pt.hit_weights(prev.delta, prev.pdf_w, light_pdf).0;
             }
         }
-        if depth == params.max_depth {
+        // A pane (thin dielectric) may still be passed at the last depth: its pass-through is
+        // Mitsuba's null event, no bounce (`Scene::is_null_transmission`).
+        let pane = scene.has_null_transmission(hit.material);
+        if depth == params.max_depth && !pane {
             break;
         }
         let sf = hit.shading_frame();
@@ -139,25 +142,41 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
             wo,
         };
         if nee && !scene.material_is_delta(hit.material) {
-            l += beta * nee_at_surface(pt, scene, &at, sampler);
+            l += beta * nee_at_surface(pt, scene, &at, medium, sampler);
         }
         let Some(bs) = continue_path(scene, &at, &rules, &mut beta, depth, sampler) else {
             break;
         };
-        medium = scene.medium_across(hit.interface, hit.ng, bs.wi);
+        let crossed = pane && scene.is_null_transmission(hit.material, sf.ns(), wo, bs.wi);
+        if depth == params.max_depth && !crossed {
+            break;
+        }
+        medium = scene.medium_after(hit.interface, hit.ng, bs.wi, medium);
+        ray = hit.spawn_ray(bs.wi);
+        if crossed {
+            // As a null boundary: no vertex, so MIS still weighs from the last real one, whose
+            // shadow rays pass the pane too (`Scene::transmittance_estimate_past_panes`).
+            continue;
+        }
         prev = Previous {
             pdf_w: bs.pdf_w,
             delta: bs.delta,
             p: hit.p,
         };
-        ray = hit.spawn_ray(bs.wi);
         depth += 1;
     }
     l
 }
 
-/// Next-event estimation from a surface vertex: `pt`'s, times the transmittance to the light.
-fn nee_at_surface(pt: &Pt, scene: &Scene, at: &WalkPoint, sampler: &mut Sampler) -> Color {
+/// Next-event estimation from a surface vertex: `pt`'s, times the transmittance to the light;
+/// `medium` is the one the walk arrived in (kept by a shape that declares none).
+fn nee_at_surface(
+    pt: &Pt,
+    scene: &Scene,
+    at: &WalkPoint,
+    medium: Option<MediumId>,
+    sampler: &mut Sampler,
+) -> Color {
     let hit = at.hit;
     let material = scene.material(hit.material);
     next_event(
@@ -173,7 +192,7 @@ fn nee_at_surface(pt: &Pt, scene: &Scene, at: &WalkPoint, sampler: &mut Sampler)
                 pdf_w: ev.pdf_w,
             }
         },
-        |wi| scene.medium_across(hit.interface, hit.ng, wi),
+        |wi| scene.medium_after(hit.interface, hit.ng, wi, medium),
     )
 }
 
@@ -231,7 +250,9 @@ fn next_event(
     if s.f == Color::ZERO {
         return Color::ZERO;
     }
-    let tr = shadow_transmittance(scene, from, light_end(&ls), medium_towards(ls.wi), sampler);
+    let tr = scene
+        .transmittance_estimate_past_panes(from, light_end(&ls), medium_towards(ls.wi), sampler)
+        .unwrap_or(Color::ZERO);
     if tr == Color::ZERO {
         return Color::ZERO;
     }

@@ -1,10 +1,13 @@
-//! The suite's scenes: every `tests/scenes/*/*.xml` outside `participating_media`, with the
-//! estimators its file name implies and its reference images.
+//! The suite's scenes: every `tests/scenes/*/*.xml`, with the estimators its file name implies
+//! and its reference images.
 
 use std::path::{Path, PathBuf};
 
-/// Folders left out: they need participating media, which lt does not simulate.
-const SKIPPED_FOLDERS: [&str; 1] = ["participating_media"];
+/// lt's estimators for the media scenes (Mitsuba's `volpath` and `volpathmis`), the one list the
+/// suite, its table and `tests/mitsuba_suite.rs` read: judging another estimator on every media
+/// scene (`bdpt`, once it walks through media) is one entry here. `light` is judged only where
+/// the camera sees no delta surface (`super::not_judged`).
+pub const MEDIA_ESTIMATORS: &[&str] = &["pt", "light"];
 
 /// One scene of the suite.
 #[derive(Clone, Debug)]
@@ -17,15 +20,21 @@ pub struct Case {
     pub reference_var: PathBuf,
     /// lt's estimators for the Mitsuba integrator the file name ends in.
     pub estimators: &'static [&'static str],
+    /// The reference was traced from the camera (every integrator but `ptracer`): it holds what
+    /// the camera sees through delta surfaces, which light tracing cannot join.
+    pub traced_from_camera: bool,
 }
 
 /// lt's estimators for a file name's integrator suffix: Mitsuba's `path` and `direct` (a path
-/// tracer) with `pt` and `bdpt`, its `ptracer` (a light tracer) with `light` and `bdpt`.
+/// tracer) with `pt` and `bdpt`, its `ptracer` (a light tracer) with `light` and `bdpt`, its
+/// volumetric path tracers `volpath` and `volpathmis` with [`MEDIA_ESTIMATORS`].
 pub fn estimators_for(stem: &str) -> Option<(&str, &'static [&'static str])> {
-    const SUFFIXES: [(&str, &[&str]); 3] = [
+    const SUFFIXES: [(&str, &[&str]); 5] = [
         ("_path", &["pt", "bdpt"]),
         ("_direct", &["pt", "bdpt"]),
         ("_ptracer", &["light", "bdpt"]),
+        ("_volpathmis", MEDIA_ESTIMATORS),
+        ("_volpath", MEDIA_ESTIMATORS),
     ];
     SUFFIXES
         .into_iter()
@@ -49,7 +58,7 @@ pub fn discover(dir: &Path) -> Result<Vec<Case>, String> {
         let Some(fname) = folder.file_name().and_then(|f| f.to_str()) else {
             continue;
         };
-        if !folder.is_dir() || SKIPPED_FOLDERS.contains(&fname) {
+        if !folder.is_dir() {
             continue;
         }
         for xml in list(&folder)? {
@@ -61,7 +70,8 @@ pub fn discover(dir: &Path) -> Result<Vec<Case>, String> {
             };
             let Some((base, estimators)) = estimators_for(stem) else {
                 return Err(format!(
-                    "{}: the file name ends in no integrator the suite knows (_path, _direct, _ptracer)",
+                    "{}: the file name ends in no integrator the suite knows (_path, _direct, \
+                     _ptracer, _volpath, _volpathmis)",
                     xml.display()
                 ));
             };
@@ -70,6 +80,7 @@ pub fn discover(dir: &Path) -> Result<Vec<Case>, String> {
                 name: format!("{fname}/{stem}"),
                 reference: refs.join(format!("{base}_ref_rgb.exr")),
                 reference_var: refs.join(format!("{base}_ref_rgb_var.exr")),
+                traced_from_camera: !stem.ends_with("_ptracer"),
                 xml,
                 estimators,
             });
@@ -99,6 +110,14 @@ mod tests {
             estimators_for("test_various_emitters_ptracer"),
             Some(("test_various_emitters", &["light", "bdpt"][..]))
         );
-        assert_eq!(estimators_for("test_x_volpath"), None);
+        assert_eq!(
+            estimators_for("test_x_volpath"),
+            Some(("test_x", MEDIA_ESTIMATORS))
+        );
+        assert_eq!(
+            estimators_for("test_x_volpathmis"),
+            Some(("test_x", MEDIA_ESTIMATORS))
+        );
+        assert_eq!(estimators_for("test_x_volprim"), None);
     }
 }

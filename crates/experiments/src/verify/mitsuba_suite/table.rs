@@ -17,6 +17,7 @@ fn cell(o: Option<&Outcome>) -> String {
             j.mean_ratio
         ),
         Some(Outcome::Error(m)) => format!("error: {}", escape(m)),
+        Some(Outcome::NotJudged(m)) => format!("not judged: {}", escape(m)),
     }
 }
 
@@ -34,9 +35,10 @@ pub fn markdown(rows: &[Row], budget: &Budget, command: &str) -> String {
     let run: usize = rows.iter().map(|r| r.outcomes.len()).sum();
     let mut s = format!(
         "# Mitsuba 3's render-test suite, rendered by lt\n\n\
-         `{command}` — every scene of `tests/scenes/*/` outside `participating_media`, loaded as \
-         written (no `--approximate`), rendered with the estimators its file name implies (`_path`, \
-         `_direct`: pt and bdpt; `_ptracer`: light and bdpt) and judged against Mitsuba's reference \
+         `{command}` — every scene of `tests/scenes/*/`, loaded as written (no `--approximate`), \
+         rendered with the estimators its file name implies (`_path`, `_direct`: pt and bdpt; \
+         `_ptracer`: light and bdpt; `_volpath`, `_volpathmis`: {}, light not judged where the \
+         camera sees a delta lobe) and judged against Mitsuba's reference \
          by its own rule with lt's standard errors: per pixel value z = |mean − ref| / \
          sqrt(max(se², 1e-4/n) + max(var, 1e-4)/32000 + (1e-3·ref)²) with n = min(spp, \
          2·10⁶/pixels) (Mitsuba's floor at no more than its own test's budget) and the reference's \
@@ -47,6 +49,7 @@ pub fn markdown(rows: &[Row], budget: &Budget, command: &str) -> String {
          per estimator, seed {}; the standard errors are the spread of the passes.\n\n\
          {loads} of {} scenes load; {passing} of {run} renders pass.\n\n\
          | scene | loads | pt | bdpt | light | reason if refused |\n|---|---|---|---|---|---|\n",
+        super::cases::MEDIA_ESTIMATORS.join(" and "),
         100.0 * PASS_FRACTION,
         budget.passes,
         budget.spp_per_pass,

@@ -29,7 +29,9 @@ const MEDIUM_IGNORED: [&str; 2] = ["sample_emitters", "has_spectral_extinction"]
 /// A volume as read, placed once the scene's origin is known.
 #[derive(Clone)]
 enum VolumeAt {
-    Constant(Color),
+    /// A `constvolume` or a plain value; its `to_world` places the box a heterogeneous medium
+    /// lives in (identity for a plain value, as Mitsuba's `get_volume` makes it).
+    Constant(Color, DMat4),
     Grid {
         grid: Arc<lt_core::medium::VolumeGrid>,
         to_world: DMat4,
@@ -41,7 +43,10 @@ enum VolumeAt {
 impl VolumeAt {
     fn at(&self, origin: DVec3) -> Result<Volume, String> {
         match self {
-            VolumeAt::Constant(c) => Ok(Volume::Constant(*c)),
+            VolumeAt::Constant(c, to_world) => {
+                let m = DMat4::from_translation(-origin) * *to_world;
+                Volume::placed_constant(*c, m.as_mat4())
+            }
             VolumeAt::Grid {
                 grid,
                 to_world,
@@ -76,8 +81,9 @@ impl<'a> Loader<'a> {
             "heterogeneous" => {
                 let sigma_t = self.volume_param(&p, "sigma_t", ColorUse::Unbounded)?;
                 let albedo = self.volume_param(&p, "albedo", ColorUse::Reflectance)?;
-                let sigma_t = sigma_t.unwrap_or(VolumeAt::Constant(Color::ONE));
-                let albedo = albedo.unwrap_or(VolumeAt::Constant(Color::splat(0.75)));
+                let unplaced = |c| VolumeAt::Constant(c, DMat4::IDENTITY);
+                let sigma_t = sigma_t.unwrap_or(unplaced(Color::ONE));
+                let albedo = albedo.unwrap_or(unplaced(Color::splat(0.75)));
                 let error = p.err(e, "");
                 let make = move |origin: DVec3| -> Result<Medium, SceneError> {
                     let fail = |m: String| SceneError {
@@ -161,7 +167,7 @@ impl<'a> Loader<'a> {
         usage: ColorUse,
     ) -> Result<Option<VolumeAt>, SceneError> {
         if let Some(c) = p.color(name, usage, self.opts, &mut self.report)? {
-            return Ok(Some(VolumeAt::Constant(c)));
+            return Ok(Some(VolumeAt::Constant(c, DMat4::IDENTITY)));
         }
         match p.named_nested(&["volume"], name)? {
             Some(v) => self.volume(v, usage).map(Some),
@@ -174,9 +180,14 @@ impl<'a> Loader<'a> {
         let v = match p.kind {
             "constvolume" => {
                 let c = p.color("value", usage, self.opts, &mut self.report)?;
-                // A constant has no place: its to_world changes nothing.
-                p.finish(&["to_world"], &mut self.report)?;
-                return Ok(VolumeAt::Constant(c.unwrap_or(Color::ONE)));
+                // Its to_world places its box: where a heterogeneous medium over it exists.
+                let to_world = p
+                    .transform("to_world")?
+                    .map_or(DMat4::IDENTITY, |(x, _)| x.m);
+                let v = VolumeAt::Constant(c.unwrap_or(Color::ONE), to_world);
+                v.at(DVec3::ZERO)
+                    .map_err(|m| p.err(e, format!("volume `constvolume`: {m}")))?;
+                v
             }
             "gridvolume" => self.grid_volume(&p)?,
             _ => return Err(super::kinds::unknown_type(self.doc, e)),

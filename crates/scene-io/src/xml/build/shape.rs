@@ -170,7 +170,8 @@ impl<'a> Loader<'a> {
                     ep.finish(&["sampling_weight"], &mut self.report)?;
                     let emits =
                         self.finish_shape(&p, b, geometry, material, Some(texture), flip)?;
-                    b.set_last_shape_media(media);
+                    b.set_last_shape_media(media)
+                        .map_err(|m| p.err(p.elem, m))?;
                     return Ok(emits);
                 }
                 let r = ep
@@ -181,7 +182,8 @@ impl<'a> Loader<'a> {
             }
         };
         let emits = self.finish_shape(&p, b, geometry, material, emission, flip)?;
-        b.set_last_shape_media(media);
+        b.set_last_shape_media(media)
+            .map_err(|m| p.err(p.elem, m))?;
         Ok(emits)
     }
 
