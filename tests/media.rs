@@ -156,7 +156,7 @@ pub(crate) fn grid_sphere() -> Scene {
         Mat4::from_translation(c - Vec3::splat(r)) * Mat4::from_scale(Vec3::splat(2.0 * r));
     let vol = GridVolume::new(std::sync::Arc::new(grid), to_world, false, WrapMode::Clamp).unwrap();
     let hg = PhaseFunction::henyey_greenstein(-0.3).unwrap();
-    let albedo = Volume::Constant(Color::splat(0.8));
+    let albedo = Volume::constant(Color::splat(0.8));
     let m = GridMedium::new(Volume::Grid(vol), 1.0, albedo, hg).unwrap();
     medium_sphere_with(false, Medium::Grid(Box::new(m)))
 }

@@ -629,14 +629,74 @@ fn too_many_medium_pairs_is_an_error_not_a_panic() {
         }
         b.try_build()
     };
-    let limit = MAX_MEDIUM_INTERFACES - 1;
+    // The builder adds each medium's (m, m) (the interface of a vertex on a shape naming no
+    // media inside m): of the 256 such pairs the shapes below name all but (255, 255), so the
+    // last count that fits is one shape fewer than the table's room.
+    let limit = MAX_MEDIUM_INTERFACES - 2;
     assert!(scene(limit).is_ok());
     let Err(e) = scene(limit + 1) else {
         panic!("{} pairs built", limit + 1);
     };
     assert_eq!(
         e,
-        "the shapes name 65536 distinct (interior, exterior) media pairs; at most 65535 are \
-         supported"
+        "the shapes name 65536 distinct (interior, exterior) media pairs, each medium's (m, m) \
+         included; at most 65535 are supported"
     );
+}
+
+/// An area light on a shape that names no media, inside a null sphere of fog, emits into the fog
+/// (`Scene::settle_unnamed_light_media`): a camera walk reaching it keeps the fog
+/// (`medium_after`), so a light subpath must start there too; one in vacuum stays in vacuum.
+#[test]
+fn an_unnamed_emitter_inside_fog_emits_into_the_fog() {
+    use lt_core::bsdf::{Diffuse, Material, Null};
+    use lt_core::camera::{Camera, FovAxis};
+    use lt_core::scene::{MediumInterface, RenderSettings, SceneBuilder, ShapeGeometry};
+    use lt_core::texture::Texture;
+    let scene = |fog_around_lamp: bool| {
+        let camera =
+            Camera::look_at(Vec3::Z * 5.0, Vec3::ZERO, Vec3::Y, 40.0, FovAxis::X, 2, 2).unwrap();
+        let mut b = SceneBuilder::new(camera, RenderSettings::default());
+        let fog =
+            Homogeneous::new(Color::ONE, Color::splat(0.5), 1.0, PhaseFunction::Isotropic).unwrap();
+        let fog = b.add_medium(Medium::Homogeneous(fog));
+        let null = b.add_material(Material::Null(Null));
+        let white = b.add_material(Material::Diffuse(Diffuse {
+            albedo: Color::splat(0.5),
+        }));
+        b.add_shape(
+            ShapeGeometry::Sphere {
+                center: Vec3::ZERO,
+                radius: 2.0,
+            },
+            null,
+            None,
+            false,
+        );
+        b.set_last_shape_media(MediumInterface {
+            interior: Some(fog),
+            exterior: None,
+        });
+        let lamp = if fog_around_lamp {
+            Vec3::ZERO
+        } else {
+            Vec3::X * 4.0
+        };
+        b.add_emitting_shape(
+            ShapeGeometry::Sphere {
+                center: lamp,
+                radius: 0.25,
+            },
+            white,
+            Some(Texture::Constant(Color::ONE)),
+            false,
+        );
+        b.try_build().unwrap()
+    };
+    assert_eq!(
+        scene(true).light_medium(0),
+        Some(0),
+        "a lamp inside the fog"
+    );
+    assert_eq!(scene(false).light_medium(0), None, "a lamp outside the fog");
 }

@@ -208,10 +208,17 @@ impl SceneBuilder {
     /// more distinct (interior, exterior) media pairs than [`MAX_MEDIUM_INTERFACES`] allows.
     pub fn try_build(mut self) -> Result<Scene, String> {
         // Checked before any work: a refused scene costs nothing.
+        // Each medium also gets the pair (m, m): the interface of a surface vertex on a shape that
+        // names no media, reached inside m (`Scene::interface_within`).
+        let within = (0..self.media.len() as MediumId).map(|m| MediumInterface {
+            interior: Some(m),
+            exterior: Some(m),
+        });
         let pairs: HashSet<MediumInterface> = self
             .shape_media
             .iter()
             .copied()
+            .chain(within)
             .chain([MediumInterface::default()])
             .collect();
         if pairs.len() > MAX_MEDIUM_INTERFACES {
@@ -326,8 +333,24 @@ impl SceneBuilder {
         let has_media = self.camera_medium.is_some()
             || interfaces.len() > 1
             || light_media.iter().any(Option::is_some);
+        let within_medium = if has_media {
+            (0..self.media.len() as MediumId)
+                .map(|m| {
+                    let both = MediumInterface {
+                        interior: Some(m),
+                        exterior: Some(m),
+                    };
+                    *interface_index.entry(both).or_insert_with(|| {
+                        interfaces.push(both);
+                        (interfaces.len() - 1) as u16
+                    })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let light_sampler = LightSampler::new(&lights, bounding_sphere);
-        Ok(Scene {
+        let mut scene = Scene {
             origin,
             camera: self.camera,
             settings: self.settings,
@@ -341,17 +364,21 @@ impl SceneBuilder {
             source_files: Vec::new(),
             media: self.media,
             interfaces,
+            within_medium,
             camera_medium: self.camera_medium,
             light_media,
             has_media,
             accel,
-        })
+        };
+        scene.settle_unnamed_light_media();
+        Ok(scene)
     }
 }
 
 fn too_many_interfaces(pairs: usize) -> String {
     format!(
-        "the shapes name {} distinct (interior, exterior) media pairs; at most {} are supported",
+        "the shapes name {} distinct (interior, exterior) media pairs, each medium's (m, m) \
+         included; at most {} are supported",
         pairs - 1,
         MAX_MEDIUM_INTERFACES - 1
     )

@@ -117,6 +117,19 @@ impl Scene {
         }
     }
 
+    /// The interface a surface vertex at a hit with interface `interface` carries when its walk
+    /// arrived in `current`: the shape's own, or — for a shape that names no media, inside a
+    /// medium m — the pair (m, m). The vertex then keeps the medium it sits in on both sides, so
+    /// `PathVertex::medium_towards`, the joins and the oracle read the same medium as
+    /// [`Scene::medium_after`] gives the walk, from either end of an edge.
+    #[inline]
+    pub fn interface_within(&self, interface: u16, current: Option<MediumId>) -> u16 {
+        match current {
+            Some(m) if interface == 0 => self.within_medium[m as usize],
+            _ => interface,
+        }
+    }
+
     /// True when material `material` has a lobe Mitsuba's `volpath` counts as a null event (a
     /// plain `thindielectric`; a textured one is walked as any delta material): a sample there
     /// may not count toward `max_depth`, and the media walks' shadow rays pass it.
@@ -144,6 +157,44 @@ impl Scene {
     #[inline]
     pub fn is_null_transmission(&self, material: u32, ns: Vec3, wo: Vec3, wi: Vec3) -> bool {
         self.has_null_transmission(material) && ns.dot(wo) * ns.dot(wi) < 0.0
+    }
+
+    /// An area light on a shape that names no media emits into the medium around it, as the
+    /// walks that reach it see it (`medium_after` keeps the arriving medium there): found once,
+    /// here, by following a ray from the light's surface to the first shape that names media and
+    /// taking that shape's medium on the ray's side (a well-formed scene: media are bounded by
+    /// closed shapes). Without this a light subpath would start in vacuum where a camera walk
+    /// reaches the same light inside fog (Mitsuba's emitter_inside_medium test).
+    pub(super) fn settle_unnamed_light_media(&mut self) {
+        if !self.has_media {
+            return;
+        }
+        for l in 0..self.lights.len() {
+            let crate::light::Light::Area(area) = &self.lights[l] else {
+                continue;
+            };
+            if self.shapes[area.shape as usize].interface != 0 {
+                continue;
+            }
+            let half = crate::math::Vec2::splat(0.5);
+            if let Some(le) = area.sample_le(half, half) {
+                self.light_media[l] = self.medium_around(le.ray);
+            }
+        }
+    }
+
+    /// The medium a ray starts in, judged by the first shape naming media that it reaches
+    /// (vacuum when it reaches none).
+    fn medium_around(&self, mut ray: Ray) -> Option<MediumId> {
+        for _ in 0..MAX_CROSSINGS {
+            let hit = self.intersect(&ray)?;
+            let interface = self.shapes[hit.shape as usize].interface;
+            if interface != 0 {
+                return self.medium_across(interface, hit.ng, -ray.d);
+            }
+            ray = hit.spawn_ray(ray.d);
+        }
+        None
     }
 
     /// The medium light `light` emits into.

@@ -95,6 +95,9 @@ pub struct Scene {
     pub media: Vec<crate::medium::Medium>,
     /// The distinct (interior, exterior) pairs of the shapes; entry 0 is (none, none).
     pub interfaces: Vec<MediumInterface>,
+    /// For each medium m, the index of the pair (m, m) in `interfaces`: what a surface vertex on
+    /// a shape that names no media carries when a walk reached it inside m (empty without media).
+    pub within_medium: Vec<u16>,
     /// The medium the camera sits in.
     pub camera_medium: Option<crate::medium::MediumId>,
     /// The medium each light emits into (an area light: its shape's exterior, the side its

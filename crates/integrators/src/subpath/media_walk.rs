@@ -165,7 +165,7 @@ pub(super) fn random_walk(
             if crossings > MAX_NULL_CROSSINGS {
                 return;
             }
-            medium = scene.medium_across(hit.interface, hit.ng, ray.d);
+            medium = scene.medium_after(hit.interface, hit.ng, ray.d, medium);
             ray = hit.spawn_ray(ray.d);
             continue;
         }
@@ -173,7 +173,10 @@ pub(super) fn random_walk(
         let wo = -ray.d;
         let n = out.vertices.len();
         let prev = &out.vertices[n - 1];
-        let v = PathVertex::surface_through_media(&hit, wo, beta, pdf, flight.forward, prev);
+        let mut v = PathVertex::surface_through_media(&hit, wo, beta, pdf, flight.forward, prev);
+        // A shape that names no media keeps the medium the walk is in, on both sides.
+        v.interface = scene.interface_within(hit.interface, medium);
+        let interface = v.interface;
         out.vertices.push(v);
         if n + 1 >= limits.max_vertices {
             return;
@@ -191,7 +194,7 @@ pub(super) fn random_walk(
         let (before, v) = (&mut before[n - 1], &mut v[0]);
         v.delta = bs.delta;
         before.pdf_rev = reverse_density(before, v, bs.pdf_rev_w) * flight.reverse;
-        medium = scene.medium_across(hit.interface, hit.ng, bs.wi);
+        medium = scene.medium_across(interface, hit.ng, bs.wi);
         pdf = bs.pdf_w;
         ray = hit.spawn_ray(bs.wi);
         flight = Flight::leaving(false);

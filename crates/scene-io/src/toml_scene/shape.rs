@@ -127,7 +127,8 @@ pub(super) fn shape(
     }
     let emits = radiance.is_some();
     b.add_shape(geometry, material, radiance, d.flip_normals);
-    b.set_last_shape_media(interface);
+    b.set_last_shape_media(interface)
+        .map_err(|why| ctx.at(def.span(), format!("{what}: {why}")))?;
     Ok(emits)
 }
 
