@@ -1,6 +1,8 @@
 //! The workspace's checks that can share one process, one module per file (see Cargo.toml for
 //! why they are one binary and which stay apart). Run one file's checks with, for example,
-//! `cargo test --release --test checks agreement::`.
+//! `cargo test --release --test checks agreement::`. The crates' own integration tests live here
+//! too, under `integrators::` and `scene_io::` (tests/integrators/, tests/scene_io/): a binary per
+//! crate would cost a thin-LTO link each for a few seconds of tests.
 
 // The statistics here walk blocks × channels of several parallel arrays at once (run means,
 // references, weights); index loops say that plainest.
@@ -31,3 +33,18 @@ mod xml_cornell;
 mod xml_errors;
 mod xml_file_rules;
 mod xml_roundtrip;
+
+/// lt-integrators' integration tests (photon tracing, subpath walks, work tallies).
+mod integrators {
+    mod photons;
+    mod subpaths;
+    mod tally;
+}
+
+/// lt-scene-io's integration tests (TOML and XML scene files, the shipped scenes, media in XML).
+mod scene_io {
+    mod scene_files;
+    mod shipped_scenes;
+    mod smallvcm_twins;
+    mod xml_media;
+}

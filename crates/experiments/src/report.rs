@@ -8,7 +8,7 @@
 //! The page carries a hidden self-check (`report/selfcheck.js`, the first script to run): it
 //! counts window errors, unhandled rejections and `console.error` calls, waits for the page's
 //! images, and writes a JSON line into `<pre id="lt-selfcheck" hidden>` — what
-//! `tests/report_browser.rs` reads from Chromium's dumped DOM.
+//! `crates/experiments/tests/report_browser.rs` reads from Chromium's dumped DOM.
 
 pub mod findings;
 mod html;

@@ -1,5 +1,5 @@
-//! What the cluster tests share (included by each with `#[path]`): the `lt` binary they drive,
-//! a small scene, and image comparison in f32 ulps.
+//! What the cluster tests (`cluster_*`) share: the `lt` binary they drive, a small scene, and
+//! image comparison in f32 ulps.
 
 #![allow(dead_code)]
 
@@ -8,6 +8,11 @@ use lt_experiments::cluster::shard::{read_state, ShardState};
 use lt_experiments::image_io::read_exr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+/// The repository's `scenes/` folder.
+pub fn scenes_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
 
 /// A fresh scratch folder for test `name`.
 pub fn scratch(name: &str) -> PathBuf {
@@ -102,7 +107,7 @@ pub fn lt_err(lt: &Path, args: &[&str]) -> String {
 
 /// The Cornell box at a small resolution, written into `dir` (its content is what is hashed).
 pub fn small_scene(dir: &Path, w: u32, h: u32) -> PathBuf {
-    let src = lt_tests::scenes_dir().join("cornell-box.toml");
+    let src = scenes_dir().join("cornell-box.toml");
     let text = std::fs::read_to_string(src).unwrap();
     assert!(text.contains("resolution = [256, 256]"));
     let text = text.replace(

@@ -345,7 +345,7 @@ fn xml_bad_media_give_one_clear_error() {
 #[test]
 fn xml_mitsubas_media_suite_loads() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/mitsuba-render-tests/tests/scenes/participating_media");
+        .join("../../shared/mitsuba-render-tests/tests/scenes/participating_media");
     if !dir.is_dir() {
         assert!(
             std::env::var("LT_REQUIRE_MITSUBA_SUITE").as_deref() != Ok("1"),

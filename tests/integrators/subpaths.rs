@@ -13,7 +13,7 @@ use lt_scene_io::load_scene;
 use std::path::PathBuf;
 
 fn scene(name: &str) -> Scene {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../../scenes/{name}.toml"));
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../scenes/{name}.toml"));
     let mut s = load_scene(&p).unwrap();
     s.camera = s.camera.with_resolution(32, 32);
     s

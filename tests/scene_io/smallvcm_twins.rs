@@ -11,7 +11,7 @@ use lt_scene_io::load_scene;
 use std::path::PathBuf;
 
 fn load(name: &str) -> Scene {
-    let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"))
+    let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes"))
         .join(format!("{name}.toml"));
     load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
 }

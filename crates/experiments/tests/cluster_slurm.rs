@@ -11,9 +11,7 @@
 //! (LT_SLURM_PARTITION picks its partition). The daemons it starts are stopped whatever happens
 //! (a guard's Drop runs on success and on panic).
 
-#[path = "cluster_common.rs"]
-mod common;
-use common::*;
+use crate::cluster_common::*;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -25,7 +23,7 @@ struct Cluster {
 }
 
 fn script() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../crates/experiments/scripts/slurm-private.sh")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scripts/slurm-private.sh")
 }
 
 impl Drop for Cluster {

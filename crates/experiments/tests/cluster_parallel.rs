@@ -6,9 +6,7 @@
 //! Without GNU parallel installed the test says so loudly and passes, unless
 //! LT_REQUIRE_PARALLEL=1 (CI).
 
-#[path = "cluster_common.rs"]
-mod common;
-use common::*;
+use crate::cluster_common::*;
 use std::process::{Command, Stdio};
 use std::time::Instant;
 

@@ -5,9 +5,7 @@
 //! bit the collected render, a lost shard is named and redone alone, and bad requests get one
 //! clear error.
 
-#[path = "cluster_common.rs"]
-mod common;
-use common::*;
+use crate::cluster_common::*;
 
 #[test]
 fn local_plan_collects_the_one_process_render_and_redoes_only_what_is_lost() {
@@ -211,7 +209,7 @@ fn a_study_plan_is_collected_from_the_cache() {
     let lt = lt_binary(&dir);
     let plan = dir.join("plan");
     let results = dir.join("results");
-    let scenes = lt_tests::scenes_dir();
+    let scenes = scenes_dir();
     let cache = results.join("cache");
     let args = [
         "plan",
@@ -284,7 +282,7 @@ fn a_study_of_the_testbed_is_planned_and_collected_from_the_cache() {
     let lt = lt_binary(&dir);
     let plan = dir.join("plan");
     let results = dir.join("results");
-    let scenes = lt_tests::scenes_dir();
+    let scenes = scenes_dir();
     let p = plan.to_str().unwrap();
     lt_ok(
         &lt,

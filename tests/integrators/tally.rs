@@ -11,7 +11,7 @@ use std::ops::ControlFlow;
 use std::path::PathBuf;
 
 fn scene(name: &str, width: u32) -> Scene {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../../scenes/{name}.toml"));
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../scenes/{name}.toml"));
     let mut s = load_scene(&p).unwrap();
     s.camera = s.camera.with_resolution(width, width);
     s

@@ -25,7 +25,7 @@ const SCENES: [&str; 11] = [
 ];
 
 fn scenes_dir() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"))
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes"))
 }
 
 fn load(name: &str) -> Scene {
