@@ -51,6 +51,24 @@ fn runs_at(
     lt_tests::runs_at(&scene(), integrator, params, checkpoints, RUNS, seed)
 }
 
+/// Pass counts at which `sppm_photon_runs` keeps its runs' estimates.
+const SPPM_PASSES: [u32; 5] = [32, 64, 128, 256, 512];
+
+/// `RUNS` runs of sppm with `direct = photons` and radius exponent `alpha`, kept at
+/// `SPPM_PASSES`: made once per test binary and shared by the variance-rate test and, at
+/// α = 2/3, the ppm floor test (both read only variances across runs; 16 × 512 passes saved).
+fn sppm_photon_runs(alpha: f64, seed: u64) -> std::sync::Arc<Vec<Vec<Image>>> {
+    lt_tests::shared(
+        &format!("consistency sppm direct=photons α={alpha} seed {seed}"),
+        || {
+            let params = IntegratorParams::new()
+                .with("direct", "photons")
+                .with("alpha", alpha);
+            runs_at("sppm", &params, &SPPM_PASSES, seed)
+        },
+    )
+}
+
 /// The long unbiased reference, per block.
 fn reference() -> BlockEstimate {
     let (_, blocks) = render_blocks(&scene(), "pt", IntegratorParams::default(), 4096, 1, BLOCK);
@@ -132,14 +150,11 @@ fn variance_slope(runs: &[Vec<Image>], ns: &[u32], keep: impl Fn(usize) -> bool 
 
 #[test]
 fn variance_of_sppm_falls_as_n_to_the_minus_alpha() {
-    let ns = [32, 64, 128, 256, 512];
+    let ns = SPPM_PASSES;
     let z = sidak_threshold(1e-3, 2);
     let mut failures = Vec::new();
     for (alpha, seed) in [(2.0 / 3.0, 3000), (0.4, 4000)] {
-        let params = IntegratorParams::new()
-            .with("direct", "photons")
-            .with("alpha", alpha);
-        let runs = runs_at("sppm", &params, &ns, seed);
+        let runs = sppm_photon_runs(alpha, seed);
         let k = runs[0].len();
         let slope = variance_slope(&runs, &ns, |_| true);
         let loo: Vec<f64> = (0..k)
@@ -174,10 +189,13 @@ fn variance_of_sppm_falls_as_n_to_the_minus_alpha() {
 fn ppm_variance_has_the_floor_of_its_fixed_visible_points() {
     // sppm and ppm with the same settings: after 512 passes ppm's variance across runs still
     // holds the spread of where its one visible point per pixel fell, which sppm averages away.
+    // sppm's runs are the variance test's at α = 2/3 (sppm's default), taken at 64 and 512.
     let ns = [64, 512];
     let params = IntegratorParams::new().with("direct", "photons");
     let ppm = runs_at("ppm", &params, &ns, 5000);
-    let sppm = runs_at("sppm", &params, &ns, 6000);
+    let sppm = sppm_photon_runs(2.0 / 3.0, 3000);
+    let at = |n: u32| SPPM_PASSES.iter().position(|&m| m == n).unwrap();
+    let sppm = [sppm[at(ns[0])].clone(), sppm[at(ns[1])].clone()];
     let decay =
         |r: &[Vec<Image>]| median_variance(&r[0], |_| true) / median_variance(&r[1], |_| true);
     let (dp, ds) = (decay(&ppm), decay(&sppm));
