@@ -34,9 +34,10 @@ use crate::subpath::camera_loop::{
     camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight,
 };
 use crate::subpath::connect::{nee_density, splat_light_subpath_in};
+use crate::subpath::media_walk::light_subpath_in;
 pub use crate::subpath::strategy_weight::{mis_weight, mis_weight_in, with_chain, with_chain_in};
 pub use crate::subpath::strategy_weight::{EndEvals, Split};
-use crate::subpath::walk::{light_subpath_in, Subpath, WalkLimits};
+use crate::subpath::walk::{Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};

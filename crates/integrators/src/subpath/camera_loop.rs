@@ -28,7 +28,8 @@ use crate::film::pixel::{pixel_sample, weighted};
 use crate::film::splat::Pass;
 use crate::record::{Completed, Recorder, Work};
 use crate::subpath::connect::{join_in, next_event_in, Joined, NextEvent};
-use crate::subpath::walk::{camera_subpath_in, Subpath, WalkLimits};
+use crate::subpath::media_walk::camera_subpath_in;
+use crate::subpath::walk::{Subpath, WalkLimits};
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
 use lt_core::path::camis::Mixture;
@@ -44,7 +45,7 @@ pub type Weight = (f64, Option<Mixture>);
 /// What a bidirectional estimator does at the camera vertices the loop visits. `z` is always the
 /// camera prefix z_0 … z_{t−1}, camera first, its last vertex the one being visited.
 pub trait CameraPolicy {
-    /// The estimator walks participating media (`walk::camera_subpath_in`, next-event estimation
+    /// The estimator walks participating media (`media_walk::camera_subpath_in`, next-event estimation
     /// and joins with transmittance estimates). A constant of the policy's type, chosen once per
     /// pass from `Scene::has_media`, so the loop without media is the surface loop alone.
     const MEDIA: bool = false;
