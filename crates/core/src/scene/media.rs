@@ -72,6 +72,17 @@ pub struct MediumPiece {
     pub b: Vec3,
 }
 
+/// A connection's segment as one walk of it found it (`Scene::connection_estimate`).
+#[derive(Clone, Copy, Debug)]
+pub struct ConnectionFlight {
+    /// An unbiased estimate of T(a, b).
+    pub transmittance: Color,
+    /// The free-flight density of a walk from a reaching b.
+    pub a_to_b: f32,
+    /// The free-flight density of a walk from b reaching a.
+    pub b_to_a: f32,
+}
+
 /// Where a segment towards a light at infinity is cut off: far enough that any positive σt
 /// extinguishes it (T = 0, as over an infinite medium), representable in f32.
 const FAR: f32 = 1e30;
@@ -379,6 +390,51 @@ impl Scene {
             }
         })?;
         Some(t * through)
+    }
+
+    /// One walk of a connection's segment a → b through null boundaries, for what a join through
+    /// media needs of it: an unbiased estimate of T(a, b) (the draws of `transmittance_estimate`,
+    /// piece by piece) and the free-flight densities of the segment walked either way
+    /// (`free_flight_density`: from a, scattering at b when `b_scatters`; from b, scattering at a
+    /// when `a_scatters`), which are the same pieces taken in the other order. `None` when an
+    /// opaque surface blocks. One walk instead of three: a bdpt join reads all of it.
+    pub fn connection_estimate(
+        &self,
+        a: ConnectionEnd,
+        b: ConnectionEnd,
+        medium: Option<MediumId>,
+        (a_scatters, b_scatters): (bool, bool),
+        sampler: &mut Sampler,
+    ) -> Option<ConnectionFlight> {
+        let (mut tr, mut a_to_b, mut b_to_a) = (Color::ONE, 1.0, 1.0);
+        // A piece's walk density is known only once it is known whether it is the last.
+        let mut last: Option<MediumPiece> = None;
+        let mut first = true;
+        let density = |piece: &MediumPiece, from_b: bool, scattered: bool| match piece.medium {
+            Some(m) if from_b => {
+                self.media[m as usize].free_flight_density(piece.b, piece.a, scattered)
+            }
+            Some(m) => self.media[m as usize].free_flight_density(piece.a, piece.b, scattered),
+            None if scattered => 0.0,
+            None => 1.0,
+        };
+        self.for_each_medium_piece(a, b, medium, Crossing::NullOnly, |piece| {
+            if let Some(m) = piece.medium {
+                tr *= self.media[m as usize].transmittance_estimate(piece.a, piece.b, sampler);
+            }
+            b_to_a *= density(&piece, true, first && a_scatters);
+            first = false;
+            if let Some(before) = last.replace(piece) {
+                a_to_b *= density(&before, false, false);
+            }
+        })?;
+        let piece = last.expect("every segment has a piece");
+        a_to_b *= density(&piece, false, b_scatters);
+        Some(ConnectionFlight {
+            transmittance: tr,
+            a_to_b,
+            b_to_a,
+        })
     }
 
     /// The oracle's T of a path edge: every surface crossed is a boundary (visibility is not

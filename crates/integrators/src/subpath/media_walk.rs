@@ -125,6 +125,8 @@ fn random_walk(
         mut pdf,
         mode,
     } = start;
+    out.back_flight.clear();
+    out.back_flight.resize(out.vertices.len(), 1.0);
     let endpoint = out.vertices.last().expect("the endpoint is pushed first");
     let mut medium = endpoint.medium_towards(scene, ray.d);
     let mut flight = Flight::leaving(false);
@@ -144,6 +146,7 @@ fn random_walk(
                     let prev = &out.vertices[n - 1];
                     let v = PathVertex::medium(m, x, wo, beta, pdf, flight.forward, prev);
                     out.vertices.push(v);
+                    out.back_flight.push(flight.reverse);
                     if beta == Color::ZERO || n + 1 >= limits.max_vertices {
                         return;
                     }
@@ -186,6 +189,7 @@ fn random_walk(
                     dir: ray.d,
                     beta,
                     pdf_w: pdf * flight.forward,
+                    back_flight: flight.reverse,
                 });
             }
             return;
@@ -205,6 +209,7 @@ fn random_walk(
         v.interface = scene.interface_within(hit.interface, medium);
         let interface = v.interface;
         out.vertices.push(v);
+        out.back_flight.push(flight.reverse);
         if n + 1 >= limits.max_vertices {
             return;
         }

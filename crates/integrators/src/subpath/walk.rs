@@ -143,6 +143,9 @@ pub struct Escape {
     /// Solid-angle density with which the last vertex chose `dir` (through media, times the
     /// probability of passing every medium on the way out).
     pub pdf_w: f32,
+    /// Through media: the free-flight density of the way out walked from infinity back to the
+    /// last vertex (`Subpath::back_flight`); 1 without media.
+    pub back_flight: f32,
 }
 
 /// One subpath: the camera or light endpoint first, then surfaces in walk order.
@@ -151,6 +154,12 @@ pub struct Subpath {
     pub vertices: Vec<PathVertex>,
     /// For camera subpaths: the walk left the scene after its last vertex.
     pub escape: Option<Escape>,
+    /// Through media, one per vertex (empty otherwise): the free-flight density of the segment
+    /// that reached the vertex walked backwards, from it to the vertex before
+    /// (`Scene::free_flight_density`; 1 at the endpoint). The walk finds it as it walks the
+    /// segment; a join patching the reverse density of the vertex before reads it here instead of
+    /// walking the segment again. (Beside the vertices, not in them: a vertex is kept at 128 bytes.)
+    pub back_flight: Vec<f32>,
 }
 
 impl Subpath {
@@ -158,7 +167,14 @@ impl Subpath {
         Subpath {
             vertices: Vec::with_capacity(n),
             escape: None,
+            back_flight: Vec::new(),
         }
+    }
+
+    /// `back_flight` of vertex `i` (1 when the walk kept none: a surface walk).
+    #[inline]
+    pub fn back_flight(&self, i: usize) -> f32 {
+        self.back_flight.get(i).copied().unwrap_or(1.0)
     }
 
     pub fn len(&self) -> usize {
@@ -330,6 +346,7 @@ pub(super) fn random_walk(
                     dir: ray.d,
                     beta,
                     pdf_w: pdf,
+                    back_flight: 1.0,
                 });
             }
             return;
