@@ -54,12 +54,18 @@ impl NullCrossings {
         ray: &mut Ray,
         medium: &mut Option<MediumId>,
     ) -> bool {
-        self.0 += 1;
-        if self.0 > MAX_NULL_CROSSINGS {
+        if !self.count() {
             return false;
         }
         *medium = scene.medium_after(hit.interface, hit.ng, ray.d, *medium);
         *ray = hit.spawn_ray(ray.d);
         true
+    }
+
+    /// Counts a null event the walk crossed itself (a pane passed); false when too many.
+    #[inline]
+    pub fn count(&mut self) -> bool {
+        self.0 += 1;
+        self.0 <= MAX_NULL_CROSSINGS
     }
 }

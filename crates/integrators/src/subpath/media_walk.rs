@@ -19,6 +19,11 @@
 //! sampled) carries the free flight of the same segment walked the other way: the pieces are the
 //! same, but the one that may scatter is the first (at the vertex before, when it lies in a
 //! medium) and the last is passed.
+//!
+//! A thin dielectric pane passed is a null event (`lt_core::scene::media`'s one rule, as `pt` and
+//! `light` walk it): no vertex, no count toward `max_vertices`; its pass probability 1 − R'
+//! multiplies the segment's free-flight densities both ways, as `Scene::free_flight_density`
+//! has it for the oracle and `Scene::connection_estimate` for joins, which pass panes.
 
 use super::media_step::{scatter_in_medium, NullCrossings};
 use super::walk::{self, camera_start, continue_subpath, light_start, reverse_density, Escape};
@@ -200,17 +205,20 @@ fn random_walk(
             }
             continue;
         }
-        crossings.reset();
         let wo = -ray.d;
         let n = out.vertices.len();
         let prev = &out.vertices[n - 1];
+        let rev_before = prev.pdf_rev;
         let mut v = PathVertex::surface_through_media(&hit, wo, beta, pdf, flight.forward, prev);
         // A shape that names no media keeps the medium the walk is in, on both sides.
         v.interface = scene.interface_within(hit.interface, medium);
         let interface = v.interface;
         out.vertices.push(v);
         out.back_flight.push(flight.reverse);
-        if n + 1 >= limits.max_vertices {
+        // A pane may be passed at the last vertex: passing it is a null event, no vertex
+        // (`Scene::is_null_transmission`); only a reflection makes it one.
+        let pane = scene.has_null_transmission(hit.material);
+        if n + 1 >= limits.max_vertices && !pane {
             return;
         }
         let Some(bs) =
@@ -219,8 +227,25 @@ fn random_walk(
             return;
         };
         medium = scene.medium_across(interface, hit.ng, bs.wi);
-        pdf = bs.pdf_w;
         ray = hit.spawn_ray(bs.wi);
+        if pane && scene.is_null_transmission(hit.material, hit.shading_frame().ns(), wo, bs.wi) {
+            // As a null boundary, but chosen with the lobe's probability 1 − R' (either way):
+            // the segment goes on from the last real vertex, its densities times that.
+            out.vertices.pop();
+            out.back_flight.pop();
+            out.vertices[n - 1].pdf_rev = rev_before;
+            flight.forward *= bs.pdf_w;
+            flight.reverse *= bs.pdf_rev_w;
+            if !crossings.count() {
+                return;
+            }
+            continue;
+        }
+        if n + 1 >= limits.max_vertices {
+            return;
+        }
+        crossings.reset();
+        pdf = bs.pdf_w;
         flight = Flight::leaving(false);
     }
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 /// suite, its table and `tests/mitsuba_suite.rs` read: judging another estimator on every media
 /// scene (`bdpt`, once it walks through media) is one entry here. `light` is judged only where
 /// the camera sees no delta surface (`super::not_judged`).
-pub const MEDIA_ESTIMATORS: &[&str] = &["pt", "light"];
+pub const MEDIA_ESTIMATORS: &[&str] = &["pt", "light", "bdpt"];
 
 /// One scene of the suite.
 #[derive(Clone, Debug)]
