@@ -24,14 +24,18 @@
 //! into the cube). Only there does the rule read the arriving medium: a walk knows it, a vertex on
 //! such a shape has the same medium on both sides.
 //!
-//! **A thin dielectric's pass-through is a null event** in Mitsuba's `volpath` (its transmission
-//! lobe is `BSDFFlags::Null`: the direction is kept), so the media walks of `pt` and `light` cross
-//! a pane as they cross a null boundary: no vertex, no count toward `max_depth`
-//! ([`Scene::is_null_transmission`]), and their shadow rays pass it with its null transmission
-//! 1 − R' ([`Scene::transmittance_estimate_past_panes`]) — the sampled pass-through has weight 1
-//! and probability 1 − R', so the two techniques estimate the same and MIS pairs them from the
-//! last real vertex. The path-space oracle and `transmittance_estimate` still see a pane as the
-//! delta vertex it is.
+//! **A thin dielectric's pass-through is a null event** in a scene with media, as in Mitsuba's
+//! `volpath` (its transmission lobe is `BSDFFlags::Null`: the direction is kept). This is one
+//! path-space decision, read by every walk through media and by the oracle: a pane passed is no
+//! vertex of the path and counts toward no `max_depth` ([`Scene::is_null_transmission`]; `pt`,
+//! `light` and bdpt's subpaths cross it as they cross a null boundary, a pane that reflects is the
+//! delta vertex it is), and a segment through it carries the pane's null transmission
+//! (1 − R') · specular_transmittance in f and its pass probability 1 − R' in every walk density
+//! (the walk samples the pass-through with that probability and weight `specular_transmittance`)
+//! — [`PanesPassed`], which `connection_estimate`, `transmittance_estimate_past_panes`,
+//! `edge_transmittance` and `free_flight_density` all take. Shadow rays and joins therefore pass
+//! panes; the two techniques estimate the same and MIS pairs them from the last real vertex.
+//! Surface scenes (no media) walk a pane as a delta vertex, as Mitsuba's `path` does.
 
 use super::SurfaceHit;
 use super::{ConnectionEnd, Scene};
@@ -72,6 +76,34 @@ pub struct MediumPiece {
     pub b: Vec3,
 }
 
+/// A connection's segment as one walk of it found it (`Scene::connection_estimate`).
+#[derive(Clone, Copy, Debug)]
+pub struct ConnectionFlight {
+    /// An unbiased estimate of T(a, b).
+    pub transmittance: Color,
+    /// The free-flight density of a walk from a reaching b.
+    pub a_to_b: f32,
+    /// The free-flight density of a walk from b reaching a.
+    pub b_to_a: f32,
+}
+
+/// What the thin dielectric panes a segment passes (as null events, module doc) do to it: the
+/// product of their null transmissions (1 − R') · specular_transmittance, the factor of f, and of
+/// their pass probabilities 1 − R', the factor of the density of every walk along the segment
+/// (either way: R' depends on |cos θ| only).
+#[derive(Clone, Copy, Debug)]
+pub struct PanesPassed {
+    pub transmission: Color,
+    pub probability: f32,
+}
+
+impl PanesPassed {
+    const NONE: PanesPassed = PanesPassed {
+        transmission: Color::ONE,
+        probability: 1.0,
+    };
+}
+
 /// Where a segment towards a light at infinity is cut off: far enough that any positive σt
 /// extinguishes it (T = 0, as over an infinite medium), representable in f32.
 const FAR: f32 = 1e30;
@@ -80,10 +112,10 @@ const FAR: f32 = 1e30;
 const MAX_CROSSINGS: usize = 1024;
 
 /// Which surfaces a segment walk passes: every one (the oracle, whose f excludes visibility:
-/// an opaque surface is then a boundary like a null one, and V zeroes the edge anyway), or null
-/// ones only (a shadow ray: an opaque surface blocks), or null ones and thin dielectric panes (the
-/// shadow rays of the media walks, as Mitsuba's `volpath` casts them: a pane passes with its
-/// null transmission 1 − R', `Scene::pane_transmission`).
+/// an opaque surface is then a boundary like a null one, and V zeroes the edge anyway; a pane
+/// passes as the null event it is), or null ones only (an opaque surface or a pane blocks), or
+/// null ones and thin dielectric panes (the shadow rays and joins of the media walks, as
+/// Mitsuba's `volpath` casts them: a pane passes as a null event, [`PanesPassed`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Crossing {
     Everything,
@@ -138,16 +170,24 @@ impl Scene {
         matches!(self.material(material), Material::ThinDielectric(_))
     }
 
-    /// What a thin dielectric pane at `hit` lets through straight along `d` (Mitsuba's
-    /// `eval_null_transmission`): (1 − R'(cos θ)) · specular_transmittance, θ from the shading
-    /// normal; zero for any other material.
-    pub fn pane_transmission(&self, hit: &SurfaceHit, d: Vec3) -> Color {
+    /// What a thin dielectric pane at `hit` does to a segment passing it straight along `d`: its
+    /// null transmission (Mitsuba's `eval_null_transmission`) (1 − R'(cos θ)) ·
+    /// specular_transmittance and pass probability 1 − R'(cos θ), θ from the shading normal (the
+    /// walk's lobe choice, `ThinDielectric::sample`); nothing passes any other material.
+    pub fn pane_passed(&self, hit: &SurfaceHit, d: Vec3) -> PanesPassed {
         match self.material(hit.material) {
             Material::ThinDielectric(t) => {
                 let cos = hit.shading_frame().ns().dot(d);
-                t.specular_transmittance * (1.0 - t.reflectance(cos))
+                let pass = 1.0 - t.reflectance(cos);
+                PanesPassed {
+                    transmission: t.specular_transmittance * pass,
+                    probability: pass,
+                }
             }
-            _ => Color::ZERO,
+            _ => PanesPassed {
+                transmission: Color::ZERO,
+                probability: 0.0,
+            },
         }
     }
 
@@ -205,7 +245,7 @@ impl Scene {
 
     /// Cuts the segment a → b (either end may be at infinity, not both) into its pieces between
     /// boundaries, starting in `medium` at `a`, in order from `a`; `visit` sees each. Returns what
-    /// the crossed panes let through (1 unless `crossing` passes panes), or None (having visited
+    /// the panes passed do to it (nothing unless `crossing` passes panes), or None (having visited
     /// the pieces before it) when a surface that `crossing` does not pass blocks.
     pub fn for_each_medium_piece(
         &self,
@@ -214,7 +254,7 @@ impl Scene {
         medium: Option<MediumId>,
         crossing: Crossing,
         mut visit: impl FnMut(MediumPiece),
-    ) -> Option<Color> {
+    ) -> Option<PanesPassed> {
         // Crossings are found from a finite end; from a light at infinity they are found from the
         // other end and walked backwards.
         let (from, to, reversed) = if a.infinite {
@@ -222,7 +262,7 @@ impl Scene {
         } else {
             (a, b, false)
         };
-        let panes = crossing == Crossing::NullAndPanes;
+        let panes = crossing != Crossing::NullOnly;
         let crossings = self.crossings(from, to, panes)?;
         let dir = if to.infinite {
             to.p
@@ -237,20 +277,21 @@ impl Scene {
         } else {
             (from.p, to.p, dir)
         };
-        let order: Box<dyn Iterator<Item = &(Vec3, u32, Vec3, Color)>> = if reversed {
+        let order: Box<dyn Iterator<Item = &(Vec3, u32, Vec3, PanesPassed)>> = if reversed {
             Box::new(crossings.iter().rev())
         } else {
             Box::new(crossings.iter())
         };
-        let (mut current, mut here, mut through) = (medium, start, Color::ONE);
+        let (mut current, mut here, mut through) = (medium, start, PanesPassed::NONE);
         for &(p, shape, ng, pane) in order {
             let s = &self.shapes[shape as usize];
             match crossing {
-                Crossing::Everything => {}
                 _ if s.null => {}
-                Crossing::NullAndPanes if self.has_null_transmission(s.material) => {
-                    through *= pane;
+                _ if panes && self.has_null_transmission(s.material) => {
+                    through.transmission *= pane.transmission;
+                    through.probability *= pane.probability;
                 }
+                Crossing::Everything => {}
                 _ => return None,
             }
             visit(MediumPiece {
@@ -271,14 +312,14 @@ impl Scene {
 
     /// The surfaces strictly between `from` (finite) and `to`, in order from `from`: each hit
     /// point with its shape, its outward geometric normal and (with `panes`, at a thin dielectric)
-    /// what the pane lets through along the walk, else 1. `None` when the walk does not end (a
-    /// degenerate spot).
+    /// what passing the pane along the walk does, else nothing. `None` when the walk does not end
+    /// (a degenerate spot).
     fn crossings(
         &self,
         from: ConnectionEnd,
         to: ConnectionEnd,
         panes: bool,
-    ) -> Option<Vec<(Vec3, u32, Vec3, Color)>> {
+    ) -> Option<Vec<(Vec3, u32, Vec3, PanesPassed)>> {
         let a = self.end(from.p, from.p_err, from.ng);
         let target = (!to.infinite).then(|| self.end(to.p, to.p_err, to.ng));
         let dir0 = match &target {
@@ -312,9 +353,9 @@ impl Scene {
             };
             let pane = if panes && self.has_null_transmission(hit.material) {
                 // Seen along the walk's direction: |cos| is the same both ways.
-                self.pane_transmission(&hit, dir)
+                self.pane_passed(&hit, dir)
             } else {
-                Color::ONE
+                PanesPassed::NONE
             };
             found.push((hit.p, hit.shape, hit.ng, pane));
             origin = offset_ray_origin(hit.p, hit.p_err, hit.ng, dir);
@@ -378,11 +419,58 @@ impl Scene {
                 t *= self.media[m as usize].transmittance_estimate(piece.a, piece.b, sampler);
             }
         })?;
-        Some(t * through)
+        Some(t * through.transmission)
+    }
+
+    /// One walk of a connection's segment a → b through null boundaries, for what a join through
+    /// media needs of it: an unbiased estimate of T(a, b) (the draws of `transmittance_estimate`,
+    /// piece by piece) and the free-flight densities of the segment walked either way
+    /// (`free_flight_density`: from a, scattering at b when `b_scatters`; from b, scattering at a
+    /// when `a_scatters`), which are the same pieces taken in the other order. Panes pass as null
+    /// events (module doc). `None` when an opaque surface blocks. One walk instead of three: a
+    /// bdpt join reads all of it.
+    pub fn connection_estimate(
+        &self,
+        a: ConnectionEnd,
+        b: ConnectionEnd,
+        medium: Option<MediumId>,
+        (a_scatters, b_scatters): (bool, bool),
+        sampler: &mut Sampler,
+    ) -> Option<ConnectionFlight> {
+        let (mut tr, mut a_to_b, mut b_to_a) = (Color::ONE, 1.0, 1.0);
+        // A piece's walk density is known only once it is known whether it is the last.
+        let mut last: Option<MediumPiece> = None;
+        let mut first = true;
+        let density = |piece: &MediumPiece, from_b: bool, scattered: bool| match piece.medium {
+            Some(m) if from_b => {
+                self.media[m as usize].free_flight_density(piece.b, piece.a, scattered)
+            }
+            Some(m) => self.media[m as usize].free_flight_density(piece.a, piece.b, scattered),
+            None if scattered => 0.0,
+            None => 1.0,
+        };
+        let panes = self.for_each_medium_piece(a, b, medium, Crossing::NullAndPanes, |piece| {
+            if let Some(m) = piece.medium {
+                tr *= self.media[m as usize].transmittance_estimate(piece.a, piece.b, sampler);
+            }
+            b_to_a *= density(&piece, true, first && a_scatters);
+            first = false;
+            if let Some(before) = last.replace(piece) {
+                a_to_b *= density(&before, false, false);
+            }
+        })?;
+        let piece = last.expect("every segment has a piece");
+        a_to_b *= density(&piece, false, b_scatters);
+        Some(ConnectionFlight {
+            transmittance: tr * panes.transmission,
+            a_to_b: a_to_b * panes.probability,
+            b_to_a: b_to_a * panes.probability,
+        })
     }
 
     /// The oracle's T of a path edge: every surface crossed is a boundary (visibility is not
-    /// part of f(x̄)), so it is defined for every edge; on a visible edge it is `transmittance`.
+    /// part of f(x̄)), so it is defined for every edge, and a pane passed is a null event (its
+    /// null transmission, module doc); on a visible edge it is `transmittance` times the panes'.
     pub fn edge_transmittance(
         &self,
         a: ConnectionEnd,
@@ -396,18 +484,15 @@ impl Scene {
             }
         });
         // A segment caught in a degenerate spot (no end to its crossings) carries nothing.
-        if walked.is_some() {
-            t
-        } else {
-            Color::ZERO
-        }
+        walked.map_or(Color::ZERO, |panes| t * panes.transmission)
     }
 
     /// The density with which free-flight sampling from `a` towards `b`, restarted in each medium
     /// piece after a boundary, produces the outcome that ends at `b`: the product of the pieces'
     /// pass probabilities, times (when `scattered_at_b`) the last piece's density per unit length
-    /// of scattering at `b` instead of its pass probability (`Medium::free_flight_density`). A
-    /// vacuum piece is passed with probability 1 (and nothing scatters in it: density 0).
+    /// of scattering at `b` instead of its pass probability (`Medium::free_flight_density`), times
+    /// the pass probability of every pane on the way (a null event, module doc). A vacuum piece
+    /// is passed with probability 1 (and nothing scatters in it: density 0).
     pub fn free_flight_density(
         &self,
         a: ConnectionEnd,
@@ -419,11 +504,11 @@ impl Scene {
         let walked =
             self.for_each_medium_piece(a, b, medium, Crossing::Everything, |p| pieces.push(p));
         // A segment caught in a degenerate spot (no end to its crossings) has no density.
-        if walked.is_none() {
+        let Some(panes) = walked else {
             return 0.0;
-        }
+        };
         let last = pieces.len() - 1;
-        let mut p = 1.0;
+        let mut p = panes.probability;
         for (i, piece) in pieces.iter().enumerate() {
             let scattered = scattered_at_b && i == last;
             p *= match piece.medium {

@@ -33,10 +33,11 @@ use crate::record::{NoRecord, Recorder, Work};
 use crate::subpath::camera_loop::{
     camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight,
 };
-use crate::subpath::connect::{nee_density, splat_light_subpath_in};
+use crate::subpath::connect::{nee_density, splat_light_subpath_in, JoinFlights};
+use crate::subpath::media_walk::light_subpath_in;
 pub use crate::subpath::strategy_weight::{mis_weight, mis_weight_in, with_chain, with_chain_in};
 pub use crate::subpath::strategy_weight::{EndEvals, Split};
-use crate::subpath::walk::{light_subpath_in, Subpath, WalkLimits};
+use crate::subpath::walk::{Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
@@ -91,7 +92,8 @@ struct Pairing {
 /// subpath `y` it is paired with; weights from the stored densities (`strategy_weight`).
 /// `MEDIA`: the scene has participating media (chosen once per pass: `Bdpt::item_in`).
 struct Policy<'a, const MEDIA: bool> {
-    y: &'a [PathVertex],
+    /// With its walk's free flights (`Subpath::back_flight`, through media).
+    y: &'a Subpath,
     /// Next-event estimation's density of y_0 from y_1.
     light_nee: f64,
     h: Heuristic,
@@ -102,8 +104,15 @@ struct Policy<'a, const MEDIA: bool> {
 impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     const MEDIA: bool = MEDIA;
 
-    fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], _: Vec2) -> Weight {
-        let (split, evals) = Split::reached(path);
+    fn emitter_weight(
+        &self,
+        scene: &Scene,
+        path: &[PathVertex],
+        flights: JoinFlights,
+        _: Vec2,
+    ) -> Weight {
+        let (split, mut evals) = Split::reached(path);
+        evals.flights = Some(flights);
         let w = mis_weight_in::<MEDIA>(scene, split, evals, self.h, self.ratio);
         (w, None)
     }
@@ -112,11 +121,12 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         &self,
         scene: &Scene,
         z: &[PathVertex],
-        x0: &PathVertex,
-        camera_end: BsdfEval,
+        (x0, camera_end): (&PathVertex, BsdfEval),
+        flights: JoinFlights,
         _: Vec2,
     ) -> Weight {
-        let (split, evals) = Split::next_event(z, x0, camera_end);
+        let (split, mut evals) = Split::next_event(z, x0, camera_end);
+        evals.flights = Some(flights);
         let w = mis_weight_in::<MEDIA>(scene, split, evals, self.h, self.ratio);
         (w, None)
     }
@@ -170,7 +180,8 @@ impl Bdpt {
             WalkLimits::light(self.params.max_depth, self.params.rr_depth),
             &mut scratch.light,
         );
-        let y = &scratch.light.vertices;
+        let light = &scratch.light;
+        let y = &light.vertices;
         let light_nee = if y.len() >= 2 {
             nee_density(scene, &y[0], &y[1])
         } else {
@@ -200,9 +211,15 @@ impl Bdpt {
                         camera: &camera_only,
                         light_nee,
                     };
+                    let flights = JoinFlights {
+                        edge: c.flights,
+                        light_back: light.back_flight(s - 1),
+                        camera_back: 1.0,
+                    };
                     let evals = EndEvals {
                         light_end: c.eval,
                         camera_end: None,
+                        flights: Some(flights),
                     };
                     (mis_weight_in::<MEDIA>(scene, split, evals, h, ratio), None)
                 },
@@ -212,7 +229,7 @@ impl Bdpt {
             return Color::ZERO;
         };
         let mut policy = Policy::<MEDIA> {
-            y,
+            y: light,
             light_nee,
             h,
             ratio,

@@ -41,7 +41,7 @@ use crate::record::{NoRecord, Recorder, Work};
 use crate::subpath::camera_loop::{
     camera_sample, CameraPolicy, CameraScratch, Depths, Joins, Weight,
 };
-use crate::subpath::connect::{nee_density, splat_light_subpath};
+use crate::subpath::connect::{nee_density, splat_light_subpath, JoinFlights};
 use crate::subpath::strategy_weight::{with_chain, EndEvals, Split};
 use crate::subpath::walk::{light_subpath, Subpath, WalkLimits};
 use crate::Integrator;
@@ -301,6 +301,7 @@ impl LvcBdpt {
             let evals = EndEvals {
                 light_end: c.eval,
                 camera_end: None,
+                flights: None,
             };
             (mis.weight(scene, split, evals), None)
         });
@@ -397,7 +398,13 @@ struct Policy<'a> {
 }
 
 impl CameraPolicy for Policy<'_> {
-    fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], _: Vec2) -> Weight {
+    fn emitter_weight(
+        &self,
+        scene: &Scene,
+        path: &[PathVertex],
+        _: JoinFlights,
+        _: Vec2,
+    ) -> Weight {
         let (split, evals) = Split::reached(path);
         (self.mis.weight(scene, split, evals), None)
     }
@@ -406,8 +413,8 @@ impl CameraPolicy for Policy<'_> {
         &self,
         scene: &Scene,
         z: &[PathVertex],
-        x0: &PathVertex,
-        camera_end: BsdfEval,
+        (x0, camera_end): (&PathVertex, BsdfEval),
+        _: JoinFlights,
         _: Vec2,
     ) -> Weight {
         let (split, evals) = Split::next_event(z, x0, camera_end);

@@ -11,7 +11,8 @@
 
 use super::{is_null, point_end, surface_end};
 use crate::splat::Splats;
-use crate::subpath::walk::{continue_path, russian_roulette, WalkPoint, WalkRules};
+use crate::subpath::media_step::{scatter_in_medium, NullCrossings};
+use crate::subpath::walk::{continue_path, Emission, WalkPoint, WalkStart};
 use lt_core::bsdf::TransportMode;
 use lt_core::geometry::Ray;
 use lt_core::light::Light;
@@ -20,9 +21,6 @@ use lt_core::medium::{FreeFlight, MediumId};
 use lt_core::sampling::Sampler;
 use lt_core::scene::ConnectionEnd;
 use lt_core::Scene;
-
-/// More null crossings than this on one segment is a ray caught in a degenerate spot: it ends.
-const MAX_NULL_CROSSINGS: u32 = 1024;
 
 /// How long the walk may grow and what each splat is scaled by (1 / light paths per pass).
 #[derive(Clone, Copy, Debug)]
@@ -34,17 +32,11 @@ pub struct LightWalk {
 
 /// Traces one light subpath through media and splats every joinable vertex into `splats`.
 pub fn trace(scene: &Scene, walk: LightWalk, sampler: &mut Sampler, splats: &mut Splats) {
-    let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
+    let Some(emission) = Emission::sample(scene, sampler) else {
         return;
     };
-    let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
+    let (li, pmf, le) = (emission.light, emission.pmf, &emission.le);
     let light = &scene.lights[li];
-    let Some(le) = light.sample_le(u_pos, u_dir, scene.bounding_sphere) else {
-        return;
-    };
-    if le.radiance == Color::ZERO || le.pdf_pos == 0.0 || le.pdf_dir == 0.0 {
-        return;
-    }
     let mut medium = scene.light_medium(li as u32);
     if let Light::Area(_) = light {
         // x0 seen by the camera: Le towards the lens |cos θ0| / (pmf pdf_pos).
@@ -73,21 +65,14 @@ pub fn trace(scene: &Scene, walk: LightWalk, sampler: &mut Sampler, splats: &mut
     if walk.max_depth < 2 {
         return;
     }
-    let cos0 = if light.is_infinite() || light.delta_position() {
-        1.0
-    } else {
-        le.n.dot(le.ray.d).abs()
-    };
-    let mut beta = le.radiance * (cos0 / (pmf * le.pdf_pos * le.pdf_dir));
-    let rules = WalkRules {
-        mode: TransportMode::Importance,
-        rr_reference: beta,
-        rr_depth: walk.rr_depth,
-    };
-    let mut ray = le.ray;
+    let start = emission.walk_start(scene);
+    let rules = start.rules(walk.rr_depth);
+    let WalkStart {
+        mut ray, mut beta, ..
+    } = start;
     // The index of the vertex the walk finds next (x0 on the light is 0).
     let mut n = 1;
-    let mut crossings = 0;
+    let mut crossings = NullCrossings::default();
     loop {
         let hit = scene.intersect(&ray);
         if let Some(m) = medium {
@@ -116,16 +101,13 @@ pub fn trace(scene: &Scene, walk: LightWalk, sampler: &mut Sampler, splats: &mut
                     if n + 1 >= walk.max_depth {
                         return;
                     }
-                    let Some(ps) = phase.sample(wo, sampler.next_2d()) else {
+                    let Some(ps) = scatter_in_medium(phase, wo, &rules, &mut beta, n, sampler)
+                    else {
                         return;
                     };
-                    beta *= ps.value / ps.pdf;
-                    if !russian_roulette(&mut beta, rules.rr_reference, n, walk.rr_depth, sampler) {
-                        return;
-                    }
                     ray = Ray::new(x, ps.wi);
                     n += 1;
-                    crossings = 0;
+                    crossings.reset();
                     continue;
                 }
                 FreeFlight::Passed { weight } => {
@@ -140,15 +122,12 @@ pub fn trace(scene: &Scene, walk: LightWalk, sampler: &mut Sampler, splats: &mut
             return;
         };
         if is_null(scene, &hit) {
-            crossings += 1;
-            if crossings > MAX_NULL_CROSSINGS {
+            if !crossings.cross(scene, &hit, &mut ray, &mut medium) {
                 return;
             }
-            medium = scene.medium_after(hit.interface, hit.ng, ray.d, medium);
-            ray = hit.spawn_ray(ray.d);
             continue;
         }
-        crossings = 0;
+        crossings.reset();
         let sf = hit.shading_frame();
         let at = WalkPoint {
             hit: &hit,

@@ -19,7 +19,7 @@ pub mod light;
 pub mod pt;
 
 use lt_core::light::LightLiSample;
-use lt_core::math::{Color, Vec3};
+use lt_core::math::Vec3;
 use lt_core::scene::{ConnectionEnd, SurfaceHit};
 use lt_core::Scene;
 
@@ -66,18 +66,4 @@ pub fn light_end(ls: &LightLiSample) -> ConnectionEnd {
 #[inline]
 pub fn is_null(scene: &Scene, hit: &SurfaceHit) -> bool {
     scene.shapes[hit.shape as usize].null
-}
-
-/// T(a, b) estimated through null boundaries, zero where an opaque surface blocks.
-#[inline]
-pub fn shadow_transmittance(
-    scene: &Scene,
-    a: ConnectionEnd,
-    b: ConnectionEnd,
-    medium: Option<lt_core::medium::MediumId>,
-    sampler: &mut lt_core::sampling::Sampler,
-) -> Color {
-    scene
-        .transmittance_estimate(a, b, medium, sampler)
-        .unwrap_or(Color::ZERO)
 }

@@ -11,9 +11,8 @@
 
 use super::{is_null, light_end, point_end, surface_end};
 use crate::pt::{Pt, Techniques};
-use crate::subpath::walk::{
-    continue_path, escaped_radiance, russian_roulette, WalkPoint, WalkRules,
-};
+use crate::subpath::media_step::{scatter_in_medium, NullCrossings};
+use crate::subpath::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
 use lt_core::bsdf::TransportMode;
 use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec3};
@@ -21,9 +20,6 @@ use lt_core::medium::{FreeFlight, MediumId, PhaseFunction};
 use lt_core::sampling::Sampler;
 use lt_core::scene::ConnectionEnd;
 use lt_core::{Scene, Vec2};
-
-/// More null crossings than this on one segment is a ray caught in a degenerate spot: it ends.
-const MAX_NULL_CROSSINGS: u32 = 1024;
 
 /// The last real vertex, as MIS and the light pdf of an emitter hit read it.
 #[derive(Clone, Copy)]
@@ -57,7 +53,7 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
         p: ray.o,
     };
     let mut depth = 1;
-    let mut crossings = 0;
+    let mut crossings = NullCrossings::default();
     loop {
         let hit = scene.intersect(&ray);
         if let Some(m) = medium {
@@ -75,13 +71,10 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
                     if nee {
                         l += beta * nee_in_medium(pt, scene, x, wo, phase, m, sampler);
                     }
-                    let Some(ps) = phase.sample(wo, sampler.next_2d()) else {
+                    let Some(ps) = scatter_in_medium(phase, wo, &rules, &mut beta, depth, sampler)
+                    else {
                         break;
                     };
-                    beta *= ps.value / ps.pdf;
-                    if !russian_roulette(&mut beta, Color::ONE, depth, params.rr_depth, sampler) {
-                        break;
-                    }
                     prev = Previous {
                         pdf_w: ps.pdf,
                         delta: false,
@@ -89,7 +82,7 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
                     };
                     ray = Ray::new(x, ps.wi);
                     depth += 1;
-                    crossings = 0;
+                    crossings.reset();
                     continue;
                 }
                 FreeFlight::Passed { weight } => {
@@ -110,15 +103,12 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
             break;
         };
         if is_null(scene, &hit) {
-            crossings += 1;
-            if crossings > MAX_NULL_CROSSINGS {
+            if !crossings.cross(scene, &hit, &mut ray, &mut medium) {
                 break;
             }
-            medium = scene.medium_after(hit.interface, hit.ng, ray.d, medium);
-            ray = hit.spawn_ray(ray.d);
             continue;
         }
-        crossings = 0;
+        crossings.reset();
         let wo = -ray.d;
         if let Some(li) = hit.light {
             let light = &scene.lights[li as usize];

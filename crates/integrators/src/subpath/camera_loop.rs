@@ -27,8 +27,9 @@
 use crate::film::pixel::{pixel_sample, weighted};
 use crate::film::splat::Pass;
 use crate::record::{Completed, Recorder, Work};
-use crate::subpath::connect::{join_in, next_event_in, Joined, NextEvent};
-use crate::subpath::walk::{camera_subpath_in, Subpath, WalkLimits};
+use crate::subpath::connect::{join_in, next_event_in, JoinFlights, Joined, NextEvent};
+use crate::subpath::media_walk::camera_subpath_in;
+use crate::subpath::walk::{Subpath, WalkLimits};
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
 use lt_core::path::camis::Mixture;
@@ -44,7 +45,7 @@ pub type Weight = (f64, Option<Mixture>);
 /// What a bidirectional estimator does at the camera vertices the loop visits. `z` is always the
 /// camera prefix z_0 … z_{t−1}, camera first, its last vertex the one being visited.
 pub trait CameraPolicy {
-    /// The estimator walks participating media (`walk::camera_subpath_in`, next-event estimation
+    /// The estimator walks participating media (`media_walk::camera_subpath_in`, next-event estimation
     /// and joins with transmittance estimates). A constant of the policy's type, chosen once per
     /// pass from `Scene::has_media`, so the loop without media is the surface loop alone.
     const MEDIA: bool = false;
@@ -55,8 +56,15 @@ pub trait CameraPolicy {
     fn walked(&mut self, _scene: &Scene, _z: &[PathVertex], _raster: Vec2) {}
 
     /// s = 0: the weight of the path `path` = z_0 … z_m, x0 — a camera walk and the light
-    /// endpoint it reached (its `pdf_fwd` the walk's density of x0).
-    fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], raster: Vec2) -> Weight;
+    /// endpoint it reached (its `pdf_fwd` the walk's density of x0). Through media `flights`
+    /// holds the walk's free flight of x0 → z_m (`camera_back`).
+    fn emitter_weight(
+        &self,
+        scene: &Scene,
+        path: &[PathVertex],
+        flights: JoinFlights,
+        raster: Vec2,
+    ) -> Weight;
 
     /// Whether the techniques with s ≥ 1 run (`bpm` has merges only).
     #[inline]
@@ -64,14 +72,15 @@ pub trait CameraPolicy {
         true
     }
 
-    /// s = 1: the weight of next-event estimation's light sample `x0` joined to z_{t−1}, whose
-    /// BSDF towards it is `camera_end`.
+    /// s = 1: the weight of next-event estimation's light sample x0 joined to z_{t−1}, whose
+    /// BSDF towards it is `camera_end` (`light_end` = (x0, camera_end)); through media `flights` holds the shadow ray's free
+    /// flights and the walk's of z_{t−1} → z_{t−2}.
     fn next_event_weight(
         &self,
         scene: &Scene,
         z: &[PathVertex],
-        x0: &PathVertex,
-        camera_end: BsdfEval,
+        light_end: (&PathVertex, BsdfEval),
+        flights: JoinFlights,
         raster: Vec2,
     ) -> Weight;
 
@@ -144,11 +153,15 @@ pub struct Connection<'a> {
     pub joined: &'a Joined,
     /// Where on the film the path lands.
     pub raster: Vec2,
+    /// Through media: every free flight the weight patches (the edge's from `joined`).
+    pub flights: JoinFlights,
 }
 
 /// The connections of camera vertex z_{t−1}: joins, records and sums them.
 pub struct Joins<'a, R> {
     z: &'a [PathVertex],
+    /// Through media: the camera walk's free flight of z_{t−1} → z_{t−2} (`Subpath::back_flight`).
+    z_back: f32,
     max_k: usize,
     raster: Vec2,
     rec: &'a mut R,
@@ -185,16 +198,17 @@ impl<R: Recorder> Joins<'_, R> {
         scale: f32,
         weight: impl FnOnce(Connection) -> Weight,
     ) {
-        self.join_in::<false>(scene, y, scale, weight)
+        self.join_in::<false>(scene, (y, 1.0), scale, weight)
     }
 
     /// `join`, through media when `MEDIA` (the policy's `CameraPolicy::MEDIA`): the value
-    /// carries the edge's transmittance estimate.
+    /// carries the edge's transmittance estimate; `y_back` is the light walk's free flight of
+    /// y_{s−1} → y_{s−2} (`Subpath::back_flight`).
     #[inline]
     pub fn join_in<const MEDIA: bool>(
         &mut self,
         scene: &Scene,
-        y: &[PathVertex],
+        (y, y_back): (&[PathVertex], f32),
         scale: f32,
         weight: impl FnOnce(Connection) -> Weight,
     ) {
@@ -213,11 +227,17 @@ impl<R: Recorder> Joins<'_, R> {
                 break 'attempt;
             };
             let value = joined.value * scale;
+            let flights = JoinFlights {
+                edge: joined.flights,
+                light_back: y_back,
+                camera_back: self.z_back,
+            };
             let (w, mixture) = weight(Connection {
                 light: y,
                 camera: self.z,
                 joined: &joined,
                 raster: self.raster,
+                flights,
             });
             if R::ACTIVE {
                 if let Some(m) = mixture {
@@ -248,21 +268,24 @@ impl<R: Recorder> Joins<'_, R> {
         &mut self,
         scene: &Scene,
         y: &[PathVertex],
-        weight: impl FnMut(Connection) -> Weight,
+        mut weight: impl FnMut(Connection) -> Weight,
     ) {
-        self.join_subpath_in::<false>(scene, y, weight)
+        for s in 2..=y.len().min(self.max_k + 1 - self.z.len()) {
+            self.join_in::<false>(scene, (&y[..s], 1.0), 1.0, &mut weight);
+        }
     }
 
-    /// `join_subpath`, through media when `MEDIA`.
+    /// `join_subpath`, through media when `MEDIA`: `y` with its walk's `back_flight`s.
     #[inline]
     pub fn join_subpath_in<const MEDIA: bool>(
         &mut self,
         scene: &Scene,
-        y: &[PathVertex],
+        y: &Subpath,
         mut weight: impl FnMut(Connection) -> Weight,
     ) {
         for s in 2..=y.len().min(self.max_k + 1 - self.z.len()) {
-            self.join_in::<MEDIA>(scene, &y[..s], 1.0, &mut weight);
+            let prefix = (&y.vertices[..s], y.back_flight(s - 1));
+            self.join_in::<MEDIA>(scene, prefix, 1.0, &mut weight);
         }
     }
 }
@@ -297,7 +320,8 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
     }
     let mut transmittance =
         P::MEDIA.then(|| Sampler::for_item(Domain::Aux, pass.seed, pixel, pass.pass as u64));
-    let z = &scratch.camera.vertices;
+    let camera = &scratch.camera;
+    let z = &camera.vertices;
     policy.walked(scene, z, raster);
     rec.begin_sample(pixel, film.weight);
     rec.lap(Work::CameraWalk);
@@ -314,8 +338,9 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
                 let le = scene.lights[li as usize].emitted(x0.ng, x0.wo, x0.uv);
                 if le != Color::ZERO {
                     let value = zv.beta * le;
-                    l +=
-                        emitter_reached(scene, policy, (&z[..t - 1], x0, value), reached, &mut ctx);
+                    let back = camera.back_flight(t - 1);
+                    let walk = (&z[..t - 1], x0, back, value);
+                    l += emitter_reached(scene, policy, walk, reached, &mut ctx);
                 }
                 ctx.rec.lap(Work::Connection { s: 0, t: t as u16 });
             }
@@ -326,11 +351,13 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
         if policy.connects() {
             // s = 1: next-event estimation from z_{t−1}.
             if t <= max_k {
-                l += next_event_weighted(scene, policy, &z[..t], &mut cs, &mut ctx);
+                let back = camera.back_flight(t - 1);
+                l += next_event_weighted(scene, policy, (&z[..t], back), &mut cs, &mut ctx);
                 ctx.rec.lap(Work::Connection { s: 1, t: t as u16 });
             }
             let mut joins = Joins {
                 z: &z[..t],
+                z_back: camera.back_flight(t - 1),
                 max_k,
                 raster,
                 rec: &mut *ctx.rec,
@@ -342,7 +369,7 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
         policy.at_vertex(scene, &z[..t], &mut ctx, &mut l);
     }
     // s = 0 at infinity: the walk left the scene after its last vertex.
-    if let Some(esc) = scratch.camera.escape {
+    if let Some(esc) = camera.escape {
         if z.len() <= max_k {
             for &li in &scene.infinite_lights {
                 let le = scene.lights[li as usize].escaped(esc.dir);
@@ -351,7 +378,8 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
                 }
                 let x0 = PathVertex::light_escaped(li, esc.dir, esc.beta, esc.pdf_w);
                 let value = esc.beta * le;
-                l += emitter_reached(scene, policy, (z, x0, value), reached, &mut ctx);
+                let walk = (&z[..], x0, esc.back_flight, value);
+                l += emitter_reached(scene, policy, walk, reached, &mut ctx);
             }
             ctx.rec.lap(Work::Connection {
                 s: 0,
@@ -362,19 +390,24 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
     weighted(l, film.weight)
 }
 
-/// Strategy s = 0: the camera walk `camera` reached light endpoint `x0` with unweighted
-/// contribution `value`; the path is assembled in `path` (weighed and reported as one).
+/// Strategy s = 0: the camera walk `camera` reached light endpoint `x0` (through media with the
+/// free flight `back` of x0 → the walk's last vertex) with unweighted contribution `value`; the
+/// path is assembled in `path` (weighed and reported as one).
 fn emitter_reached<P: CameraPolicy, R: Recorder>(
     scene: &Scene,
     policy: &P,
-    (camera, x0, value): (&[PathVertex], PathVertex, Color),
+    (camera, x0, back, value): (&[PathVertex], PathVertex, f32, Color),
     path: &mut Vec<PathVertex>,
     ctx: &mut SampleCtx<'_, R>,
 ) -> Color {
     path.clear();
     path.extend_from_slice(camera);
     path.push(x0);
-    let (w, mixture) = policy.emitter_weight(scene, path, ctx.raster);
+    let flights = JoinFlights {
+        camera_back: back,
+        ..JoinFlights::default()
+    };
+    let (w, mixture) = policy.emitter_weight(scene, path, flights, ctx.raster);
     if R::ACTIVE {
         if let Some(m) = mixture {
             ctx.rec.mixture(m);
@@ -393,12 +426,13 @@ fn emitter_reached<P: CameraPolicy, R: Recorder>(
     value * w as f32
 }
 
-/// Strategy s = 1 at z_{t−1} (`z` = z_0 … z_{t−1}): one light chosen by power and sampled
-/// towards it (`connect::next_event`'s three numbers from `sampler`).
+/// Strategy s = 1 at z_{t−1} (`z` = z_0 … z_{t−1}, through media with the walk's free flight
+/// `back` of z_{t−1} → z_{t−2}): one light chosen by power and sampled towards it
+/// (`connect::next_event`'s three numbers from `sampler`).
 fn next_event_weighted<P: CameraPolicy, R: Recorder>(
     scene: &Scene,
     policy: &P,
-    z: &[PathVertex],
+    (z, back): (&[PathVertex], f32),
     sampler: &mut Sampler,
     ctx: &mut SampleCtx<'_, R>,
 ) -> Color {
@@ -406,6 +440,7 @@ fn next_event_weighted<P: CameraPolicy, R: Recorder>(
         x0,
         camera_end,
         value,
+        flights,
     }) = (if P::MEDIA {
         next_event_in::<true>(scene, &z[z.len() - 1], sampler)
     } else {
@@ -414,7 +449,12 @@ fn next_event_weighted<P: CameraPolicy, R: Recorder>(
     else {
         return Color::ZERO;
     };
-    let (w, mixture) = policy.next_event_weight(scene, z, &x0, camera_end, ctx.raster);
+    let flights = JoinFlights {
+        edge: flights,
+        light_back: 1.0,
+        camera_back: back,
+    };
+    let (w, mixture) = policy.next_event_weight(scene, z, (&x0, camera_end), flights, ctx.raster);
     if R::ACTIVE {
         if let Some(m) = mixture {
             ctx.rec.mixture(m);

@@ -12,7 +12,41 @@ use lt_core::path::camis::Mixture;
 use lt_core::path::scatter::connectable;
 use lt_core::path::{PathVertex, VertexKind};
 use lt_core::sampling::Sampler;
+use lt_core::scene::ConnectionFlight;
 use lt_core::Scene;
+
+/// The free-flight densities of a connection's edge walked either way (`Scene::free_flight_density`),
+/// found by the join's own walk of it (`Scene::connection_estimate`); 1 without media, unread.
+#[derive(Clone, Copy, Debug)]
+pub struct EdgeFlights {
+    /// A walk from the light end reaching the camera end.
+    pub from_light: f32,
+    /// A walk from the camera end reaching the light end.
+    pub from_camera: f32,
+}
+
+impl Default for EdgeFlights {
+    fn default() -> EdgeFlights {
+        EdgeFlights {
+            from_light: 1.0,
+            from_camera: 1.0,
+        }
+    }
+}
+
+/// Every free-flight density a strategy's MIS weight patches (`strategy_weight::with_chain_in`):
+/// the connecting edge both ways, and the segment arriving at each end walked backwards — which
+/// the walk that made that end found as it walked it (`Subpath::back_flight`), so no join walks
+/// a subpath's segment again.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct JoinFlights {
+    pub edge: EdgeFlights,
+    /// x_{s−1} → x_{s−2}: the light end's arriving segment from its far end (s ≥ 2).
+    pub light_back: f32,
+    /// x_s → x_{s+1}: the camera end's arriving segment from its far end (t ≥ 2); for s = 0
+    /// the segment x0 → x1 of the walk that reached the emitter.
+    pub camera_back: f32,
+}
 
 /// A light-subpath vertex seen by the camera.
 #[derive(Clone, Copy, Debug)]
@@ -26,6 +60,8 @@ pub struct CameraConnection {
     pub eval: Option<BsdfEval>,
     /// The camera vertex the connection sampled (the eye, or a point of a thin lens).
     pub camera: PathVertex,
+    /// Through media: the edge's free-flight densities.
+    pub flights: EdgeFlights,
 }
 
 /// The BSDF of surface vertex `v` between its stored incoming direction `v.wo` and the direction
@@ -60,29 +96,21 @@ fn in_medium(scene: &Scene, medium: MediumId, wo: Vec3, wi: Vec3) -> BsdfEval {
     }
 }
 
-/// What the edge between two subpath vertices lets through: visibility alone without media;
-/// through media (`MEDIA`) an unbiased transmittance estimate through null boundaries and every
-/// medium on the way (`Scene::transmittance_estimate`, ratio tracking in grids, exact in
-/// homogeneous media), zero where an opaque surface blocks. The estimate enters the contribution
-/// only: no density of any technique depends on it.
+/// The edge a → b between two subpath vertices through media, walked once: an unbiased estimate
+/// of its transmittance through null boundaries and every medium on the way (ratio tracking in
+/// grids, exact in homogeneous media) and its free-flight densities either way (`a_to_b`,
+/// `b_to_a`), which the join's MIS weight reads (no density depends on the estimate). `None`
+/// when an opaque surface blocks. Without media a join asks `Scene::connection_visible` alone.
 #[inline]
-pub fn edge_throughput<const MEDIA: bool>(
+pub fn edge_estimate(
     scene: &Scene,
     a: &PathVertex,
     b: &PathVertex,
     sampler: &mut Sampler,
-) -> Color {
-    if !MEDIA {
-        return if scene.connection_visible(a, b) {
-            Color::ONE
-        } else {
-            Color::ZERO
-        };
-    }
+) -> Option<ConnectionFlight> {
     let medium = a.medium_towards(scene, a.dir_to(b));
-    scene
-        .transmittance_estimate(a.into(), b.into(), medium, sampler)
-        .unwrap_or(Color::ZERO)
+    let scatters = (a.in_medium(), b.in_medium());
+    scene.connection_estimate(a.into(), b.into(), medium, scatters, sampler)
 }
 
 /// Joins light-subpath vertex `y` (x0 on a light, or a non-delta surface) to a point of the lens
@@ -138,17 +166,29 @@ pub fn connect_to_camera_in<const MEDIA: bool>(
         return None;
     }
     let camera = PathVertex::camera_at(cam, lens.origin, Color::ONE);
-    let tr = edge_throughput::<MEDIA>(scene, y, &camera, sampler);
-    if tr == Color::ZERO {
+    let (value, flights) = if MEDIA {
+        let f = edge_estimate(scene, y, &camera, sampler)?;
+        let flights = EdgeFlights {
+            from_light: f.a_to_b,
+            from_camera: f.b_to_a,
+        };
+        (value * f.transmittance, flights)
+    } else {
+        if !scene.connection_visible(y, &camera) {
+            return None;
+        }
+        (value, EdgeFlights::default())
+    };
+    if value == Color::ZERO {
         return None;
     }
-    let value = if MEDIA { value * tr } else { value };
     Some(CameraConnection {
         raster: lens.raster,
         dir: lens.dir,
         value: value * (lens.importance * lens.cos_lens / lens.distance_squared),
         eval,
         camera,
+        flights,
     })
 }
 
@@ -261,6 +301,8 @@ pub struct Joined {
     pub light_end: BsdfEval,
     pub camera_end: BsdfEval,
     pub value: Color,
+    /// Through media: the edge's free-flight densities.
+    pub flights: EdgeFlights,
 }
 
 pub fn join(scene: &Scene, y: &PathVertex, z: &PathVertex) -> Option<Joined> {
@@ -291,17 +333,22 @@ pub fn join_in<const MEDIA: bool>(
             light_end,
             camera_end,
             value,
+            flights: EdgeFlights::default(),
         });
     }
     if value == Color::ZERO {
         return None;
     }
     let sampler = sampler.expect("a join through media draws its transmittance estimate");
-    let tr = edge_throughput::<true>(scene, y, z, sampler);
-    (tr != Color::ZERO).then_some(Joined {
+    let f = edge_estimate(scene, y, z, sampler)?;
+    (f.transmittance != Color::ZERO).then_some(Joined {
         light_end,
         camera_end,
-        value: value * tr,
+        value: value * f.transmittance,
+        flights: EdgeFlights {
+            from_light: f.a_to_b,
+            from_camera: f.b_to_a,
+        },
     })
 }
 
@@ -314,6 +361,8 @@ pub struct NextEvent {
     pub camera_end: BsdfEval,
     /// β_z f_cos Le / (pmf pdf_w): the unweighted contribution.
     pub value: Color,
+    /// Through media: the shadow ray's free-flight densities.
+    pub flights: EdgeFlights,
 }
 
 pub fn next_event(scene: &Scene, z: &PathVertex, sampler: &mut Sampler) -> Option<NextEvent> {
@@ -341,19 +390,27 @@ pub fn next_event_in<const MEDIA: bool>(
     let x0 = PathVertex::light_sampled(scene, li as u32, &ls, pmf, z);
     // Without media the shadow ray runs from x0, as it always has (same bits); through media
     // from z, whose side of a surface names the medium the ray starts in.
-    let tr = if MEDIA {
-        edge_throughput::<true>(scene, z, &x0, sampler)
-    } else {
-        edge_throughput::<false>(scene, &x0, z, sampler)
-    };
-    if tr == Color::ZERO {
-        return None;
-    }
     let value = z.beta * camera_end.f_cos * ls.radiance / (pmf * ls.pdf_w);
-    let value = if MEDIA { value * tr } else { value };
+    let (value, flights) = if MEDIA {
+        let f = edge_estimate(scene, z, &x0, sampler)?;
+        if f.transmittance == Color::ZERO {
+            return None;
+        }
+        let flights = EdgeFlights {
+            from_light: f.b_to_a,
+            from_camera: f.a_to_b,
+        };
+        (value * f.transmittance, flights)
+    } else {
+        if !scene.connection_visible(&x0, z) {
+            return None;
+        }
+        (value, EdgeFlights::default())
+    };
     Some(NextEvent {
         x0,
         camera_end,
         value,
+        flights,
     })
 }

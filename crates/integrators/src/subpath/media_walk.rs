@@ -1,6 +1,8 @@
 //! The subpath tracer through participating media (issue 43, item 4): `walk::random_walk` with
-//! free flights. Bidirectional estimators pick it once per pass (`camera_subpath_in::<true>`,
-//! `light_subpath_in::<true>`) for a scene with media; a scene without media never enters it.
+//! free flights, and the entries bidirectional estimators call, `camera_subpath_in` and
+//! `light_subpath_in`, which pick it or the surface walk by `MEDIA` — once per pass, from
+//! `Scene::has_media`, so a scene without media runs the surface walk's code alone. (They live
+//! here, not in `walk`, so the imports run one way: this module reads `walk`, never the reverse.)
 //!
 //! Along each segment the walk samples a free flight in the ray's medium (Mitsuba's per-ray
 //! medium: the medium a vertex leaves into, `PathVertex::medium_towards`, switched at every
@@ -17,18 +19,63 @@
 //! sampled) carries the free flight of the same segment walked the other way: the pieces are the
 //! same, but the one that may scatter is the first (at the vertex before, when it lies in a
 //! medium) and the last is passed.
+//!
+//! A thin dielectric pane passed is a null event (`lt_core::scene::media`'s one rule, as `pt` and
+//! `light` walk it): no vertex, no count toward `max_vertices`; its pass probability 1 − R'
+//! multiplies the segment's free-flight densities both ways, as `Scene::free_flight_density`
+//! has it for the oracle and `Scene::connection_estimate` for joins, which pass panes.
 
-use super::walk::{continue_path, reverse_density, russian_roulette, Escape, Subpath};
-use super::walk::{WalkLimits, WalkPoint, WalkRules, WalkStart};
+use super::media_step::{scatter_in_medium, NullCrossings};
+use super::walk::{self, camera_start, continue_subpath, light_start, reverse_density, Escape};
+use super::walk::{Subpath, WalkLimits, WalkStart};
 use lt_core::geometry::Ray;
-use lt_core::math::{Color, Vec3};
+use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::medium::{FreeFlight, Medium};
 use lt_core::path::PathVertex;
 use lt_core::sampling::Sampler;
 use lt_core::Scene;
 
-/// More null crossings than this on one segment is a ray caught in a degenerate spot: it ends.
-const MAX_NULL_CROSSINGS: u32 = 1024;
+/// `walk::camera_subpath`, through participating media when `MEDIA` (medium vertices where free
+/// flights scatter, null surfaces crossed).
+pub fn camera_subpath_in<const MEDIA: bool>(
+    scene: &Scene,
+    raster: Vec2,
+    sampler: &mut Sampler,
+    limits: WalkLimits,
+    out: &mut Subpath,
+) {
+    if let Some(start) = camera_start(scene, raster, sampler, limits, out) {
+        dispatch::<MEDIA>(scene, start, sampler, limits, out);
+    }
+}
+
+/// `walk::light_subpath`, through participating media when `MEDIA` (see `camera_subpath_in`).
+pub fn light_subpath_in<const MEDIA: bool>(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    limits: WalkLimits,
+    out: &mut Subpath,
+) {
+    if let Some(start) = light_start(scene, sampler, limits, out) {
+        dispatch::<MEDIA>(scene, start, sampler, limits, out);
+    }
+}
+
+/// The surface walk, or the walk through media (`MEDIA`, a constant of the instantiation).
+#[inline(always)]
+fn dispatch<const MEDIA: bool>(
+    scene: &Scene,
+    start: WalkStart,
+    sampler: &mut Sampler,
+    limits: WalkLimits,
+    out: &mut Subpath,
+) {
+    if MEDIA {
+        random_walk(scene, start, sampler, limits, out)
+    } else {
+        walk::random_walk(scene, start, sampler, limits, out)
+    }
+}
 
 /// Where a segment towards nothing is cut off when it passes a medium (as `scene/media.rs` does
 /// for a light at infinity): far enough that any positive σt extinguishes it.
@@ -69,28 +116,26 @@ impl Flight {
 
 /// `walk::random_walk` through media: extends `out` (which holds at least its endpoint) along
 /// `start.ray` until the walk ends or fills `max_vertices`.
-pub(super) fn random_walk(
+fn random_walk(
     scene: &Scene,
     start: WalkStart,
     sampler: &mut Sampler,
     limits: WalkLimits,
     out: &mut Subpath,
 ) {
+    let rules = start.rules(limits.rr_depth);
     let WalkStart {
         mut ray,
         mut beta,
         mut pdf,
         mode,
     } = start;
-    let rules = WalkRules {
-        mode,
-        rr_reference: beta,
-        rr_depth: limits.rr_depth,
-    };
+    out.back_flight.clear();
+    out.back_flight.resize(out.vertices.len(), 1.0);
     let endpoint = out.vertices.last().expect("the endpoint is pushed first");
     let mut medium = endpoint.medium_towards(scene, ray.d);
     let mut flight = Flight::leaving(false);
-    let mut crossings = 0;
+    let mut crossings = NullCrossings::default();
     loop {
         let hit = scene.intersect(&ray);
         if let Some(m) = medium {
@@ -106,23 +151,16 @@ pub(super) fn random_walk(
                     let prev = &out.vertices[n - 1];
                     let v = PathVertex::medium(m, x, wo, beta, pdf, flight.forward, prev);
                     out.vertices.push(v);
+                    out.back_flight.push(flight.reverse);
                     if beta == Color::ZERO || n + 1 >= limits.max_vertices {
                         return;
                     }
                     let phase = mm.phase();
-                    let Some(ps) = phase.sample(wo, sampler.next_2d()) else {
+                    let Some(ps) =
+                        scatter_in_medium(phase, wo, &rules, &mut beta, n as u32, sampler)
+                    else {
                         return;
                     };
-                    beta *= ps.value / ps.pdf;
-                    if !russian_roulette(
-                        &mut beta,
-                        rules.rr_reference,
-                        n as u32,
-                        rules.rr_depth,
-                        sampler,
-                    ) {
-                        return;
-                    }
                     // The reverse density of the vertex before: the phase function from ps.wi
                     // back to wo, then the segment's free flight walked backwards.
                     let (before, v) = out.vertices.split_at_mut(n);
@@ -132,7 +170,7 @@ pub(super) fn random_walk(
                     pdf = ps.pdf;
                     ray = Ray::new(x, ps.wi);
                     flight = Flight::leaving(true);
-                    crossings = 0;
+                    crossings.reset();
                     continue;
                 }
                 FreeFlight::Passed { weight } => {
@@ -156,47 +194,58 @@ pub(super) fn random_walk(
                     dir: ray.d,
                     beta,
                     pdf_w: pdf * flight.forward,
+                    back_flight: flight.reverse,
                 });
             }
             return;
         };
         if scene.shapes[hit.shape as usize].null {
-            crossings += 1;
-            if crossings > MAX_NULL_CROSSINGS {
+            if !crossings.cross(scene, &hit, &mut ray, &mut medium) {
                 return;
             }
-            medium = scene.medium_after(hit.interface, hit.ng, ray.d, medium);
-            ray = hit.spawn_ray(ray.d);
             continue;
         }
-        crossings = 0;
         let wo = -ray.d;
         let n = out.vertices.len();
         let prev = &out.vertices[n - 1];
+        let rev_before = prev.pdf_rev;
         let mut v = PathVertex::surface_through_media(&hit, wo, beta, pdf, flight.forward, prev);
         // A shape that names no media keeps the medium the walk is in, on both sides.
         v.interface = scene.interface_within(hit.interface, medium);
         let interface = v.interface;
         out.vertices.push(v);
+        out.back_flight.push(flight.reverse);
+        // A pane may be passed at the last vertex: passing it is a null event, no vertex
+        // (`Scene::is_null_transmission`); only a reflection makes it one.
+        let pane = scene.has_null_transmission(hit.material);
+        if n + 1 >= limits.max_vertices && !pane {
+            return;
+        }
+        let Some(bs) =
+            continue_subpath(scene, &hit, &rules, &mut beta, out, flight.reverse, sampler)
+        else {
+            return;
+        };
+        medium = scene.medium_across(interface, hit.ng, bs.wi);
+        ray = hit.spawn_ray(bs.wi);
+        if pane && scene.is_null_transmission(hit.material, hit.shading_frame().ns(), wo, bs.wi) {
+            // As a null boundary, but chosen with the lobe's probability 1 − R' (either way):
+            // the segment goes on from the last real vertex, its densities times that.
+            out.vertices.pop();
+            out.back_flight.pop();
+            out.vertices[n - 1].pdf_rev = rev_before;
+            flight.forward *= bs.pdf_w;
+            flight.reverse *= bs.pdf_rev_w;
+            if !crossings.count() {
+                return;
+            }
+            continue;
+        }
         if n + 1 >= limits.max_vertices {
             return;
         }
-        let sf = hit.shading_frame();
-        let at = WalkPoint {
-            hit: &hit,
-            sf: &sf,
-            wo,
-        };
-        let Some(bs) = continue_path(scene, &at, &rules, &mut beta, n as u32, sampler) else {
-            return;
-        };
-        let (before, v) = out.vertices.split_at_mut(n);
-        let (before, v) = (&mut before[n - 1], &mut v[0]);
-        v.delta = bs.delta;
-        before.pdf_rev = reverse_density(before, v, bs.pdf_rev_w) * flight.reverse;
-        medium = scene.medium_across(interface, hit.ng, bs.wi);
+        crossings.reset();
         pdf = bs.pdf_w;
-        ray = hit.spawn_ray(bs.wi);
         flight = Flight::leaving(false);
     }
 }

@@ -5,7 +5,7 @@
 //! integrator files import no other integrator file.
 
 use crate::subpath::camera_loop::Connection;
-use crate::subpath::connect::{emission_densities, nee_density};
+use crate::subpath::connect::{emission_densities, nee_density, JoinFlights};
 use crate::subpath::walk::reverse_density;
 use lt_core::bsdf::BsdfEval;
 use lt_core::path::scatter::{connectable, connectable_inside};
@@ -31,6 +31,10 @@ pub struct Split<'a> {
 pub struct EndEvals {
     pub light_end: Option<BsdfEval>,
     pub camera_end: Option<BsdfEval>,
+    /// Through media: the free flights the join and the walks found (`JoinFlights`); `None`
+    /// walks each patched segment again (`Scene::free_flight_density`), as a checker holding
+    /// only the path must.
+    pub flights: Option<JoinFlights>,
 }
 
 impl<'a> Split<'a> {
@@ -59,6 +63,7 @@ impl<'a> Split<'a> {
         let evals = EndEvals {
             light_end: None,
             camera_end: Some(camera_end),
+            flights: None,
         };
         (split, evals)
     }
@@ -74,6 +79,7 @@ impl<'a> Split<'a> {
         let evals = EndEvals {
             light_end: Some(c.joined.light_end),
             camera_end: Some(c.joined.camera_end),
+            flights: Some(c.flights),
         };
         (split, evals)
     }
@@ -115,8 +121,9 @@ pub fn with_chain<T>(
 /// `with_chain`, for a path that may pass through media when `MEDIA`: every density the join
 /// patches is a walk's that was never walked (the connecting edge in either direction, and the
 /// two end vertices' arriving edges walked backwards), so each takes its free-flight density
-/// (`free_flight`) beside the converted direction density, as the walks' stored ones do. No
-/// transmittance estimate enters: the weights read densities only.
+/// beside the converted direction density, as the walks' stored ones do: from `evals.flights`
+/// (what the join's walk of the edge and the subpaths' walks found), or walked anew (`free_flight`)
+/// when absent. No transmittance estimate enters: the weights read densities only.
 pub fn with_chain_in<const MEDIA: bool, T>(
     scene: &Scene,
     split: Split,
@@ -180,6 +187,13 @@ pub fn with_chain_in<const MEDIA: bool, T>(
     camera[k] = 1.0;
     light[k] = 0.0;
     let mut nee = split.light_nee;
+    // The stored free flight `pick(f)`, or the segment `from` → `to` walked anew.
+    let flight = |pick: fn(&JoinFlights) -> f32, from: &PathVertex, to: &PathVertex| -> f64 {
+        match &evals.flights {
+            Some(f) => pick(f) as f64,
+            None => free_flight(scene, from, to),
+        }
+    };
     match (s, t) {
         (0, _) => {
             // The camera walk made x0; the light walk's densities of x0 and x1 are emission's.
@@ -191,7 +205,7 @@ pub fn with_chain_in<const MEDIA: bool, T>(
                 let x1 = x1.unwrap();
                 light[1] = l1;
                 if MEDIA {
-                    light[1] *= free_flight(scene, x0, x1);
+                    light[1] *= flight(|f| f.camera_back, x0, x1);
                 }
                 nee = nee_density(scene, x0, x1);
             }
@@ -203,13 +217,13 @@ pub fn with_chain_in<const MEDIA: bool, T>(
             let dir = cam.dir_to(yv);
             camera[k - 1] = reverse_density(yv, cam, scene.camera.pdf_dir(cam.p, dir)) as f64;
             if MEDIA {
-                camera[k - 1] *= free_flight(scene, cam, yv);
+                camera[k - 1] *= flight(|f| f.edge.from_camera, cam, yv);
             }
             if s >= 2 {
                 let ev = evals.light_end.expect("a surface connected to the camera");
                 camera[k - 2] = reverse_density(&y[s - 2], yv, ev.pdf_rev_w) as f64;
                 if MEDIA {
-                    camera[k - 2] *= free_flight(scene, yv, &y[s - 2]);
+                    camera[k - 2] *= flight(|f| f.light_back, yv, &y[s - 2]);
                 }
             }
         }
@@ -218,12 +232,12 @@ pub fn with_chain_in<const MEDIA: bool, T>(
             let ev_z = evals.camera_end.expect("the camera end is a surface");
             camera[s - 1] = reverse_density(yv, zv, ev_z.pdf_w) as f64;
             if MEDIA {
-                camera[s - 1] *= free_flight(scene, zv, yv);
+                camera[s - 1] *= flight(|f| f.edge.from_camera, zv, yv);
             }
             if s + 1 < k {
                 light[s + 1] = reverse_density(&z[t - 2], zv, ev_z.pdf_rev_w) as f64;
                 if MEDIA {
-                    light[s + 1] *= free_flight(scene, zv, &z[t - 2]);
+                    light[s + 1] *= flight(|f| f.camera_back, zv, &z[t - 2]);
                 }
             }
             if s == 1 {
@@ -232,7 +246,7 @@ pub fn with_chain_in<const MEDIA: bool, T>(
                 light[0] = l0;
                 light[1] = l1;
                 if MEDIA {
-                    light[1] *= free_flight(scene, yv, zv);
+                    light[1] *= flight(|f| f.edge.from_light, yv, zv);
                 }
                 nee = yv.pdf_fwd as f64;
             } else {
@@ -240,8 +254,8 @@ pub fn with_chain_in<const MEDIA: bool, T>(
                 light[s] = yv.convert_density(ev_y.pdf_w, zv) as f64;
                 camera[s - 2] = reverse_density(&y[s - 2], yv, ev_y.pdf_rev_w) as f64;
                 if MEDIA {
-                    light[s] *= free_flight(scene, yv, zv);
-                    camera[s - 2] *= free_flight(scene, yv, &y[s - 2]);
+                    light[s] *= flight(|f| f.edge.from_light, yv, zv);
+                    camera[s - 2] *= flight(|f| f.light_back, yv, &y[s - 2]);
                 }
             }
         }

@@ -10,6 +10,7 @@
 
 use lt_core::bsdf::{BsdfSample, ShadingFrame, TransportMode};
 use lt_core::geometry::Ray;
+use lt_core::light::LightLeSample;
 use lt_core::math::{Color, Vec3};
 use lt_core::path::PathVertex;
 use lt_core::sampling::Sampler;
@@ -142,6 +143,9 @@ pub struct Escape {
     /// Solid-angle density with which the last vertex chose `dir` (through media, times the
     /// probability of passing every medium on the way out).
     pub pdf_w: f32,
+    /// Through media: the free-flight density of the way out walked from infinity back to the
+    /// last vertex (`Subpath::back_flight`); 1 without media.
+    pub back_flight: f32,
 }
 
 /// One subpath: the camera or light endpoint first, then surfaces in walk order.
@@ -150,6 +154,12 @@ pub struct Subpath {
     pub vertices: Vec<PathVertex>,
     /// For camera subpaths: the walk left the scene after its last vertex.
     pub escape: Option<Escape>,
+    /// Through media, one per vertex (empty otherwise): the free-flight density of the segment
+    /// that reached the vertex walked backwards, from it to the vertex before
+    /// (`Scene::free_flight_density`; 1 at the endpoint). The walk finds it as it walks the
+    /// segment; a join patching the reverse density of the vertex before reads it here instead of
+    /// walking the segment again. (Beside the vertices, not in them: a vertex is kept at 128 bytes.)
+    pub back_flight: Vec<f32>,
 }
 
 impl Subpath {
@@ -157,7 +167,14 @@ impl Subpath {
         Subpath {
             vertices: Vec::with_capacity(n),
             escape: None,
+            back_flight: Vec::new(),
         }
+    }
+
+    /// `back_flight` of vertex `i` (1 when the walk kept none: a surface walk).
+    #[inline]
+    pub fn back_flight(&self, i: usize) -> f32 {
+        self.back_flight.get(i).copied().unwrap_or(1.0)
     }
 
     pub fn len(&self) -> usize {
@@ -172,7 +189,8 @@ impl Subpath {
 /// Traces a camera subpath through `raster`: z0 = the lens point (the pinhole's eye, or a thin
 /// lens's aperture sample: two numbers from `sampler`), then the surfaces the walk meets
 /// (radiance mode). The primary ray's density is the film-wide `Camera::pdf_dir`, so β starts at
-/// 1 (see `lt_core::path` on image normalisation).
+/// 1 (see `lt_core::path` on image normalisation). The walk through media is
+/// `media_walk::camera_subpath_in`.
 pub fn camera_subpath(
     scene: &Scene,
     raster: Vec2,
@@ -180,136 +198,147 @@ pub fn camera_subpath(
     limits: WalkLimits,
     out: &mut Subpath,
 ) {
-    camera_subpath_in::<false>(scene, raster, sampler, limits, out)
+    if let Some(start) = camera_start(scene, raster, sampler, limits, out) {
+        random_walk(scene, start, sampler, limits, out);
+    }
 }
 
-/// `camera_subpath`, through participating media when `MEDIA` (`media_walk`: medium vertices
-/// where free flights scatter, null surfaces crossed). The estimator picks `MEDIA` once per pass
-/// from `Scene::has_media`, so a scene without media runs the surface walk's code alone.
-pub fn camera_subpath_in<const MEDIA: bool>(
+/// Begins a camera subpath in `out`: z0 pushed, and the primary ray its walk follows (`None` when
+/// the limits allow z0 alone).
+pub(super) fn camera_start(
     scene: &Scene,
     raster: Vec2,
     sampler: &mut Sampler,
     limits: WalkLimits,
     out: &mut Subpath,
-) {
+) -> Option<WalkStart> {
     out.vertices.clear();
     out.escape = None;
     let ray = scene.camera.sample_ray(raster, sampler);
     out.vertices
         .push(PathVertex::camera_at(&scene.camera, ray.o, Color::ONE));
     if limits.max_vertices < 2 {
-        return;
+        return None;
     }
     let pdf = scene.camera.pdf_dir(ray.o, ray.d);
-    let start = WalkStart {
+    Some(WalkStart {
         ray,
         beta: Color::ONE,
         pdf,
         mode: TransportMode::Radiance,
-    };
-    walk::<MEDIA>(scene, start, sampler, limits, out);
-}
-
-/// The surface walk, or the walk through media (`MEDIA`, a constant of the instantiation).
-#[inline(always)]
-fn walk<const MEDIA: bool>(
-    scene: &Scene,
-    start: WalkStart,
-    sampler: &mut Sampler,
-    limits: WalkLimits,
-    out: &mut Subpath,
-) {
-    if MEDIA {
-        super::media_walk::random_walk(scene, start, sampler, limits, out)
-    } else {
-        random_walk(scene, start, sampler, limits, out)
-    }
+    })
 }
 
 /// Traces a light subpath: y0 on a light chosen by power (`Light::sample_le`), then the surfaces
 /// the emitted ray meets (importance mode). β of y0 is Le / pdf_fwd; the emitted direction's
-/// cosine and density enter β at y1.
+/// cosine and density enter β at y1. The walk through media is `media_walk::light_subpath_in`.
 pub fn light_subpath(scene: &Scene, sampler: &mut Sampler, limits: WalkLimits, out: &mut Subpath) {
-    light_subpath_in::<false>(scene, sampler, limits, out)
+    if let Some(start) = light_start(scene, sampler, limits, out) {
+        random_walk(scene, start, sampler, limits, out);
+    }
 }
 
-/// `light_subpath`, through participating media when `MEDIA` (see `camera_subpath_in`).
-pub fn light_subpath_in<const MEDIA: bool>(
+/// A light chosen by power and an emitted ray sampled from it (`Light::sample_le`): what every
+/// light walk starts from, surface or media, subpath or `light`'s splatting walk.
+pub struct Emission {
+    pub light: usize,
+    pub pmf: f32,
+    pub le: LightLeSample,
+}
+
+impl Emission {
+    /// Three numbers from `sampler` (light choice, position, direction); `None` when nothing is
+    /// emitted.
+    pub fn sample(scene: &Scene, sampler: &mut Sampler) -> Option<Emission> {
+        let (light, pmf, _) = scene.light_sampler.sample(sampler.next_f32())?;
+        let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
+        let le = scene.lights[light].sample_le(u_pos, u_dir, scene.bounding_sphere)?;
+        if le.radiance == Color::ZERO || le.pdf_pos == 0.0 || le.pdf_dir == 0.0 {
+            return None;
+        }
+        Some(Emission { light, pmf, le })
+    }
+
+    /// The walk along the emitted ray (importance mode): β at y1 is Le |cos θ0| / (pmf pdf_pos
+    /// pdf_dir); a light at infinity has no cosine at y0 and its perpendicular-disk density
+    /// belongs to y1.
+    pub fn walk_start(&self, scene: &Scene) -> WalkStart {
+        let (light, le) = (&scene.lights[self.light], &self.le);
+        let cos0 = if light.is_infinite() || light.delta_position() {
+            1.0
+        } else {
+            le.n.dot(le.ray.d).abs()
+        };
+        let beta = le.radiance * (cos0 / (self.pmf * le.pdf_pos * le.pdf_dir));
+        let pdf = if light.is_infinite() {
+            le.pdf_pos
+        } else {
+            le.pdf_dir
+        };
+        WalkStart {
+            ray: le.ray,
+            beta,
+            pdf,
+            mode: TransportMode::Importance,
+        }
+    }
+}
+
+/// Begins a light subpath in `out`: y0 pushed, and the emitted ray its walk follows (`None` when
+/// nothing is emitted or the limits allow y0 alone).
+pub(super) fn light_start(
     scene: &Scene,
     sampler: &mut Sampler,
     limits: WalkLimits,
     out: &mut Subpath,
-) {
+) -> Option<WalkStart> {
     out.vertices.clear();
     out.escape = None;
-    let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
-        return;
-    };
-    let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
-    let light = &scene.lights[li];
-    let Some(le) = light.sample_le(u_pos, u_dir, scene.bounding_sphere) else {
-        return;
-    };
-    if le.radiance == Color::ZERO || le.pdf_pos == 0.0 || le.pdf_dir == 0.0 {
-        return;
-    }
-    let y0 = PathVertex::light_emitted(scene, li as u32, &le, pmf);
+    let e = Emission::sample(scene, sampler)?;
+    let y0 = PathVertex::light_emitted(scene, e.light as u32, &e.le, e.pmf);
     out.vertices.push(y0);
     if limits.max_vertices < 2 {
-        return;
+        return None;
     }
-    // β at y1: Le |cos θ0| / (pmf pdf_pos pdf_dir); a light at infinity has no cosine at y0 and
-    // its perpendicular-disk density belongs to y1.
-    let cos0 = if light.is_infinite() || light.delta_position() {
-        1.0
-    } else {
-        le.n.dot(le.ray.d).abs()
-    };
-    let beta = le.radiance * (cos0 / (pmf * le.pdf_pos * le.pdf_dir));
-    let pdf = if light.is_infinite() {
-        le.pdf_pos
-    } else {
-        le.pdf_dir
-    };
-    let start = WalkStart {
-        ray: le.ray,
-        beta,
-        pdf,
-        mode: TransportMode::Importance,
-    };
-    walk::<MEDIA>(scene, start, sampler, limits, out);
+    Some(e.walk_start(scene))
 }
 
 /// The first ray of a subpath's walk, leaving its endpoint: the throughput it carries, the
 /// density with which the endpoint chose it (see `PathVertex::surface`) and the transport mode.
-pub(super) struct WalkStart {
+pub struct WalkStart {
     pub ray: Ray,
     pub beta: Color,
     pub pdf: f32,
     pub mode: TransportMode,
 }
 
+impl WalkStart {
+    /// The rules of a walk from here: its mode, roulette against the β it starts with.
+    pub fn rules(&self, rr_depth: u32) -> WalkRules {
+        WalkRules {
+            mode: self.mode,
+            rr_reference: self.beta,
+            rr_depth,
+        }
+    }
+}
+
 /// Extends `out` (which holds at least its endpoint) along `start.ray` until the walk ends or
 /// fills `max_vertices`.
-fn random_walk(
+pub(super) fn random_walk(
     scene: &Scene,
     start: WalkStart,
     sampler: &mut Sampler,
     limits: WalkLimits,
     out: &mut Subpath,
 ) {
+    let rules = start.rules(limits.rr_depth);
     let WalkStart {
         mut ray,
         mut beta,
         mut pdf,
         mode,
     } = start;
-    let rules = WalkRules {
-        mode,
-        rr_reference: beta,
-        rr_depth: limits.rr_depth,
-    };
     loop {
         let Some(hit) = scene.intersect(&ray) else {
             if mode == TransportMode::Radiance && !scene.infinite_lights.is_empty() {
@@ -317,6 +346,7 @@ fn random_walk(
                     dir: ray.d,
                     beta,
                     pdf_w: pdf,
+                    back_flight: 1.0,
                 });
             }
             return;
@@ -331,24 +361,42 @@ fn random_walk(
         if n + 1 >= limits.max_vertices {
             return;
         }
-        let sf = hit.shading_frame();
-        let at = WalkPoint {
-            hit: &hit,
-            sf: &sf,
-            wo,
-        };
-        let Some(bs) = continue_path(scene, &at, &rules, &mut beta, n as u32, sampler) else {
+        let Some(bs) = continue_subpath(scene, &hit, &rules, &mut beta, out, 1.0, sampler) else {
             return;
         };
-        // The reverse density of the vertex before: how a walk from the other end, arriving along
-        // bs.wi, would have chosen it.
-        let (before, v) = out.vertices.split_at_mut(n);
-        let (before, v) = (&mut before[n - 1], &mut v[0]);
-        v.delta = bs.delta;
-        before.pdf_rev = reverse_density(before, v, bs.pdf_rev_w);
         pdf = bs.pdf_w;
         ray = hit.spawn_ray(bs.wi);
     }
+}
+
+/// Continues a subpath at its last vertex, a surface at `hit` (`continue_path`), and fills what
+/// the sample decides of the vertices: the last one's `delta`, and the `pdf_rev` of the one before
+/// — how a walk from the other end, arriving along the sampled direction, would have chosen it,
+/// times `ff_reverse`, the free flight of the segment between them walked backwards (1 without
+/// media, an exact no-op).
+#[inline(always)]
+pub(super) fn continue_subpath(
+    scene: &Scene,
+    hit: &SurfaceHit,
+    rules: &WalkRules,
+    beta: &mut Color,
+    out: &mut Subpath,
+    ff_reverse: f32,
+    sampler: &mut Sampler,
+) -> Option<BsdfSample> {
+    let n = out.vertices.len() - 1;
+    let sf = hit.shading_frame();
+    let at = WalkPoint {
+        hit,
+        sf: &sf,
+        wo: out.vertices[n].wo,
+    };
+    let bs = continue_path(scene, &at, rules, beta, n as u32, sampler)?;
+    let (before, v) = out.vertices.split_at_mut(n);
+    let (before, v) = (&mut before[n - 1], &mut v[0]);
+    v.delta = bs.delta;
+    before.pdf_rev = reverse_density(before, v, bs.pdf_rev_w) * ff_reverse;
+    Some(bs)
 }
 
 /// The density of generating `target` from `from` with a solid-angle density `pdf_w` at `from`,

@@ -378,6 +378,8 @@ fn replay_bdpt(
     let evals = EndEvals {
         light_end: light_end.flatten(),
         camera_end: camera_end.flatten(),
+        // The checker holds the path alone: the patched free flights are walked anew.
+        flights: None,
     };
     // Through media the join's patched densities take their free flights (`with_chain_in`).
     match (n_conn == 1.0, scene.has_media) {

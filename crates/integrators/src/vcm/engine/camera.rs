@@ -8,7 +8,7 @@ use crate::record::{Merged, Recorder, Work};
 use crate::subpath::camera_loop::{
     camera_sample, CameraPolicy, Connection, Depths, Joins, SampleCtx, Weight,
 };
-use crate::subpath::connect::{emission_densities, nee_density, Joined};
+use crate::subpath::connect::{emission_densities, nee_density, JoinFlights, Joined};
 use crate::subpath::strategy_weight::Split;
 use crate::subpath::walk::reverse_density;
 use lt_core::bsdf::{BsdfEval, TransportMode};
@@ -100,7 +100,13 @@ impl CameraPolicy for VcmCamera<'_, '_> {
 
     /// The camera walk (camera first, ending at x1) reached light endpoint x0 with density c0
     /// (its `pdf_fwd`).
-    fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], raster: Vec2) -> Weight {
+    fn emitter_weight(
+        &self,
+        scene: &Scene,
+        path: &[PathVertex],
+        _: JoinFlights,
+        raster: Vec2,
+    ) -> Weight {
         let (camera, x0) = path.split_at(path.len() - 1);
         let (x0, c0) = (&x0[0], x0[0].pdf_fwd);
         let x1 = camera.last().expect("the pinhole");
@@ -138,8 +144,8 @@ impl CameraPolicy for VcmCamera<'_, '_> {
         &self,
         scene: &Scene,
         z: &[PathVertex],
-        x0: &PathVertex,
-        ev_z: BsdfEval,
+        (x0, ev_z): (&PathVertex, BsdfEval),
+        _: JoinFlights,
         raster: Vec2,
     ) -> Weight {
         let t = z.len();

@@ -233,6 +233,7 @@ impl<'a> Engine<'a> {
                 let evals = EndEvals {
                     light_end: c.eval,
                     camera_end: None,
+                    flights: None,
                 };
                 let distance = (camera.p - yv.p).length();
                 let wd = camis.connection(scene, split, evals, distance, c.raster);
