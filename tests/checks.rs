@@ -19,6 +19,7 @@ mod mis_check;
 mod mis_check_vcm;
 mod partial_merge;
 mod photon_estimates;
+mod points_beams;
 mod pt_agreement;
 mod robustness;
 mod runs;

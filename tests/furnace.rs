@@ -237,6 +237,21 @@ fn pt_next_event_only_sphere_furnace() {
 /// that joins `HANDLES_MEDIA` without a row here renders 256.
 const MEDIUM_FURNACE_PASSES: [(&str, u32); 3] = [("pt", 64), ("pt-bsdf", 64), ("light", 1024)];
 
+/// Media integrators not held to the medium furnace, with why (printed, never silent).
+const MEDIUM_FURNACE_EXCLUDED: &[(&str, &str)] = &[
+    (
+        "pp3d",
+        "a consistent kernel estimate at the default radius: 8 runs of 16 passes leave a 6–11 % \
+         standard error (the test asks < 2 %), and the kernel straddling the ball's boundary \
+         biases it there; tests/points_beams.rs holds it to pt",
+    ),
+    (
+        "pb2d",
+        "as pp3d: 1.5–10 % standard error at 8 runs of 16 passes, boundary bias of the kernel; \
+         tests/points_beams.rs holds it to pt",
+    ),
+];
+
 /// The sphere holding a ball of chromatic forward-scattering medium (HG g = 0.7), the cube one of
 /// chromatic isotropic medium, both of albedo 1 and optical radius 0.35–1.4, so many paths
 /// scatter in the ball, some many times. Every scattering counts toward max_depth 64; the ball
@@ -266,6 +281,13 @@ fn media_integrators_furnace_with_a_white_medium_ball() {
             if !handles_media(info.name) {
                 let refusal = media_refusal(info.name, &scene, &name);
                 println!("{name}: refused ({refusal})");
+                continue;
+            }
+            if let Some((_, why)) = MEDIUM_FURNACE_EXCLUDED
+                .iter()
+                .find(|(i, _)| *i == info.name)
+            {
+                println!("{name}: excluded ({why})");
                 continue;
             }
             let passes = MEDIUM_FURNACE_PASSES

@@ -21,6 +21,8 @@ pub mod record;
 pub mod registry;
 pub mod render;
 pub mod subpath;
+// Volumetric density estimation: photon points gathered by points and by camera beams.
+pub mod volume_density;
 
 // The paths crates outside this one import (the modules' homes are above).
 pub use bidirectional::{bdpt, lvc_bdpt};

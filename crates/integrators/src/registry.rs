@@ -13,6 +13,8 @@ use crate::unidirectional::pt_bsdf::{PtBsdf, PtBsdfParams};
 use crate::vcm::bpm::Bpm;
 use crate::vcm::eamis::Eamis;
 use crate::vcm::Vcm;
+use crate::volume_density::pb2d::Pb2d;
+use crate::volume_density::pp3d::Pp3d;
 use crate::{Estimator, Kind};
 use lt_core::Scene;
 
@@ -47,6 +49,9 @@ pub enum Radius {
     KnausZwicker,
     /// The pure power law rᵢ = r₁ i^((α−1)/2) (vcm, bpm: Georgiev et al. 2012, SmallVCM).
     Power,
+    /// rᵢ = r₁ i^((α−1)/d) for a kernel of dimension d (the volumetric estimators:
+    /// `volume_density::schedule`).
+    Dimension(u32),
 }
 
 impl Radius {
@@ -57,6 +62,9 @@ impl Radius {
             Radius::Fixed => Some(1.0),
             Radius::KnausZwicker => Some(crate::density::radius::global_scale2(i, alpha)),
             Radius::Power => Some(crate::density::radius::power_scale2(i, alpha)),
+            Radius::Dimension(d) => {
+                Some(crate::volume_density::schedule::radius_scale(i, alpha, d).powi(2))
+            }
         }
     }
 }
@@ -214,6 +222,26 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         radius: Radius::Power,
         make: |s, r| Ok(Estimator::Consistent(Box::new(Eamis::read(s, r)?))),
     },
+    IntegratorInfo {
+        name: "pp3d",
+        about: "volumetric photon mapping: photon points gathered at the first medium vertex \
+                (3-D kernel), pt elsewhere",
+        kind: Kind::Consistent,
+        weights: Weights::None,
+        source: include_str!("volume_density/pp3d.rs"),
+        radius: Radius::Dimension(3),
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Pp3d::read(s, r)?))),
+    },
+    IntegratorInfo {
+        name: "pb2d",
+        about: "beam radiance estimate: photon points gathered along camera beams in media \
+                (2-D kernel), pt elsewhere",
+        kind: Kind::Consistent,
+        weights: Weights::None,
+        source: include_str!("volume_density/pb2d.rs"),
+        radius: Radius::Dimension(2),
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Pb2d::read(s, r)?))),
+    },
 ];
 
 /// The names of the integrators whose weights `w` describes, in table order.
@@ -252,7 +280,7 @@ pub fn make_integrator(
 
 /// The integrators that walk participating media (`media/`); every other refuses a scene with
 /// media rather than render it silently wrong (issue 43, item 4).
-pub const HANDLES_MEDIA: &[&str] = &["pt", "pt-bsdf", "light", "bdpt"];
+pub const HANDLES_MEDIA: &[&str] = &["pt", "pt-bsdf", "light", "bdpt", "pp3d", "pb2d"];
 
 /// One clear line for an integrator that cannot render the scene's media.
 fn refuse_media(name: &str, scene: &Scene) -> Result<(), String> {

@@ -38,8 +38,48 @@ struct Scatter {
     pdf_w: f32,
 }
 
+/// What a camera walk does in a medium besides `pt`'s free-flight sampling: the volumetric
+/// density estimators (`volume_density`) end the walk at its first medium vertex with a kernel
+/// estimate there (photon points) or along the flight that would have found it (beams). `pt`'s
+/// own walk is [`Volpath`], whose defaults do nothing; the walk is monomorphised per kind, so
+/// `pt` runs the code it ran before.
+pub trait MediumEvents {
+    /// At the start of a free flight in medium `m` along `ray` up to `t_max`, whose scattering
+    /// vertex would be the walk's `depth`-th: an estimate to add (times β) of every path whose
+    /// first medium vertex from the camera lies on this flight.
+    #[inline]
+    fn along_flight(&self, _ray: &Ray, _t_max: f32, _m: MediumId, _depth: u32) -> Option<Color> {
+        None
+    }
+
+    /// At a sampled scattering `x` (the walk's `depth`-th vertex, β holding σs there): `Some`
+    /// ends the walk with that estimate (times β) of the in-scattered radiance; `None` goes on
+    /// as `pt`.
+    #[inline]
+    fn at_scatter(&self, _x: Vec3, _wo: Vec3, _m: MediumId, _depth: u32) -> Option<Color> {
+        None
+    }
+}
+
+/// `pt`'s own walk: free flights sampled, medium vertices lit by next-event estimation and
+/// continued by phase sampling.
+pub struct Volpath;
+
+impl MediumEvents for Volpath {}
+
 /// The radiance estimate of one camera sample at `raster` through media.
 pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> Color {
+    radiance_with(pt, scene, raster, sampler, &Volpath)
+}
+
+/// `radiance` with the medium events `events` (see [`MediumEvents`]).
+pub fn radiance_with<E: MediumEvents>(
+    pt: &Pt,
+    scene: &Scene,
+    raster: Vec2,
+    sampler: &mut Sampler,
+    events: &E,
+) -> Color {
     let params = pt.params;
     let nee = params.techniques != Techniques::Bsdf;
     let rules = WalkRules::camera(params.rr_depth);
@@ -59,6 +99,9 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
         if let Some(m) = medium {
             let t_max = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
             let mm = &scene.media[m as usize];
+            if let Some(along) = events.along_flight(&ray, t_max, m, depth) {
+                l += beta * along;
+            }
             match mm.sample_free_flight(ray.o, ray.d, t_max, sampler) {
                 FreeFlight::Scattered { t, weight } => {
                     beta *= weight;
@@ -67,6 +110,10 @@ pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> 
                     }
                     let x = ray.o + ray.d * t;
                     let wo = -ray.d;
+                    if let Some(estimate) = events.at_scatter(x, wo, m, depth) {
+                        l += beta * estimate;
+                        break;
+                    }
                     let phase = mm.phase();
                     if nee {
                         l += beta * nee_in_medium(pt, scene, x, wo, phase, m, sampler);
