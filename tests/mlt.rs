@@ -1,7 +1,7 @@
 //! Metropolis light transport (`pssmlt`, `mmlt`) against bdpt, and the honesty of its error bars.
 //!
 //! 1. **Agreement.** On shipped scenes with an area light, a point light behind a specular ball
-//!    (caustics: specular chains and a delta light), `pssmlt` over
+//!    (caustics: specular chains and a delta light) and rough glass, `pssmlt` over
 //!    bdpt, `pssmlt` over pt and `mmlt` agree with bdpt per 8×8 block: `CONSISTENT_RUNS`
 //!    independent runs of each Metropolis estimator (each with its own bootstrap, so the
 //!    normalisation's error is inside the spread) against bdpt's passes, Student-t and Šidák over
