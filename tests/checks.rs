@@ -17,6 +17,7 @@ mod material_grid;
 mod media;
 mod mis_check;
 mod mis_check_vcm;
+mod mlt;
 mod partial_merge;
 mod photon_estimates;
 mod points_beams;

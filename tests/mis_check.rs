@@ -329,6 +329,8 @@ fn reweigh<const MEDIA: bool>(scene: &lt_core::Scene, r: &Record, h: Heuristic) 
         camera_end: (z.len() >= 2)
             .then(|| eval_towards(scene, zv, zv.dir_to(yv), Radiance))
             .flatten(),
+        // The oracle walks every segment anew rather than trusting the walks' cached flights.
+        flights: None,
     };
     let light_nee = if r.s >= 2 {
         nee_density(scene, &y[0], &y[1])

@@ -9,6 +9,7 @@ pub mod math;
 pub mod measure;
 pub mod medium;
 pub mod path;
+pub mod primary_space;
 pub mod sampling;
 pub mod scene;
 pub mod shape;

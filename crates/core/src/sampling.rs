@@ -6,9 +6,15 @@ use rand_pcg::rand_core::Rng;
 use rand_pcg::Pcg32;
 
 /// A PCG stream keyed by (seed, pixel or path index, pass), so any work split gives the same numbers.
+/// Inside `primary_space::with_space` (Metropolis), `for_item` instead hands out a sampler that
+/// reads the installed chain's stream for its domain (`stream` names it; `PCG` otherwise).
 pub struct Sampler {
     rng: Pcg32,
+    stream: u8,
 }
+
+/// `Sampler::stream` of an ordinary PCG sampler.
+const PCG: u8 = u8::MAX;
 
 /// SplitMix64 finaliser: decorrelates the key words before they become PCG state and stream.
 #[inline]
@@ -42,7 +48,11 @@ impl Sampler {
     /// are exactly `Sampler::new`'s.
     pub fn for_item(domain: Domain, seed: u64, item: u64, pass: u64) -> Sampler {
         debug_assert!(item < 1 << DOMAIN_SHIFT);
-        Sampler::new(seed, item ^ ((domain as u64) << DOMAIN_SHIFT), pass)
+        let mut s = Sampler::new(seed, item ^ ((domain as u64) << DOMAIN_SHIFT), pass);
+        if crate::primary_space::installed() {
+            s.stream = 1 + domain as u8;
+        }
+        s
     }
 
     /// The stream for one work item (a pixel, or a light path) in one pass of one seeded run.
@@ -52,12 +62,21 @@ impl Sampler {
         let stream = mix64(pass ^ mix64(seed.wrapping_add(item.rotate_left(32))));
         Sampler {
             rng: Pcg32::new(state, stream),
+            stream: PCG,
         }
+    }
+
+    /// The PCG generator itself (the primary space's own stream of fresh and mutated numbers).
+    pub(crate) fn into_rng(self) -> Pcg32 {
+        self.rng
     }
 
     /// Uniform in [0, 1), never 1.
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
+        if self.stream != PCG {
+            return crate::primary_space::next_installed(self.stream as usize);
+        }
         (self.rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
     }
 

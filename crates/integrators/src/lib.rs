@@ -7,6 +7,7 @@
 
 // The estimators, by family (each file opens with its key table).
 pub mod bidirectional;
+pub mod metropolis;
 pub mod photon;
 pub mod unidirectional;
 pub mod vcm;

@@ -3,6 +3,8 @@
 
 use crate::bidirectional::bdpt::{Bdpt, BdptParams};
 use crate::bidirectional::lvc_bdpt::{LvcBdpt, LvcParams};
+use crate::metropolis::mmlt::Mmlt;
+use crate::metropolis::pssmlt::Pssmlt;
 use crate::params::{IntegratorParams, ParamReader};
 use crate::photon::pm::{Pm, PmParams};
 use crate::photon::ppm::Ppm;
@@ -241,6 +243,25 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         source: include_str!("volume_density/pb2d.rs"),
         radius: Radius::Dimension(2),
         make: |s, r| Ok(Estimator::Consistent(Box::new(Pb2d::read(s, r)?))),
+    },
+    IntegratorInfo {
+        name: "pssmlt",
+        about: "primary-sample-space Metropolis (Kelemen) over bdpt's or pt's samples; \
+                error bars from independent runs",
+        kind: Kind::Consistent,
+        weights: Weights::None,
+        source: include_str!("metropolis/pssmlt.rs"),
+        radius: Radius::None,
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Pssmlt::read(s, r)?))),
+    },
+    IntegratorInfo {
+        name: "mmlt",
+        about: "multiplexed Metropolis: one chain set per path length, one bdpt strategy per state",
+        kind: Kind::Consistent,
+        weights: Weights::None,
+        source: include_str!("metropolis/mmlt.rs"),
+        radius: Radius::None,
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Mmlt::read(s, r)?))),
     },
 ];
 

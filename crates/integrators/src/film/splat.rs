@@ -29,6 +29,22 @@ impl Splats {
         }
     }
 
+    /// The splats recorded so far, in order, as (pixel, value).
+    pub fn entries(&self) -> &[(u32, Color)] {
+        &self.entries
+    }
+
+    /// Invalid values dropped so far.
+    pub fn invalid(&self) -> u64 {
+        self.invalid
+    }
+
+    /// Forgets every splat and the invalid count (a buffer reused per sample: Metropolis).
+    pub fn clear(&mut self) {
+        self.entries.clear();
+        self.invalid = 0;
+    }
+
     /// Adds `value` to pixel `index` (row-major); invalid values are dropped and counted.
     pub fn add_to_pixel(&mut self, index: u32, value: Color) {
         if !is_valid_color(value) {

@@ -1,0 +1,180 @@
+//! The function a Metropolis chain samples: a point u of primary sample space mapped, through an
+//! existing integrator's per-path code run on u's numbers, to the splats it adds to the image.
+//!
+//! With N pixels, u's first two numbers (stream 0) pick a pixel uniformly and the base integrator
+//! runs that pixel's work item with every random stream read from u (`primary_space`). F(u) is
+//! N times the item's splats, so E_u[F] is one pass of the base integrator: the image.
+//! The scalar the chain follows is I(u) = Σ luminance of F(u)'s splats (Kelemen et al. 2002).
+//!
+//! MMLT (Hachisuka et al. 2014) restricts F to paths of k segments and one strategy (s, t),
+//! s + t = k + 1, chosen by u's third number uniformly among the k + 1 bdpt samples (t ≥ 1):
+//! F_k(u) = N (k + 1) · w_{s,t} f / p_{s,t}, bdpt's own MIS-weighted contribution of that strategy
+//! (read through the `Recorder` bdpt reports every completed path to), so Σ_k E_u[F_k] is bdpt's
+//! image again.
+
+use crate::bidirectional::bdpt::{self, Bdpt};
+use crate::film::pixel::{pixel_sample, weighted};
+use crate::film::splat::{Pass, Splats, Worker};
+use crate::record::{Completed, NoRecord, Recorder};
+use crate::unidirectional::pt::Pt;
+use lt_core::camera::FilmFilter;
+use lt_core::math::{luminance, Color};
+use lt_core::primary_space::{next_installed, with_space, PrimarySpace};
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::Scene;
+
+/// The per-path estimator a chain runs on its numbers.
+pub enum Base {
+    Pt(Pt),
+    Bdpt(Bdpt),
+}
+
+/// Which part of the base's contribution a chain samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Restrict {
+    /// Everything one work item adds (PSSMLT).
+    Full,
+    /// Paths of `k` segments, one strategy drawn per sample (MMLT; bdpt only).
+    Length(usize),
+}
+
+/// One evaluated point: F(u) as splats (pixel, value) and I(u).
+#[derive(Clone, Debug, Default)]
+pub struct Sample {
+    pub splats: Vec<(u32, Color)>,
+    pub importance: f64,
+}
+
+/// Per-thread buffers of an evaluation.
+pub struct Scratch {
+    bdpt: Option<bdpt::Scratch>,
+    item: Splats,
+    picked: Splats,
+}
+
+impl Base {
+    pub fn scratch(&self, scene: &Scene) -> Scratch {
+        let (w, h) = (scene.camera.width, scene.camera.height);
+        Scratch {
+            bdpt: match self {
+                Base::Bdpt(b) => Some(b.scratch()),
+                Base::Pt(_) => None,
+            },
+            item: Splats::new(w, h),
+            picked: Splats::new(w, h),
+        }
+    }
+
+    /// F(u) and I(u) for the state `space` holds in its current iteration, into `out`; returns
+    /// the number of invalid (NaN, infinite, negative) values dropped.
+    pub fn evaluate(
+        &self,
+        scene: &Scene,
+        restrict: Restrict,
+        space: &mut PrimarySpace,
+        scratch: &mut Scratch,
+        out: &mut Sample,
+    ) -> u64 {
+        scratch.item.clear();
+        scratch.picked.clear();
+        let n = scene.camera.pixel_count() as u64;
+        let mut scale = n as f32;
+        with_space(space, || {
+            let pixel = pick_pixel(n);
+            match (self, restrict) {
+                (Base::Pt(pt), _) => {
+                    // pixel_pass's sample, on the chain's camera stream.
+                    let mut s = Sampler::for_item(Domain::Camera, 0, pixel, 0);
+                    if let Some(film) = pixel_sample(scene, pixel, &mut s) {
+                        let c = pt.radiance(scene, film.raster, &mut s);
+                        scratch
+                            .item
+                            .add_to_pixel(pixel as u32, weighted(c, film.weight));
+                    }
+                }
+                (Base::Bdpt(b), Restrict::Full) => {
+                    let mut worker = Worker {
+                        splats: &mut scratch.item,
+                        scratch: scratch.bdpt.as_mut().expect("bdpt scratch"),
+                        rec: &mut NoRecord,
+                    };
+                    b.item(scene, Pass { seed: 0, pass: 0 }, pixel, &mut worker);
+                }
+                (Base::Bdpt(b), Restrict::Length(k)) => {
+                    let s = ((next_installed(0) * (k + 1) as f32) as usize).min(k);
+                    scale *= (k + 1) as f32;
+                    let mut pick = Pick {
+                        k,
+                        s,
+                        pixel: pixel as u32,
+                        film_weight: 1.0,
+                        film: scene.camera.film(),
+                        out: &mut scratch.picked,
+                    };
+                    let mut worker = Worker {
+                        splats: &mut scratch.item,
+                        scratch: scratch.bdpt.as_mut().expect("bdpt scratch"),
+                        rec: &mut pick,
+                    };
+                    b.item(scene, Pass { seed: 0, pass: 0 }, pixel, &mut worker);
+                }
+            }
+        });
+        let taken = match restrict {
+            Restrict::Length(_) => &scratch.picked,
+            Restrict::Full => &scratch.item,
+        };
+        out.splats.clear();
+        out.importance = 0.0;
+        for &(p, c) in taken.entries() {
+            let c = c * scale;
+            out.importance += luminance(c).max(0.0) as f64;
+            out.splats.push((p, c));
+        }
+        scratch.item.invalid() + scratch.picked.invalid()
+    }
+}
+
+/// A pixel uniformly from stream 0's next two numbers (48 bits, so every pixel of any film has the
+/// same chance to within 2⁻²⁴ of itself; one 24-bit number would favour some pixels by up to
+/// N / 2²⁴ when N does not divide 2²⁴).
+fn pick_pixel(n: u64) -> u64 {
+    let hi = next_installed(0) as f64;
+    let lo = next_installed(0) as f64;
+    let u = hi + lo * (1.0 / (1u64 << 24) as f64);
+    ((u * n as f64) as u64).min(n - 1)
+}
+
+/// Keeps the one strategy (s, t = k + 1 − s) a sample chose, from everything bdpt reports: its
+/// weighted value where bdpt would add it (the pixel's own estimate times the film weight for
+/// t ≥ 2; through the film filter at the splat position for light tracing, t = 1).
+struct Pick<'a> {
+    k: usize,
+    s: usize,
+    pixel: u32,
+    film_weight: f32,
+    film: &'a FilmFilter,
+    out: &'a mut Splats,
+}
+
+impl Recorder for Pick<'_> {
+    const ACTIVE: bool = true;
+
+    fn begin_sample(&mut self, _pixel: u64, film_weight: f32) {
+        self.film_weight = film_weight;
+    }
+
+    fn completed(&mut self, path: Completed) {
+        let k = path.light.len() + path.camera.len() - 1;
+        if k != self.k || path.s != self.s || path.weight <= 0.0 {
+            return;
+        }
+        let c = path.value * path.weight as f32;
+        if k + 1 - path.s >= 2 {
+            self.out
+                .add_to_pixel(self.pixel, weighted(c, self.film_weight));
+        } else {
+            self.out.add_filtered(self.film, path.raster, c);
+        }
+    }
+}

@@ -1,0 +1,193 @@
+//! Metropolis light transport (`pssmlt`, `mmlt`) against bdpt, and the honesty of its error bars.
+//!
+//! 1. **Agreement.** On shipped scenes with an area light, a point light behind a specular ball
+//!    (caustics: specular chains and a delta light) and rough glass, `pssmlt` over
+//!    bdpt, `pssmlt` over pt and `mmlt` agree with bdpt per 8×8 block: `CONSISTENT_RUNS`
+//!    independent runs of each Metropolis estimator (each with its own bootstrap, so the
+//!    normalisation's error is inside the spread) against bdpt's passes, Student-t and Šidák over
+//!    every block × channel × comparison (`agreement_t`).
+//! 2. **Coverage.** A Markov chain's passes are correlated, so the spread of passes understates
+//!    a run's error; independent runs do not. On a tiny film, per (pixel, run): the interval of
+//!    run r from its own passes (t quantile, P − 1 degrees of freedom) and from the other runs'
+//!    spread (leave-one-out, t with R − 2), each widened by bdpt's reference error, against bdpt's
+//!    reference. The per-run coverage fractions are independent across runs, so their mean has a
+//!    standard error: the independent-run coverage must be within z of its nominal 95 %, and the
+//!    per-pass coverage z below it.
+
+use lt_estimators::agreement::{agreement_t, sidak_threshold};
+use lt_estimators::running::RunningImage;
+use lt_estimators::Image;
+use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
+use lt_tests::{render_blocks, shipped_scene};
+use std::ops::ControlFlow;
+
+const ALPHA: f64 = 1e-3;
+
+/// (integrator, its `--set` keys) compared with bdpt.
+fn metropolis() -> Vec<(&'static str, IntegratorParams)> {
+    vec![
+        ("pssmlt", IntegratorParams::new().with("bootstrap", 4096)),
+        (
+            "pssmlt",
+            IntegratorParams::new()
+                .with("base", "pt")
+                .with("bootstrap", 4096),
+        ),
+        ("mmlt", IntegratorParams::new().with("bootstrap", 4096)),
+    ]
+}
+
+const SCENES: [&str; 3] = [
+    "cornell-box",
+    "cornell-point-caustic",
+    "cornell-rough-glass",
+];
+
+#[test]
+fn metropolis_agrees_with_bdpt_on_shipped_scenes() {
+    let configs = metropolis();
+    let comparisons = SCENES.len() * configs.len();
+    let per = -(((-ALPHA).ln_1p()) / comparisons as f64).exp_m1();
+    let mut failures = Vec::new();
+    for name in SCENES {
+        let scene = shipped_scene(name, Some((16, 16)));
+        let (_, reference) = render_blocks(&scene, "bdpt", IntegratorParams::new(), 512, 1, 8);
+        for (integrator, params) in &configs {
+            let (r, blocks) = render_blocks(&scene, integrator, params.clone(), 64, 100, 8);
+            assert_eq!(
+                r.invalid_samples, 0,
+                "{integrator} on {name}: invalid samples"
+            );
+            let a = agreement_t(&blocks, &reference, per);
+            let (m, b) = (blocks.estimate(), reference.estimate());
+            let total = |e: &lt_estimators::blocks::BlockEstimate| -> f64 {
+                e.mean.iter().map(|p| p[0] + p[1] + p[2]).sum()
+            };
+            let line = format!(
+                "{integrator} {:?} on {name}: max |z| {:.2} (threshold {:.2}), image ratio {:.4}",
+                params.pairs(),
+                a.max_abs_z,
+                a.threshold,
+                total(&m) / total(&b)
+            );
+            println!("{line}");
+            if !a.passed() {
+                failures.push(line);
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Student-t two-sided 95 % quantile with `dof` degrees of freedom (Cornish–Fisher series from
+/// the normal quantile; within 1e-3 for dof ≥ 5).
+fn t95(dof: f64) -> f64 {
+    let z: f64 = 1.959964;
+    let g1 = (z.powi(3) + z) / 4.0;
+    let g2 = (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / 96.0;
+    let g3 = (3.0 * z.powi(7) + 19.0 * z.powi(5) + 17.0 * z.powi(3) - 15.0 * z) / 384.0;
+    z + g1 / dof + g2 / dof.powi(2) + g3 / dof.powi(3)
+}
+
+#[test]
+fn independent_runs_cover_and_per_pass_error_bars_do_not() {
+    let scene = shipped_scene("cornell-box", Some((8, 8)));
+    let n = 64usize;
+    // bdpt's reference, its own per-pixel standard error kept.
+    let bdpt = make_integrator("bdpt", &scene, &IntegratorParams::new()).unwrap();
+    let opts = |passes, seed| RenderOptions {
+        passes,
+        time_limit: None,
+        seed,
+        threads: 0,
+    };
+    let reference = render(&scene, &bdpt, &opts(4096, 1), |_| ControlFlow::Continue(())).unwrap();
+    let ref_se = reference.per_pass.as_ref().unwrap().std_error();
+    let ref_mean = reference.estimate;
+
+    let mlt = make_integrator("pssmlt", &scene, &IntegratorParams::new()).unwrap();
+    let (runs, passes) = (16usize, 64u32);
+    // Per run: its estimate and the spread of its passes (pass image i = i·E_i − (i−1)·E_{i−1},
+    // as b̂ is fixed within a run and every pass does the same number of mutations).
+    let mut estimates: Vec<Image> = Vec::new();
+    let mut pass_se: Vec<Image> = Vec::new();
+    for r in 0..runs {
+        let mut prev = Image::new(8, 8);
+        let mut spread = RunningImage::new(8, 8);
+        let result = render(&scene, &mlt, &opts(passes, 200 + r as u64), |rep| {
+            let e = rep.estimate();
+            let i = rep.passes_done as f64;
+            let mut p = Image::new(8, 8);
+            for k in 0..n {
+                for c in 0..3 {
+                    p.data[k][c] = i * e.data[k][c] - (i - 1.0) * prev.data[k][c];
+                }
+            }
+            spread.add(&p);
+            prev = e;
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+        assert_eq!(result.invalid_samples, 0);
+        estimates.push(result.estimate);
+        pass_se.push(spread.std_error());
+    }
+    let (t_pass, t_runs) = (t95(passes as f64 - 1.0), t95(runs as f64 - 2.0));
+    let mut cover_pass = vec![0.0f64; runs];
+    let mut cover_runs = vec![0.0f64; runs];
+    for r in 0..runs {
+        for k in 0..n {
+            // Channel 1 (green) alone: the three channels of a pixel share their paths.
+            let c = 1;
+            let x = estimates[r].data[k][c];
+            let truth = ref_mean.data[k][c];
+            let rse2 = ref_se.data[k][c].powi(2);
+            let se_p = (pass_se[r].data[k][c].powi(2) + rse2).sqrt();
+            cover_pass[r] += ((x - truth).abs() <= t_pass * se_p) as u8 as f64 / n as f64;
+            // Leave-one-out spread of the other runs: independent of run r.
+            let others: Vec<f64> = (0..runs)
+                .filter(|&q| q != r)
+                .map(|q| estimates[q].data[k][c])
+                .collect();
+            let m = others.iter().sum::<f64>() / others.len() as f64;
+            let var =
+                others.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (others.len() - 1) as f64;
+            let se_r = (var + rse2).sqrt();
+            cover_runs[r] += ((x - truth).abs() <= t_runs * se_r) as u8 as f64 / n as f64;
+        }
+    }
+    let stats = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+        (m, (var / v.len() as f64).sqrt())
+    };
+    let (cp, sp) = stats(&cover_pass);
+    let (cr, sr) = stats(&cover_runs);
+    // Two checks: Šidák over them.
+    let z = sidak_threshold(ALPHA, 2);
+    println!(
+        "pssmlt on cornell-box 8×8, {runs} runs × {passes} passes: coverage of nominal 95 % \
+         intervals from passes {:.1} % ± {:.1} %, from independent runs {:.1} % ± {:.1} % \
+         (threshold z {z:.2})",
+        100.0 * cp,
+        100.0 * sp,
+        100.0 * cr,
+        100.0 * sr
+    );
+    let z_runs = (cr - 0.95) / sr.max(1e-12);
+    assert!(
+        z_runs.abs() < z,
+        "independent-run intervals cover {:.1} % ± {:.1} %, not 95 % (z = {z_runs:.2})",
+        100.0 * cr,
+        100.0 * sr
+    );
+    let z_gap = (cr - cp) / (sp * sp + sr * sr).sqrt().max(1e-12);
+    assert!(
+        z_gap > z,
+        "per-pass intervals cover {:.1} %, not significantly below the runs' {:.1} % (z = {z_gap:.2})",
+        100.0 * cp,
+        100.0 * cr
+    );
+    // The runs must have had something to cover: a lit image.
+    assert!(ref_mean.data.iter().any(|p| p[1] > 0.0));
+}
