@@ -31,7 +31,6 @@ pub(crate) use light::{light, with_medium};
 pub(crate) use material::material;
 pub(crate) use medium::medium;
 pub(crate) use shape::shape;
-pub(crate) use texture::texture;
 
 use crate::xml::doc::{Doc, Elem, Source};
 use crate::xml::resolve::Resolver;
