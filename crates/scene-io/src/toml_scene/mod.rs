@@ -1,24 +1,16 @@
 //! The TOML scene format (docs/scene-format.md): text → `SceneFile` (`schema`, serde's view of
-//! the file) → `Scene` (`assemble` here). Materials and media go through the plugin tree the
-//! XML reader builds from (`tree`: TOML's keys renamed, then `xml/build`), and so do the
-//! lights; the camera and shapes are still built here (`camera`, `shape`, with `texture` for an
-//! emitting shape's texture).
+//! the file) → the plugin tree the XML reader builds from (`tree`: TOML's keys renamed, every
+//! check that speaks of them made) → `Scene`, by `xml/build`, once for both formats.
 
-mod camera;
 pub(crate) mod schema;
-mod shape;
-pub(crate) mod texture;
 pub(crate) mod tree;
 
 use crate::error::Ctx;
-use crate::world::WorldBuilder;
+use crate::xml::doc::Elem;
 use crate::SceneError;
-use camera::{camera, render};
-use glam::DVec3;
 use lt_core::medium::MediumId;
 use lt_core::Scene;
 use schema::SceneFile;
-use shape::shape;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -79,56 +71,68 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
     Ok(scene)
 }
 
-/// The parsed file as a scene, built in file order so that ids and the first error follow it;
-/// with the volume files its media read.
+/// The parsed file as a scene, built from its plugin tree by the builders an XML scene goes
+/// through; with the volume files its media read.
 fn assemble(
     ctx: &Ctx,
     path: &Path,
     file: &SceneFile,
 ) -> Result<(Scene, Vec<std::path::PathBuf>), SceneError> {
-    // Checked here, at the origin, so that a degenerate camera is the error reported first.
-    camera(ctx, &file.camera, DVec3::ZERO)?;
-    let settings = render(ctx, file)?;
-    let mut b = WorldBuilder::new(settings);
-    // Materials, then media, each in file order, as the plugin tree the XML builders read.
+    let doc = tree::document(path, ctx.text, plugins(ctx, file)?);
+    let no_light = || {
+        ctx.whole(
+            "the scene has no light: give a shape a non-zero `emission` or add a [[lights]] entry",
+        )
+    };
+    let opts = crate::LoadOptions::default();
+    let (scene, _, files) = crate::xml::build::load(&doc, &opts, &no_light)?;
+    Ok((scene, files.into_iter().filter(is_volume).collect()))
+}
+
+/// The file's top-level plugins in the order both builders and Mitsuba read them (every id
+/// defined before a reference to it): integrator, media, sensor, BSDFs, emitters, shapes. The
+/// TOML checks run in the file's own order (camera and `[render]` first, then materials, media,
+/// lights and shapes), so the first error is the first a reader of the file meets.
+pub(crate) fn plugins(ctx: &Ctx, file: &SceneFile) -> Result<Vec<Elem>, SceneError> {
+    let settings = tree::settings(ctx, file)?;
+    let sensor = tree::sensor(ctx, &file.camera, settings.spp)?;
     let mut materials: Vec<_> = file.materials.iter().collect();
     materials.sort_by_key(|(_, def)| def.span().start);
     let mut media: Vec<_> = file.media.iter().collect();
     media.sort_by_key(|(_, def)| def.span().start);
-    let mut plugins = Vec::new();
-    for (name, def) in materials {
-        plugins.push(tree::material(ctx, name, def)?);
-    }
-    for (name, def) in media {
-        plugins.push(tree::medium(ctx, name, def)?);
-    }
+    let bsdfs = materials
+        .into_iter()
+        .map(|(name, def)| tree::material(ctx, name, def))
+        .collect::<Result<Vec<_>, _>>()?;
+    let media = media
+        .into_iter()
+        .map(|(name, def)| tree::medium(ctx, name, def))
+        .collect::<Result<Vec<_>, _>>()?;
+    // Medium names checked in TOML's words before the tree refers to them by id.
     let media_names: HashMap<String, MediumId> =
         file.media.keys().map(|k| (k.clone(), 0)).collect();
+    let mut emitters = Vec::new();
     for def in &file.lights {
-        // The name checked here, in TOML's words, before the tree refers to it by id.
         medium_named(ctx, &def.get_ref().medium, &media_names)?;
-        plugins.push(tree::with_medium(tree::light(ctx, def)?, def.get_ref()));
+        emitters.push(tree::with_medium(tree::light(ctx, def)?, def.get_ref()));
     }
-    let doc = tree::document(path, ctx.text, plugins);
-    let defined = crate::xml::build::define(&doc, &mut b)?;
-    let ids: HashMap<&str, u32> = defined
-        .materials
-        .iter()
-        .map(|(k, &v)| (k.as_str(), v))
-        .collect();
-    let media = |name: &Option<schema::S<String>>| medium_named(ctx, name, &defined.media);
-    let mut emitters = defined.emitters;
+    let names: Vec<&str> = file.materials.keys().map(String::as_str).collect();
+    let mut shapes = Vec::new();
     for def in &file.shapes {
-        emitters += shape(ctx, def, &ids, &defined.media, &mut b)? as usize;
+        let d = def.get_ref();
+        for m in [&d.interior, &d.exterior] {
+            medium_named(ctx, m, &media_names)?;
+        }
+        shapes.push(tree::shape(ctx, def, &names)?);
     }
-    if emitters == 0 {
-        return Err(ctx.whole(
-            "the scene has no light: give a shape a non-zero `emission` or add a [[lights]] entry",
-        ));
-    }
-    b.set_camera_medium(media(&file.camera.get_ref().medium)?);
-    let scene = b.build(|origin| camera(ctx, &file.camera, origin))?;
-    Ok((scene, defined.files.into_iter().filter(is_volume).collect()))
+    medium_named(ctx, &file.camera.get_ref().medium, &media_names)?;
+    let mut out = vec![tree::integrator(file, &settings)];
+    out.extend(media);
+    out.push(sensor);
+    out.extend(bsdfs);
+    out.extend(emitters);
+    out.extend(shapes);
+    Ok(out)
 }
 
 /// The files a medium read (its grids), as opposed to a material's textures.

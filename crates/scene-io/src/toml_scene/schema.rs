@@ -17,7 +17,7 @@ pub type V3 = [f64; 3];
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     pub camera: S<CameraDef>,
-    pub render: Option<RenderDef>,
+    pub render: Option<S<RenderDef>>,
     #[serde(default)]
     pub materials: BTreeMap<String, S<MaterialDef>>,
     #[serde(default)]

@@ -36,7 +36,13 @@ pub use build::UNBOUNDED_DEPTH_SUBSTITUTE;
 /// mesh file, in the order read.
 pub fn load_xml(path: &Path, opts: &LoadOptions) -> Result<(Scene, LoadReport), SceneError> {
     let doc = doc::read(path, &opts.defines)?;
-    let (mut scene, report, meshes) = build::load(&doc, opts)?;
+    let no_light = || {
+        doc.err(
+            &doc.root,
+            "the scene has no light: no emitter with a non-zero value",
+        )
+    };
+    let (mut scene, report, meshes) = build::load(&doc, opts, &no_light)?;
     scene.source_files = doc
         .sources
         .iter()

@@ -8,7 +8,7 @@
 //! check that speaks of TOML's keys is made here.
 
 use super::texture::{color, texture};
-use super::{elem, float, float64, plugin, reference, string};
+use super::{elem, float, float64, plugin, point, reference, string};
 use crate::error::Ctx;
 use crate::toml_scene::schema::{LightDef, S};
 use crate::xml::doc::Elem;
@@ -34,23 +34,7 @@ pub(crate) fn light(ctx: &Ctx, def: &S<LightDef>) -> Result<Elem, SceneError> {
     let kind = d.kind.get_ref().as_str();
     let span = def.span();
     let what = format!("a {kind} light");
-    let given = [
-        ("position", d.position.as_ref().map(S::span)),
-        ("intensity", d.intensity.as_ref().map(S::span)),
-        ("direction", d.direction.as_ref().map(S::span)),
-        ("solid_angle", d.solid_angle.as_ref().map(S::span)),
-        ("radiance", d.radiance.as_ref().map(S::span)),
-        ("irradiance", d.irradiance.as_ref().map(S::span)),
-        ("file", d.file.as_ref().map(S::span)),
-        ("scale", d.scale.as_ref().map(S::span)),
-        ("rotate", d.rotate.as_ref().map(S::span)),
-        ("target", d.target.as_ref().map(S::span)),
-        ("up", d.up.as_ref().map(S::span)),
-        ("cutoff_angle", d.cutoff_angle.as_ref().map(S::span)),
-        ("beam_width", d.beam_width.as_ref().map(S::span)),
-        ("texture", d.texture.as_ref().map(S::span)),
-        ("fov", d.fov.as_ref().map(S::span)),
-    ];
+    let given = given!(d; position, intensity, direction, solid_angle, radiance, irradiance, file, scale, rotate, target, up, cutoff_angle, beam_width, texture, fov);
     let e = match kind {
         "point" => {
             ctx.only(&given, &["position", "intensity"], &what)?;
@@ -146,12 +130,6 @@ pub(crate) fn with_medium(mut e: Elem, d: &LightDef) -> Elem {
 }
 
 type Given<'g> = &'g [(&'static str, Option<Range<usize>>)];
-
-/// A point or vector in f64, as given.
-fn point(name: &str, p: DVec3, span: Range<usize>) -> Elem {
-    let v = format!("{}, {}, {}", p.x, p.y, p.z);
-    elem("point", &[("name", name), ("value", &v)], span)
-}
 
 /// A TOML `direction` (towards the light) as Mitsuba's `direction` (the light's travel): the f32
 /// direction negated, which both loaders normalise.

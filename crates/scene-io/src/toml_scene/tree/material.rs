@@ -66,14 +66,7 @@ fn perturbed(ctx: &Ctx, def: &S<MaterialDef>, e: Elem) -> Result<Elem, SceneErro
     let d = def.get_ref();
     let mut m = match (&d.normal_map, &d.bump_map) {
         (None, None) => {
-            let stray = [
-                ("bump_scale", d.bump_scale.as_ref().map(S::span)),
-                (
-                    "flip_invalid_normals",
-                    d.flip_invalid_normals.as_ref().map(S::span),
-                ),
-                ("bump_shadowing", d.bump_shadowing.as_ref().map(S::span)),
-            ];
+            let stray = given!(d; bump_scale, flip_invalid_normals, bump_shadowing);
             if let Some((key, Some(span))) = stray.into_iter().find(|(_, s)| s.is_some()) {
                 return Err(ctx.at(span, format!("`{key}` needs a `normal_map` or `bump_map`")));
             }
@@ -114,46 +107,7 @@ fn perturbed(ctx: &Ctx, def: &S<MaterialDef>, e: Elem) -> Result<Elem, SceneErro
 
 /// The keys given, with their spans (serde knows only the union of every type's keys).
 fn given(d: &MaterialDef) -> Vec<(&'static str, Option<Range<usize>>)> {
-    vec![
-        ("albedo", d.albedo.as_ref().map(S::span)),
-        ("reflectance", d.reflectance.as_ref().map(S::span)),
-        ("ior", d.ior.as_ref().map(S::span)),
-        ("roughness", d.roughness.as_ref().map(S::span)),
-        ("material", d.material.as_ref().map(S::span)),
-        ("eta", d.eta.as_ref().map(S::span)),
-        ("k", d.k.as_ref().map(S::span)),
-        ("distribution", d.distribution.as_ref().map(S::span)),
-        ("alpha", d.alpha.as_ref().map(S::span)),
-        ("alpha_u", d.alpha_u.as_ref().map(S::span)),
-        ("alpha_v", d.alpha_v.as_ref().map(S::span)),
-        ("transmittance", d.transmittance.as_ref().map(S::span)),
-        ("twosided", d.twosided.as_ref().map(S::span)),
-        ("albedo_texture", d.albedo_texture.as_ref().map(S::span)),
-        (
-            "reflectance_texture",
-            d.reflectance_texture.as_ref().map(S::span),
-        ),
-        ("alpha_texture", d.alpha_texture.as_ref().map(S::span)),
-        ("alpha_u_texture", d.alpha_u_texture.as_ref().map(S::span)),
-        ("alpha_v_texture", d.alpha_v_texture.as_ref().map(S::span)),
-        ("nonlinear", d.nonlinear.as_ref().map(S::span)),
-        ("base_color", d.base_color.as_ref().map(S::span)),
-        (
-            "base_color_texture",
-            d.base_color_texture.as_ref().map(S::span),
-        ),
-        ("anisotropic", d.anisotropic.as_ref().map(S::span)),
-        ("metallic", d.metallic.as_ref().map(S::span)),
-        ("spec_trans", d.spec_trans.as_ref().map(S::span)),
-        ("specular", d.specular.as_ref().map(S::span)),
-        ("spec_tint", d.spec_tint.as_ref().map(S::span)),
-        ("sheen", d.sheen.as_ref().map(S::span)),
-        ("sheen_tint", d.sheen_tint.as_ref().map(S::span)),
-        ("flatness", d.flatness.as_ref().map(S::span)),
-        ("clearcoat", d.clearcoat.as_ref().map(S::span)),
-        ("clearcoat_gloss", d.clearcoat_gloss.as_ref().map(S::span)),
-        ("diff_trans", d.diff_trans.as_ref().map(S::span)),
-    ]
+    given!(d; albedo, reflectance, ior, roughness, material, eta, k, distribution, alpha, alpha_u, alpha_v, transmittance, twosided, albedo_texture, reflectance_texture, alpha_texture, alpha_u_texture, alpha_v_texture, nonlinear, base_color, base_color_texture, anisotropic, metallic, spec_trans, specular, spec_tint, sheen, sheen_tint, flatness, clearcoat, clearcoat_gloss, diff_trans).to_vec()
 }
 
 /// The keys each type takes.

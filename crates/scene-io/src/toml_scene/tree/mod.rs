@@ -8,15 +8,29 @@
 //! Each element's `range` is the byte span of the TOML value it comes from (of the table for a
 //! plugin), and `src` is 0, the TOML file: a builder's error names the TOML line.
 
+/// The keys of a TOML table that were given, as `[(key, Some(span) or None)]` in the order
+/// listed (`field as "Key"` where the file spells it otherwise): serde knows only the union of
+/// every type's keys, so each type's checks (`Ctx::only`) ask which of them the file gave.
+macro_rules! given {
+    ($d:expr; $($field:ident $(as $key:literal)?),* $(,)?) => {
+        [$((given!(@key $field $($key)?), $d.$field.as_ref().map(toml::Spanned::span))),*]
+    };
+    (@key $field:ident) => { stringify!($field) };
+    (@key $field:ident $key:literal) => { $key };
+}
+
+mod camera;
 mod light;
 mod material;
 mod medium;
+mod shape;
 mod texture;
 
+pub(crate) use camera::{integrator, sensor, settings};
 pub(crate) use light::{light, with_medium};
 pub(crate) use material::material;
 pub(crate) use medium::medium;
-pub(crate) use texture::texture;
+pub(crate) use shape::shape;
 
 use crate::xml::doc::{Doc, Elem, Source};
 use crate::xml::resolve::Resolver;
@@ -62,6 +76,20 @@ pub(crate) fn float(name: &str, x: f32, span: Range<usize>) -> Elem {
 /// A number the builder reads in f64 (its exact decimal).
 pub(crate) fn float64(name: &str, x: f64, span: Range<usize>) -> Elem {
     elem("float", &[("name", name), ("value", &format!("{x}"))], span)
+}
+
+pub(crate) fn integer(name: &str, v: i64, span: Range<usize>) -> Elem {
+    elem(
+        "integer",
+        &[("name", name), ("value", &v.to_string())],
+        span,
+    )
+}
+
+/// A point or vector in f64, as given (its exact decimal).
+pub(crate) fn point(name: &str, p: glam::DVec3, span: Range<usize>) -> Elem {
+    let v = format!("{}, {}, {}", p.x, p.y, p.z);
+    elem("point", &[("name", name), ("value", &v)], span)
 }
 
 pub(crate) fn rgb(name: &str, c: [f32; 3], span: Range<usize>) -> Elem {

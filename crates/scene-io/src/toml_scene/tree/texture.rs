@@ -22,15 +22,7 @@ pub(crate) fn texture(ctx: &Ctx, def: &S<TextureDef>, name: &str) -> Result<Elem
             .push(elem("scale", &[("value", &num(s))], def.span()));
         t.children.push(to_uv);
     }
-    let given = [
-        ("file", d.file.as_ref().map(S::span)),
-        ("filter", d.filter.as_ref().map(S::span)),
-        ("wrap", d.wrap.as_ref().map(S::span)),
-        ("raw", d.raw.as_ref().map(S::span)),
-        ("color0", d.color0.as_ref().map(S::span)),
-        ("color1", d.color1.as_ref().map(S::span)),
-        ("scale", d.scale.as_ref().map(S::span)),
-    ];
+    let given = given!(d; file, filter, wrap, raw, color0, color1, scale);
     let what = format!("a {kind} texture");
     match kind {
         "bitmap" => {

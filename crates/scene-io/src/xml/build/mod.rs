@@ -22,7 +22,7 @@ mod shape;
 mod texture;
 
 pub use integrator::UNBOUNDED_DEPTH_SUBSTITUTE;
-pub(crate) use medium::{open_surface, MEDIA};
+pub(crate) use medium::MEDIA;
 
 pub(super) struct Loader<'a> {
     doc: &'a Doc,
@@ -59,9 +59,13 @@ fn collect_ids<'a>(doc: &'a Doc, e: &'a Elem, ids: &mut Ids<'a>) -> Result<(), S
     Ok(())
 }
 
-pub(super) fn load(
+/// The scene of a plugin tree (an XML file's, or one a TOML file was turned into), its report
+/// and the files its meshes, volumes and textures came from; `no_light` is the error for a scene
+/// that emits nothing, in the words of the tree's format.
+pub(crate) fn load(
     doc: &Doc,
     opts: &LoadOptions,
+    no_light: &dyn Fn() -> SceneError,
 ) -> Result<(Scene, LoadReport, Vec<PathBuf>), SceneError> {
     let mut ids = Ids::new();
     collect_ids(doc, &doc.root, &mut ids)?;
@@ -71,20 +75,7 @@ pub(super) fn load(
     if !problems.is_empty() {
         return Err(kinds::combined(problems));
     }
-    let mut l = Loader {
-        doc,
-        opts,
-        report: LoadReport::default(),
-        ids,
-        materials: HashMap::new(),
-        default_material: None,
-        default_emitter_material: None,
-        meshes: Vec::new(),
-        media: HashMap::new(),
-        media_made: Vec::new(),
-        camera_medium: None,
-        emitter_medium: None,
-    };
+    let mut l = Loader::new(doc, opts, ids);
     let root = &doc.root;
     let by_tag = |t: &'static str| root.children.iter().filter(move |c| c.tag == t);
     let sensors: Vec<&Elem> = by_tag("sensor").collect();
@@ -143,10 +134,7 @@ pub(super) fn load(
         }
     }
     if emitters == 0 {
-        return Err(doc.err(
-            root,
-            "the scene has no light: no emitter with a non-zero value",
-        ));
+        return Err(no_light());
     }
     let Loader {
         report,
@@ -169,69 +157,24 @@ pub(super) fn load(
     Ok((scene, report, meshes))
 }
 
-/// What a tree made from another format (TOML's `toml_scene::tree`) defines at its top level:
-/// each BSDF's material id and each medium's id, by the element's `id`, and the files read.
-#[derive(Default)]
-pub(crate) struct Defined {
-    pub materials: HashMap<String, u32>,
-    pub media: HashMap<String, MediumId>,
-    pub files: Vec<PathBuf>,
-    /// Emitters that emit (those that emit nothing are dropped, as in an XML scene).
-    pub emitters: usize,
-}
-
-/// Builds the top-level `<bsdf>`, `<medium>` and `<emitter>` elements of `doc` into `b`, in
-/// document order, with the builders an XML scene's go through.
-pub(crate) fn define(doc: &Doc, b: &mut WorldBuilder) -> Result<Defined, SceneError> {
-    let mut ids = Ids::new();
-    collect_ids(doc, &doc.root, &mut ids)?;
-    let opts = LoadOptions::default();
-    let mut l = Loader {
-        doc,
-        opts: &opts,
-        report: LoadReport::default(),
-        ids,
-        materials: HashMap::new(),
-        default_material: None,
-        default_emitter_material: None,
-        meshes: Vec::new(),
-        media: HashMap::new(),
-        media_made: Vec::new(),
-        camera_medium: None,
-        emitter_medium: None,
-    };
-    let mut out = Defined::default();
-    for c in &doc.root.children {
-        let id = c.attr("id").unwrap_or_default().to_string();
-        match c.tag.as_str() {
-            "bsdf" => {
-                let m = l.material(c, b)?;
-                out.materials.insert(id, m);
-            }
-            "medium" => {
-                let m = l.medium(c)?;
-                out.media.insert(id, m);
-            }
-            "emitter" => {
-                match l.emitter(c)? {
-                    Some((desc, Some(position))) => b.add_light_at(desc, position),
-                    Some((desc, None)) => b.add_light(desc),
-                    None => continue,
-                }
-                b.set_last_light_medium(l.emitter_medium.take());
-                out.emitters += 1;
-            }
-            _ => {}
+impl<'a> Loader<'a> {
+    fn new(doc: &'a Doc, opts: &'a LoadOptions, ids: Ids<'a>) -> Self {
+        Loader {
+            doc,
+            opts,
+            report: LoadReport::default(),
+            ids,
+            materials: HashMap::new(),
+            default_material: None,
+            default_emitter_material: None,
+            meshes: Vec::new(),
+            media: HashMap::new(),
+            media_made: Vec::new(),
+            camera_medium: None,
+            emitter_medium: None,
         }
     }
-    for make in l.media_made {
-        b.add_medium(make);
-    }
-    out.files = l.meshes;
-    Ok(out)
-}
 
-impl<'a> Loader<'a> {
     fn plugin(&mut self, e: &'a Elem) -> Result<Plugin<'a>, SceneError> {
         Plugin::new(self.doc, &self.ids, e, &mut self.report)
     }

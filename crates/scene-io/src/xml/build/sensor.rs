@@ -116,10 +116,22 @@ impl<'a> Loader<'a> {
             (fov, a)
         };
         let to_world = p.transform("to_world")?;
+        // lt's own `half_width` (what a TOML orthographic camera gives, with a look-at taken
+        // exactly); Mitsuba writes it as a to_world scale, read below.
+        let half_width = match p.float("half_width")? {
+            Some(_) if p.kind != "orthographic" => {
+                return Err(p.err(e, "`half_width` belongs to an orthographic sensor"))
+            }
+            Some(hw) if !matches!(&to_world, None | Some((Xform { lookat: Some(_), .. }, _))) => {
+                return Err(p.err(e, format!("give an orthographic sensor `half_width` ({hw}) or a to_world scale, not both (with `half_width`, to_world is one look-at)")))
+            }
+            hw => hw,
+        };
         // An orthographic sensor's film spans [-1, 1] across x and ±1/aspect in y in camera
         // space (Mitsuba's `orthographic_projection`), scaled by to_world: the x column's length.
         let ortho_half_width = match (&to_world, p.kind) {
             (_, kind) if kind != "orthographic" => None,
+            _ if half_width.is_some() => half_width.map(|hw| hw as f32),
             (Some((Xform { m, lookat: None }, te)), _) => {
                 let (sx, sy) = (m.x_axis.truncate().length(), m.y_axis.truncate().length());
                 if !((sx - sy).abs() <= 1e-6 * sx.max(sy)) {

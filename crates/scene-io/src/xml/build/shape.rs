@@ -168,8 +168,9 @@ impl<'a> Loader<'a> {
                         ));
                     }
                     ep.finish(&["sampling_weight"], &mut self.report)?;
-                    let emits =
-                        self.finish_shape(&p, b, geometry, material, Some(texture), flip)?;
+                    // A black texture emits nothing, as a black radiance does.
+                    let radiance = (texture.max_value() > 0.0).then_some(texture);
+                    let emits = self.finish_shape(&p, b, geometry, material, radiance, flip)?;
                     b.set_last_shape_media(media)
                         .map_err(|m| p.err(p.elem, m))?;
                     return Ok(emits);
@@ -521,6 +522,18 @@ fn obj_ply_serialized<'a>(
         return Err(p.err(e, format!("shape `{}` needs a `filename`", p.kind)));
     };
     let mut face_normals = p.boolean("face_normals")?.unwrap_or(false);
+    // lt's own: what a mesh without normals shades with, Mitsuba's smooth normals or flat faces
+    // (a TOML mesh's rule); `lt convert` prints "flat" as `face_normals` when the file has none.
+    let flat_if_missing = match p.string("missing_normals")? {
+        None | Some(("smooth", _)) => false,
+        Some(("flat", _)) => true,
+        Some((other, ne)) => {
+            return Err(p.err(
+                ne,
+                format!("`missing_normals` must be `smooth` or `flat`, got `{other}`"),
+            ))
+        }
+    };
     let shape_index = match p.kind {
         "serialized" => p.integer("shape_index")?.map_or(Ok(0), |i| {
             u32::try_from(i).map_err(|_| {
@@ -557,7 +570,7 @@ fn obj_ply_serialized<'a>(
     l.meshes.push(path);
     if face_normals {
         mesh.normals = None;
-    } else if mesh.normals.is_none() {
+    } else if mesh.normals.is_none() && !flat_if_missing {
         // Mitsuba shades a mesh without normals smoothly, with normals it computes.
         mesh.normals = Some(vertex_normals(&mesh));
     }
