@@ -1,7 +1,7 @@
 //! Metropolis light transport (`pssmlt`, `mmlt`) against bdpt, and the honesty of its error bars.
 //!
 //! 1. **Agreement.** On shipped scenes with an area light, a point light behind a specular ball
-//!    (caustics: specular chains and a delta light) and rough glass, `pssmlt` over
+//!    (caustics: specular chains and a delta light), `pssmlt` over
 //!    bdpt, `pssmlt` over pt and `mmlt` agree with bdpt per 8×8 block: `CONSISTENT_RUNS`
 //!    independent runs of each Metropolis estimator (each with its own bootstrap, so the
 //!    normalisation's error is inside the spread) against bdpt's passes, Student-t and Šidák over
@@ -37,11 +37,9 @@ fn metropolis() -> Vec<(&'static str, IntegratorParams)> {
     ]
 }
 
-const SCENES: [&str; 3] = [
-    "cornell-box",
-    "cornell-point-caustic",
-    "cornell-rough-glass",
-];
+// Two scenes keep the test inside its CI share (~60 CPU s); rough glass cost a third more and
+// added no path kind the point-light caustic scene lacks to Metropolis' mutations.
+const SCENES: [&str; 2] = ["cornell-box", "cornell-point-caustic"];
 
 #[test]
 fn metropolis_agrees_with_bdpt_on_shipped_scenes() {
