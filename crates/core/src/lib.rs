@@ -4,6 +4,7 @@
 pub mod bsdf;
 pub mod camera;
 pub mod geometry;
+pub mod keyed_pcg;
 pub mod light;
 pub mod math;
 pub mod measure;

@@ -97,6 +97,12 @@ impl PrimarySpace {
         self.len_before = self.coords.len();
     }
 
+    /// Reads the iteration's coordinates again from the first (a test replays what samplers drew).
+    #[cfg(test)]
+    pub(crate) fn rewind_draws(&mut self) {
+        self.drawn = [0; STREAMS];
+    }
+
     /// The proposal becomes the chain's state.
     pub fn accept(&mut self) {
         self.backup.clear();
@@ -175,12 +181,11 @@ impl PrimarySpace {
 }
 
 fn pcg(seed: u64, key: u64) -> Pcg32 {
-    let s = crate::sampling::Sampler::new(seed, key, u64::MAX - 7);
-    s.into_rng()
+    crate::keyed_pcg::keyed_pcg(seed, key, u64::MAX - 7)
 }
 
 fn uniform(rng: &mut Pcg32) -> f32 {
-    (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    crate::keyed_pcg::uniform_f32(rng)
 }
 
 /// x wrapped into [0, 1) (never 1 after rounding to f32).
@@ -422,28 +427,5 @@ mod tests {
         for (a, b) in values.iter().zip(&after) {
             assert!(offset(*a, *b).abs() < 0.2, "{a} vs {b}");
         }
-    }
-
-    #[test]
-    fn installed_space_feeds_samplers() {
-        use crate::sampling::{Domain, Sampler};
-        let mut space = PrimarySpace::new(2, 3, 0.01);
-        space.start_iteration(true);
-        let (a, b) = with_space(&mut space, || {
-            let mut cam = Sampler::for_item(Domain::Camera, 0, 0, 0);
-            let mut light = Sampler::for_item(Domain::Light, 0, 0, 0);
-            (cam.next_f32(), light.next_f32())
-        });
-        assert!(!installed());
-        // Replaying the same iteration reads the same coordinates.
-        let mut s = space.clone();
-        s.drawn = [0; STREAMS];
-        assert_eq!(s.next(1 + Domain::Camera as usize), a);
-        assert_eq!(s.next(1 + Domain::Light as usize), b);
-        // Outside, samplers are PCG streams as before.
-        assert_eq!(
-            Sampler::for_item(Domain::Camera, 5, 9, 2).next_f32(),
-            Sampler::new(5, 9, 2).next_f32()
-        );
     }
 }

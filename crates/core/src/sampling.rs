@@ -1,8 +1,8 @@
 //! Random streams and the warps every estimator shares. Each `sample_x` has its `x_pdf` beside it,
 //! and the pair is tested together (the pdf integrates to one and matches the histogram).
 
+use crate::keyed_pcg::{keyed_pcg, uniform_f32};
 use crate::math::{Vec2, Vec3, PI};
-use rand_pcg::rand_core::Rng;
 use rand_pcg::Pcg32;
 
 /// A PCG stream keyed by (seed, pixel or path index, pass), so any work split gives the same numbers.
@@ -15,14 +15,6 @@ pub struct Sampler {
 
 /// `Sampler::stream` of an ordinary PCG sampler.
 const PCG: u8 = u8::MAX;
-
-/// SplitMix64 finaliser: decorrelates the key words before they become PCG state and stream.
-#[inline]
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58476d1ce4e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d049bb133111eb);
-    z ^ (z >> 31)
-}
 
 /// Which family of work items a stream belongs to. Light path i and pixel i are different items:
 /// without the domain word they would draw the same numbers, correlating the two ends of every
@@ -58,17 +50,10 @@ impl Sampler {
     /// The stream for one work item (a pixel, or a light path) in one pass of one seeded run.
     /// Integrators use `for_item`, which keeps domains apart.
     pub fn new(seed: u64, item: u64, pass: u64) -> Sampler {
-        let state = mix64(seed ^ mix64(item.wrapping_add(0x9e3779b97f4a7c15)));
-        let stream = mix64(pass ^ mix64(seed.wrapping_add(item.rotate_left(32))));
         Sampler {
-            rng: Pcg32::new(state, stream),
+            rng: keyed_pcg(seed, item, pass),
             stream: PCG,
         }
-    }
-
-    /// The PCG generator itself (the primary space's own stream of fresh and mutated numbers).
-    pub(crate) fn into_rng(self) -> Pcg32 {
-        self.rng
     }
 
     /// Uniform in [0, 1), never 1.
@@ -77,7 +62,7 @@ impl Sampler {
         if self.stream != PCG {
             return crate::primary_space::next_installed(self.stream as usize);
         }
-        (self.rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+        uniform_f32(&mut self.rng)
     }
 
     #[inline]
@@ -315,5 +300,28 @@ mod tests {
         assert!((d.length() - 1.0).abs() < 1e-6);
         assert!(1.0 - d.z <= h * 1.0001);
         assert!((uniform_cone_pdf(h) * omega - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn installed_space_feeds_samplers() {
+        use crate::primary_space::{installed, with_space, PrimarySpace};
+        let mut space = PrimarySpace::new(2, 3, 0.01);
+        space.start_iteration(true);
+        let (a, b) = with_space(&mut space, || {
+            let mut cam = Sampler::for_item(Domain::Camera, 0, 0, 0);
+            let mut light = Sampler::for_item(Domain::Light, 0, 0, 0);
+            (cam.next_f32(), light.next_f32())
+        });
+        assert!(!installed());
+        // Replaying the same iteration reads the same coordinates.
+        let mut s = space.clone();
+        s.rewind_draws();
+        assert_eq!(s.next(1 + Domain::Camera as usize), a);
+        assert_eq!(s.next(1 + Domain::Light as usize), b);
+        // Outside, samplers are PCG streams as before.
+        assert_eq!(
+            Sampler::for_item(Domain::Camera, 5, 9, 2).next_f32(),
+            Sampler::new(5, 9, 2).next_f32()
+        );
     }
 }
