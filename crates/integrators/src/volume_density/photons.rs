@@ -9,17 +9,14 @@
 //! density times its weight σs T/p_ff, divided by σs): the kernel estimates in `points.rs` and
 //! `beams.rs` then multiply σs back at the query point, where the camera walk needs it.
 
-use crate::subpath::walk::{continue_path, russian_roulette, WalkPoint, WalkRules};
-use lt_core::bsdf::TransportMode;
+use crate::subpath::media_step::NullCrossings;
+use crate::subpath::walk::{continue_path, russian_roulette, Emission, WalkPoint, WalkStart};
 use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec3};
 use lt_core::medium::{FreeFlight, MediumId};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
 use rayon::prelude::*;
-
-/// More null crossings than this on one segment is a ray caught in a degenerate spot: it ends.
-const MAX_NULL_CROSSINGS: u32 = 1024;
 
 /// What a photon carries besides its position (kept apart, in `VolumePhotons::points`, for the
 /// grids). 12 + 12 + 4 + 4 = 32 bytes, plus 12 for the position.
@@ -98,33 +95,19 @@ fn walk(
     sampler: &mut Sampler,
     out: &mut Vec<(Vec3, PhotonData)>,
 ) {
-    let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
+    // The light subpath's start, as every light walk draws it (same numbers, same β).
+    let Some(emission) = Emission::sample(scene, sampler) else {
         return;
     };
-    let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
-    let light = &scene.lights[li];
-    let Some(le) = light.sample_le(u_pos, u_dir, scene.bounding_sphere) else {
-        return;
-    };
-    if le.radiance == Color::ZERO || le.pdf_pos == 0.0 || le.pdf_dir == 0.0 {
-        return;
-    }
-    let mut medium = scene.light_medium(li as u32);
-    let cos0 = if light.is_infinite() || light.delta_position() {
-        1.0
-    } else {
-        le.n.dot(le.ray.d).abs()
-    };
-    let mut beta = le.radiance * (cos0 / (pmf * le.pdf_pos * le.pdf_dir));
-    let rules = WalkRules {
-        mode: TransportMode::Importance,
-        rr_reference: beta,
-        rr_depth,
-    };
-    let mut ray = le.ray;
+    let mut medium = scene.light_medium(emission.light as u32);
+    let start = emission.walk_start(scene);
+    let rules = start.rules(rr_depth);
+    let WalkStart {
+        mut ray, mut beta, ..
+    } = start;
     // The index of the vertex the walk finds next (x0 on the light is 0).
     let mut n = 1;
-    let mut crossings = 0;
+    let mut crossings = NullCrossings::default();
     loop {
         let hit = scene.intersect(&ray);
         if let Some(m) = medium {
@@ -160,7 +143,7 @@ fn walk(
                     }
                     ray = Ray::new(x, ps.wi);
                     n += 1;
-                    crossings = 0;
+                    crossings.reset();
                     continue;
                 }
                 FreeFlight::Passed { weight } => {
@@ -175,15 +158,12 @@ fn walk(
             return;
         };
         if scene.shapes[hit.shape as usize].null {
-            crossings += 1;
-            if crossings > MAX_NULL_CROSSINGS {
+            if !crossings.cross(scene, &hit, &mut ray, &mut medium) {
                 return;
             }
-            medium = scene.medium_after(hit.interface, hit.ng, ray.d, medium);
-            ray = hit.spawn_ray(ray.d);
             continue;
         }
-        crossings = 0;
+        crossings.reset();
         let sf = hit.shading_frame();
         let at = WalkPoint {
             hit: &hit,
