@@ -714,7 +714,7 @@ const MEDIA_RESOLUTION: u32 = 24;
 
 /// Passes per media integrator (the reference `pt` first); one that joins `HANDLES_MEDIA`
 /// without a row here renders `MEDIA_DEFAULT_PASSES`.
-const MEDIA_PASSES: [(&str, u32); 6] = [
+const MEDIA_PASSES: [(&str, u32); 7] = [
     ("pt", 1024),
     ("pt-bsdf", 1024),
     ("light", 512),
@@ -722,6 +722,7 @@ const MEDIA_PASSES: [(&str, u32); 6] = [
     // Consistent: per run, `CONSISTENT_RUNS` runs (tests/points_beams.rs holds them closer).
     ("pp3d", 32),
     ("pb2d", 32),
+    ("bb1d", 32),
 ];
 const MEDIA_DEFAULT_PASSES: u32 = 256;
 

@@ -109,6 +109,7 @@ const FURNACE_EXCLUDED: &[(&str, &str)] = &[
               1.5–10 % standard error; see tests/furnace.rs MEDIUM_FURNACE_EXCLUDED",
     ),
     ("pb2d", "as pp3d, with the 2-D kernel"),
+    ("bb1d", "as pp3d, with the 1-D kernel across photon and camera beams"),
 ];
 
 #[test]
@@ -259,7 +260,7 @@ fn agreement_passes(name: &str, glass: bool) -> Option<u32> {
         "bdpt" => Some(32),
         // Their kernels need ~10⁴ photon paths per pass to be judged by runs' spread: held to pt
         // on every shipped media scene by agreement.rs and tests/points_beams.rs instead.
-        "pp3d" | "pb2d" => None,
+        "pp3d" | "pb2d" | "bb1d" => None,
         _ => panic!("{name} walks media: give it agreement passes here"),
     }
 }

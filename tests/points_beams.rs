@@ -1,14 +1,14 @@
-//! The volumetric density estimators (`pp3d`, `pb2d`: issue 45) agree with `pt` on shipped media
-//! scenes at their default radius (1 % of the scene's diameter, shrinking by the schedule), from
-//! 8,192 photon paths per pass.
+//! The volumetric density estimators (`pp3d`, `pb2d`, `bb1d`: issue 45) agree with `pt` on shipped
+//! media scenes at their default radius (1 % of the scene's diameter, shrinking by the schedule),
+//! from 8,192 photon paths per pass (points) or BB1D_PHOTON_PATHS (beams).
 //!
 //! Consistent estimators have no per-pass error bar: each is rendered in `CONSISTENT_RUNS`
 //! independent runs (`render_blocks`), the reference `pt` per pass, and the two compared by
 //! Welch's t per channel over the whole image (one block: the most power for the CPU seconds),
 //! Šidák-corrected over every comparison of the test. The scenes are the two whose images are
 //! mostly light scattered in the medium (`hg-spot`, `smallupbp-isosph`), so a wrong kernel
-//! normalisation moves the image most; a planted ×1.1 on either kernel fails here (recorded in
-//! results/points-beams.md). The registry loops (agreement, furnace, robustness, determinism)
+//! normalisation moves the image most; a planted ×1.1 on any of the three kernels fails here
+//! (recorded in results/points-beams.md). The registry loops (agreement, furnace, robustness, determinism)
 //! cover every media scene at fewer passes.
 
 use lt_estimators::agreement::agreement_t;
@@ -17,13 +17,21 @@ use lt_tests::{render_blocks, shipped_scene};
 
 /// The scenes: their images are mostly medium-scattered light.
 const SCENES: [&str; 2] = ["media/hg-spot", "media/smallupbp-isosph"];
-const ESTIMATORS: [&str; 2] = ["pp3d", "pb2d"];
+/// (estimator, photon paths per pass).
+const ESTIMATORS: [(&str, u32); 3] = [
+    ("pp3d", PHOTON_PATHS),
+    ("pb2d", PHOTON_PATHS),
+    ("bb1d", BB1D_PHOTON_PATHS),
+];
 const RESOLUTION: u32 = 16;
 const PT_PASSES: u32 = 2048;
 /// Per run (`CONSISTENT_RUNS` runs), each of `PHOTON_PATHS` photon paths: the default (one per
 /// pixel, 256 here) leaves pp3d's 3-D kernel a 3–5 % standard error, too wide to see a ×1.1.
 const PASSES: u32 = 32;
 const PHOTON_PATHS: u32 = 8192;
+/// A photon beam reaches every camera beam that crosses its flight, so far fewer light paths
+/// give bb1d a standard error below pb2d's (and its index grows with the beams' lengths).
+const BB1D_PHOTON_PATHS: u32 = 512;
 /// The test's false-alarm rate, shared by all comparisons (Šidák).
 const ALPHA: f64 = 0.01;
 
@@ -44,11 +52,11 @@ fn point_and_beam_estimates_agree_with_pt_on_media_scenes() {
             seed,
             block,
         );
-        for (j, estimator) in ESTIMATORS.iter().enumerate() {
+        for (j, &(estimator, photon_paths)) in ESTIMATORS.iter().enumerate() {
             let (rendered, blocks) = render_blocks(
                 &scene,
                 estimator,
-                IntegratorParams::new().with("photons_per_pass", PHOTON_PATHS),
+                IntegratorParams::new().with("photons_per_pass", photon_paths),
                 PASSES,
                 seed + 1 + 10 * j as u64,
                 block,

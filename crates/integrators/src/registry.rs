@@ -15,6 +15,7 @@ use crate::unidirectional::pt_bsdf::{PtBsdf, PtBsdfParams};
 use crate::vcm::bpm::Bpm;
 use crate::vcm::eamis::Eamis;
 use crate::vcm::Vcm;
+use crate::volume_density::bb1d::Bb1d;
 use crate::volume_density::pb2d::Pb2d;
 use crate::volume_density::pp3d::Pp3d;
 use crate::{Estimator, Kind};
@@ -245,6 +246,16 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         make: |s, r| Ok(Estimator::Consistent(Box::new(Pb2d::read(s, r)?))),
     },
     IntegratorInfo {
+        name: "bb1d",
+        about: "photon beams: light subpaths' flights through media gathered along camera beams \
+                (1-D kernel), pt elsewhere",
+        kind: Kind::Consistent,
+        weights: Weights::None,
+        source: include_str!("volume_density/bb1d.rs"),
+        radius: Radius::Dimension(1),
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Bb1d::read(s, r)?))),
+    },
+    IntegratorInfo {
         name: "pssmlt",
         about: "primary-sample-space Metropolis (Kelemen) over bdpt's or pt's samples; \
                 error bars from independent runs",
@@ -301,7 +312,7 @@ pub fn make_integrator(
 
 /// The integrators that walk participating media (`media/`); every other refuses a scene with
 /// media rather than render it silently wrong (issue 43, item 4).
-pub const HANDLES_MEDIA: &[&str] = &["pt", "pt-bsdf", "light", "bdpt", "pp3d", "pb2d"];
+pub const HANDLES_MEDIA: &[&str] = &["pt", "pt-bsdf", "light", "bdpt", "pp3d", "pb2d", "bb1d"];
 
 /// One clear line for an integrator that cannot render the scene's media.
 fn refuse_media(name: &str, scene: &Scene) -> Result<(), String> {

@@ -14,11 +14,12 @@
 //!
 //! **The acceleration structure.** A uniform grid over the photons' spheres of radius r (each
 //! photon listed in every cell its sphere's box touches, ≤ 8 with cells ≥ 2r), walked along the
-//! beam by a 3-D DDA (Amanatides & Woo 1987). The cells' t intervals partition the beam, and a
-//! photon counts only in the cell whose interval holds its t_p (that cell holds x_{t_p}, which
-//! lies within r of the photon, so the photon is listed there): each photon once, in a fixed
-//! order, so the sum is the same bits at any thread count.
+//! beam by a 3-D DDA (Amanatides & Woo 1987; `cell_frame.rs`). The cells' t intervals partition
+//! the beam, and a photon counts only in the cell whose interval holds its t_p (that cell holds
+//! x_{t_p}, which lies within r of the photon, so the photon is listed there): each photon once,
+//! in a fixed order, so the sum is the same bits at any thread count.
 
+use super::cell_frame::{CellFrame, CellLists};
 use super::photons::VolumePhotons;
 use crate::media::pt::MediumEvents;
 use lt_core::geometry::Ray;
@@ -31,12 +32,7 @@ const MAX_CELLS_PER_AXIS: f32 = 128.0;
 
 /// Photon spheres of radius r in a uniform grid, for beam queries.
 pub struct BeamGrid {
-    lo: Vec3,
-    cell: f32,
-    dims: [i32; 3],
-    /// Cell `c` lists `entries[starts[c]..starts[c + 1]]` (photon indices, increasing).
-    starts: Vec<u32>,
-    entries: Vec<u32>,
+    lists: CellLists,
 }
 
 impl BeamGrid {
@@ -51,131 +47,30 @@ impl BeamGrid {
         }
         // A margin past r: DDA boundaries carry rounding, and x_{t_p} must stay inside.
         let margin = Vec3::splat(r * 1.01 + 1e-4 * (hi - lo).max_element());
-        let (lo, hi) = (lo - margin, hi + margin);
-        let cell = (2.0 * r).max((hi - lo).max_element() / MAX_CELLS_PER_AXIS);
-        let ext = (hi - lo) / cell;
-        let dims = [
-            (ext.x.ceil() as i32).max(1),
-            (ext.y.ceil() as i32).max(1),
-            (ext.z.ceil() as i32).max(1),
-        ];
-        let mut grid = BeamGrid {
-            lo,
-            cell,
-            dims,
-            starts: Vec::new(),
-            entries: Vec::new(),
-        };
-        let cells = (dims[0] * dims[1] * dims[2]) as usize;
+        let frame = CellFrame::new(lo - margin, hi + margin, 2.0 * r, MAX_CELLS_PER_AXIS);
         let pad = Vec3::splat(r * 1.001);
-        let mut counts = vec![0u32; cells + 1];
-        for &p in points {
-            grid.for_cells_of_box(p - pad, p + pad, |c| counts[c + 1] += 1);
-        }
-        for c in 0..cells {
-            counts[c + 1] += counts[c];
-        }
-        let mut fill = counts.clone();
-        let mut entries = vec![0u32; counts[cells] as usize];
-        for (i, &p) in points.iter().enumerate() {
-            grid.for_cells_of_box(p - pad, p + pad, |c| {
-                entries[fill[c] as usize] = i as u32;
-                fill[c] += 1;
-            });
-        }
-        grid.starts = counts;
-        grid.entries = entries;
-        Some(grid)
+        let lists = CellLists::build(frame, points.len(), |i, emit| {
+            frame.for_cells_of_box(points[i] - pad, points[i] + pad, emit)
+        });
+        Some(BeamGrid { lists })
     }
 
     /// Bytes held: per photon about 4 × the cells it touches (≤ 8), plus 4 per cell.
     pub fn bytes(&self) -> usize {
-        4 * (self.starts.len() + self.entries.len())
-    }
-
-    fn cell_of(&self, p: Vec3) -> [i32; 3] {
-        let q = (p - self.lo) / self.cell;
-        [
-            (q.x.floor() as i32).clamp(0, self.dims[0] - 1),
-            (q.y.floor() as i32).clamp(0, self.dims[1] - 1),
-            (q.z.floor() as i32).clamp(0, self.dims[2] - 1),
-        ]
-    }
-
-    #[inline]
-    fn index(&self, c: [i32; 3]) -> usize {
-        ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize
-    }
-
-    fn for_cells_of_box(&self, a: Vec3, b: Vec3, mut f: impl FnMut(usize)) {
-        let (ca, cb) = (self.cell_of(a), self.cell_of(b));
-        for z in ca[2]..=cb[2] {
-            for y in ca[1]..=cb[1] {
-                for x in ca[0]..=cb[0] {
-                    f(self.index([x, y, z]));
-                }
-            }
-        }
+        self.lists.bytes()
     }
 
     /// Calls `f(photon, t_lo, t_hi)` for every photon listed in every cell the ray's [0, t_max)
     /// crosses, in DDA order, with the cell's interval [t_lo, t_hi) of t: the intervals partition
     /// the clipped ray, so the caller counts a photon only when its t_p lies in the interval.
     pub fn for_each_along(&self, ray: &Ray, t_max: f32, mut f: impl FnMut(u32, f32, f32)) {
-        let hi = self.lo
-            + Vec3::new(
-                self.dims[0] as f32,
-                self.dims[1] as f32,
-                self.dims[2] as f32,
-            ) * self.cell;
-        // Slab clip of [0, t_max) to the grid's box.
-        let inv = ray.d.recip();
-        let (t0, t1) = ((self.lo - ray.o) * inv, (hi - ray.o) * inv);
-        let t_enter = t0.min(t1).max_element().max(0.0);
-        let t_end = t0.max(t1).min_element().min(t_max);
-        if !(t_enter < t_end) {
-            return;
-        }
-        let o = ray.o;
-        let d = ray.d;
-        let mut c = self.cell_of(o + d * t_enter);
-        let dd = [d.x, d.y, d.z];
-        let (oo, lo) = ([o.x, o.y, o.z], [self.lo.x, self.lo.y, self.lo.z]);
-        let step = dd.map(|v| if v > 0.0 { 1 } else { -1 });
-        // The t where the ray leaves cell c across axis k.
-        let boundary = |k: usize, ck: i32| -> f32 {
-            if dd[k] == 0.0 {
-                return f32::INFINITY;
-            }
-            let edge = if dd[k] > 0.0 { ck + 1 } else { ck };
-            (lo[k] + edge as f32 * self.cell - oo[k]) / dd[k]
-        };
-        let mut t_exit = [boundary(0, c[0]), boundary(1, c[1]), boundary(2, c[2])];
-        let mut t_cur = t_enter;
-        loop {
-            let k = if t_exit[0] <= t_exit[1] && t_exit[0] <= t_exit[2] {
-                0
-            } else if t_exit[1] <= t_exit[2] {
-                1
-            } else {
-                2
-            };
-            let t_next = t_exit[k].min(t_end);
-            let cell = self.index(c);
-            let (s, e) = (self.starts[cell] as usize, self.starts[cell + 1] as usize);
-            for &i in &self.entries[s..e] {
-                f(i, t_cur, t_next);
-            }
-            if t_next >= t_end {
-                break;
-            }
-            c[k] += step[k];
-            if c[k] < 0 || c[k] >= self.dims[k] {
-                break;
-            }
-            t_exit[k] = boundary(k, c[k]);
-            t_cur = t_next;
-        }
+        self.lists
+            .frame
+            .for_cells_along(ray, t_max, |cell, _, t_lo, t_hi| {
+                for &i in self.lists.items(cell) {
+                    f(i, t_lo, t_hi);
+                }
+            });
     }
 }
 

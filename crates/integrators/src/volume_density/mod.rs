@@ -1,8 +1,10 @@
 //! Volumetric density estimation (issue 45): photons stored at the medium vertices of light
 //! subpaths, gathered by the camera walk in a medium through a kernel — photon points by a point
-//! (`pp3d`, 3-D kernel) or by a camera beam (`pb2d`, 2-D kernel). Progressive: every pass traces
-//! its own photons, renders one camera sample per pixel with them and a radius shrunk by
-//! `schedule` for the kernel's dimension; the image is the mean of the passes.
+//! (`pp3d`, 3-D kernel) or by a camera beam (`pb2d`, 2-D kernel) — or the light subpaths' whole
+//! flights through media as photon beams, gathered by a camera beam (`bb1d`, 1-D kernel).
+//! Progressive: every pass traces its own photons (or beams), renders one camera sample per pixel
+//! with them and a radius shrunk by `schedule` for the kernel's dimension; the image is the mean
+//! of the passes.
 //!
 //! **Which paths each part estimates** (so the whole is the image, nothing counted twice). The
 //! camera walk is `pt` through media (`media::pt::radiance_with`, NEE and BSDF sampling under MIS
@@ -15,15 +17,21 @@
 //!   whatever its vertices), joined by the kernel. `pp3d` samples y by free flight and stops
 //!   there (no NEE, no phase sampling at y); `pb2d` integrates y along the whole flight with the
 //!   beam estimate and lets the walk go on only when the sampled flight passes (weight T/P), so
-//!   prefixes with a medium vertex are never continued.
+//!   prefixes with a medium vertex are never continued; `bb1d` splits as `pb2d` (the camera
+//!   walk's flight is the query beam), and integrates the light side's last vertex along its
+//!   flight too (a photon beam carries what the points of its flight carry: `photon_beams.rs`).
 //!
 //! A path of k segments is counted once: t segments from the camera to y, k − t from the light
 //! (the photon's `segments`), k ≤ max_depth. Surfaces are never density-estimated here: the
 //! photons are only volume photons, so a scene without media stores none and renders `pt`'s
 //! estimate.
 
+pub mod bb1d;
+pub mod beam_beam;
 pub mod beams;
+pub mod cell_frame;
 pub mod pb2d;
+pub mod photon_beams;
 pub mod photons;
 pub mod points;
 pub mod pp3d;
@@ -41,7 +49,7 @@ use lt_estimators::Image;
 /// The default initial radius as a fraction of the scene's bounding-sphere diameter.
 pub const DEFAULT_RADIUS_SCENE: f32 = 0.01;
 
-/// The keys `pp3d` and `pb2d` share (their files' tables document them).
+/// The keys `pp3d`, `pb2d` and `bb1d` share (their files' tables document them).
 #[derive(Clone, Copy, Debug)]
 pub struct VolumeParams {
     pub max_depth: u32,
@@ -51,7 +59,7 @@ pub struct VolumeParams {
     /// r₁ in scene units.
     pub radius: f32,
     pub alpha: f64,
-    /// Kernel dimension: 3 for points, 2 for beams.
+    /// Kernel dimension: 3 for points, 2 for points × beams, 1 for beams × beams.
     pub dimension: u32,
 }
 
@@ -123,11 +131,15 @@ impl VolumeParams {
 /// Which query the camera walk makes in a medium.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Query {
+    /// Photon points at the first medium vertex (`pp3d`).
     Points,
+    /// Photon points along the camera beam (`pb2d`).
     Beams,
+    /// Photon beams along the camera beam (`bb1d`).
+    BeamBeams,
 }
 
-/// One run of `pp3d` or `pb2d`: the sum of the pass images so far.
+/// One run of `pp3d`, `pb2d` or `bb1d`: the sum of the pass images so far.
 pub struct VolumeRun<'a> {
     pub params: &'a VolumeParams,
     pub query: Query,
@@ -164,21 +176,34 @@ impl ProgressiveRun for VolumeRun<'_> {
     fn pass(&mut self, pass: u32) -> u64 {
         let (scene, p) = (self.scene, self.params);
         let paths = p.photon_paths(scene);
-        let photons = photons::trace(scene, p.max_depth, p.rr_depth, paths, self.seed, pass);
         let scale = schedule::radius_scale(pass + 1, p.alpha, p.dimension);
         let r = p.radius * scale as f32;
-        let (image, invalid, index_bytes) = match self.query {
+        let (depth, rr) = (p.max_depth, p.rr_depth);
+        // (image, invalid samples, what was stored, its bytes each, index bytes)
+        let (image, invalid, stored, each, index_bytes) = match self.query {
             Query::Points => {
-                let q = points::PointQuery::new(scene, &photons, r, p.max_depth);
+                let photons = photons::trace(scene, depth, rr, paths, self.seed, pass);
+                let q = points::PointQuery::new(scene, &photons, r, depth);
                 let (img, bad) = self.render_with(&q, pass);
                 // PointGrid: one u32 per photon and per bucket (≈ one per photon).
-                (img, bad, 8 * photons.points.len())
+                let n = photons.points.len();
+                (img, bad, n, photons::VolumePhotons::BYTES_PER_PHOTON, 8 * n)
             }
             Query::Beams => {
-                let q = beams::BeamQuery::new(scene, &photons, r, p.max_depth);
+                let photons = photons::trace(scene, depth, rr, paths, self.seed, pass);
+                let q = beams::BeamQuery::new(scene, &photons, r, depth);
                 let bytes = q.grid.as_ref().map_or(0, |g| g.bytes());
                 let (img, bad) = self.render_with(&q, pass);
-                (img, bad, bytes)
+                let n = photons.points.len();
+                (img, bad, n, photons::VolumePhotons::BYTES_PER_PHOTON, bytes)
+            }
+            Query::BeamBeams => {
+                let pb = photon_beams::PhotonBeams::trace(scene, depth, rr, paths, self.seed, pass);
+                let q = beam_beam::BeamBeamQuery::new(scene, &pb, r, depth);
+                let bytes = q.index.as_ref().map_or(0, |g| g.bytes());
+                let (img, bad) = self.render_with(&q, pass);
+                let n = pb.beams.len();
+                (img, bad, n, photon_beams::PhotonBeams::BYTES_PER_BEAM, bytes)
             }
         };
         for (s, v) in self.sum.data.iter_mut().zip(&image.data) {
@@ -190,15 +215,15 @@ impl ProgressiveRun for VolumeRun<'_> {
         self.log.photon_paths.push(paths);
         self.log.radius_scale.push(scale);
         self.log.mean_radius.push(r as f64);
-        let stored = photons.points.len();
+        let what = if self.query == Query::BeamBeams {
+            "photon beams"
+        } else {
+            "volume photons"
+        };
         self.log.facts.retain(|(k, _)| !k.starts_with("last pass"));
         self.log.facts.push((
-            "last pass volume photons".into(),
-            format!(
-                "{stored} ({} B each, index {} B)",
-                photons::VolumePhotons::BYTES_PER_PHOTON,
-                index_bytes
-            ),
+            format!("last pass {what}"),
+            format!("{stored} ({each} B each, index {index_bytes} B)"),
         ));
         invalid
     }

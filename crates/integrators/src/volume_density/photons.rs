@@ -46,6 +46,32 @@ impl VolumePhotons {
         std::mem::size_of::<Vec3>() + std::mem::size_of::<PhotonData>();
 }
 
+/// What a light walk leaves behind: photon points at its medium vertices (`VolumePhotons`) or
+/// photon beams along its flights through media (`photon_beams.rs`). One walk, so both see the
+/// same light subpaths from the same streams.
+pub trait LightRecord: Default + Send {
+    /// A flight in medium `m` along `ray` up to `t_max` (the next surface, or infinity), whose
+    /// scattering vertex would be the subpath's `n`-th; `beta` is the throughput at its start,
+    /// already scaled by 1 / photon paths.
+    fn flight(&mut self, _ray: &Ray, _t_max: f32, _m: MediumId, _beta: Color, _n: u32) {}
+    /// A medium vertex at `x` (its data as a photon point).
+    fn scatter(&mut self, _x: Vec3, _photon: PhotonData) {}
+    /// Appends another path's record (paths kept in order).
+    fn append(&mut self, other: Self);
+}
+
+impl LightRecord for VolumePhotons {
+    fn scatter(&mut self, x: Vec3, photon: PhotonData) {
+        self.points.push(x);
+        self.data.push(photon);
+    }
+
+    fn append(&mut self, other: Self) {
+        self.points.extend(other.points);
+        self.data.extend(other.data);
+    }
+}
+
 /// Traces `paths` light subpaths of pass `pass` (streams `Domain::Light`, item = path index) and
 /// keeps their medium vertices with at most `max_depth − 1` segments (a camera prefix has at
 /// least one).
@@ -57,29 +83,36 @@ pub fn trace(
     seed: u64,
     pass: u32,
 ) -> VolumePhotons {
+    trace_records(scene, max_depth, rr_depth, paths, seed, pass)
+}
+
+/// `trace` for any record: the same walks, recorded by `R`, in path order.
+pub fn trace_records<R: LightRecord>(
+    scene: &Scene,
+    max_depth: u32,
+    rr_depth: u32,
+    paths: u64,
+    seed: u64,
+    pass: u32,
+) -> R {
+    let mut all = R::default();
     if !scene.has_media || paths == 0 || max_depth < 2 {
-        return VolumePhotons::default();
+        return all;
     }
     let scale = 1.0 / paths as f32;
-    let per_path: Vec<Vec<(Vec3, PhotonData)>> = (0..paths)
+    let per_path: Vec<R> = (0..paths)
         .into_par_iter()
         .map(|j| {
             let mut s = Sampler::for_item(Domain::Light, seed, j, pass as u64);
-            let mut out = Vec::new();
+            let mut out = R::default();
             walk(scene, max_depth, rr_depth, scale, &mut s, &mut out);
             out
         })
         .collect();
-    let n = per_path.iter().map(Vec::len).sum();
-    let mut photons = VolumePhotons {
-        points: Vec::with_capacity(n),
-        data: Vec::with_capacity(n),
-    };
-    for (p, d) in per_path.into_iter().flatten() {
-        photons.points.push(p);
-        photons.data.push(d);
+    for r in per_path {
+        all.append(r);
     }
-    photons
+    all
 }
 
 /// `v / σs` per channel, zero where σs is (β is zero there too).
@@ -93,7 +126,7 @@ fn walk(
     rr_depth: u32,
     scale: f32,
     sampler: &mut Sampler,
-    out: &mut Vec<(Vec3, PhotonData)>,
+    out: &mut impl LightRecord,
 ) {
     // The light subpath's start, as every light walk draws it (same numbers, same β).
     let Some(emission) = Emission::sample(scene, sampler) else {
@@ -113,6 +146,7 @@ fn walk(
         if let Some(m) = medium {
             let t_max = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
             let mm = &scene.media[m as usize];
+            out.flight(&ray, t_max, m, beta * scale, n);
             match mm.sample_free_flight(ray.o, ray.d, t_max, sampler) {
                 FreeFlight::Scattered { t, weight } => {
                     beta *= weight;
@@ -122,7 +156,7 @@ fn walk(
                     let x = ray.o + ray.d * t;
                     let wo = -ray.d;
                     let power = without_sigma_s(beta, mm.sigma_s(x)) * scale;
-                    out.push((
+                    out.scatter(
                         x,
                         PhotonData {
                             wi: wo,
@@ -130,7 +164,7 @@ fn walk(
                             medium: m,
                             segments: n,
                         },
-                    ));
+                    );
                     if n + 1 >= max_depth {
                         return;
                     }
