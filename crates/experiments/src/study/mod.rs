@@ -14,6 +14,7 @@ pub mod lecture;
 pub mod metrics;
 pub mod output;
 pub mod per_length;
+pub mod radius_media;
 pub mod radius_plane;
 pub mod radius_shrinkage;
 pub mod reference;

@@ -151,7 +151,7 @@ pub fn radiance(x: f64, y: f64) -> f64 {
 }
 
 /// Gauss–Legendre nodes and weights on [0, 1]: the core's rule on [−1, 1], mapped.
-fn gauss_legendre_unit(n: usize) -> Vec<(f64, f64)> {
+pub fn gauss_legendre_unit(n: usize) -> Vec<(f64, f64)> {
     let (nodes, weights) = lt_core::bsdf::quadrature::gauss_legendre(n);
     nodes
         .iter()
@@ -321,7 +321,7 @@ pub fn predicted(alpha: f64) -> (f64, f64, f64) {
     )
 }
 
-fn slope(xs: &[f64], ys: &[f64]) -> Result<f64, String> {
+pub fn slope(xs: &[f64], ys: &[f64]) -> Result<f64, String> {
     if let Some(y) = ys.iter().find(|y| !(**y > 0.0)) {
         return Err(format!("value {y:.3e} ≤ 0 in the tail"));
     }
@@ -366,41 +366,17 @@ pub fn measure(ctx: &StudyContext, est: RadiusSchedule, alpha: f64) -> Result<Me
                 .collect::<Result<_, String>>()
         })
         .collect::<Result<_, String>>()?;
-    let runs = entries.len();
-    let conf = scale.confidence;
-    let mut at_n = Vec::new();
-    let mut exact_at_n = Vec::new();
-    let mut targets = Vec::new();
-    for (k, vals) in values.iter().enumerate() {
-        let target: Vec<f64> = ex.value.clone();
-        let stat = |which: usize| {
-            jackknife(runs, conf, |kept| {
-                let (b, v) = bias2_variance(vals, kept, &target);
-                Ok([b, v, b + v][which])
-            })
-        };
-        at_n.push([stat(0)?, stat(1)?, stat(2)?]);
-        let np = points.len().max(1) as f64;
-        let b2 = ex.bias[k].iter().map(|b| b * b).sum::<f64>() / np;
-        let v = ex.variance[k].iter().sum::<f64>() / np;
-        exact_at_n.push([b2, v, b2 + v]);
-        targets.push(target);
-    }
-    let last = *snaps.last().unwrap_or(&1);
-    let tail_idx: Vec<usize> = (0..snaps.len()).filter(|&k| 8 * snaps[k] >= last).collect();
-    let xs: Vec<f64> = tail_idx.iter().map(|&k| (snaps[k] as f64).ln()).collect();
-    let measured_slope = |which: usize| {
-        jackknife(runs, conf, |kept| {
-            let ys: Vec<f64> = tail_idx
-                .iter()
-                .map(|&k| {
-                    let (b, v) = bias2_variance(&values[k], kept, &targets[k]);
-                    [b, v, b + v][which]
-                })
-                .collect();
-            slope(&xs, &ys)
+    let measured = measured_rates(&values, &ex.value, &snaps, scale.confidence)?;
+    let np = points.len().max(1) as f64;
+    let exact_at_n: Vec<[f64; 3]> = (0..snaps.len())
+        .map(|k| {
+            let b2 = ex.bias[k].iter().map(|b| b * b).sum::<f64>() / np;
+            let v = ex.variance[k].iter().sum::<f64>() / np;
+            [b2, v, b2 + v]
         })
-    };
+        .collect();
+    let tail_idx = &measured.tail_idx;
+    let xs: Vec<f64> = tail_idx.iter().map(|&k| (snaps[k] as f64).ln()).collect();
     let exact_slope = |which: usize| {
         let ys: Vec<f64> = tail_idx.iter().map(|&k| exact_at_n[k][which]).collect();
         slope(&xs, &ys).unwrap_or(f64::NAN)
@@ -415,10 +391,60 @@ pub fn measure(ctx: &StudyContext, est: RadiusSchedule, alpha: f64) -> Result<Me
         alpha,
         tail: tail_idx.iter().map(|&k| snaps[k]).collect(),
         snaps,
-        at_n,
+        at_n: measured.at_n,
         exact_at_n,
-        slopes: [measured_slope(0), measured_slope(1), measured_slope(2)],
+        slopes: measured.slopes,
         exact_slopes,
+    })
+}
+
+/// What K independent runs show at one set of points: per snapshot (bias², variance, MSE) with
+/// jackknife intervals, and their log-log slopes against N over the tail (N ≥ last / 8).
+pub struct MeasuredRates {
+    pub at_n: Vec<[Jackknifed; 3]>,
+    pub slopes: [Result<Jackknifed, String>; 3],
+    /// Indices of the tail's snapshots.
+    pub tail_idx: Vec<usize>,
+}
+
+/// `values[snapshot][run][point]` against the exact `target[point]` (the plane's radiance here,
+/// a medium's single scattering in `radius_media`).
+pub fn measured_rates(
+    values: &[Vec<Vec<f64>>],
+    target: &[f64],
+    snaps: &[u32],
+    conf: f64,
+) -> Result<MeasuredRates, String> {
+    let runs = values.first().map_or(0, Vec::len);
+    let mut at_n = Vec::new();
+    for vals in values {
+        let stat = |which: usize| {
+            jackknife(runs, conf, |kept| {
+                let (b, v) = bias2_variance(vals, kept, target);
+                Ok([b, v, b + v][which])
+            })
+        };
+        at_n.push([stat(0)?, stat(1)?, stat(2)?]);
+    }
+    let last = *snaps.last().unwrap_or(&1);
+    let tail_idx: Vec<usize> = (0..snaps.len()).filter(|&k| 8 * snaps[k] >= last).collect();
+    let xs: Vec<f64> = tail_idx.iter().map(|&k| (snaps[k] as f64).ln()).collect();
+    let measured_slope = |which: usize| {
+        jackknife(runs, conf, |kept| {
+            let ys: Vec<f64> = tail_idx
+                .iter()
+                .map(|&k| {
+                    let (b, v) = bias2_variance(&values[k], kept, target);
+                    [b, v, b + v][which]
+                })
+                .collect();
+            slope(&xs, &ys)
+        })
+    };
+    Ok(MeasuredRates {
+        at_n,
+        slopes: [measured_slope(0), measured_slope(1), measured_slope(2)],
+        tail_idx,
     })
 }
 
