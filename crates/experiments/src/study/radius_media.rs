@@ -60,8 +60,9 @@ pub fn scene(scale: &Scale) -> PathBuf {
         .unwrap_or_else(|| "scenes/studies/medium-point.toml".into())
 }
 
-/// (runs, passes, photon-path divisor) at a scale: the full and committed scales' are what
-/// results/points-beams.md reports (3 estimators × 4 α × 16 runs of 256 passes, ≈ 10 CPU min).
+/// (runs, passes, photon-path divisor) at a scale. results/points-beams.md reports the quick
+/// scale (≈ 9 s CPU); the committed and full scales (16 runs of 256 passes, 10× the photons)
+/// take longer than 20 CPU min on a shared 2-core machine (pb2d at α = 0.9 keeps r ≈ r₁).
 pub fn media_scale(scale: &Scale) -> (usize, u32, u64) {
     match scale.name {
         "full" | "committed" => (16, 256, 1),
