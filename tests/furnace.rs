@@ -166,8 +166,13 @@ fn run_on(
     Ok(summary)
 }
 
-/// Asserts one case: it must pass, or, if it is a known failure, still fail as recorded.
+/// Asserts one case at 64 passes: it must pass, or, if it is a known failure, still fail as
+/// recorded.
 fn check(integrator: &str, sphere: bool, scale: f32) {
+    check_with(integrator, sphere, scale, 64);
+}
+
+fn check_with(integrator: &str, sphere: bool, scale: f32, passes: u32) {
     let case = if sphere { "sphere" } else { "cube" };
     if let Some(why) = excluded(integrator, case) {
         println!("{integrator} {case} furnace: excluded ({why})");
@@ -178,7 +183,13 @@ fn check(integrator: &str, sphere: bool, scale: f32) {
         .find(|(i, c, s, _)| *i == integrator && *c == case && *s == scale)
         .map(|(_, _, _, why)| *why);
     match (
-        run(integrator, IntegratorParams::default(), 64, sphere, scale),
+        run(
+            integrator,
+            IntegratorParams::default(),
+            passes,
+            sphere,
+            scale,
+        ),
         known,
     ) {
         (Ok(summary), None) => println!("{summary}"),
@@ -208,11 +219,16 @@ fn every_integrator_cube_furnace() {
 fn every_integrator_furnace_is_scale_invariant() {
     for info in INTEGRATORS {
         for scale in [1e-3, 1e6] {
-            check(info.name, true, scale);
-            check(info.name, false, scale);
+            check_with(info.name, true, scale, SCALED_PASSES);
+            check_with(info.name, false, scale, SCALED_PASSES);
         }
     }
 }
+
+/// Passes of the scaled furnaces, half the unscaled ones': what goes wrong far from unit scale
+/// (offsets that self-intersect or leak, roulette against an absolute throughput) loses or adds
+/// whole paths, errors of many per cent, while the 2 % spread bound still holds here.
+const SCALED_PASSES: u32 = 32;
 
 /// Without roulette every furnace path reaches max_depth = 64 segments, past the MIS arrays bdpt
 /// keeps on the stack (it panicked there before they spilled to the heap). Few passes: these

@@ -89,15 +89,24 @@ fn check_furnace(integrator: &str, medium: Medium, passes: u32) {
     );
 }
 
+/// Without `light`: its 65,536 passes here were half of this file's cost, and the HG furnace
+/// below keeps light tracing with the camera inside a chromatic medium; its isotropic splats are
+/// held to a furnace by tests/furnace.rs (the isotropic medium cube, seen from outside).
 #[test]
 fn furnace_isotropic_chromatic() {
     let m = || homogeneous(Color::new(0.5, 1.0, 2.0), 1.0, PhaseFunction::Isotropic);
     for (integrator, passes) in FURNACE_PASSES {
+        if integrator == "light" {
+            println!("light: not in the isotropic furnace (see this test's doc)");
+            continue;
+        }
         check_furnace(integrator, m(), passes);
     }
 }
 
-/// Passes per integrator of the furnaces (light tracing reaches the unit sphere rarely).
+/// Passes per integrator of the furnaces (light tracing reaches the unit sphere rarely, and its
+/// splats from medium vertices around the eye are heavy-tailed: at 16,384 passes the HG furnace
+/// came out at 0.895 ± 0.031 in red, |z| 3.42 of 3.59; at 65,536 it holds).
 const FURNACE_PASSES: [(&str, u32); 4] =
     [("pt", 64), ("pt-bsdf", 64), ("light", 65536), ("bdpt", 64)];
 

@@ -163,7 +163,7 @@ fn sampled_directions_follow_the_pdf_chi2() {
     // The cases in a fixed order with their seeds, then run on every core: the outcomes, gathered
     // back in case order, do not depend on the thread count.
     let mut cases = Vec::new();
-    let mut seed = 1u64;
+    let mut seed = 0u64; // radiance cases keep the seeds they had beside importance ones
     for (index, (_, m)) in registry.iter().enumerate() {
         if m.is_delta() {
             continue;
@@ -173,10 +173,11 @@ fn sampled_directions_follow_the_pdf_chi2() {
             if absorbs_from(m, &sf, wo) {
                 continue; // a one-sided material seen from behind: nothing to fit
             }
-            for mode in MODES {
-                seed += 1;
-                cases.push((index, cos, wo, mode, seed));
-            }
+            // Radiance mode only: importance-mode sampling draws the same directions with the
+            // same pdfs from the same variates (`check_adjoint` holds that exactly), and `pdf`
+            // has no mode, so a second mode would fit the same distribution again.
+            seed += 2;
+            cases.push((index, cos, wo, TransportMode::Radiance, seed));
         }
     }
     let run_case = |&(index, cos, wo, mode, seed): &(usize, f32, Vec3, TransportMode, u64)| {
@@ -318,7 +319,17 @@ fn sample_weight_and_pdfs_agree_with_eval() {
                     let (u_lobe, u) = (s.next_f32(), s.next_2d());
                     let r = m.sample(&sf, wo, u_lobe, u, TransportMode::Radiance);
                     let i = m.sample(&sf, wo, u_lobe, u, TransportMode::Importance);
-                    let (Some(r), Some(i)) = (r, i) else { continue };
+                    let (r, i) = match (r, i) {
+                        (Some(r), Some(i)) => (r, i),
+                        (None, None) => continue,
+                        (r, i) => {
+                            // The χ² test fits radiance mode alone on this equality.
+                            failures.push(format!(
+                                "{label}: radiance sample {r:?} but importance sample {i:?}"
+                            ));
+                            break;
+                        }
+                    };
                     if let Err(e) = check_sample(&m, &sf, wo, &r)
                         .and_then(|_| check_adjoint(&m, &sf, wo, &r, &i))
                     {
@@ -510,7 +521,9 @@ fn non_delta_materials_are_reciprocal() {
 #[test]
 fn energy_is_conserved_and_diffuse_returns_its_albedo() {
     let sf = flat_frame();
-    let n = 200_000;
+    // 100k samples per case (200k cost CI a minute): each estimate's standard error grows by √2,
+    // and the failure messages print it beside the disagreement.
+    let n = 100_000;
     let registry = test_registry();
     // Cases in a fixed order, each with its own seed, run on every core (as the χ² test does).
     let mut cases = Vec::new();
