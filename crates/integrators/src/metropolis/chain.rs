@@ -13,6 +13,7 @@
 use super::target::{Base, Restrict, Sample, Scratch};
 use lt_core::primary_space::PrimarySpace;
 use lt_core::sampling::{Distribution1D, Sampler};
+use lt_core::math::luminance;
 use lt_core::{Color, Scene};
 use rayon::prelude::*;
 
@@ -69,6 +70,9 @@ pub struct ChainSet {
     weights: Vec<f32>,
     chains: Vec<Chain>,
     film: Vec<[f64; 3]>,
+    /// Luminance of the splats of the latest `advance`, per pixel (its pass's share of the
+    /// film, for the batch-means ESS).
+    pass_luminance: Vec<f64>,
     /// Mutations done (over all chains) and accepted.
     pub mutations: u64,
     pub accepted: u64,
@@ -110,6 +114,7 @@ impl ChainSet {
             weights: weights.iter().map(|w| w.0 as f32).collect(),
             chains: Vec::new(),
             film: vec![[0.0; 3]; scene.camera.pixel_count()],
+            pass_luminance: vec![0.0; scene.camera.pixel_count()],
             mutations: 0,
             accepted: 0,
         };
@@ -178,12 +183,14 @@ impl ChainSet {
             })
             .collect();
         let mut invalid = 0;
+        self.pass_luminance.iter_mut().for_each(|v| *v = 0.0);
         for (splats, accepted, bad) in results {
             for (p, c) in splats {
                 let px = &mut self.film[p as usize];
                 px[0] += c.x as f64;
                 px[1] += c.y as f64;
                 px[2] += c.z as f64;
+                self.pass_luminance[p as usize] += luminance(c) as f64;
             }
             self.accepted += accepted;
             invalid += bad;
@@ -202,6 +209,19 @@ impl ChainSet {
             for c in 0..3 {
                 out[c] += px[c] * scale;
             }
+        }
+    }
+
+    /// The latest `advance` as an estimate of the image's luminance on its own: b times its mean
+    /// splat per mutation, added to `out` (the passes' mean of these is `add_estimate`'s).
+    pub fn add_pass_luminance(&self, per_chain: u64, out: &mut [f64]) {
+        let done = per_chain * self.chains.len() as u64;
+        if done == 0 {
+            return;
+        }
+        let scale = self.b / done as f64;
+        for (o, v) in out.iter_mut().zip(&self.pass_luminance) {
+            *o += v * scale;
         }
     }
 
