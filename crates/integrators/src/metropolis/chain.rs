@@ -27,16 +27,18 @@ pub struct Mutations {
 }
 
 /// What makes a chain set's streams its own: the run's seed and the set's index (MMLT's path
-/// length), so two sets never share a number.
+/// length), so two sets' chains never share a number. The bootstrap points are keyed by
+/// `bootstrap_set`: MMLT's lengths share one bootstrap (set 0; lengths are 1 …).
 #[derive(Clone, Copy, Debug)]
 pub struct Keys {
     pub seed: u64,
     pub set: u64,
+    pub bootstrap_set: u64,
 }
 
 impl Keys {
     fn bootstrap(self, i: u64) -> u64 {
-        (self.set << 48) | i
+        (self.bootstrap_set << 48) | i
     }
     fn chain(self, j: u64) -> u64 {
         (self.set << 48) | (1 << 40) | j
@@ -102,23 +104,79 @@ impl ChainSet {
             )
             .collect();
         let invalid: u64 = weights.iter().map(|w| w.1).sum();
-        let n = bootstrap.max(1) as f64;
-        let b = weights.iter().map(|w| w.0).sum::<f64>() / n;
-        let var = weights.iter().map(|w| (w.0 - b).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-        let set = ChainSet {
+        let importance = weights.iter().map(|w| w.0).collect();
+        let set = ChainSet::from_bootstrap(scene, restrict, importance, sigma, keys);
+        (set, invalid)
+    }
+
+    /// MMLT's bootstrap: `bootstrap` uniform points, each one bdpt sample giving I_k for every
+    /// length k = 1 … `lengths` (`Base::evaluate_lengths`), so each b̂_k averages all the points
+    /// rather than its 1/`lengths` share. Returns the sets (length k's keyed `set: k`) and the
+    /// invalid values dropped.
+    pub fn bootstrap_lengths(
+        base: &Base,
+        scene: &Scene,
+        lengths: usize,
+        bootstrap: u64,
+        sigma: f32,
+        seed: u64,
+    ) -> (Vec<ChainSet>, u64) {
+        let shared = Keys {
+            seed,
+            set: 0,
+            bootstrap_set: 0,
+        };
+        let points: Vec<(Vec<f64>, u64)> = (0..bootstrap)
+            .into_par_iter()
+            .map_init(
+                || base.scratch(scene),
+                |scratch, i| {
+                    let mut space = shared.bootstrap_point(i, sigma);
+                    let mut importance = Vec::with_capacity(lengths);
+                    let bad =
+                        base.evaluate_lengths(scene, lengths, &mut space, scratch, &mut importance);
+                    (importance, bad)
+                },
+            )
+            .collect();
+        let invalid = points.iter().map(|p| p.1).sum();
+        let sets = (1..=lengths)
+            .map(|k| {
+                let importance = points.iter().map(|p| p.0[k - 1]).collect();
+                let keys = Keys {
+                    set: k as u64,
+                    ..shared
+                };
+                ChainSet::from_bootstrap(scene, Restrict::Length(k), importance, sigma, keys)
+            })
+            .collect();
+        (sets, invalid)
+    }
+
+    /// A set from its bootstrap's I values: b̂ their mean, its standard error sd/√B.
+    fn from_bootstrap(
+        scene: &Scene,
+        restrict: Restrict,
+        importance: Vec<f64>,
+        sigma: f32,
+        keys: Keys,
+    ) -> ChainSet {
+        let n = importance.len().max(1) as f64;
+        let b = importance.iter().sum::<f64>() / n;
+        let var = importance.iter().map(|w| (w - b).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        ChainSet {
             restrict,
             b,
             b_std_error: (var / n).sqrt(),
             keys,
             sigma,
-            weights: weights.iter().map(|w| w.0 as f32).collect(),
+            weights: importance.iter().map(|&w| w as f32).collect(),
             chains: Vec::new(),
             film: vec![[0.0; 3]; scene.camera.pixel_count()],
             pass_luminance: vec![0.0; scene.camera.pixel_count()],
             mutations: 0,
             accepted: 0,
-        };
-        (set, invalid)
+        }
     }
 
     /// Starts `chains` chains from bootstrap points resampled ∝ I (none when b̂ = 0).
