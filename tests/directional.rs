@@ -57,8 +57,9 @@ const KNOWN_FAILURES: &[(&str, &str, &str)] = &[];
 /// Configurations this test's budget cannot hold to 2 % (name, reason): reported, not rendered.
 const IMPRECISE: &[(&str, &str)] = &[(
     "mmlt",
-    "7–8 % standard error at 11 runs (per-length bootstraps split the pixel count over \
-     max_depth lengths); held to bdpt in tests/mlt.rs",
+    "4.5 % standard error at 11 runs (one shared bootstrap of 256 points, each length's b̂_k \
+     from one random strategy times k + 1; 7–8 % when the lengths split it); held to bdpt in \
+     tests/mlt.rs",
 )];
 
 /// The square [-HALF, HALF]² at y = 0 (normal +y), seen obliquely from above; the camera sees

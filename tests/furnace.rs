@@ -30,13 +30,9 @@ const LE: f32 = 0.5;
 /// is "sphere" or "cube". The furnace has no delta surface and no delta light, so every estimator
 /// can see all of it; what excludes one is its precision. A listed case is reported, never
 /// silently skipped.
-const MMLT_IMPRECISE: &str = "8 runs × 16 passes leave mmlt 6–9 % standard error (its \
-    per-length bootstraps split the pixel count over max_depth lengths), not the 2 % the test \
-    needs; mmlt is held to bdpt in tests/mlt.rs";
-const EXCLUDED: &[(&str, &str, &str)] = &[
-    ("mmlt", "sphere", MMLT_IMPRECISE),
-    ("mmlt", "cube", MMLT_IMPRECISE),
-];
+// Empty: mmlt's per-length bootstraps split the pixel count over max_depth (64) lengths, 4
+// points each, and its b̂_k left it 6–9 % standard error; its lengths now share one bootstrap.
+const EXCLUDED: &[(&str, &str, &str)] = &[];
 
 /// Furnace cases that fail because of an integrator bug, kept asserted (the case must still fail,
 /// so a fix is noticed and the entry removed): (integrator, case, scale, the bug).

@@ -12,11 +12,16 @@
 //!    spread (leave-one-out, t with R − 2), each widened by bdpt's reference error, against bdpt's
 //!    reference. The per-run coverage fractions are independent across runs, so their mean has a
 //!    standard error: the independent-run coverage must be within z of its nominal 95 %, and the
-//!    per-pass coverage z below it.
+//!    per-pass coverage z below it. The gap is the chain's correlation: each run's batch-means
+//!    ESS (its record's `ess` image, `lt_estimators::batch_means`) says how much too narrow its
+//!    per-pass intervals are, and b̂'s bootstrap error (fixed within a run) adds to the miss:
+//!    the coverage they predict must not fall below the observed one (batch means at 8 passes
+//!    per batch can only understate the correlation), and ESS's share of it must be significant
+//!    (against ESS/P = 1), both paired over runs.
 
 use lt_estimators::agreement::{agreement_t, sidak_threshold};
 use lt_estimators::running::RunningImage;
-use lt_estimators::Image;
+use lt_estimators::{naive_interval_coverage, Image};
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
 use lt_tests::{render_blocks, shipped_scene};
 use std::ops::ControlFlow;
@@ -109,6 +114,12 @@ fn independent_runs_cover_and_per_pass_error_bars_do_not() {
     // as b̂ is fixed within a run and every pass does the same number of mutations).
     let mut estimates: Vec<Image> = Vec::new();
     let mut pass_se: Vec<Image> = Vec::new();
+    // Per run: ESS/P per pixel from the run's own batch means (its record's `ess` image).
+    let mut ess: Vec<Image> = Vec::new();
+    // Per run: b̂'s relative standard error (its bootstrap's; fixed within a run, so neither the
+    // passes nor their batches see it) and the batches its ESS used.
+    let mut b_rel: Vec<f64> = Vec::new();
+    let mut batches = String::new();
     for r in 0..runs {
         let mut prev = Image::new(8, 8);
         let mut spread = RunningImage::new(8, 8);
@@ -127,12 +138,35 @@ fn independent_runs_cover_and_per_pass_error_bars_do_not() {
         })
         .unwrap();
         assert_eq!(result.invalid_samples, 0);
+        let log = result.log.expect("a consistent run has a log");
+        let fact = |key: &str| -> String {
+            log.facts
+                .iter()
+                .find(|(k, _)| k == key)
+                .map(|(_, v)| v.clone())
+                .unwrap_or_else(|| panic!("no {key} in the record"))
+        };
+        let num = |key: &str| -> f64 { fact(key).parse().unwrap() };
+        b_rel.push(num("b_std_error") / num("b"));
+        batches = fact("ess_batches");
+        let (_, ratio) = log
+            .images
+            .into_iter()
+            .find(|(name, _)| name == "ess")
+            .expect("an ESS image after 64 passes");
+        ess.push(ratio);
         estimates.push(result.estimate);
         pass_se.push(spread.std_error());
     }
     let (t_pass, t_runs) = (t95(passes as f64 - 1.0), t95(runs as f64 - 2.0));
     let mut cover_pass = vec![0.0f64; runs];
     let mut cover_runs = vec![0.0f64; runs];
+    // What ESS and b̂ predict for the per-pass intervals: run r's pixel k is off by its naive
+    // error over √(ESS/P) (luminance's ESS applied to green; a pixel with none taken as
+    // independent), by b̂'s relative error times the pixel, and by the reference's error.
+    let mut predicted = vec![0.0f64; runs];
+    // The same with ESS/P = 1: what b̂ and the reference alone would predict.
+    let mut predicted_independent = vec![0.0f64; runs];
     for r in 0..runs {
         for k in 0..n {
             // Channel 1 (green) alone: the three channels of a pixel share their paths.
@@ -142,6 +176,13 @@ fn independent_runs_cover_and_per_pass_error_bars_do_not() {
             let rse2 = ref_se.data[k][c].powi(2);
             let se_p = (pass_se[r].data[k][c].powi(2) + rse2).sqrt();
             cover_pass[r] += ((x - truth).abs() <= t_pass * se_p) as u8 as f64 / n as f64;
+            let rho = ess[r].data[k][0];
+            let rho = if rho > 0.0 { rho } else { 1.0 };
+            let other = (rse2 + (truth * b_rel[r]).powi(2)).sqrt();
+            let p = naive_interval_coverage(t_pass, pass_se[r].data[k][c], rho, se_p, other);
+            predicted[r] += p / n as f64;
+            let p1 = naive_interval_coverage(t_pass, pass_se[r].data[k][c], 1.0, se_p, other);
+            predicted_independent[r] += p1 / n as f64;
             // Leave-one-out spread of the other runs: independent of run r.
             let others: Vec<f64> = (0..runs)
                 .filter(|&q| q != r)
@@ -161,8 +202,14 @@ fn independent_runs_cover_and_per_pass_error_bars_do_not() {
     };
     let (cp, sp) = stats(&cover_pass);
     let (cr, sr) = stats(&cover_runs);
-    // Two checks: Šidák over them.
-    let z = sidak_threshold(ALPHA, 2);
+    // Paired over runs: observed minus ESS-predicted per-pass coverage.
+    let diff: Vec<f64> = (0..runs).map(|r| cover_pass[r] - predicted[r]).collect();
+    let (cd, sd) = stats(&diff);
+    let mut lit: Vec<f64> = ess.iter().flat_map(|e| e.data.iter().map(|p| p[0])).filter(|&v| v > 0.0).collect();
+    lit.sort_by(f64::total_cmp);
+    let median_ess = lit.get(lit.len() / 2).copied().unwrap_or(f64::NAN);
+    // Four checks: Šidák over them.
+    let z = sidak_threshold(ALPHA, 4);
     println!(
         "pssmlt on cornell-box 8×8, {runs} runs × {passes} passes: coverage of nominal 95 % \
          intervals from passes {:.1} % ± {:.1} %, from independent runs {:.1} % ± {:.1} % \
@@ -171,6 +218,44 @@ fn independent_runs_cover_and_per_pass_error_bars_do_not() {
         100.0 * sp,
         100.0 * cr,
         100.0 * sr
+    );
+    println!(
+        "batch-means ESS/P median {median_ess:.3} ({batches} per run) with b̂'s relative error \
+         (mean {:.3}) predicts per-pass coverage {:.1} %; observed − predicted {:.1} % ± {:.1} %",
+        b_rel.iter().sum::<f64>() / runs as f64,
+        100.0 * (cp - cd),
+        100.0 * cd,
+        100.0 * sd
+    );
+    // Batch means with batches of 8 passes can only understate the correlation (its finite-batch
+    // bias; ESS/P falls to 0.288 and 0.257 with 256 and 1,024 passes, batches of 16 and 32), so
+    // the prediction may sit above the observed coverage but not below it.
+    assert!(
+        cd / sd.max(1e-12) < z,
+        "ESS predicts per-pass coverage {:.1} %, below the observed {:.1} % (difference {:.1} % ± {:.1} %)",
+        100.0 * (cp - cd),
+        100.0 * cp,
+        100.0 * cd,
+        100.0 * sd
+    );
+    // ESS's share: with ESS/P = 1 (b̂ and the reference alone) the prediction must be
+    // significantly higher.
+    let share: Vec<f64> = (0..runs)
+        .map(|r| predicted_independent[r] - predicted[r])
+        .collect();
+    let (ce, se_e) = stats(&share);
+    println!(
+        "without ESS (b̂'s and the reference's errors alone) the prediction is {:.1} %: ESS lowers \
+         it by {:.1} % ± {:.1} %",
+        100.0 * (cp - cd + ce),
+        100.0 * ce,
+        100.0 * se_e
+    );
+    assert!(
+        ce / se_e.max(1e-12) > z,
+        "ESS lowers the predicted per-pass coverage by only {:.1} % ± {:.1} %",
+        100.0 * ce,
+        100.0 * se_e
     );
     let z_runs = (cr - 0.95) / sr.max(1e-12);
     assert!(

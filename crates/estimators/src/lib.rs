@@ -3,6 +3,7 @@
 //! log-log fits, efficiency. No rendering code lives here.
 
 pub mod agreement;
+pub mod batch_means;
 pub mod bias_variance;
 pub mod binomial;
 pub mod blocks;
@@ -20,6 +21,7 @@ pub use agreement::{
     agreement, agreement_t, agreement_with_reference, agreement_with_reference_t, sidak_threshold,
     Agreement,
 };
+pub use batch_means::{naive_interval_coverage, BatchMeans, Ess, EssSummary};
 pub use bias_variance::{BiasVariance, ImageBiasVariance, Interval};
 pub use binomial::{binomial_test, BinomialTest};
 pub use blocks::{block_means, BlockEstimate, RunningBlocks};

@@ -168,6 +168,10 @@ pub struct RunRecord {
     /// Per pass, r_i/r_0 and the mean radius, for progressive estimators.
     pub radius_scale: Vec<f64>,
     pub mean_radius: Vec<f64>,
+    /// The first run's log facts (Metropolis: b̂, acceptance, batch-means ESS); empty in
+    /// records written before they were kept.
+    #[serde(default)]
+    pub facts: Vec<(String, String)>,
     pub code_version: String,
     pub threads: usize,
 }
@@ -354,6 +358,7 @@ fn render_into(spec: &RunSpec, scene: &Scene, threads: usize, dir: &Path) -> Res
         std_error_source: source.into(),
         radius_scale: log.map(|l| l.radius_scale.clone()).unwrap_or_default(),
         mean_radius: log.map(|l| l.mean_radius.clone()).unwrap_or_default(),
+        facts: log.map(|l| l.facts.clone()).unwrap_or_default(),
         code_version: crate::cache::CODE_VERSION.into(),
         threads,
     };

@@ -100,6 +100,7 @@ pub fn assemble(plan: &Plan, a: &Assembly) -> Result<bool, String> {
             },
             radius_scale: Vec::new(),
             mean_radius: Vec::new(),
+            facts: Vec::new(),
             code_version: CODE_VERSION.into(),
             threads: 0,
         };

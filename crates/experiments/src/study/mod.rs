@@ -12,6 +12,7 @@ pub mod convergence;
 pub mod equal_time;
 pub mod lecture;
 pub mod metrics;
+pub mod metropolis;
 pub mod output;
 pub mod per_length;
 pub mod radius_media;

@@ -4,7 +4,8 @@
 use super::context::StudyContext;
 use super::scale::Scale;
 use super::{
-    convergence, equal_time, per_length, radius_media, radius_plane, radius_shrinkage, smoke, techniques,
+    convergence, equal_time, metropolis, per_length, radius_media, radius_plane, radius_shrinkage, smoke,
+    techniques,
     unbiased_consistent,
 };
 use crate::runs::RunSpec;
@@ -82,6 +83,13 @@ pub const STUDIES: &[StudyInfo] = &[
         listed: false,
         specs: |scale, _| Ok(techniques::specs(scale)),
         run: techniques::run,
+    },
+    // Not in `all`: about 25 CPU minutes at the quick scale (results/mlt.md). Run it by name.
+    StudyInfo {
+        name: metropolis::NAME,
+        listed: false,
+        specs: |scale, _| metropolis::specs(scale),
+        run: metropolis::run,
     },
     StudyInfo {
         name: "smoke",

@@ -13,6 +13,7 @@
 use super::target::{Base, Restrict, Sample, Scratch};
 use lt_core::primary_space::PrimarySpace;
 use lt_core::sampling::{Distribution1D, Sampler};
+use lt_core::math::luminance;
 use lt_core::{Color, Scene};
 use rayon::prelude::*;
 
@@ -26,16 +27,18 @@ pub struct Mutations {
 }
 
 /// What makes a chain set's streams its own: the run's seed and the set's index (MMLT's path
-/// length), so two sets never share a number.
+/// length), so two sets' chains never share a number. The bootstrap points are keyed by
+/// `bootstrap_set`: MMLT's lengths share one bootstrap (set 0; lengths are 1 …).
 #[derive(Clone, Copy, Debug)]
 pub struct Keys {
     pub seed: u64,
     pub set: u64,
+    pub bootstrap_set: u64,
 }
 
 impl Keys {
     fn bootstrap(self, i: u64) -> u64 {
-        (self.set << 48) | i
+        (self.bootstrap_set << 48) | i
     }
     fn chain(self, j: u64) -> u64 {
         (self.set << 48) | (1 << 40) | j
@@ -69,6 +72,9 @@ pub struct ChainSet {
     weights: Vec<f32>,
     chains: Vec<Chain>,
     film: Vec<[f64; 3]>,
+    /// Luminance of the splats of the latest `advance`, per pixel (its pass's share of the
+    /// film, for the batch-means ESS).
+    pass_luminance: Vec<f64>,
     /// Mutations done (over all chains) and accepted.
     pub mutations: u64,
     pub accepted: u64,
@@ -98,22 +104,79 @@ impl ChainSet {
             )
             .collect();
         let invalid: u64 = weights.iter().map(|w| w.1).sum();
-        let n = bootstrap.max(1) as f64;
-        let b = weights.iter().map(|w| w.0).sum::<f64>() / n;
-        let var = weights.iter().map(|w| (w.0 - b).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-        let set = ChainSet {
+        let importance = weights.iter().map(|w| w.0).collect();
+        let set = ChainSet::from_bootstrap(scene, restrict, importance, sigma, keys);
+        (set, invalid)
+    }
+
+    /// MMLT's bootstrap: `bootstrap` uniform points, each one bdpt sample giving I_k for every
+    /// length k = 1 … `lengths` (`Base::evaluate_lengths`), so each b̂_k averages all the points
+    /// rather than its 1/`lengths` share. Returns the sets (length k's keyed `set: k`) and the
+    /// invalid values dropped.
+    pub fn bootstrap_lengths(
+        base: &Base,
+        scene: &Scene,
+        lengths: usize,
+        bootstrap: u64,
+        sigma: f32,
+        seed: u64,
+    ) -> (Vec<ChainSet>, u64) {
+        let shared = Keys {
+            seed,
+            set: 0,
+            bootstrap_set: 0,
+        };
+        let points: Vec<(Vec<f64>, u64)> = (0..bootstrap)
+            .into_par_iter()
+            .map_init(
+                || base.scratch(scene),
+                |scratch, i| {
+                    let mut space = shared.bootstrap_point(i, sigma);
+                    let mut importance = Vec::with_capacity(lengths);
+                    let bad =
+                        base.evaluate_lengths(scene, lengths, &mut space, scratch, &mut importance);
+                    (importance, bad)
+                },
+            )
+            .collect();
+        let invalid = points.iter().map(|p| p.1).sum();
+        let sets = (1..=lengths)
+            .map(|k| {
+                let importance = points.iter().map(|p| p.0[k - 1]).collect();
+                let keys = Keys {
+                    set: k as u64,
+                    ..shared
+                };
+                ChainSet::from_bootstrap(scene, Restrict::Length(k), importance, sigma, keys)
+            })
+            .collect();
+        (sets, invalid)
+    }
+
+    /// A set from its bootstrap's I values: b̂ their mean, its standard error sd/√B.
+    fn from_bootstrap(
+        scene: &Scene,
+        restrict: Restrict,
+        importance: Vec<f64>,
+        sigma: f32,
+        keys: Keys,
+    ) -> ChainSet {
+        let n = importance.len().max(1) as f64;
+        let b = importance.iter().sum::<f64>() / n;
+        let var = importance.iter().map(|w| (w - b).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        ChainSet {
             restrict,
             b,
             b_std_error: (var / n).sqrt(),
             keys,
             sigma,
-            weights: weights.iter().map(|w| w.0 as f32).collect(),
+            weights: importance.iter().map(|&w| w as f32).collect(),
             chains: Vec::new(),
             film: vec![[0.0; 3]; scene.camera.pixel_count()],
+            pass_luminance: vec![0.0; scene.camera.pixel_count()],
             mutations: 0,
             accepted: 0,
-        };
-        (set, invalid)
+        }
     }
 
     /// Starts `chains` chains from bootstrap points resampled ∝ I (none when b̂ = 0).
@@ -178,12 +241,14 @@ impl ChainSet {
             })
             .collect();
         let mut invalid = 0;
+        self.pass_luminance.iter_mut().for_each(|v| *v = 0.0);
         for (splats, accepted, bad) in results {
             for (p, c) in splats {
                 let px = &mut self.film[p as usize];
                 px[0] += c.x as f64;
                 px[1] += c.y as f64;
                 px[2] += c.z as f64;
+                self.pass_luminance[p as usize] += luminance(c) as f64;
             }
             self.accepted += accepted;
             invalid += bad;
@@ -202,6 +267,19 @@ impl ChainSet {
             for c in 0..3 {
                 out[c] += px[c] * scale;
             }
+        }
+    }
+
+    /// The latest `advance` as an estimate of the image's luminance on its own: b times its mean
+    /// splat per mutation, added to `out` (the passes' mean of these is `add_estimate`'s).
+    pub fn add_pass_luminance(&self, per_chain: u64, out: &mut [f64]) {
+        let done = per_chain * self.chains.len() as u64;
+        if done == 0 {
+            return;
+        }
+        let scale = self.b / done as f64;
+        for (o, v) in out.iter_mut().zip(&self.pass_luminance) {
+            *o += v * scale;
         }
     }
 

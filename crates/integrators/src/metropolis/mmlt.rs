@@ -1,8 +1,9 @@
 //! `mmlt` — multiplexed Metropolis light transport (Hachisuka, Kaplanyan & Dachsbacher 2014):
 //! one chain set per path length k (1 … `max_depth` segments), each state choosing one bdpt
 //! strategy (s, t = k + 1 − s) from its own primary number and contributing that strategy's
-//! MIS-weighted value times k + 1 (`target`). Each length has its own bootstrap (the `bootstrap`
-//! points split evenly over lengths) and b̂_k; a pass's N mutations are shared ∝ b̂_k.
+//! MIS-weighted value times k + 1 (`target`). The lengths share one bootstrap: each of its points
+//! is one bdpt sample, which holds every length's I_k (the same number picks each length's
+//! strategy), so every b̂_k averages all `bootstrap` points; a pass's N mutations are shared ∝ b̂_k.
 //! bdpt's walks run in full and the chosen strategy is kept (through bdpt's recorder hook), so
 //! a mutation costs a bdpt sample, not one strategy's. Consistent: error bars from `--runs K`.
 //!
@@ -13,11 +14,11 @@
 //! | `mis` | power/balance | power | heuristic over bdpt's strategies |
 //! | `p_large` | f32 | 0.3 | probability of a large step (an independent proposal) |
 //! | `sigma` | f32 | 0.01 | standard deviation of a small step per primary coordinate |
-//! | `bootstrap` | u64 | the pixel count | independent points estimating the b_k, over all lengths |
+//! | `bootstrap` | u64 | the pixel count | independent points (bdpt samples), each giving every length's I_k, estimating the b_k |
 //! | `chains` | u64 | 256 | at most this many chains per path length, fewer when its share of a pass's mutations is smaller |
 
-use super::chain::{ChainSet, Keys};
-use super::target::{Base, Restrict};
+use super::chain::ChainSet;
+use super::target::Base;
 use super::{bootstrap_size, ChainParams, MetropolisRun};
 use crate::bidirectional::bdpt::{Bdpt, BdptParams};
 use crate::params::ParamReader;
@@ -65,23 +66,14 @@ impl Progressive for Mmlt {
 
     fn start<'a>(&'a self, scene: &'a Scene, seed: u64) -> Box<dyn ProgressiveRun + 'a> {
         let p = self.chains;
-        let lengths = self.max_depth.max(1) as u64;
-        let per_length = bootstrap_size(scene, &p).div_ceil(lengths);
-        let mut bad = 0;
-        let sets = (1..=lengths)
-            .map(|k| {
-                let (set, b) = ChainSet::bootstrap(
-                    &self.base,
-                    scene,
-                    Restrict::Length(k as usize),
-                    per_length,
-                    p.mutations.sigma,
-                    Keys { seed, set: k },
-                );
-                bad += b;
-                set
-            })
-            .collect();
+        let (sets, bad) = ChainSet::bootstrap_lengths(
+            &self.base,
+            scene,
+            self.max_depth.max(1) as usize,
+            bootstrap_size(scene, &p),
+            p.mutations.sigma,
+            seed,
+        );
         Box::new(MetropolisRun::new(scene, &self.base, p, sets, bad))
     }
 }

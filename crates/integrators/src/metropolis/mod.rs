@@ -6,6 +6,11 @@
 //! its own bootstrap, so the normalisation's error is in it). A pass advances every chain by
 //! its share of N mutations (N = pixel count: one mutation per pixel per pass).
 //!
+//! Each pass's own luminance image (b̂ times its mean splat) goes to a batch-means accumulator
+//! (`lt_estimators::batch_means`): the record gives ESS/P per pixel (P passes) — median and
+//! 5 %/95 % quantiles over the pixels with light, `ess_*` facts — and `OUT.ess.exr`. A per-pass
+//! error bar is too narrow by √(ESS/P).
+//!
 //! - `target`: u ↦ F(u), the base integrator's per-path code run on a chain's numbers;
 //! - `chain`: the chains, bootstrap, expected-value splats;
 //! - `pssmlt`, `mmlt`: the two integrators (their key tables).
@@ -19,7 +24,7 @@ use crate::params::ParamReader;
 use crate::{ProgressLog, ProgressiveRun};
 use chain::{ChainSet, Mutations};
 use lt_core::Scene;
-use lt_estimators::Image;
+use lt_estimators::{BatchMeans, Ess, Image};
 use target::Base;
 
 /// Chain settings both integrators read.
@@ -69,6 +74,8 @@ pub struct MetropolisRun<'a> {
     /// Mutations per chain per pass, per set.
     per_chain: Vec<u64>,
     bootstrap_invalid: u64,
+    /// Every pass's luminance image, for the per-pixel effective sample size.
+    batches: BatchMeans,
 }
 
 impl<'a> MetropolisRun<'a> {
@@ -102,6 +109,7 @@ impl<'a> MetropolisRun<'a> {
             sets,
             per_chain,
             bootstrap_invalid: bad,
+            batches: BatchMeans::new(scene.camera.pixel_count()),
         }
     }
 }
@@ -112,6 +120,11 @@ impl ProgressiveRun for MetropolisRun<'_> {
         for (set, &m) in self.sets.iter_mut().zip(&self.per_chain) {
             invalid += set.advance(self.base, self.scene, m, self.params.mutations);
         }
+        let mut pass = vec![0.0; self.scene.camera.pixel_count()];
+        for (set, &m) in self.sets.iter().zip(&self.per_chain) {
+            set.add_pass_luminance(m, &mut pass);
+        }
+        self.batches.add_pass(&pass);
         invalid
     }
 
@@ -153,11 +166,39 @@ impl ProgressiveRun for MetropolisRun<'_> {
                 }
             }
         }
+        let mut images = Vec::new();
+        if let Some(ess) = self.batches.ess() {
+            facts.extend(ess_facts(&ess));
+            let cam = &self.scene.camera;
+            let mut img = Image::new(cam.width as usize, cam.height as usize);
+            for (px, r) in img.data.iter_mut().zip(&ess.ratio) {
+                *px = [r.unwrap_or(0.0); 3];
+            }
+            images.push(("ess".to_string(), img));
+        }
         ProgressLog {
             facts,
+            images,
             ..ProgressLog::default()
         }
     }
+}
+
+/// The record's ESS summary: ESS/P (P passes) over the pixels that have one, and the batches.
+fn ess_facts(ess: &Ess) -> Vec<(String, String)> {
+    let mut facts = vec![(
+        "ess_batches".to_string(),
+        format!("{} × {} passes", ess.batches, ess.batch_len),
+    )];
+    if let Some(s) = ess.summary() {
+        facts.extend([
+            ("ess_over_passes_median".to_string(), format!("{:.4}", s.median)),
+            ("ess_over_passes_q05".to_string(), format!("{:.4}", s.q05)),
+            ("ess_over_passes_q95".to_string(), format!("{:.4}", s.q95)),
+            ("ess_pixels".to_string(), s.pixels.to_string()),
+        ]);
+    }
+    facts
 }
 
 /// The bootstrap size when the key is not set: one point per pixel (one pass's work).

@@ -78,7 +78,11 @@ impl Progressive for Pssmlt {
             Restrict::Full,
             bootstrap_size(scene, &p),
             p.mutations.sigma,
-            Keys { seed, set: 0 },
+            Keys {
+                seed,
+                set: 0,
+                bootstrap_set: 0,
+            },
         );
         Box::new(MetropolisRun::new(scene, &self.base, p, vec![set], bad))
     }

@@ -10,7 +10,9 @@
 //! s + t = k + 1, chosen by u's third number uniformly among the k + 1 bdpt samples (t ≥ 1):
 //! F_k(u) = N (k + 1) · w_{s,t} f / p_{s,t}, bdpt's own MIS-weighted contribution of that strategy
 //! (read through the `Recorder` bdpt reports every completed path to), so Σ_k E_u[F_k] is bdpt's
-//! image again.
+//! image again. One bdpt sample on u holds every F_k(u) at once (the same third number picks
+//! each length's strategy), so MMLT's bootstrap reads all lengths from one evaluation
+//! (`evaluate_lengths`).
 
 use crate::bidirectional::bdpt::{self, Bdpt};
 use crate::film::pixel::{pixel_sample, weighted};
@@ -49,7 +51,8 @@ pub struct Sample {
 pub struct Scratch {
     bdpt: Option<bdpt::Scratch>,
     item: Splats,
-    picked: Splats,
+    /// The kept strategy's splats per path length (one buffer for a single length).
+    picked: Vec<Splats>,
 }
 
 impl Base {
@@ -61,7 +64,7 @@ impl Base {
                 Base::Pt(_) => None,
             },
             item: Splats::new(w, h),
-            picked: Splats::new(w, h),
+            picked: Vec::new(),
         }
     }
 
@@ -75,8 +78,7 @@ impl Base {
         scratch: &mut Scratch,
         out: &mut Sample,
     ) -> u64 {
-        scratch.item.clear();
-        scratch.picked.clear();
+        scratch.clear_picked(1, scene);
         let n = scene.camera.pixel_count() as u64;
         let mut scale = n as f32;
         with_space(space, || {
@@ -101,27 +103,13 @@ impl Base {
                     b.item(scene, Pass { seed: 0, pass: 0 }, pixel, &mut worker);
                 }
                 (Base::Bdpt(b), Restrict::Length(k)) => {
-                    let s = ((next_installed(0) * (k + 1) as f32) as usize).min(k);
                     scale *= (k + 1) as f32;
-                    let mut pick = Pick {
-                        k,
-                        s,
-                        pixel: pixel as u32,
-                        film_weight: 1.0,
-                        film: scene.camera.film(),
-                        out: &mut scratch.picked,
-                    };
-                    let mut worker = Worker {
-                        splats: &mut scratch.item,
-                        scratch: scratch.bdpt.as_mut().expect("bdpt scratch"),
-                        rec: &mut pick,
-                    };
-                    b.item(scene, Pass { seed: 0, pass: 0 }, pixel, &mut worker);
+                    picked_item(b, scene, pixel, k, scratch);
                 }
             }
         });
         let taken = match restrict {
-            Restrict::Length(_) => &scratch.picked,
+            Restrict::Length(_) => &scratch.picked[0],
             Restrict::Full => &scratch.item,
         };
         out.splats.clear();
@@ -131,8 +119,73 @@ impl Base {
             out.importance += luminance(c).max(0.0) as f64;
             out.splats.push((p, c));
         }
-        scratch.item.invalid() + scratch.picked.invalid()
+        scratch.item.invalid() + scratch.picked[0].invalid()
     }
+
+    /// I_k(u) for every length k = 1 … `lengths` from one bdpt sample on u, into `importance`
+    /// (k − 1 indexed): each what `evaluate` with `Restrict::Length(k)` gives for the same u, bit
+    /// for bit. Returns the invalid values dropped. Only for a bdpt base.
+    pub fn evaluate_lengths(
+        &self,
+        scene: &Scene,
+        lengths: usize,
+        space: &mut PrimarySpace,
+        scratch: &mut Scratch,
+        importance: &mut Vec<f64>,
+    ) -> u64 {
+        let Base::Bdpt(b) = self else {
+            panic!("per-length evaluation needs a bdpt base")
+        };
+        scratch.clear_picked(lengths, scene);
+        let n = scene.camera.pixel_count() as u64;
+        with_space(space, || picked_item(b, scene, pick_pixel(n), 1, scratch));
+        importance.clear();
+        let mut invalid = scratch.item.invalid();
+        for (i, picked) in scratch.picked.iter().enumerate() {
+            let scale = n as f32 * (i + 2) as f32;
+            let lum: f64 = picked
+                .entries()
+                .iter()
+                .fold(0.0, |acc, &(_, c)| acc + luminance(c * scale).max(0.0) as f64);
+            importance.push(lum);
+            invalid += picked.invalid();
+        }
+        invalid
+    }
+}
+
+impl Scratch {
+    /// Empties the item's splats and `lengths` per-length buffers.
+    fn clear_picked(&mut self, lengths: usize, scene: &Scene) {
+        self.item.clear();
+        let (w, h) = (scene.camera.width, scene.camera.height);
+        if self.picked.len() < lengths {
+            self.picked.resize_with(lengths, || Splats::new(w, h));
+        }
+        self.picked.truncate(lengths);
+        self.picked.iter_mut().for_each(Splats::clear);
+    }
+}
+
+/// Runs bdpt's item for `pixel` on the installed space, keeping for each length k ≥ `first_k`
+/// (k − `first_k` indexing `scratch.picked`) the one strategy the space's next stream-0 number
+/// picks: s = ⌊v (k + 1)⌋.
+fn picked_item(b: &Bdpt, scene: &Scene, pixel: u64, first_k: usize, scratch: &mut Scratch) {
+    let v = next_installed(0);
+    let mut pick = Pick {
+        first_k,
+        v,
+        pixel: pixel as u32,
+        film_weight: 1.0,
+        film: scene.camera.film(),
+        out: &mut scratch.picked,
+    };
+    let mut worker = Worker {
+        splats: &mut scratch.item,
+        scratch: scratch.bdpt.as_mut().expect("bdpt scratch"),
+        rec: &mut pick,
+    };
+    b.item(scene, Pass { seed: 0, pass: 0 }, pixel, &mut worker);
 }
 
 /// A pixel uniformly from stream 0's next two numbers (48 bits, so every pixel of any film has the
@@ -145,16 +198,18 @@ fn pick_pixel(n: u64) -> u64 {
     ((u * n as f64) as u64).min(n - 1)
 }
 
-/// Keeps the one strategy (s, t = k + 1 − s) a sample chose, from everything bdpt reports: its
-/// weighted value where bdpt would add it (the pixel's own estimate times the film weight for
-/// t ≥ 2; through the film filter at the splat position for light tracing, t = 1).
+/// Keeps, per path length k, the one strategy (s, t = k + 1 − s) a sample chose, from everything
+/// bdpt reports: its weighted value where bdpt would add it (the pixel's own estimate times the
+/// film weight for t ≥ 2; through the film filter at the splat position for light tracing, t = 1).
 struct Pick<'a> {
-    k: usize,
-    s: usize,
+    /// The length `out[0]` holds; `out[i]` holds length `first_k + i`.
+    first_k: usize,
+    /// The strategy number: s = ⌊v (k + 1)⌋ at length k.
+    v: f32,
     pixel: u32,
     film_weight: f32,
     film: &'a FilmFilter,
-    out: &'a mut Splats,
+    out: &'a mut [Splats],
 }
 
 impl Recorder for Pick<'_> {
@@ -166,15 +221,21 @@ impl Recorder for Pick<'_> {
 
     fn completed(&mut self, path: Completed) {
         let k = path.light.len() + path.camera.len() - 1;
-        if k != self.k || path.s != self.s || path.weight <= 0.0 {
+        let Some(out) = k
+            .checked_sub(self.first_k)
+            .and_then(|i| self.out.get_mut(i))
+        else {
+            return;
+        };
+        let s = ((self.v * (k + 1) as f32) as usize).min(k);
+        if path.s != s || path.weight <= 0.0 {
             return;
         }
         let c = path.value * path.weight as f32;
         if k + 1 - path.s >= 2 {
-            self.out
-                .add_to_pixel(self.pixel, weighted(c, self.film_weight));
+            out.add_to_pixel(self.pixel, weighted(c, self.film_weight));
         } else {
-            self.out.add_filtered(self.film, path.raster, c);
+            out.add_filtered(self.film, path.raster, c);
         }
     }
 }
