@@ -872,5 +872,8 @@ fn delta_lobes_follow_the_shading_frame_across_the_geometric_plane() {
             }
         }
     }
-    assert!(crossing > 0, "no sample crossed ng's plane: the check cannot fail");
+    assert!(
+        crossing > 0,
+        "no sample crossed ng's plane: the check cannot fail"
+    );
 }
