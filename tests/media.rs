@@ -400,7 +400,7 @@ fn floor_scene(floor_named: bool, pane: bool, fog_around: bool) -> Scene {
         false,
     );
     if fog_around {
-        // The light emits into the fog (`Scene::light_medium` reads its declared exterior).
+        // The light emits into the fog (`Scene::light_medium_towards` reads its declared exterior).
         b.set_last_shape_media(in_fog);
     }
     if pane {

@@ -644,16 +644,19 @@ fn too_many_medium_pairs_is_an_error_not_a_panic() {
     );
 }
 
-/// An area light on a shape that names no media, inside a null sphere of fog, emits into the fog
-/// (`Scene::settle_unnamed_light_media`): a camera walk reaching it keeps the fog
-/// (`medium_after`), so a light subpath must start there too; one in vacuum stays in vacuum.
+/// An area light on a shape that names no media emits, from each of its points, into the medium
+/// around that point (`Scene::light_medium_towards`): a camera walk reaching it keeps the medium
+/// it arrived in (`medium_after`), so a light subpath must start there too — in the fog inside a
+/// null sphere of fog, in vacuum outside it, and on a lamp straddling the sphere's boundary, on
+/// each side its own (one medium per light, found once at build, failed the last case).
 #[test]
-fn an_unnamed_emitter_inside_fog_emits_into_the_fog() {
+fn an_unnamed_emitter_emits_into_the_medium_around_each_point() {
     use lt_core::bsdf::{Diffuse, Material, Null};
     use lt_core::camera::{Camera, FovAxis};
     use lt_core::scene::{MediumInterface, RenderSettings, SceneBuilder, ShapeGeometry};
     use lt_core::texture::Texture;
-    let scene = |fog_around_lamp: bool| {
+    // A lamp of radius 0.5 at `lamp` beside a fog sphere of radius 2 at the origin.
+    let scene = |lamp: Vec3| {
         let camera =
             Camera::look_at(Vec3::Z * 5.0, Vec3::ZERO, Vec3::Y, 40.0, FovAxis::X, 2, 2).unwrap();
         let mut b = SceneBuilder::new(camera, RenderSettings::default());
@@ -677,15 +680,10 @@ fn an_unnamed_emitter_inside_fog_emits_into_the_fog() {
             interior: Some(fog),
             exterior: None,
         });
-        let lamp = if fog_around_lamp {
-            Vec3::ZERO
-        } else {
-            Vec3::X * 4.0
-        };
         b.add_emitting_shape(
             ShapeGeometry::Sphere {
                 center: lamp,
-                radius: 0.25,
+                radius: 0.5,
             },
             white,
             Some(Texture::Constant(Color::ONE)),
@@ -693,10 +691,38 @@ fn an_unnamed_emitter_inside_fog_emits_into_the_fog() {
         );
         b.try_build().unwrap()
     };
+    // Emitted from the lamp's point `p` along its outward normal.
+    let emits_into = |scene: &lt_core::Scene, p: Vec3, n: Vec3| {
+        let at = lt_core::scene::ConnectionEnd {
+            p,
+            p_err: Vec3::splat(1e-6),
+            ng: n,
+            infinite: false,
+        };
+        scene.light_medium_towards(0, at, n)
+    };
+    let inside = scene(Vec3::ZERO);
     assert_eq!(
-        scene(true).light_medium(0),
+        emits_into(&inside, Vec3::X * 0.5, Vec3::X),
         Some(0),
         "a lamp inside the fog"
     );
-    assert_eq!(scene(false).light_medium(0), None, "a lamp outside the fog");
+    let outside = scene(Vec3::X * 4.0);
+    assert_eq!(
+        emits_into(&outside, Vec3::X * 4.5, Vec3::X),
+        None,
+        "a lamp outside the fog"
+    );
+    // Straddling the fog's boundary at x = 2: each point emits into its own side.
+    let straddling = scene(Vec3::X * 2.0);
+    assert_eq!(
+        emits_into(&straddling, Vec3::X * 1.5, -Vec3::X),
+        Some(0),
+        "its part in the fog"
+    );
+    assert_eq!(
+        emits_into(&straddling, Vec3::X * 2.5, Vec3::X),
+        None,
+        "its part outside"
+    );
 }

@@ -469,7 +469,7 @@ impl Material {
 }
 
 /// `Material::sample` for a material's local BSDF: to the shading frame and back, the side
-/// check and the adjoint correction.
+/// check (smooth lobes only, [`consistent_sides`]) and the adjoint correction.
 #[inline]
 fn sample_local<B: LocalBsdf + ?Sized>(
     m: &B,
@@ -485,7 +485,7 @@ fn sample_local<B: LocalBsdf + ?Sized>(
     }
     let s = m.sample(wo_l, u_lobe, u, mode)?;
     let wi = sf.frame.to_world(s.wi);
-    if !consistent_sides(sf, wo, wi, wo_l.z, s.wi.z) {
+    if !s.delta && !consistent_sides(sf, wo, wi, wo_l.z, s.wi.z) {
         return None;
     }
     let weight = s.weight * adjoint_correction(sf, wo, wi, wo_l.z, mode);
@@ -533,7 +533,12 @@ fn pdf_local<B: LocalBsdf + ?Sized>(m: &B, sf: &ShadingFrame, wo: Vec3, wi: Vec3
 }
 
 /// Rejects directions that the shading normal and the geometric normal place on different sides;
-/// following them would leak light through the surface.
+/// following them would leak light through the surface. Smooth lobes only: a delta lobe's one
+/// direction (mirror, smooth dielectric, a plastic's coat) is followed as the shading frame gives
+/// it, as Mitsuba 3 and pbrt-v4 do (the medium beyond is still the side `ng` says). Rejecting it
+/// lost light wherever a smooth-normal mesh's shading and geometric normals disagree: Mitsuba's
+/// homo_dielectric_envmap (water spheres and ring, 3072 and 5632 triangles) read 2–5 % dark over
+/// the ring in 4×4-pixel blocks (z down to −12, image ×0.997 at 8192 spp; pt and bdpt alike).
 #[inline]
 fn consistent_sides(sf: &ShadingFrame, wo: Vec3, wi: Vec3, cos_s_o: f32, cos_s_i: f32) -> bool {
     (wo.dot(sf.ng) * cos_s_o > 0.0) && (wi.dot(sf.ng) * cos_s_i > 0.0)

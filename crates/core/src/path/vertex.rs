@@ -198,14 +198,15 @@ impl PathVertex {
 
     /// The medium a segment leaving this vertex in direction `w` lies in, at its start (Mitsuba's
     /// per-ray medium, `scene/media.rs`): a medium vertex's own, the side of a surface `w` leaves
-    /// into, the camera's, the medium a light emits into (an area light's: the side its normal
-    /// faces; at infinity none). Later null boundaries on the way are `Scene`'s business.
+    /// into, the camera's, the medium a light emits into from this point along `w`
+    /// (`Scene::light_medium_towards`; at infinity none). Later null boundaries on the way are
+    /// `Scene`'s business.
     pub fn medium_towards(&self, scene: &Scene, w: Vec3) -> Option<crate::medium::MediumId> {
         match self.kind {
             VertexKind::Medium { medium } => Some(medium),
             VertexKind::Surface { .. } => scene.medium_across(self.interface, self.ng, w),
             VertexKind::Camera => scene.camera_medium,
-            VertexKind::Light { light, .. } => scene.light_medium(light),
+            VertexKind::Light { light, .. } => scene.light_medium_towards(light, self.into(), w),
         }
     }
 

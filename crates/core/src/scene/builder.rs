@@ -350,7 +350,7 @@ impl SceneBuilder {
             Vec::new()
         };
         let light_sampler = LightSampler::new(&lights, bounding_sphere);
-        let mut scene = Scene {
+        let scene = Scene {
             origin,
             camera: self.camera,
             settings: self.settings,
@@ -370,7 +370,6 @@ impl SceneBuilder {
             has_media,
             accel,
         };
-        scene.settle_unnamed_light_media();
         Ok(scene)
     }
 }

@@ -479,7 +479,7 @@ pub fn light_walk(fs: &FogScene, rng: &mut Sampler, max_k: usize, out: &mut dyn 
     let mut beta = f / (pmf * le.pdf_pos * le.pdf_dir) as f64;
     let mut pdf_w = le.pdf_dir;
     let (mut o, mut d) = (le.ray.o, le.ray.d);
-    let mut medium = scene.light_medium(li as u32);
+    let mut medium = scene.light_medium_towards(li as u32, (&x0).into(), le.ray.d);
     for k in 1..max_k {
         let prev = *verts.last().unwrap();
         let fl = fly(fs, o, d, medium, rng);

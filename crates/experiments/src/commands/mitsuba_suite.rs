@@ -2,7 +2,7 @@
 //! (`crate::verify::mitsuba_suite`), the scoreboard written.
 
 use crate::image_io::write_atomic;
-use crate::verify::mitsuba_suite::{run_suite_only, table, Budget, DEFAULT_OUT};
+use crate::verify::mitsuba_suite::{run_suite_pairs, table, Budget, DEFAULT_OUT};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -30,6 +30,11 @@ pub struct SuiteArgs {
     /// committed scoreboard is never overwritten by a part of it.
     #[arg(long)]
     pub only: Vec<String>,
+    /// Only these estimators (repeatable; default: every one the scene's file name implies), so
+    /// one estimator can be judged on the suite without paying for the others. A run with it is
+    /// partial, as with `--only`.
+    #[arg(long)]
+    pub estimator: Vec<String>,
     /// Where the table is written (atomically); default results/mitsuba-render-tests.md for a
     /// full run, nowhere for a partial one.
     #[arg(long)]
@@ -64,12 +69,19 @@ pub fn run(args: &SuiteArgs) -> Result<(), String> {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     }
-    let rows = run_suite_only(&args.dir, &budget, &args.only)?;
+    let scene_chosen =
+        |name: &str| args.only.is_empty() || args.only.iter().any(|o| name.contains(o.as_str()));
+    let estimator_chosen =
+        |e: &str| args.estimator.is_empty() || args.estimator.iter().any(|x| x == e);
+    let rows = run_suite_pairs(&args.dir, &budget, |name, e| {
+        scene_chosen(name) && estimator_chosen(e)
+    })?;
     if rows.is_empty() {
         return Err(format!(
-            "no scene of {} matches --only {}",
+            "no scene of {} matches --only {} with --estimator {}",
             args.dir.display(),
-            args.only.join(", ")
+            args.only.join(", "),
+            args.estimator.join(", ")
         ));
     }
     let mut command = format!(
@@ -82,9 +94,13 @@ pub fn run(args: &SuiteArgs) -> Result<(), String> {
     for o in &args.only {
         command += &format!(" --only {o}");
     }
+    for e in &args.estimator {
+        command += &format!(" --estimator {e}");
+    }
     let md = table::markdown(&rows, &budget, &command);
     print!("{md}");
-    let out = match (&args.out, args.only.is_empty()) {
+    let full = args.only.is_empty() && args.estimator.is_empty();
+    let out = match (&args.out, full) {
         (Some(out), _) => out.clone(),
         (None, true) => PathBuf::from(DEFAULT_OUT),
         (None, false) => return Ok(()),

@@ -1,5 +1,5 @@
 //! `light` through participating media: light subpaths leave the emitter in the medium it sits in
-//! (`Scene::light_medium`), free-flight sampling along each segment either scatters — a medium
+//! (`Scene::light_medium_towards`), free-flight sampling along each segment either scatters — a medium
 //! vertex, born here, whose phase function is sampled to go on — or passes to the next surface;
 //! `null` surfaces are crossed without a vertex. Every vertex that can be joined (x0 on an area
 //! light, a non-delta surface, a medium vertex) is connected to a lens point (t = 1) and splatted
@@ -37,20 +37,15 @@ pub fn trace(scene: &Scene, walk: LightWalk, sampler: &mut Sampler, splats: &mut
     };
     let (li, pmf, le) = (emission.light, emission.pmf, &emission.le);
     let light = &scene.lights[li];
-    let mut medium = scene.light_medium(li as u32);
+    let mut medium = emission.medium(scene);
     if let Light::Area(_) = light {
         // x0 seen by the camera: Le towards the lens |cos θ0| / (pmf pdf_pos).
-        let from = ConnectionEnd {
-            p: le.p,
-            p_err: le.p_err,
-            ng: le.n,
-            infinite: false,
-        };
+        let from = emission.at();
         let emitted = |to_camera: Vec3| {
             light.emitted(le.n, to_camera, le.uv) * (le.n.dot(to_camera).abs() / (pmf * le.pdf_pos))
         };
-        let m = medium;
-        splat(scene, walk, (le.p, from), |_| m, sampler, splats, emitted);
+        let towards = |w: Vec3| scene.light_medium_towards(li as u32, from, w);
+        splat(scene, walk, (le.p, from), towards, sampler, splats, emitted);
     } else if light.is_infinite() && !light.delta_direction() {
         let dir = -le.ray.d;
         splat_at_infinity(

@@ -282,6 +282,21 @@ impl Emission {
             mode: TransportMode::Importance,
         }
     }
+
+    /// The emitter's point as a connection's end (on the bounding disk for a light at infinity).
+    pub fn at(&self) -> lt_core::scene::ConnectionEnd {
+        lt_core::scene::ConnectionEnd {
+            p: self.le.p,
+            p_err: self.le.p_err,
+            ng: self.le.n,
+            infinite: false,
+        }
+    }
+
+    /// The medium the emitted ray starts in (`Scene::light_medium_towards`).
+    pub fn medium(&self, scene: &Scene) -> Option<lt_core::medium::MediumId> {
+        scene.light_medium_towards(self.light as u32, self.at(), self.le.ray.d)
+    }
 }
 
 /// Begins a light subpath in `out`: y0 pushed, and the emitted ray its walk follows (`None` when

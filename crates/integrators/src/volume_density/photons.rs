@@ -132,7 +132,7 @@ fn walk(
     let Some(emission) = Emission::sample(scene, sampler) else {
         return;
     };
-    let mut medium = scene.light_medium(emission.light as u32);
+    let mut medium = emission.medium(scene);
     let start = emission.walk_start(scene);
     let rules = start.rules(rr_depth);
     let WalkStart {
