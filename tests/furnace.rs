@@ -216,7 +216,11 @@ fn every_integrator_furnace_is_scale_invariant() {
     for info in INTEGRATORS {
         for scale in [1e-3, 1e6] {
             // mmlt's 8 runs of 32 passes leave it ≈ 2.7 % (1.9 % at 64): it keeps 64.
-            let passes = if info.name == "mmlt" { 64 } else { SCALED_PASSES };
+            let passes = if info.name == "mmlt" {
+                64
+            } else {
+                SCALED_PASSES
+            };
             check_with(info.name, true, scale, passes);
             check_with(info.name, false, scale, passes);
         }

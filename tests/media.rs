@@ -118,7 +118,10 @@ const FURNACE_EXCLUDED: &[(&str, &str)] = &[
               1.5–10 % standard error; see tests/furnace.rs MEDIUM_FURNACE_EXCLUDED",
     ),
     ("pb2d", "as pp3d, with the 2-D kernel"),
-    ("bb1d", "as pp3d, with the 1-D kernel across photon and camera beams"),
+    (
+        "bb1d",
+        "as pp3d, with the 1-D kernel across photon and camera beams",
+    ),
 ];
 
 #[test]

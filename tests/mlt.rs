@@ -205,7 +205,11 @@ fn independent_runs_cover_and_per_pass_error_bars_do_not() {
     // Paired over runs: observed minus ESS-predicted per-pass coverage.
     let diff: Vec<f64> = (0..runs).map(|r| cover_pass[r] - predicted[r]).collect();
     let (cd, sd) = stats(&diff);
-    let mut lit: Vec<f64> = ess.iter().flat_map(|e| e.data.iter().map(|p| p[0])).filter(|&v| v > 0.0).collect();
+    let mut lit: Vec<f64> = ess
+        .iter()
+        .flat_map(|e| e.data.iter().map(|p| p[0]))
+        .filter(|&v| v > 0.0)
+        .collect();
     lit.sort_by(f64::total_cmp);
     let median_ess = lit.get(lit.len() / 2).copied().unwrap_or(f64::NAN);
     // Four checks: Šidák over them.

@@ -86,7 +86,8 @@ impl BatchMeans {
             self.batch_len *= 2;
             return;
         }
-        self.batches.push(self.open.iter().map(|&v| v as f32).collect());
+        self.batches
+            .push(self.open.iter().map(|&v| v as f32).collect());
         self.open.iter_mut().for_each(|v| *v = 0.0);
         self.open_len = 0;
     }
@@ -204,7 +205,11 @@ mod tests {
     /// E[s²] of k equally-distributed correlated variables = (k·c(0) − Var(Σ)/k)/(k − 1).
     fn ar1_expected(rho: f64, k: usize, m: usize) -> (f64, f64) {
         let var_sum = |n: usize| -> f64 {
-            n as f64 + 2.0 * (1..n).map(|h| (n - h) as f64 * rho.powi(h as i32)).sum::<f64>()
+            n as f64
+                + 2.0
+                    * (1..n)
+                        .map(|h| (n - h) as f64 * rho.powi(h as i32))
+                        .sum::<f64>()
         };
         let geo = (0..m).map(|a| rho.powi(a as i32)).sum::<f64>();
         let c = |d: usize| -> f64 {

@@ -70,7 +70,11 @@ fn plan(scale: &Scale) -> Plan {
 /// `lt study metropolis --scale bitterli -D integrator=path` veach-bidir.
 fn scenes(scale: &Scale) -> Result<Vec<PathBuf>, String> {
     let mut candidates: Vec<PathBuf> = Vec::new();
-    for p in scale.scenes.iter().chain(std::iter::once(&scale.focus_scene)) {
+    for p in scale
+        .scenes
+        .iter()
+        .chain(std::iter::once(&scale.focus_scene))
+    {
         match stem(p).as_str() {
             "veach-door" => candidates.extend([
                 p.clone(),
@@ -78,9 +82,12 @@ fn scenes(scale: &Scale) -> Result<Vec<PathBuf>, String> {
             ]),
             // scenes/bitterli/veach-bidir/scene.xml → scenes/veach-door.toml
             "veach-bidir" => candidates.extend(
-                [Some(p.clone()), p.ancestors().nth(3).map(|d| d.join("veach-door.toml"))]
-                    .into_iter()
-                    .flatten(),
+                [
+                    Some(p.clone()),
+                    p.ancestors().nth(3).map(|d| d.join("veach-door.toml")),
+                ]
+                .into_iter()
+                .flatten(),
             ),
             _ => {}
         }
@@ -175,7 +182,12 @@ struct Measured {
     curve: Vec<(f64, f64)>,
 }
 
-fn equal_time(ctx: &StudyContext, p: &Plan, scene: &PathBuf, r: &Reference) -> Result<Vec<Measured>, String> {
+fn equal_time(
+    ctx: &StudyContext,
+    p: &Plan,
+    scene: &PathBuf,
+    r: &Reference,
+) -> Result<Vec<Measured>, String> {
     let conf = ctx.scale.confidence;
     let mut out = Vec::new();
     for integrator in INTEGRATORS {
@@ -196,7 +208,10 @@ fn equal_time(ctx: &StudyContext, p: &Plan, scene: &PathBuf, r: &Reference) -> R
             }
             per_snapshot.push(v);
             times.push(mean(
-                &entries.iter().map(|e| e.cpu_seconds_at(s).unwrap_or(f64::NAN)).collect::<Vec<_>>(),
+                &entries
+                    .iter()
+                    .map(|e| e.cpu_seconds_at(s).unwrap_or(f64::NAN))
+                    .collect::<Vec<_>>(),
             ));
         }
         let rel = per_snapshot.last().cloned().unwrap_or_default();
@@ -263,10 +278,17 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         for m in &measured {
             let (rel, rel_i) = interval_cells(&m.rel, conf);
             let (slope, slope_i) = match &m.slope {
-                Ok(j) => (num(j.estimate), format!("[{}, {}]", num(j.interval.lo), num(j.interval.hi))),
+                Ok(j) => (
+                    num(j.estimate),
+                    format!("[{}, {}]", num(j.interval.lo), num(j.interval.hi)),
+                ),
                 Err(e) => ("–".into(), e.clone()),
             };
-            let ess = if m.ess.is_empty() { "–".into() } else { num(mean(&m.ess)) };
+            let ess = if m.ess.is_empty() {
+                "–".into()
+            } else {
+                num(mean(&m.ess))
+            };
             rows.push(vec![
                 m.integrator.to_string(),
                 m.passes.to_string(),
@@ -284,7 +306,17 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             &format!("{name}: equal CPU time"),
             "relMSE after the budget; RMSE-like column √relMSE; slope of relMSE against time \
              (−1 for independent passes).",
-            &["integrator", "passes", "CPU s", "relMSE", "interval", "√relMSE", "slope", "slope interval", "ESS/P"],
+            &[
+                "integrator",
+                "passes",
+                "CPU s",
+                "relMSE",
+                "interval",
+                "√relMSE",
+                "slope",
+                "slope interval",
+                "ESS/P",
+            ],
             rows,
             true,
         )?;
@@ -304,7 +336,11 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
                 })
                 .collect(),
         };
-        out.chart(&format!("{name}-time"), &chart, "relMSE against CPU time, mean of the runs")?;
+        out.chart(
+            &format!("{name}-time"),
+            &chart,
+            "relMSE against CPU time, mean of the runs",
+        )?;
     }
     // The sweep: pssmlt on veach-door at fixed passes.
     let Some(door) = sweep_scene(&scenes) else {

@@ -101,7 +101,11 @@ pub fn config_specs(scale: &Scale, estimator: &str, alpha: f64) -> Vec<RunSpec> 
 pub fn specs(scale: &Scale) -> Vec<RunSpec> {
     ESTIMATORS
         .iter()
-        .flat_map(|&(e, d)| alphas(d).into_iter().flat_map(move |a| config_specs(scale, e, a)))
+        .flat_map(|&(e, d)| {
+            alphas(d)
+                .into_iter()
+                .flat_map(move |a| config_specs(scale, e, a))
+        })
         .collect()
 }
 
@@ -142,7 +146,11 @@ pub fn single_scattering(o: [f64; 3], d: [f64; 3], nodes: &[(f64, f64)]) -> f64 
 /// Every pixel's exact value and its variance over the filter's box (the camera sample's own 1/N
 /// term, ~0 with a box of 1/500 pixel): Gauss–Legendre `per_axis`² points over the box, the rays from the
 /// scene's own camera (`Camera::generate_ray`), `along` nodes on each ray.
-pub fn exact_pixels(spec: &RunSpec, per_axis: usize, along: usize) -> Result<(Vec<f64>, Vec<f64>), String> {
+pub fn exact_pixels(
+    spec: &RunSpec,
+    per_axis: usize,
+    along: usize,
+) -> Result<(Vec<f64>, Vec<f64>), String> {
     let scene = spec.load_scene()?;
     let cam = &scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
@@ -341,7 +349,15 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         "per-n",
         "bias² and variance at every N",
         "Mean over pixels, with one jackknife standard error.",
-        &["integrator", "α", "N", "bias²", "± bias²", "variance", "± variance"],
+        &[
+            "integrator",
+            "α",
+            "N",
+            "bias²",
+            "± bias²",
+            "variance",
+            "± variance",
+        ],
         per_n,
         false,
     )?;
@@ -361,6 +377,9 @@ mod tests {
             assert!(la > 0.0 && ((la - lb) / lb).abs() < 1e-9, "{la} vs {lb}");
         }
         // A ray missing the cube sees nothing.
-        assert_eq!(single_scattering([3.0, 0.0, 5.0], [0.0, 0.0, -1.0], &a), 0.0);
+        assert_eq!(
+            single_scattering([3.0, 0.0, 5.0], [0.0, 0.0, -1.0], &a),
+            0.0
+        );
     }
 }

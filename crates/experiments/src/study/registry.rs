@@ -4,9 +4,8 @@
 use super::context::StudyContext;
 use super::scale::Scale;
 use super::{
-    convergence, equal_time, metropolis, per_length, radius_media, radius_plane, radius_shrinkage, smoke,
-    techniques,
-    unbiased_consistent,
+    convergence, equal_time, metropolis, per_length, radius_media, radius_plane, radius_shrinkage,
+    smoke, techniques, unbiased_consistent,
 };
 use crate::runs::RunSpec;
 

@@ -11,9 +11,9 @@
 //! start-up samples are discarded.
 
 use super::target::{Base, Restrict, Sample, Scratch};
+use lt_core::math::luminance;
 use lt_core::primary_space::PrimarySpace;
 use lt_core::sampling::{Distribution1D, Sampler};
-use lt_core::math::luminance;
 use lt_core::{Color, Scene};
 use rayon::prelude::*;
 

@@ -192,7 +192,10 @@ fn ess_facts(ess: &Ess) -> Vec<(String, String)> {
     )];
     if let Some(s) = ess.summary() {
         facts.extend([
-            ("ess_over_passes_median".to_string(), format!("{:.4}", s.median)),
+            (
+                "ess_over_passes_median".to_string(),
+                format!("{:.4}", s.median),
+            ),
             ("ess_over_passes_q05".to_string(), format!("{:.4}", s.q05)),
             ("ess_over_passes_q95".to_string(), format!("{:.4}", s.q95)),
             ("ess_pixels".to_string(), s.pixels.to_string()),

@@ -143,10 +143,9 @@ impl Base {
         let mut invalid = scratch.item.invalid();
         for (i, picked) in scratch.picked.iter().enumerate() {
             let scale = n as f32 * (i + 2) as f32;
-            let lum: f64 = picked
-                .entries()
-                .iter()
-                .fold(0.0, |acc, &(_, c)| acc + luminance(c * scale).max(0.0) as f64);
+            let lum: f64 = picked.entries().iter().fold(0.0, |acc, &(_, c)| {
+                acc + luminance(c * scale).max(0.0) as f64
+            });
             importance.push(lum);
             invalid += picked.invalid();
         }

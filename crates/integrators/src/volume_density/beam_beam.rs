@@ -96,8 +96,7 @@ impl MediumEvents for BeamBeamQuery<'_> {
                     if b.medium != m || b.segments > longest {
                         continue;
                     }
-                    let Some((s, t, u, sin)) = closest_points(ray.o, ray.d, b.origin, b.dir)
-                    else {
+                    let Some((s, t, u, sin)) = closest_points(ray.o, ray.d, b.origin, b.dir) else {
                         continue;
                     };
                     // Counted in the one cell whose interval holds s (each beam once).
@@ -139,7 +138,10 @@ mod tests {
         )
         .unwrap();
         assert!((s - 2.0).abs() < 1e-6 && (t - 3.0).abs() < 1e-6, "{s} {t}");
-        assert!((u - 1.0).abs() < 1e-6 && (sin - 1.0).abs() < 1e-6, "{u} {sin}");
+        assert!(
+            (u - 1.0).abs() < 1e-6 && (sin - 1.0).abs() < 1e-6,
+            "{u} {sin}"
+        );
         assert!(closest_points(Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X).is_none());
     }
 }

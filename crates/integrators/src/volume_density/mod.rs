@@ -203,7 +203,13 @@ impl ProgressiveRun for VolumeRun<'_> {
                 let bytes = q.index.as_ref().map_or(0, |g| g.bytes());
                 let (img, bad) = self.render_with(&q, pass);
                 let n = pb.beams.len();
-                (img, bad, n, photon_beams::PhotonBeams::BYTES_PER_BEAM, bytes)
+                (
+                    img,
+                    bad,
+                    n,
+                    photon_beams::PhotonBeams::BYTES_PER_BEAM,
+                    bytes,
+                )
             }
         };
         for (s, v) in self.sum.data.iter_mut().zip(&image.data) {
