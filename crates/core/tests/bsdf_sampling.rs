@@ -439,9 +439,12 @@ fn check_adjoint(
         (w_o.dot(ns).abs() * w_i.dot(ng).abs() / (w_i.dot(ns).abs() * w_o.dot(ng).abs())) as f64
     };
     // Refraction scales radiance (not importance) by 1/η², η = η_i/η_o; undo it before comparing.
+    // Whether the sample refracted is the shading frame's word: a delta lobe follows it across
+    // ng's plane (as in Mitsuba 3 and pbrt-v4), and a smooth lobe is kept only where the two
+    // frames agree.
     let glass_scale = match m.refraction_ior() {
-        Some(ior) if wi.dot(ng) * wo.dot(ng) < 0.0 => {
-            let eta = if wo.dot(ng) > 0.0 { ior } else { 1.0 / ior } as f64;
+        Some(ior) if wi.dot(ns) * wo.dot(ns) < 0.0 => {
+            let eta = if wo.dot(ns) > 0.0 { ior } else { 1.0 / ior } as f64;
             eta * eta
         }
         _ => 1.0,
