@@ -240,11 +240,15 @@ fn mitsuba_render_suite_keeps_passing() {
             assert!(r.outcomes.is_empty());
         }
     }
-    // The pinned scenes at 256 spp in 32 independent passes, at most 6 s per estimator.
+    // The pinned scenes at 256 spp in 32 independent passes, whatever the machine's load: the
+    // time limit is a safety net. At 6 s a machine at load 8–15 cut bdpt to 176 spp on
+    // normalmap_identity_roughconductor, where it failed; an idle 2-core machine renders every
+    // pinned pair's 256 spp within 6 s (63 of 63 at 256 spp, 99 s for this whole test), so CI
+    // pays the same.
     let budget = Budget {
         passes: 32,
         spp_per_pass: 8,
-        time_per_estimator: Duration::from_secs(6),
+        time_per_estimator: Duration::from_secs(120),
         threads: 0,
         seed: 0,
         diagnostics: None,
@@ -274,15 +278,10 @@ fn mitsuba_render_suite_keeps_passing() {
             ));
         }
     }
-    // The media scenes, each with every media estimator not exempt, at 256 spp whatever the
-    // machine's load: the time limit is a safety net, not the budget (seed 0 at any thread count
-    // gives the same image, so the judgement is the one results/mitsuba-suite-media.md records,
-    // every pinned value ≥ 99.85 % there); at 6 s a loaded machine cut them to 56–96 spp, where
-    // their heavy tails fail the rule.
-    let budget = Budget {
-        time_per_estimator: Duration::from_secs(120),
-        ..budget
-    };
+    // The media scenes, each with every media estimator not exempt, at the same fixed 256 spp
+    // (seed 0 at any thread count gives the same image, so the judgement is the one
+    // results/mitsuba-suite-media.md records, every pinned value ≥ 99.85 % there).
+
     let rows = run_suite_pairs(&dir, &budget, |scene, estimator| {
         MEDIA_SCENES.contains(&scene) && !media_exempt(scene, estimator)
     })
