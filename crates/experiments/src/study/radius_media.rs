@@ -53,11 +53,7 @@ pub fn alphas(d: u32) -> [f64; 4] {
 }
 
 pub fn scene(scale: &Scale) -> PathBuf {
-    scale
-        .focus_scene
-        .parent()
-        .map(|d| d.join("studies/medium-point.toml"))
-        .unwrap_or_else(|| "scenes/studies/medium-point.toml".into())
+    scale.scene_beside_focus("studies/medium-point.toml")
 }
 
 /// (runs, passes, photon-path divisor) at a scale. results/points-beams.md reports the quick

@@ -97,11 +97,7 @@ pub const ALBEDO: f64 = 0.5;
 pub const R1: f64 = 0.5;
 
 pub fn scene(scale: &Scale) -> PathBuf {
-    scale
-        .focus_scene
-        .parent()
-        .map(|d| d.join("point-plane.toml"))
-        .unwrap_or_else(|| "scenes/point-plane.toml".into())
+    scale.scene_beside_focus("point-plane.toml")
 }
 
 /// (runs, passes, photon paths per pass) of the study at a scale. The full scale's are set here

@@ -115,6 +115,15 @@ fn every_integrator_renders(scenes: Vec<PathBuf>) -> Vec<PathBuf> {
 }
 
 impl Scale {
+    /// A scene file named relative to the focus scene's folder (`scenes/` when the focus scene
+    /// has none): the studies' own scenes live beside it.
+    pub fn scene_beside_focus(&self, relative: &str) -> PathBuf {
+        self.focus_scene
+            .parent()
+            .map(|d| d.join(relative))
+            .unwrap_or_else(|| PathBuf::from("scenes").join(relative))
+    }
+
     pub fn named(name: &str, scenes_dir: &Path) -> Result<Scale, String> {
         let all = every_integrator_renders(shipped_scenes(scenes_dir)?);
         let scene = |n: &str| scenes_dir.join(format!("{n}.toml"));
