@@ -13,6 +13,7 @@
 //! (m doubles) when the store is full. The summary regroups them into about √P batches of about
 //! √P passes (Flegal & Jones' choice, consistent for σ²_∞ under mixing conditions).
 
+use crate::running::RunningStat;
 /// Completed batches kept before neighbours merge: memory is this many f32 per pixel.
 pub const MAX_BATCHES: usize = 64;
 
@@ -21,9 +22,8 @@ pub const MAX_BATCHES: usize = 64;
 pub struct BatchMeans {
     pixels: usize,
     passes: u64,
-    /// Welford mean and sum of squared deviations of every pass, per pixel.
-    mean: Vec<f64>,
-    m2: Vec<f64>,
+    /// Every pass's values, per pixel: the naive variance σ²₀.
+    naive: Vec<RunningStat>,
     /// Passes per completed batch.
     batch_len: u64,
     /// Sums of the completed batches' passes, batch-major.
@@ -52,8 +52,7 @@ impl BatchMeans {
         BatchMeans {
             pixels,
             passes: 0,
-            mean: vec![0.0; pixels],
-            m2: vec![0.0; pixels],
+            naive: vec![RunningStat::new(); pixels],
             batch_len: 1,
             batches: Vec::new(),
             open: vec![0.0; pixels],
@@ -69,11 +68,8 @@ impl BatchMeans {
     pub fn add_pass(&mut self, values: &[f64]) {
         assert_eq!(values.len(), self.pixels, "one value per pixel");
         self.passes += 1;
-        let n = self.passes as f64;
         for (i, &x) in values.iter().enumerate() {
-            let d = x - self.mean[i];
-            self.mean[i] += d / n;
-            self.m2[i] += d * (x - self.mean[i]);
+            self.naive[i].add(x);
             self.open[i] += x;
         }
         self.open_len += 1;
@@ -113,7 +109,7 @@ impl BatchMeans {
         let mut naive_var = Vec::with_capacity(self.pixels);
         let mut batch_var = Vec::with_capacity(self.pixels);
         for i in 0..self.pixels {
-            let s0 = self.m2[i] / (self.passes as f64 - 1.0);
+            let s0 = self.naive[i].sample_variance();
             let means: Vec<f64> = grouped.iter().map(|b| b[i] as f64 / m as f64).collect();
             let mu = means.iter().sum::<f64>() / kb as f64;
             let s_bm = means.iter().map(|y| (y - mu).powi(2)).sum::<f64>() / (kb as f64 - 1.0);
