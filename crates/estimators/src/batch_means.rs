@@ -14,6 +14,7 @@
 //! √P passes (Flegal & Jones' choice, consistent for σ²_∞ under mixing conditions).
 
 use crate::running::RunningStat;
+
 /// Completed batches kept before neighbours merge: memory is this many f32 per pixel.
 pub const MAX_BATCHES: usize = 64;
 
