@@ -10,7 +10,7 @@
 //! sd/√B); chains start at bootstrap points resampled ∝ I, so each starts at stationarity and no
 //! start-up samples are discarded.
 
-use super::target::{Base, Restrict, Sample, Scratch};
+use super::target::{Base, LengthImportance, Restrict, Sample, Scratch};
 use lt_core::math::luminance;
 use lt_core::primary_space::PrimarySpace;
 use lt_core::sampling::{Distribution1D, Sampler};
@@ -104,15 +104,16 @@ impl ChainSet {
             )
             .collect();
         let invalid: u64 = weights.iter().map(|w| w.1).sum();
-        let importance = weights.iter().map(|w| w.0).collect();
-        let set = ChainSet::from_bootstrap(scene, restrict, importance, sigma, keys);
+        let importance: Vec<f64> = weights.iter().map(|w| w.0).collect();
+        let set = ChainSet::from_bootstrap(scene, restrict, &importance, &importance, sigma, keys);
         (set, invalid)
     }
 
     /// MMLT's bootstrap: `bootstrap` uniform points, each one bdpt sample giving I_k for every
     /// length k = 1 … `lengths` (`Base::evaluate_lengths`), so each b̂_k averages all the points
-    /// rather than its 1/`lengths` share. Returns the sets (length k's keyed `set: k`) and the
-    /// invalid values dropped.
+    /// rather than its 1/`lengths` share, and b̂_k averages each point's sum over all strategies
+    /// (`LengthImportance::all_strategies`), while chains start ∝ the picked strategy's I_k.
+    /// Returns the sets (length k's keyed `set: k`) and the invalid values dropped.
     pub fn bootstrap_lengths(
         base: &Base,
         scene: &Scene,
@@ -126,7 +127,7 @@ impl ChainSet {
             set: 0,
             bootstrap_set: 0,
         };
-        let points: Vec<(Vec<f64>, u64)> = (0..bootstrap)
+        let points: Vec<(Vec<LengthImportance>, u64)> = (0..bootstrap)
             .into_par_iter()
             .map_init(
                 || base.scratch(scene),
@@ -142,28 +143,32 @@ impl ChainSet {
         let invalid = points.iter().map(|p| p.1).sum();
         let sets = (1..=lengths)
             .map(|k| {
-                let importance = points.iter().map(|p| p.0[k - 1]).collect();
+                let picked: Vec<f64> = points.iter().map(|p| p.0[k - 1].picked).collect();
+                let all: Vec<f64> = points.iter().map(|p| p.0[k - 1].all_strategies).collect();
                 let keys = Keys {
                     set: k as u64,
                     ..shared
                 };
-                ChainSet::from_bootstrap(scene, Restrict::Length(k), importance, sigma, keys)
+                ChainSet::from_bootstrap(scene, Restrict::Length(k), &picked, &all, sigma, keys)
             })
             .collect();
         (sets, invalid)
     }
 
-    /// A set from its bootstrap's I values: b̂ their mean, its standard error sd/√B.
+    /// A set from its bootstrap: the chains start ∝ `importance` (each point's I), b̂ is the mean
+    /// of `estimates` (I itself, or any estimator of it with the same mean per point), its
+    /// standard error sd/√B.
     fn from_bootstrap(
         scene: &Scene,
         restrict: Restrict,
-        importance: Vec<f64>,
+        importance: &[f64],
+        estimates: &[f64],
         sigma: f32,
         keys: Keys,
     ) -> ChainSet {
-        let n = importance.len().max(1) as f64;
-        let b = importance.iter().sum::<f64>() / n;
-        let var = importance.iter().map(|w| (w - b).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        let n = estimates.len().max(1) as f64;
+        let b = estimates.iter().sum::<f64>() / n;
+        let var = estimates.iter().map(|w| (w - b).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
         ChainSet {
             restrict,
             b,

@@ -12,7 +12,10 @@
 //! (read through the `Recorder` bdpt reports every completed path to), so Σ_k E_u[F_k] is bdpt's
 //! image again. One bdpt sample on u holds every F_k(u) at once (the same third number picks
 //! each length's strategy), so MMLT's bootstrap reads all lengths from one evaluation
-//! (`evaluate_lengths`).
+//! (`evaluate_lengths`). It holds every strategy's value too, so b_k = E_u[I_k(u)] is estimated
+//! by the expectation over the strategy number in closed form: E_s[(k + 1) I_{s,k}] =
+//! Σ_s I_{s,k}, bdpt's own length-k luminance (Rao–Blackwellised over s: same mean, never more
+//! variance), while the chains still start from the one picked strategy ∝ I_k(u).
 
 use crate::bidirectional::bdpt::{self, Bdpt};
 use crate::film::pixel::{pixel_sample, weighted};
@@ -53,6 +56,8 @@ pub struct Scratch {
     item: Splats,
     /// The kept strategy's splats per path length (one buffer for a single length).
     picked: Vec<Splats>,
+    /// Every strategy's splats per path length (MMLT's bootstrap only).
+    every: Vec<Splats>,
 }
 
 impl Base {
@@ -65,6 +70,7 @@ impl Base {
             },
             item: Splats::new(w, h),
             picked: Vec::new(),
+            every: Vec::new(),
         }
     }
 
@@ -104,7 +110,7 @@ impl Base {
                 }
                 (Base::Bdpt(b), Restrict::Length(k)) => {
                     scale *= (k + 1) as f32;
-                    picked_item(b, scene, pixel, k, scratch);
+                    picked_item(b, scene, pixel, k, false, scratch);
                 }
             }
         });
@@ -123,34 +129,48 @@ impl Base {
     }
 
     /// I_k(u) for every length k = 1 … `lengths` from one bdpt sample on u, into `importance`
-    /// (k − 1 indexed): each what `evaluate` with `Restrict::Length(k)` gives for the same u, bit
-    /// for bit. Returns the invalid values dropped. Only for a bdpt base.
+    /// (k − 1 indexed): `picked` is what `evaluate` with `Restrict::Length(k)` gives for the same
+    /// u, bit for bit; `all_strategies` is Σ_s of the strategies' I_{s,k}, the expectation of
+    /// `picked` over u's strategy number. Returns the invalid values dropped. Only for a bdpt base.
     pub fn evaluate_lengths(
         &self,
         scene: &Scene,
         lengths: usize,
         space: &mut PrimarySpace,
         scratch: &mut Scratch,
-        importance: &mut Vec<f64>,
+        importance: &mut Vec<LengthImportance>,
     ) -> u64 {
         let Base::Bdpt(b) = self else {
             panic!("per-length evaluation needs a bdpt base")
         };
         scratch.clear_picked(lengths, scene);
         let n = scene.camera.pixel_count() as u64;
-        with_space(space, || picked_item(b, scene, pick_pixel(n), 1, scratch));
+        with_space(space, || picked_item(b, scene, pick_pixel(n), 1, true, scratch));
         importance.clear();
         let mut invalid = scratch.item.invalid();
-        for (i, picked) in scratch.picked.iter().enumerate() {
-            let scale = n as f32 * (i + 2) as f32;
-            let lum: f64 = picked.entries().iter().fold(0.0, |acc, &(_, c)| {
+        let total = |splats: &Splats, scale: f32| -> f64 {
+            splats.entries().iter().fold(0.0, |acc, &(_, c)| {
                 acc + luminance(c * scale).max(0.0) as f64
+            })
+        };
+        for (i, (picked, every)) in scratch.picked.iter().zip(&scratch.every).enumerate() {
+            importance.push(LengthImportance {
+                picked: total(picked, n as f32 * (i + 2) as f32),
+                all_strategies: total(every, n as f32),
             });
-            importance.push(lum);
             invalid += picked.invalid();
         }
         invalid
     }
+}
+
+/// One bootstrap point's I_k for one length k (`Base::evaluate_lengths`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LengthImportance {
+    /// (k + 1) · N · luminance of the strategy u's number picked: the chain's target at u.
+    pub picked: f64,
+    /// N · luminance summed over all k + 1 strategies: E[`picked`] over the strategy number.
+    pub all_strategies: f64,
 }
 
 impl Scratch {
@@ -163,13 +183,25 @@ impl Scratch {
         }
         self.picked.truncate(lengths);
         self.picked.iter_mut().for_each(Splats::clear);
+        if self.every.len() < lengths {
+            self.every.resize_with(lengths, || Splats::new(w, h));
+        }
+        self.every.truncate(lengths);
+        self.every.iter_mut().for_each(Splats::clear);
     }
 }
 
 /// Runs bdpt's item for `pixel` on the installed space, keeping for each length k ≥ `first_k`
 /// (k − `first_k` indexing `scratch.picked`) the one strategy the space's next stream-0 number
-/// picks: s = ⌊v (k + 1)⌋.
-fn picked_item(b: &Bdpt, scene: &Scene, pixel: u64, first_k: usize, scratch: &mut Scratch) {
+/// picks: s = ⌊v (k + 1)⌋; with `every`, each length's strategies all in `scratch.every` too.
+fn picked_item(
+    b: &Bdpt,
+    scene: &Scene,
+    pixel: u64,
+    first_k: usize,
+    every: bool,
+    scratch: &mut Scratch,
+) {
     let v = next_installed(0);
     let mut pick = Pick {
         first_k,
@@ -178,6 +210,7 @@ fn picked_item(b: &Bdpt, scene: &Scene, pixel: u64, first_k: usize, scratch: &mu
         film_weight: 1.0,
         film: scene.camera.film(),
         out: &mut scratch.picked,
+        every: if every { Some(&mut scratch.every) } else { None },
     };
     let mut worker = Worker {
         splats: &mut scratch.item,
@@ -209,6 +242,8 @@ struct Pick<'a> {
     film_weight: f32,
     film: &'a FilmFilter,
     out: &'a mut [Splats],
+    /// Every strategy's value per length, indexed as `out` (MMLT's bootstrap).
+    every: Option<&'a mut Vec<Splats>>,
 }
 
 impl Recorder for Pick<'_> {
@@ -226,15 +261,25 @@ impl Recorder for Pick<'_> {
         else {
             return;
         };
-        let s = ((self.v * (k + 1) as f32) as usize).min(k);
-        if path.s != s || path.weight <= 0.0 {
+        if path.weight <= 0.0 {
             return;
         }
         let c = path.value * path.weight as f32;
-        if k + 1 - path.s >= 2 {
-            out.add_to_pixel(self.pixel, weighted(c, self.film_weight));
-        } else {
-            out.add_filtered(self.film, path.raster, c);
+        let light_traced = k + 1 - path.s < 2;
+        let (pixel, film_weight, film) = (self.pixel, self.film_weight, self.film);
+        let add = |splats: &mut Splats| {
+            if light_traced {
+                splats.add_filtered(film, path.raster, c);
+            } else {
+                splats.add_to_pixel(pixel, weighted(c, film_weight));
+            }
+        };
+        if let Some(every) = self.every.as_deref_mut() {
+            add(&mut every[k - self.first_k]);
+        }
+        let s = ((self.v * (k + 1) as f32) as usize).min(k);
+        if path.s == s {
+            add(out);
         }
     }
 }
