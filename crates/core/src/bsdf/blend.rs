@@ -104,3 +104,33 @@ impl Blend {
             + w * self.second.delta_lobe_probability(sf, wo)
     }
 }
+
+/// The sampling tests' blends (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Blend {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::microfacet::MicrofacetType::Ggx;
+        use super::test_registry::*;
+        let blend = |weight, first, second| {
+            Material::Blend(Box::new(Blend {
+                weight: constant(weight),
+                first,
+                second,
+            }))
+        };
+        vec![
+            (
+                "blend-0.3-diffuse-roughconductor",
+                blend(
+                    0.3,
+                    Material::Diffuse(super::Diffuse { albedo: COLOR }),
+                    rough_gold(Ggx, 0.2, 0.2, true),
+                ),
+            ),
+            (
+                "blend-0.6-plastic-glossy",
+                blend(0.6, plastic(COLOR, false), glossy(0.3)),
+            ),
+        ]
+    }
+}

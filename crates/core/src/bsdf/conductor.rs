@@ -54,3 +54,19 @@ impl LocalBsdf for Conductor {
         true
     }
 }
+
+/// The sampling tests' smooth conductor (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Conductor {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::test_registry::*;
+        use super::Material;
+        vec![(
+            "conductor-Au",
+            Material::Conductor(Conductor {
+                ior: gold(),
+                specular_reflectance: CONDUCTOR_TINT,
+            }),
+        )]
+    }
+}

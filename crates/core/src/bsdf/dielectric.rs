@@ -67,3 +67,17 @@ impl LocalBsdf for Dielectric {
         true
     }
 }
+
+/// The sampling tests' glasses, seen from both sides (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Dielectric {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::Material;
+        let glass = |ior| Material::Dielectric(Dielectric { ior });
+        vec![
+            ("glass-1.5", glass(1.5)),
+            ("glass-1/1.5", glass(1.0 / 1.5)),
+            ("glass-2.4", glass(2.4)),
+        ]
+    }
+}

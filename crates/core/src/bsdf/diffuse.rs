@@ -90,3 +90,26 @@ impl LocalBsdf for FrontDiffuse {
         false
     }
 }
+
+/// The sampling tests' diffuse material (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Diffuse {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::test_registry::*;
+        use super::Material;
+        vec![("diffuse", Material::Diffuse(Diffuse { albedo: COLOR }))]
+    }
+}
+
+/// The sampling tests' one-sided diffuse material (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for FrontDiffuse {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::test_registry::*;
+        use super::Material;
+        vec![(
+            "diffuse-front",
+            Material::FrontDiffuse(FrontDiffuse { albedo: COLOR }),
+        )]
+    }
+}

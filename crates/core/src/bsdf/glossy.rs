@@ -135,3 +135,17 @@ impl LocalBsdf for Glossy {
         false
     }
 }
+
+/// The sampling tests' glossy materials, near-specular to very rough (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Glossy {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::test_registry::*;
+        vec![
+            ("glossy-0.05", glossy(0.05)),
+            ("glossy-0.2", glossy(0.2)),
+            ("glossy-0.5", glossy(0.5)),
+            ("glossy-1.0", glossy(1.0)),
+        ]
+    }
+}

@@ -88,6 +88,35 @@ impl Mask {
     }
 }
 
+/// The sampling tests' masks (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Mask {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::test_registry::*;
+        let mask = |opacity, inner| {
+            Material::Mask(Box::new(Mask {
+                opacity: constant(opacity),
+                inner,
+            }))
+        };
+        vec![
+            (
+                "mask-0.4-diffuse",
+                mask(0.4, Material::Diffuse(super::Diffuse { albedo: COLOR })),
+            ),
+            (
+                "mask-0.7-twosided-plastic",
+                mask(
+                    0.7,
+                    Material::TwoSided(super::TwoSided {
+                        inner: Box::new(plastic(COLOR, false)),
+                    }),
+                ),
+            ),
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -35,3 +35,13 @@ impl LocalBsdf for Mirror {
         true
     }
 }
+
+/// The sampling tests' mirror (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Mirror {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::test_registry::*;
+        use super::Material;
+        vec![("mirror", Material::Mirror(Mirror { reflectance: COLOR }))]
+    }
+}

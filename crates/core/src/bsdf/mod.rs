@@ -187,65 +187,82 @@ pub trait LocalBsdf {
     }
 }
 
-#[derive(Clone, Debug)]
-pub enum Material {
-    Diffuse(Diffuse),
-    /// Mitsuba's `diffuse` outside `twosided`: black from behind.
-    FrontDiffuse(FrontDiffuse),
-    Mirror(Mirror),
-    Dielectric(Dielectric),
-    Glossy(Glossy),
-    Conductor(Conductor),
-    RoughConductor(RoughConductor),
-    /// Mitsuba's `plastic`: a delta lobe beside a diffuse one.
-    Plastic(Plastic),
-    RoughPlastic(RoughPlastic),
-    /// Mitsuba's `roughdielectric`: microfacet reflection and refraction (Walter et al. 2007).
-    RoughDielectric(RoughDielectric),
-    /// Mitsuba's `thindielectric`: a pane, delta reflection and straight pass-through.
-    ThinDielectric(ThinDielectric),
-    /// Mitsuba's `principled` (Burley's Disney BSDF as Mitsuba evaluates it).
-    Principled(Principled),
-    /// Mitsuba's `principledthin`: the Disney BSDF of a two-sided sheet.
-    PrincipledThin(PrincipledThin),
-    /// Mitsuba's `twosided` around a one-sided material (conductors, plastics, …).
-    TwoSided(TwoSided),
-    /// Parameters read from textures at the shading point's uv.
-    Textured(Box<Textured>),
-    /// A material under a normal or bump map (Mitsuba's `normalmap`, `bumpmap`).
-    Perturbed(Box<Perturbed>),
-    /// A material that is partly absent (Mitsuba's `mask`): a pass-through delta lobe beside it.
-    Mask(Box<Mask>),
-    /// A weighted sum of two materials (Mitsuba's `blendbsdf`).
-    Blend(Box<Blend>),
-    /// Mitsuba's `null`: a boundary between media that scatters nothing (`null.rs`).
-    Null(Null),
-}
+/// Declares `Material` from one list naming each variant once: the plain materials (one
+/// `LocalBsdf` each) and the wrappers around other materials (whose arms `impl Material` writes
+/// out). From the list it also writes `match_plain!` and, for the sampling tests, the fixture list
+/// every variant's type contributes to (`test_registry::Fixtures`, in its own file): a new
+/// material is one line here. `$d` is a `$`, so that the macro can write a macro.
+macro_rules! materials {
+    ($d:tt
+     plain { $($(#[$plain_doc:meta])* $plain:ident,)* }
+     wrappers { $($(#[$wrapper_doc:meta])* $wrapper:ident,)* }) => {
+        #[derive(Clone, Debug)]
+        pub enum Material {
+            $($(#[$plain_doc])* $plain($plain),)*
+            $($(#[$wrapper_doc])* $wrapper(Box<$wrapper>),)*
+        }
 
-/// Matches `$material`'s plain variants with `$m` bound to its BSDF, each arm its own copy of
-/// `$body` (static dispatch: the BSDF's `sample`/`eval`/`pdf` inline into the frame code, where
-/// a `&dyn LocalBsdf` would cost an indirect call each); `$rest` are the wrapper arms.
-macro_rules! match_plain {
-    ($material:expr, $m:ident => $body:expr, $($rest:tt)*) => {
-        match $material {
-            Material::Diffuse($m) => $body,
-            Material::FrontDiffuse($m) => $body,
-            Material::Mirror($m) => $body,
-            Material::Dielectric($m) => $body,
-            Material::Glossy($m) => $body,
-            Material::Conductor($m) => $body,
-            Material::RoughConductor($m) => $body,
-            Material::Plastic($m) => $body,
-            Material::RoughPlastic($m) => $body,
-            Material::RoughDielectric($m) => $body,
-            Material::ThinDielectric($m) => $body,
-            Material::Principled($m) => $body,
-            Material::PrincipledThin($m) => $body,
-            Material::TwoSided($m) => $body,
-            Material::Null($m) => $body,
-            $($rest)*
+        /// Matches `$material`'s plain variants with `$m` bound to its BSDF, each arm its own
+        /// copy of `$body` (static dispatch: the BSDF's `sample`/`eval`/`pdf` inline into the
+        /// frame code, where a `&dyn LocalBsdf` would cost an indirect call each); `$rest` are
+        /// the wrapper arms.
+        macro_rules! match_plain {
+            ($d material:expr, $d m:ident => $d body:expr, $d($d rest:tt)*) => {
+                match $d material {
+                    $(Material::$plain($d m) => $d body,)*
+                    $d($d rest)*
+                }
+            };
+        }
+
+        /// Every variant's sampling-test materials, in the list's order.
+        #[cfg(feature = "test-support")]
+        fn every_fixture() -> Vec<(&'static str, Material)> {
+            use test_registry::Fixtures;
+            let mut all = Vec::new();
+            $(all.extend($plain::fixtures());)*
+            $(all.extend($wrapper::fixtures());)*
+            all
         }
     };
+}
+
+materials! { $
+    plain {
+        Diffuse,
+        /// Mitsuba's `diffuse` outside `twosided`: black from behind.
+        FrontDiffuse,
+        Mirror,
+        Dielectric,
+        Glossy,
+        Conductor,
+        RoughConductor,
+        /// Mitsuba's `plastic`: a delta lobe beside a diffuse one.
+        Plastic,
+        RoughPlastic,
+        /// Mitsuba's `roughdielectric`: microfacet reflection and refraction (Walter et al. 2007).
+        RoughDielectric,
+        /// Mitsuba's `thindielectric`: a pane, delta reflection and straight pass-through.
+        ThinDielectric,
+        /// Mitsuba's `principled` (Burley's Disney BSDF as Mitsuba evaluates it).
+        Principled,
+        /// Mitsuba's `principledthin`: the Disney BSDF of a two-sided sheet.
+        PrincipledThin,
+        /// Mitsuba's `twosided` around a one-sided material (conductors, plastics, …).
+        TwoSided,
+        /// Mitsuba's `null`: a boundary between media that scatters nothing (`null.rs`).
+        Null,
+    }
+    wrappers {
+        /// Parameters read from textures at the shading point's uv.
+        Textured,
+        /// A material under a normal or bump map (Mitsuba's `normalmap`, `bumpmap`).
+        Perturbed,
+        /// A material that is partly absent (Mitsuba's `mask`): a pass-through delta lobe beside it.
+        Mask,
+        /// A weighted sum of two materials (Mitsuba's `blendbsdf`).
+        Blend,
+    }
 }
 
 impl Material {

@@ -44,3 +44,12 @@ impl LocalBsdf for Null {
         true
     }
 }
+
+/// The sampling tests' null BSDFs: none (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Null {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        // Nothing to sample: it scatters nothing, and paths pass it before any BSDF is asked.
+        vec![]
+    }
+}

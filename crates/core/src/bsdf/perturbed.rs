@@ -185,6 +185,16 @@ fn sides(wo: Vec3, wi: Vec3, mode: TransportMode) -> (Vec3, Vec3) {
     }
 }
 
+/// The sampling tests' normal-mapped materials: none (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Perturbed {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        // A normal or bump map needs a texture and a surface's uv; its frames are tested in
+        // this file's tests and its images in the suite's normal-map scenes.
+        vec![]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

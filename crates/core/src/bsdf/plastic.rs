@@ -184,6 +184,28 @@ impl LocalBsdf for Plastic {
     }
 }
 
+/// The sampling tests' plastics (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Plastic {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::test_registry::*;
+        use super::Material;
+        vec![
+            ("plastic", plastic(COLOR, false)),
+            ("plastic-nonlinear", plastic(COLOR, true)),
+            (
+                "plastic-ior-2.4-dark",
+                Material::Plastic(Plastic::new(
+                    2.4,
+                    Color::new(0.05, 0.1, 0.02),
+                    Color::ONE,
+                    false,
+                )),
+            ),
+        ]
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;

@@ -360,3 +360,66 @@ impl LocalBsdf for Principled {
         false
     }
 }
+
+/// The sampling tests' principled materials (base colours ≤ 0.5) (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Principled {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::Material;
+        let principled = |set: fn(&mut Principled)| {
+            let mut p = Principled {
+                base_color: Color::new(0.5, 0.35, 0.2),
+                ..Principled::mitsuba_default()
+            };
+            set(&mut p);
+            Material::Principled(p)
+        };
+        // Base colours stay ≤ 0.5: Mitsuba's principled adds its specular, sheen and clearcoat
+        // lobes on top of a diffuse whose retro-reflection alone can exceed 1 (Burley 2012,
+        // §5.3), so a bright one would break the furnace test by design, not by a bug.
+        vec![
+            ("principled-diffuse", principled(|_| {})),
+            (
+                "principled-metallic-anisotropic",
+                principled(|p| {
+                    p.metallic = 0.7;
+                    p.anisotropic = 0.6;
+                    p.roughness = 0.3;
+                    p.spec_tint = 0.5;
+                }),
+            ),
+            (
+                "principled-clearcoat-sheen-flatness",
+                principled(|p| {
+                    p.clearcoat = 0.8;
+                    p.clearcoat_gloss = 0.5;
+                    p.sheen = 0.6;
+                    p.sheen_tint = 0.5;
+                    p.flatness = 0.4;
+                    p.roughness = 0.6;
+                }),
+            ),
+            (
+                "principled-spec-trans-0.6",
+                principled(|p| {
+                    p.spec_trans = 0.6;
+                    p.has_spec_trans = true;
+                    p.roughness = 0.3;
+                    p.clearcoat = 0.3;
+                    p.sheen = 0.3;
+                    p.eta = Principled::eta_from_specular(0.4);
+                }),
+            ),
+            (
+                "principled-glass-anisotropic",
+                principled(|p| {
+                    p.spec_trans = 1.0;
+                    p.has_spec_trans = true;
+                    p.roughness = 0.4;
+                    p.anisotropic = 0.5;
+                    p.eta = 1.33;
+                }),
+            ),
+        ]
+    }
+}

@@ -101,3 +101,40 @@ impl LocalBsdf for RoughConductor {
         false
     }
 }
+
+/// The sampling tests' rough conductors (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for RoughConductor {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::microfacet::MicrofacetType::{Beckmann, Ggx};
+        use super::test_registry::*;
+        vec![
+            (
+                "roughconductor-beckmann-0.05",
+                rough_gold(Beckmann, 0.05, 0.05, true),
+            ),
+            (
+                "roughconductor-beckmann-0.3",
+                rough_gold(Beckmann, 0.3, 0.3, true),
+            ),
+            (
+                "roughconductor-beckmann-0.1x0.4",
+                rough_gold(Beckmann, 0.1, 0.4, true),
+            ),
+            (
+                "roughconductor-beckmann-0.3-all",
+                rough_gold(Beckmann, 0.3, 0.3, false),
+            ),
+            ("roughconductor-ggx-0.05", rough_gold(Ggx, 0.05, 0.05, true)),
+            ("roughconductor-ggx-0.3", rough_gold(Ggx, 0.3, 0.3, true)),
+            (
+                "roughconductor-ggx-0.4x0.1",
+                rough_gold(Ggx, 0.4, 0.1, true),
+            ),
+            (
+                "roughconductor-ggx-0.2x0.5-all",
+                rough_gold(Ggx, 0.2, 0.5, false),
+            ),
+        ]
+    }
+}

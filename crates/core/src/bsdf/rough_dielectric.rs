@@ -227,6 +227,58 @@ impl LocalBsdf for RoughDielectric {
     }
 }
 
+/// The sampling tests' rough glasses (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for RoughDielectric {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::microfacet::MicrofacetType::{Beckmann, Ggx};
+        use super::Material;
+        let rough_glass = |kind, alpha_u, alpha_v, sample_visible, ior, tinted: bool| {
+            let (r, t) = if tinted {
+                (Color::new(0.9, 1.0, 0.7), Color::new(1.0, 0.6, 0.8))
+            } else {
+                (Color::ONE, Color::ONE)
+            };
+            Material::RoughDielectric(RoughDielectric {
+                distribution: Microfacet::new(kind, alpha_u, alpha_v, sample_visible),
+                ior,
+                specular_reflectance: r,
+                specular_transmittance: t,
+            })
+        };
+        vec![
+            (
+                "roughdielectric-beckmann-0.1-1.5",
+                rough_glass(Beckmann, 0.1, 0.1, true, 1.5, false),
+            ),
+            (
+                "roughdielectric-beckmann-0.3-1/1.5",
+                rough_glass(Beckmann, 0.3, 0.3, true, 1.0 / 1.5, true),
+            ),
+            (
+                "roughdielectric-beckmann-0.4x0.1-all-1.33",
+                rough_glass(Beckmann, 0.4, 0.1, false, 1.33, false),
+            ),
+            (
+                "roughdielectric-ggx-0.05-1.5",
+                rough_glass(Ggx, 0.05, 0.05, true, 1.5, false),
+            ),
+            (
+                "roughdielectric-ggx-0.3-2.4",
+                rough_glass(Ggx, 0.3, 0.3, true, 2.4, true),
+            ),
+            (
+                "roughdielectric-ggx-0.2x0.5-1.5",
+                rough_glass(Ggx, 0.2, 0.5, true, 1.5, false),
+            ),
+            (
+                "roughdielectric-ggx-0.6-all-1/1.33",
+                rough_glass(Ggx, 0.6, 0.6, false, 1.0 / 1.33, false),
+            ),
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

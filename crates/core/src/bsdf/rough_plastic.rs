@@ -292,6 +292,38 @@ impl LocalBsdf for RoughPlastic {
     }
 }
 
+/// The sampling tests' rough plastics (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for RoughPlastic {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::microfacet::MicrofacetType::{Beckmann, Ggx};
+        use super::test_registry::*;
+        vec![
+            (
+                "roughplastic-beckmann-0.05",
+                rough_plastic(Beckmann, 0.05, true, false),
+            ),
+            (
+                "roughplastic-beckmann-0.3-nonlinear",
+                rough_plastic(Beckmann, 0.3, true, true),
+            ),
+            (
+                "roughplastic-beckmann-0.3-all",
+                rough_plastic(Beckmann, 0.3, false, false),
+            ),
+            (
+                "roughplastic-ggx-0.1-nonlinear",
+                rough_plastic(Ggx, 0.1, true, true),
+            ),
+            ("roughplastic-ggx-0.5", rough_plastic(Ggx, 0.5, true, false)),
+            (
+                "roughplastic-ggx-0.2-all",
+                rough_plastic(Ggx, 0.2, false, false),
+            ),
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::plastic::tests::{check_pins, check_pins_within};

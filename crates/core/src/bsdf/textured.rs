@@ -133,3 +133,27 @@ fn with_alpha(d: Microfacet, slot: TextureSlot, a: f32) -> Microfacet {
     };
     Microfacet::new(d.kind, au, av, d.sample_visible)
 }
+
+/// The sampling tests' textured materials (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for Textured {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::test_registry::*;
+        let textured = |base| {
+            Material::Textured(Box::new(Textured {
+                base,
+                slots: vec![(
+                    super::TextureSlot::Reflectance,
+                    Texture::Constant(TEXTURE_COLOR),
+                )],
+            }))
+        };
+        vec![
+            (
+                "textured-diffuse",
+                textured(Material::Diffuse(super::Diffuse { albedo: COLOR })),
+            ),
+            ("textured-plastic", textured(plastic(COLOR, false))),
+        ]
+    }
+}

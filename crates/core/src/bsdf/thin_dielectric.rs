@@ -74,6 +74,28 @@ impl LocalBsdf for ThinDielectric {
     }
 }
 
+/// The sampling tests' panes (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for ThinDielectric {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::Material;
+        let pane = |ior, specular_reflectance, specular_transmittance| {
+            Material::ThinDielectric(ThinDielectric {
+                ior,
+                specular_reflectance,
+                specular_transmittance,
+            })
+        };
+        vec![
+            ("thindielectric-1.5", pane(1.5, Color::ONE, Color::ONE)),
+            (
+                "thindielectric-1.33-tinted",
+                pane(1.33, Color::new(0.9, 1.0, 0.7), Color::new(1.0, 0.6, 0.8)),
+            ),
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -76,3 +76,27 @@ impl LocalBsdf for TwoSided {
         self.inner.local().has_delta_lobe()
     }
 }
+
+/// The sampling tests' two-sided materials (`test_registry`).
+#[cfg(feature = "test-support")]
+impl super::test_registry::Fixtures for TwoSided {
+    fn fixtures() -> Vec<super::test_registry::Fixture> {
+        use super::microfacet::MicrofacetType::Ggx;
+        use super::test_registry::*;
+        let two_sided = |inner| {
+            Material::TwoSided(TwoSided {
+                inner: Box::new(inner),
+            })
+        };
+        vec![
+            (
+                "twosided-roughplastic-ggx-0.3",
+                two_sided(rough_plastic(Ggx, 0.3, true, false)),
+            ),
+            (
+                "twosided-roughconductor-ggx-0.3",
+                two_sided(rough_gold(Ggx, 0.3, 0.3, true)),
+            ),
+        ]
+    }
+}

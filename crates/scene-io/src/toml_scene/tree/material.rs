@@ -13,14 +13,17 @@
 //! | `opacity`, `opacity_texture` | `mask` around it |
 //! | `twosided = true`, and every diffuse, mirror and glossy | `twosided` around the one-sided BSDF |
 //!
-//! Every other key keeps its name. Which keys each type takes, what it needs and what may not be
-//! given together is checked here, in TOML's words.
+//! Every other key keeps its name. The TOML types, the tree type each becomes and the groups of
+//! keys it takes are rows of the builder's `BSDFS` (`xml/build/bsdf_toml.rs`), so a new material
+//! needs no code here; each group is translated here, with what it needs and what may not be
+//! given together checked in TOML's words.
 
 use super::texture::{color, texture};
 use super::{boolean, float, float64, plugin, string, wrap};
 use crate::error::Ctx;
 use crate::principled_keys::{principled_eta, scalar_in_range, thin_eta};
 use crate::toml_scene::schema::{MaterialDef, TextureDef, S};
+use crate::xml::build::{toml_material, toml_materials, Keys};
 use crate::xml::doc::Elem;
 use crate::SceneError;
 use lt_core::bsdf::conductor_ior::{conductor_names, named_conductor};
@@ -110,208 +113,118 @@ fn given(d: &MaterialDef) -> Vec<(&'static str, Option<Range<usize>>)> {
     given!(d; albedo, reflectance, ior, roughness, material, eta, k, distribution, alpha, alpha_u, alpha_v, transmittance, twosided, albedo_texture, reflectance_texture, alpha_texture, alpha_u_texture, alpha_v_texture, nonlinear, base_color, base_color_texture, anisotropic, metallic, spec_trans, specular, spec_tint, sheen, sheen_tint, flatness, clearcoat, clearcoat_gloss, diff_trans).to_vec()
 }
 
-/// The keys each type takes.
-fn allowed(kind: &str) -> &'static [&'static str] {
-    match kind {
-        "diffuse" => &["albedo", "albedo_texture"],
-        "mirror" => &["reflectance"],
-        "dielectric" => &["ior"],
-        "glossy" => &["reflectance", "roughness"],
-        "thindielectric" => &["ior", "reflectance", "transmittance", "reflectance_texture"],
-        "roughdielectric" => &[
-            "ior",
-            "reflectance",
-            "transmittance",
-            "distribution",
-            "alpha",
-            "reflectance_texture",
-            "alpha_texture",
-            "alpha_u",
-            "alpha_v",
-            "alpha_u_texture",
-            "alpha_v_texture",
-        ],
-        "conductor" => &[
-            "reflectance",
-            "material",
-            "eta",
-            "k",
-            "twosided",
-            "reflectance_texture",
-        ],
-        "roughconductor" => &[
-            "reflectance",
-            "material",
-            "eta",
-            "k",
-            "twosided",
-            "distribution",
-            "alpha",
-            "reflectance_texture",
-            "alpha_texture",
-            "alpha_u",
-            "alpha_v",
-            "alpha_u_texture",
-            "alpha_v_texture",
-        ],
-        "plastic" => &[
-            "albedo",
-            "albedo_texture",
-            "reflectance",
-            "reflectance_texture",
-            "ior",
-            "nonlinear",
-            "twosided",
-        ],
-        "roughplastic" => &[
-            "albedo",
-            "albedo_texture",
-            "reflectance",
-            "reflectance_texture",
-            "ior",
-            "nonlinear",
-            "twosided",
-            "distribution",
-            "alpha",
-        ],
-        "principled" => &[
-            "base_color",
-            "base_color_texture",
-            "roughness",
-            "anisotropic",
-            "spec_trans",
-            "spec_tint",
-            "sheen",
-            "sheen_tint",
-            "flatness",
-            "ior",
-            "metallic",
-            "clearcoat",
-            "clearcoat_gloss",
-            "specular",
-        ],
-        "principledthin" => &[
-            "base_color",
-            "base_color_texture",
-            "roughness",
-            "anisotropic",
-            "spec_trans",
-            "spec_tint",
-            "sheen",
-            "sheen_tint",
-            "flatness",
-            "ior",
-            "diff_trans",
-        ],
-        _ => &[],
-    }
-}
-
-/// The TOML material types, for the unknown type's message.
-const TYPES: &str = "diffuse, mirror, dielectric, roughdielectric, thindielectric, glossy, \
-                     conductor, roughconductor, plastic, roughplastic, principled, principledthin \
-                     or null";
-
-/// The BSDF with its untextured and textured parameters, inside `twosided` where ours reflect on
-/// both sides.
+/// The BSDF of a TOML type (its row of the builder's `BSDFS`: which tree type it becomes and
+/// which groups of keys it takes), with its untextured and textured parameters, inside
+/// `twosided` where ours reflect on both sides.
 fn plain(ctx: &Ctx, name: &str, def: &S<MaterialDef>) -> Result<Elem, SceneError> {
     let d = def.get_ref();
     let kind = d.kind.get_ref().as_str();
-    let what = format!("material `{name}` of type {kind}");
-    let span = def.span();
-    let given = given(d);
-    if kind != "null" && allowed(kind).is_empty() {
+    let Some((tree_type, toml)) = toml_material(kind) else {
+        let types: Vec<&str> = toml_materials().collect();
+        let (last, rest) = types.split_last().expect("BSDFS has TOML types");
         return Err(ctx.at(
             d.kind.span(),
-            format!("unknown material type `{kind}` (expected {TYPES})"),
+            format!(
+                "unknown material type `{kind}` (expected {} or {last})",
+                rest.join(", ")
+            ),
         ));
+    };
+    let what = format!("material `{name}` of type {kind}");
+    let span = def.span();
+    let allowed: Vec<&str> = toml
+        .keys
+        .iter()
+        .flat_map(|k| k.toml_keys())
+        .copied()
+        .collect();
+    ctx.only(&given(d), &allowed, &what)?;
+    let mut b = plugin("bsdf", tree_type, span.clone());
+    for (key, value) in toml.fixed {
+        b.children.push(string(key, value, span.clone()));
     }
-    ctx.only(&given, allowed(kind), &what)?;
+    for &group in toml.keys {
+        keys(ctx, d, group, &span, &what, &mut b)?;
+    }
     let twosided = d.twosided.as_ref().is_some_and(|t| *t.get_ref());
-    let mut b;
-    match kind {
-        "null" => return Ok(plugin("bsdf", "null", span)),
-        "diffuse" => {
-            b = plugin("bsdf", "diffuse", span.clone());
-            match (&d.albedo, &d.albedo_texture) {
-                (Some(a), None) => b
-                    .children
-                    .push(color(ctx, a, "albedo", "reflectance", true)?),
-                (None, Some(t)) => b.children.push(texture(ctx, t, "reflectance")?),
-                (Some(_), Some(t)) => {
-                    return Err(ctx.at(t.span(), "give `albedo` or `albedo_texture`, not both"))
-                }
-                (None, None) => {
-                    return Err(ctx.at(
-                        span,
-                        format!("missing required key `albedo` (or `albedo_texture`) for {what}"),
-                    ))
-                }
+    Ok(if toml.always_twosided || twosided {
+        wrap("bsdf", "twosided", span, b)
+    } else {
+        b
+    })
+}
+
+/// One group of keys into the tree, in TOML's words (the renames are `Keys`' table).
+fn keys(
+    ctx: &Ctx,
+    d: &MaterialDef,
+    group: Keys,
+    span: &Range<usize>,
+    what: &str,
+    b: &mut Elem,
+) -> Result<(), SceneError> {
+    match group {
+        Keys::Albedo { to, required } => albedo(ctx, d, to, required, span, what, b),
+        Keys::Reflectance { .. } => specular_reflectance(ctx, d, b),
+        Keys::Transmittance => {
+            if let Some(t) = &d.transmittance {
+                let e = color(ctx, t, "transmittance", "specular_transmittance", true)?;
+                b.children.push(e);
             }
-            return Ok(wrap("bsdf", "twosided", span, b));
+            Ok(())
         }
-        "mirror" => {
-            b = plugin("bsdf", "conductor", span.clone());
-            b.children.push(string("material", "none", span.clone()));
-            specular_reflectance(ctx, d, &mut b)?;
-            return Ok(wrap("bsdf", "twosided", span, b));
-        }
-        "glossy" => {
-            b = plugin("bsdf", "roughconductor", span.clone());
-            b.children.push(string("material", "none", span.clone()));
-            b.children.push(string("distribution", "ggx", span.clone()));
-            let r = ctx.need(&d.roughness, "roughness", &span, &what)?;
+        Keys::DielectricIor => ior(ctx, d, span, what, Some(b)).map(drop),
+        Keys::PlasticIor { rough } => plastic_ior(ctx, d, rough, b),
+        Keys::Roughness => {
+            let r = ctx.need(&d.roughness, "roughness", span, what)?;
             let roughness = ctx.num(r, "roughness")?;
             if !(roughness >= MIN_ROUGHNESS) {
                 return Err(ctx.at(r.span(), format!("`roughness` (GGX α) must be at least {MIN_ROUGHNESS}, got {roughness} (use a mirror for a perfectly smooth surface)")));
             }
             b.children.push(float("alpha", roughness, r.span()));
-            specular_reflectance(ctx, d, &mut b)?;
-            return Ok(wrap("bsdf", "twosided", span, b));
+            Ok(())
         }
-        "dielectric" => {
-            b = plugin("bsdf", "dielectric", span.clone());
-            ior(ctx, d, &span, &what, Some(&mut b))?;
-        }
-        "roughdielectric" | "thindielectric" => {
-            b = plugin("bsdf", kind, span.clone());
-            ior(ctx, d, &span, &what, Some(&mut b))?;
-            if kind == "roughdielectric" {
-                microfacet(ctx, d, &span, &mut b)?;
+        Keys::Microfacet { .. } => microfacet(ctx, d, span, b),
+        Keys::ComplexIor => complex_ior(ctx, d, span, b),
+        Keys::Nonlinear => {
+            if let Some(n) = &d.nonlinear {
+                b.children
+                    .push(boolean("nonlinear", *n.get_ref(), n.span()));
             }
-            specular_reflectance(ctx, d, &mut b)?;
-            if let Some(t) = &d.transmittance {
-                b.children.push(color(
-                    ctx,
-                    t,
-                    "transmittance",
-                    "specular_transmittance",
-                    true,
-                )?);
-            }
+            Ok(())
         }
-        "conductor" | "roughconductor" => {
-            b = plugin("bsdf", kind, span.clone());
-            complex_ior(ctx, d, &span, &mut b)?;
-            if kind == "roughconductor" {
-                microfacet(ctx, d, &span, &mut b)?;
-            }
-            specular_reflectance(ctx, d, &mut b)?;
-        }
-        "plastic" | "roughplastic" => {
-            b = plugin("bsdf", kind, span.clone());
-            plastic(ctx, d, kind, &mut b)?;
-        }
-        _ => {
-            b = plugin("bsdf", kind, span.clone());
-            principled(ctx, d, &mut b)?;
-        }
+        // `plain` wraps the BSDF.
+        Keys::Twosided => Ok(()),
+        Keys::Principled { thin } => principled(ctx, d, thin, b),
     }
-    Ok(if twosided {
-        wrap("bsdf", "twosided", span, b)
-    } else {
-        b
-    })
+}
+
+/// `albedo` or `albedo_texture` as the reflectance `to`.
+fn albedo(
+    ctx: &Ctx,
+    d: &MaterialDef,
+    to: &str,
+    required: bool,
+    span: &Range<usize>,
+    what: &str,
+    b: &mut Elem,
+) -> Result<(), SceneError> {
+    match (&d.albedo, &d.albedo_texture) {
+        (Some(_), Some(t)) => Err(ctx.at(t.span(), "give `albedo` or `albedo_texture`, not both")),
+        (Some(a), None) => {
+            b.children.push(color(ctx, a, "albedo", to, true)?);
+            Ok(())
+        }
+        (None, Some(t)) => {
+            b.children.push(texture(ctx, t, to)?);
+            Ok(())
+        }
+        (None, None) if required => Err(ctx.at(
+            span.clone(),
+            format!("missing required key `albedo` (or `albedo_texture`) for {what}"),
+        )),
+        (None, None) => Ok(()),
+    }
 }
 
 /// `reflectance` (or `reflectance_texture`) as `specular_reflectance`.
@@ -351,16 +264,15 @@ fn ior(
     Ok(ior)
 }
 
-/// Mitsuba's `plastic` / `roughplastic`: `albedo` (its `diffuse_reflectance`), `reflectance`
-/// (`specular_reflectance`), `ior` (default polypropylene in air), `nonlinear`; the rough one
-/// adds `distribution` and `alpha`.
-fn plastic(ctx: &Ctx, d: &MaterialDef, kind: &str, b: &mut Elem) -> Result<(), SceneError> {
+/// A plastic's `ior` as `int_ior` over `ext_ior` = 1, polypropylene in air when absent (as
+/// Mitsuba's default); a rough one's must not be 1.
+fn plastic_ior(ctx: &Ctx, d: &MaterialDef, rough: bool, b: &mut Elem) -> Result<(), SceneError> {
     let span = d.kind.span();
     let ior = match &d.ior {
         None => POLYPROPYLENE_IOR / AIR_IOR,
         Some(i) => ctx.positive(i, "ior")?,
     };
-    if kind == "roughplastic" && ior == 1.0 {
+    if rough && ior == 1.0 {
         return Err(ctx.at(
             d.ior.as_ref().map_or(span.clone(), S::span),
             "a roughplastic needs `ior` ≠ 1 (as Mitsuba)",
@@ -368,25 +280,7 @@ fn plastic(ctx: &Ctx, d: &MaterialDef, kind: &str, b: &mut Elem) -> Result<(), S
     }
     let at = d.ior.as_ref().map_or(span.clone(), S::span);
     b.children.push(float("int_ior", ior, at));
-    b.children.push(float("ext_ior", 1.0, span.clone()));
-    match (&d.albedo, &d.albedo_texture) {
-        (Some(_), Some(t)) => {
-            return Err(ctx.at(t.span(), "give `albedo` or `albedo_texture`, not both"))
-        }
-        (Some(a), None) => b
-            .children
-            .push(color(ctx, a, "albedo", "diffuse_reflectance", true)?),
-        (None, Some(t)) => b.children.push(texture(ctx, t, "diffuse_reflectance")?),
-        (None, None) => {}
-    }
-    specular_reflectance(ctx, d, b)?;
-    if let Some(n) = &d.nonlinear {
-        b.children
-            .push(boolean("nonlinear", *n.get_ref(), n.span()));
-    }
-    if kind == "roughplastic" {
-        microfacet(ctx, d, &span, b)?;
-    }
+    b.children.push(float("ext_ior", 1.0, span));
     Ok(())
 }
 
@@ -493,8 +387,7 @@ fn microfacet(
 /// `principled` and `principledthin`: Mitsuba's names and defaults, except `ior` for its `eta`;
 /// scalars are numbers here (Mitsuba XML also takes textures for them). η and `specular` go
 /// into the tree in f64, as given: η = 1 exactly is moved off the index-matched interface.
-fn principled(ctx: &Ctx, d: &MaterialDef, b: &mut Elem) -> Result<(), SceneError> {
-    let thin = d.kind.get_ref() == "principledthin";
+fn principled(ctx: &Ctx, d: &MaterialDef, thin: bool, b: &mut Elem) -> Result<(), SceneError> {
     match (&d.base_color, &d.base_color_texture) {
         (Some(_), Some(t)) => {
             return Err(ctx.at(
@@ -546,4 +439,40 @@ fn principled(ctx: &Ctx, d: &MaterialDef, b: &mut Elem) -> Result<(), SceneError
         b.children.push(float64("eta", *i.get_ref(), i.span()));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::xml::build::toml_materials;
+
+    /// docs/scene-format.md's material table has a row for every TOML type of `BSDFS` (a type
+    /// added to the table and not to the docs fails here), and no row for a type TOML lacks.
+    #[test]
+    fn toml_docs_list_every_material_type() {
+        let docs = include_str!("../../../../../docs/scene-format.md");
+        let section = docs
+            .split("## `[materials.NAME]`")
+            .nth(1)
+            .and_then(|s| s.split("\n## ").next())
+            .expect("docs/scene-format.md has a `[materials.NAME]` section");
+        // The table's rows: after its header and `|---|` line.
+        let rows: Vec<&str> = section
+            .lines()
+            .skip_while(|l| !l.starts_with("|---"))
+            .filter_map(|l| l.strip_prefix("| `")?.split('`').next())
+            .collect();
+        let types: Vec<&str> = toml_materials().collect();
+        for t in &types {
+            assert!(
+                rows.contains(t),
+                "docs/scene-format.md has no row for `{t}`"
+            );
+        }
+        for r in &rows {
+            assert!(
+                types.contains(r),
+                "docs/scene-format.md documents `{r}`, not a TOML type"
+            );
+        }
+    }
 }

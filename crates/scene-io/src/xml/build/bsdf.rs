@@ -1,5 +1,7 @@
 //! `<bsdf>`: every BSDF type lt reads, each one entry of `BSDFS`.
 
+use super::bsdf_toml::Keys::{self, *};
+use super::bsdf_toml::{same_name, TomlType};
 use super::Loader;
 use crate::world::WorldBuilder;
 use crate::xml::doc::Elem;
@@ -36,7 +38,7 @@ impl<'a> Loader<'a> {
     /// leaves is an error, and parameters given as textures wrap it in `Textured`.
     pub(super) fn bsdf(&mut self, e: &'a Elem, in_twosided: bool) -> Result<Material, SceneError> {
         let p = self.plugin(e)?;
-        let Some(&(_, build)) = BSDFS.iter().find(|(name, _)| *name == p.kind) else {
+        let Some(&(_, build, _)) = BSDFS.iter().find(|(name, ..)| *name == p.kind) else {
             return Err(super::kinds::unknown_type(self.doc, e));
         };
         // Parameters given as textures: the material is built with their defaults and the
@@ -94,26 +96,83 @@ type BsdfBuilder = for<'a, 'p> fn(
     &mut Slots,
 ) -> Result<Material, SceneError>;
 
-/// Every BSDF type lt reads, with its builder: a new material is one entry here (plus its file
-/// in lt-core). The list of known types in errors and docs/xml.md is this table's.
-pub(super) const BSDFS: &[(&str, BsdfBuilder)] = &[
-    ("diffuse", diffuse),
-    ("dielectric", dielectric),
-    ("roughdielectric", rough_or_thin_dielectric),
-    ("thindielectric", rough_or_thin_dielectric),
-    ("conductor", conductor),
-    ("roughconductor", conductor),
-    ("plastic", plastic),
-    ("roughplastic", plastic),
-    ("principled", principled),
-    ("principledthin", principled),
-    ("twosided", twosided),
-    ("normalmap", perturbed),
-    ("bumpmap", perturbed),
-    ("mask", mask),
-    ("blendbsdf", blend),
-    ("null", null),
+/// Every BSDF type lt reads, with its builder and the TOML types that become it: a new material
+/// is one entry here (plus its file in lt-core). The list of known types in errors and
+/// docs/xml.md is this table's, and so are TOML's material types and their keys.
+#[rustfmt::skip] // a table: one row a line
+pub(super) const BSDFS: &[(&str, BsdfBuilder, &[TomlType])] = &[
+    ("diffuse", diffuse, &[DIFFUSE]),
+    ("dielectric", dielectric, &[same_name("dielectric", &[DielectricIor])]),
+    ("roughdielectric", rough_or_thin_dielectric, &[same_name("roughdielectric", ROUGH_GLASS)]),
+    ("thindielectric", rough_or_thin_dielectric, &[same_name("thindielectric", PANE)]),
+    ("conductor", conductor, &[MIRROR, same_name("conductor", METAL)]),
+    ("roughconductor", conductor, &[GLOSSY, same_name("roughconductor", ROUGH_METAL)]),
+    ("plastic", plastic, &[same_name("plastic", PLASTIC)]),
+    ("roughplastic", plastic, &[same_name("roughplastic", ROUGH_PLASTIC)]),
+    ("principled", principled, &[same_name("principled", &[Principled { thin: false }])]),
+    ("principledthin", principled, &[same_name("principledthin", &[Principled { thin: true }])]),
+    ("twosided", twosided, &[]),
+    ("normalmap", perturbed, &[]),
+    ("bumpmap", perturbed, &[]),
+    ("mask", mask, &[]),
+    ("blendbsdf", blend, &[]),
+    ("null", null, &[same_name("null", &[])]),
 ];
+
+// TOML's keys of the types whose rows would not fit a line, and TOML's own types.
+const ROUGH_GLASS: &[Keys] = &[DielectricIor, ANISOTROPIC, TEXTURED, Transmittance];
+const PANE: &[Keys] = &[DielectricIor, TEXTURED, Transmittance];
+const METAL: &[Keys] = &[ComplexIor, TEXTURED, Twosided];
+const ROUGH_METAL: &[Keys] = &[ComplexIor, ANISOTROPIC, TEXTURED, Twosided];
+const PLASTIC: &[Keys] = &[PLASTIC_IOR, BASE, TEXTURED, Nonlinear, Twosided];
+const ROUGH_PLASTIC: &[Keys] = &[ROUGH_IOR, BASE, TEXTURED, Nonlinear, ISOTROPIC, Twosided];
+const TEXTURED: Keys = Reflectance { textured: true };
+const ANISOTROPIC: Keys = Microfacet { anisotropic: true };
+const ISOTROPIC: Keys = Microfacet { anisotropic: false };
+const PLASTIC_IOR: Keys = PlasticIor { rough: false };
+const ROUGH_IOR: Keys = PlasticIor { rough: true };
+const BASE: Keys = Albedo {
+    to: "diffuse_reflectance",
+    required: false,
+};
+/// lt's diffuse: reflects on both sides.
+const DIFFUSE: TomlType = TomlType {
+    name: "diffuse",
+    fixed: &[],
+    keys: &[Albedo {
+        to: "reflectance",
+        required: true,
+    }],
+    always_twosided: true,
+};
+/// lt's mirror: a two-sided conductor of material `none`.
+const MIRROR: TomlType = TomlType {
+    name: "mirror",
+    fixed: &[("material", "none")],
+    keys: &[Reflectance { textured: false }],
+    always_twosided: true,
+};
+/// lt's glossy: a two-sided GGX conductor of material `none`, `roughness` its α.
+const GLOSSY: TomlType = TomlType {
+    name: "glossy",
+    fixed: &[("material", "none"), ("distribution", "ggx")],
+    keys: &[Roughness, Reflectance { textured: false }],
+    always_twosided: true,
+};
+
+/// The BSDF type a TOML material `type` becomes, and how TOML spells it.
+pub(crate) fn toml_material(name: &str) -> Option<(&'static str, &'static TomlType)> {
+    BSDFS
+        .iter()
+        .find_map(|(xml, _, toml)| toml.iter().find(|t| t.name == name).map(|t| (*xml, t)))
+}
+
+/// TOML's material types, in the table's order.
+pub(crate) fn toml_materials() -> impl Iterator<Item = &'static str> {
+    BSDFS
+        .iter()
+        .flat_map(|(_, _, toml)| toml.iter().map(|t| t.name))
+}
 
 /// Mitsuba's `null`: a boundary between media that light passes straight through.
 fn null<'a>(

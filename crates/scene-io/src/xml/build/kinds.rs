@@ -56,7 +56,7 @@ pub(super) const KINDS: &[Kind] = &[
     Kind {
         tag: "bsdf",
         what: "BSDF",
-        types: || super::bsdf::BSDFS.iter().map(|(name, _)| *name).collect(),
+        types: || super::bsdf::BSDFS.iter().map(|(name, ..)| *name).collect(),
         hint: "",
     },
     Kind {

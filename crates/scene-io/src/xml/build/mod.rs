@@ -13,6 +13,7 @@ use std::path::PathBuf;
 
 mod bsdf;
 mod bsdf_params;
+mod bsdf_toml;
 mod emitter;
 mod integrator;
 mod kinds;
@@ -21,6 +22,8 @@ mod sensor;
 mod shape;
 mod texture;
 
+pub(crate) use bsdf::{toml_material, toml_materials};
+pub(crate) use bsdf_toml::Keys;
 pub use integrator::UNBOUNDED_DEPTH_SUBSTITUTE;
 pub(crate) use medium::MEDIA;
 
