@@ -303,7 +303,7 @@ fn bdpt_weights_match_the_oracle_through_media() {
 /// Two null spheres of one fog overlapping (tests/data/overlapping-fog.xml): with per-ray media a
 /// segment through the overlap lies in other media walked one way than the other, and bdpt's
 /// reverse densities there must be the reverse walk's, as the oracle's are. The walks' own
-/// reversal of the pieces they walked failed 381 of its 900 paths (results/mitsuba-suite-media.md).
+/// reversal of the pieces they walked fails 341 of the 807 paths (results/mitsuba-suite-media.md).
 #[test]
 fn bdpt_weights_match_the_oracle_where_media_shapes_overlap() {
     let path =
