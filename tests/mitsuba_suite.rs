@@ -188,7 +188,8 @@ const MEDIA_EXEMPT: &[(&str, &str, &str)] = &[
 ];
 
 /// Why light tracing is exempt on the envmap-lit media scenes.
-const ENVMAP_LIGHT: &str = "light traced from the museum envmap: 1.4 % of its light subpaths first \
+const ENVMAP_LIGHT: &str =
+    "light traced from the museum envmap: 1.4 % of its light subpaths first \
      hit a point the camera sees, so at 256 spp a pixel holds a few splats and the passes' spread \
      underestimates its error (pixels at 0 where the reference reads 0.07; image means \
      ×0.99–1.00). Five of the six pass at 8192 spp (no_scattering: 99.73 %), 25–34 CPU s each";

@@ -113,8 +113,7 @@ pub fn edge_estimate(
     let mut f = scene.connection_estimate(a.into(), b.into(), medium, scatters, sampler)?;
     // Where media shapes overlap, a walk from b crosses other media than the pieces walked from
     // a (`PanesPassed::reversible`): its density is that walk's.
-    if !b.is_infinite() && (!f.reversible || f.end_medium != b.medium_towards(scene, b.dir_to(a)))
-    {
+    if !b.is_infinite() && (!f.reversible || f.end_medium != b.medium_towards(scene, b.dir_to(a))) {
         f.b_to_a = b.free_flight_to(scene, a);
     }
     Some(f)
