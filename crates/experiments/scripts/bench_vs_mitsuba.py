@@ -173,12 +173,16 @@ def lt_convert(lt, scene, xml):
         sys.exit(f"lt convert {scene} failed: {r.stderr.strip()}")
 
 
+# Extra `lt render` arguments for every render (--lt-ray-core).
+LT_EXTRA = []
+
+
 def lt_render(lt, scene, integrator, spp, threads, seed, out_exr, extra=()):
     """Runs `lt render`; returns its JSON record plus wall/cpu of the whole process and load1."""
     before = load1()
     cmd = [lt, "render", scene, "-i", integrator, "--spp", str(spp), "--threads", str(threads),
            "--seed", str(seed), "--max-depth", str(MAX_DEPTH), "--rr-depth", str(RR_DEPTH),
-           "--quiet", "-o", out_exr, *extra]
+           "--quiet", "-o", out_exr, *LT_EXTRA, *extra]
     for k, v in DEFINES:
         cmd += ["-D", f"{k}={v}"]
     c0 = cpu_children()
@@ -422,10 +426,15 @@ def main():
     ap.add_argument("--quick", action="store_true", help="smoke test: 4 spp, 1 round")
     ap.add_argument("--max-depth", type=int, default=MAX_DEPTH, help=f"both renderers (default {MAX_DEPTH})")
     ap.add_argument("--rr-depth", type=int, default=RR_DEPTH, help=f"both renderers (default {RR_DEPTH})")
+    ap.add_argument("--lt-ray-core", default=None,
+                    help="lt's --ray-core for every lt render (e.g. embree: the BVH library Mitsuba's "
+                         "PyPI builds trace with); default lt's auto")
     ap.add_argument("-D", dest="define", action="append", default=[], metavar="KEY=VALUE",
                     help="an XML scene's $KEY for both renderers (repeatable)")
     a = ap.parse_args()
     MAX_DEPTH, RR_DEPTH = a.max_depth, a.rr_depth
+    if a.lt_ray_core:
+        LT_EXTRA.extend(["--ray-core", a.lt_ray_core])
     for d in a.define:
         if "=" not in d:
             sys.exit(f"-D {d}: expected KEY=VALUE")

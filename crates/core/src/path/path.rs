@@ -92,9 +92,7 @@ impl Path {
             return 1.0;
         }
         let v = &self.vertices;
-        let medium = v[from].medium_towards(scene, v[from].dir_to(&v[to]));
-        let (a, b) = ((&v[from]).into(), (&v[to]).into());
-        scene.free_flight_density(a, b, medium, v[to].in_medium()) as f64
+        v[from].free_flight_to(scene, &v[to]) as f64
     }
 
     fn light<'a>(&self, scene: &'a Scene) -> &'a Light {

@@ -210,6 +210,17 @@ impl PathVertex {
         }
     }
 
+    /// The free-flight density of a walk from this vertex reaching `to`
+    /// (`Scene::free_flight_density`: per unit length when `to` lies in a medium, the probability
+    /// of passing every medium when it is a surface or a light), starting in the medium this
+    /// vertex leaves into towards `to`: the factor of a walk's density that `convert_density`
+    /// leaves out. The oracle's (`Path::densities`), the joins' and, where per-ray media are not
+    /// reversible, the walks' reverse densities all come from here.
+    pub fn free_flight_to(&self, scene: &Scene, to: &PathVertex) -> f32 {
+        let medium = self.medium_towards(scene, self.dir_to(to));
+        scene.free_flight_density(self.into(), to.into(), medium, to.in_medium())
+    }
+
     /// True for a scattering point inside a medium.
     #[inline]
     pub fn in_medium(&self) -> bool {

@@ -83,8 +83,14 @@ pub struct ConnectionFlight {
     pub transmittance: Color,
     /// The free-flight density of a walk from a reaching b.
     pub a_to_b: f32,
-    /// The free-flight density of a walk from b reaching a.
+    /// The free-flight density of a walk from b reaching a, through the media of the pieces
+    /// walked from a: the right one only when `reversible` and b's medium towards a is
+    /// `end_medium` (otherwise a walk from b crosses other media: `PathVertex::free_flight_to`).
     pub b_to_a: f32,
+    /// Every boundary crossed, walked back, undoes itself (`PanesPassed::reversible`).
+    pub reversible: bool,
+    /// The medium of the last piece, at b.
+    pub end_medium: Option<MediumId>,
 }
 
 /// What the thin dielectric panes a segment passes (as null events, module doc) do to it: the
@@ -95,12 +101,18 @@ pub struct ConnectionFlight {
 pub struct PanesPassed {
     pub transmission: Color,
     pub probability: f32,
+    /// Whether every boundary crossed (null or pane) gives back the medium before it when crossed
+    /// the other way. Per-ray media (Mitsuba's) are not reversible where two shapes naming media
+    /// overlap: leaving one inside the other enters its exterior, so the segment walked backwards
+    /// lies in other media and its free-flight density differs (`for_each_medium_piece`).
+    pub reversible: bool,
 }
 
 impl PanesPassed {
     const NONE: PanesPassed = PanesPassed {
         transmission: Color::ONE,
         probability: 1.0,
+        reversible: true,
     };
 }
 
@@ -182,11 +194,13 @@ impl Scene {
                 PanesPassed {
                     transmission: t.specular_transmittance * pass,
                     probability: pass,
+                    reversible: true,
                 }
             }
             _ => PanesPassed {
                 transmission: Color::ZERO,
                 probability: 0.0,
+                reversible: true,
             },
         }
     }
@@ -291,7 +305,9 @@ impl Scene {
                 a: here,
                 b: p,
             });
-            current = self.medium_after(s.interface, ng, d, current);
+            let next = self.medium_after(s.interface, ng, d, current);
+            through.reversible &= self.medium_after(s.interface, ng, -d, next) == current;
+            current = next;
             here = p;
         }
         visit(MediumPiece {
@@ -457,6 +473,8 @@ impl Scene {
             transmittance: tr * panes.transmission,
             a_to_b: a_to_b * panes.probability,
             b_to_a: b_to_a * panes.probability,
+            reversible: panes.reversible,
+            end_medium: piece.medium,
         })
     }
 

@@ -110,7 +110,13 @@ pub fn edge_estimate(
 ) -> Option<ConnectionFlight> {
     let medium = a.medium_towards(scene, a.dir_to(b));
     let scatters = (a.in_medium(), b.in_medium());
-    scene.connection_estimate(a.into(), b.into(), medium, scatters, sampler)
+    let mut f = scene.connection_estimate(a.into(), b.into(), medium, scatters, sampler)?;
+    // Where media shapes overlap, a walk from b crosses other media than the pieces walked from
+    // a (`PanesPassed::reversible`): its density is that walk's.
+    if !b.is_infinite() && (!f.reversible || f.end_medium != b.medium_towards(scene, b.dir_to(a))) {
+        f.b_to_a = b.free_flight_to(scene, a);
+    }
+    Some(f)
 }
 
 /// Joins light-subpath vertex `y` (x0 on a light, or a non-delta surface) to a point of the lens

@@ -20,6 +20,11 @@
 //! same, but the one that may scatter is the first (at the vertex before, when it lies in a
 //! medium) and the last is passed.
 //!
+//! Where shapes naming media overlap, per-ray media are not reversible (a boundary crossed
+//! backwards need not give back the medium before it, `PanesPassed::reversible`): the segment
+//! walked the other way lies in other media, and its reverse density is that walk's, walked anew
+//! (`PathVertex::free_flight_to`, the oracle's) — only there, so nested media pay nothing.
+//!
 //! A thin dielectric pane passed is a null event (`lt_core::scene::media`'s one rule, as `pt` and
 //! `light` walk it): no vertex, no count toward `max_vertices`; its pass probability 1 − R'
 //! multiplies the segment's free-flight densities both ways, as `Scene::free_flight_density`
@@ -30,9 +35,10 @@ use super::walk::{self, camera_start, continue_subpath, light_start, reverse_den
 use super::walk::{Subpath, WalkLimits, WalkStart};
 use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec2, Vec3};
-use lt_core::medium::{FreeFlight, Medium};
+use lt_core::medium::{FreeFlight, Medium, MediumId};
 use lt_core::path::PathVertex;
 use lt_core::sampling::Sampler;
+use lt_core::scene::SurfaceHit;
 use lt_core::Scene;
 
 /// `walk::camera_subpath`, through participating media when `MEDIA` (medium vertices where free
@@ -94,6 +100,8 @@ struct Flight {
     first: bool,
     /// The vertex the segment left is a medium vertex.
     from_medium: bool,
+    /// Every boundary crossed so far, crossed backwards, gives back the medium before it.
+    reversible: bool,
 }
 
 impl Flight {
@@ -103,7 +111,37 @@ impl Flight {
             reverse: 1.0,
             first: true,
             from_medium,
+            reversible: true,
         }
+    }
+
+    /// A boundary at `hit` was crossed along `d` from `before` into `after`.
+    fn crossed(
+        &mut self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        d: Vec3,
+        before: Option<MediumId>,
+        after: Option<MediumId>,
+    ) {
+        self.reversible &= scene.medium_after(hit.interface, hit.ng, -d, after) == before;
+    }
+
+    /// The reverse density of the segment ending at `end` (arrived in `medium`) from `start`:
+    /// the pieces walked, or — where a walk from `end` would cross other media — that walk's.
+    fn reverse_to(
+        &mut self,
+        scene: &Scene,
+        end: &PathVertex,
+        start: &PathVertex,
+        medium: Option<MediumId>,
+    ) -> f32 {
+        let w = end.dir_to(start);
+        if !self.reversible || end.medium_towards(scene, w) != medium {
+            self.reverse = end.free_flight_to(scene, start);
+            self.reversible = true;
+        }
+        self.reverse
     }
 
     /// The piece a → b in medium `m` was walked; `scattered`: the flight stopped at b.
@@ -150,8 +188,9 @@ fn random_walk(
                     let n = out.vertices.len();
                     let prev = &out.vertices[n - 1];
                     let v = PathVertex::medium(m, x, wo, beta, pdf, flight.forward, prev);
+                    let reverse = flight.reverse_to(scene, &v, prev, medium);
                     out.vertices.push(v);
-                    out.back_flight.push(flight.reverse);
+                    out.back_flight.push(reverse);
                     if beta == Color::ZERO || n + 1 >= limits.max_vertices {
                         return;
                     }
@@ -200,9 +239,11 @@ fn random_walk(
             return;
         };
         if scene.shapes[hit.shape as usize].null {
+            let (before, d) = (medium, ray.d);
             if !crossings.cross(scene, &hit, &mut ray, &mut medium) {
                 return;
             }
+            flight.crossed(scene, &hit, d, before, medium);
             continue;
         }
         let wo = -ray.d;
@@ -213,8 +254,9 @@ fn random_walk(
         // A shape that names no media keeps the medium the walk is in, on both sides.
         v.interface = scene.interface_within(hit.interface, medium);
         let interface = v.interface;
+        let reverse = flight.reverse_to(scene, &v, prev, medium);
         out.vertices.push(v);
-        out.back_flight.push(flight.reverse);
+        out.back_flight.push(reverse);
         // A pane may be passed at the last vertex: passing it is a null event, no vertex
         // (`Scene::is_null_transmission`); only a reflection makes it one.
         let pane = scene.has_null_transmission(hit.material);
@@ -226,9 +268,11 @@ fn random_walk(
         else {
             return;
         };
+        let before = medium;
         medium = scene.medium_across(interface, hit.ng, bs.wi);
         ray = hit.spawn_ray(bs.wi);
         if pane && scene.is_null_transmission(hit.material, hit.shading_frame().ns(), wo, bs.wi) {
+            flight.crossed(scene, &hit, bs.wi, before, medium);
             // As a null boundary, but chosen with the lobe's probability 1 − R' (either way):
             // the segment goes on from the last real vertex, its densities times that.
             out.vertices.pop();

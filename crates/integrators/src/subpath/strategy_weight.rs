@@ -276,6 +276,5 @@ pub fn with_chain_in<const MEDIA: bool, T>(
 /// of a walk's density that the direction's conversion (`PathVertex::convert_density`) leaves
 /// out. The oracle computes it the same way (`Path::densities`).
 fn free_flight(scene: &Scene, from: &PathVertex, to: &PathVertex) -> f64 {
-    let medium = from.medium_towards(scene, from.dir_to(to));
-    scene.free_flight_density(from.into(), to.into(), medium, to.in_medium()) as f64
+    from.free_flight_to(scene, to) as f64
 }

@@ -540,12 +540,20 @@ pub fn describe(
             } else {
                 (b.p - a.p).length()
             };
+            let (ma, mb) = (a.medium_towards(scene, w), b.medium_towards(scene, -w));
+            let ff = |x: &PathVertex, y: &PathVertex, m| {
+                scene.free_flight_density(x.into(), y.into(), m, y.in_medium())
+            };
             format!(
-                "{i}-{}: len={len:.3e} cos=({:.3e},{:.3e}) derr={:.1e}",
+                "{i}-{}: len={len:.3e} cos=({:.3e},{:.3e}) derr={:.1e} p=({},{}) media=({ma:?},{mb:?}) ff=({:e},{:e})",
                 i + 1,
                 a.ng.dot(w).abs(),
                 b.ng.dot(w).abs(),
-                lt_core::path::scatter::direction_error(a, b)
+                lt_core::path::scatter::direction_error(a, b),
+                a.p,
+                b.p,
+                ff(a, b, ma),
+                ff(b, a, mb)
             )
         })
         .collect();
