@@ -280,6 +280,12 @@ const MEDIUM_FURNACE_EXCLUDED: &[(&str, &str)] = &[
         "as pb2d, with photon beams and the 1-D kernel: the kernel straddles the ball's boundary \
          (bias there); tests/points_beams.rs holds it to pt",
     ),
+    (
+        "upbp",
+        "its PP3D and PB2D kernels straddle the ball's boundary (bias there, as pp3d's and \
+         pb2d's); agreement.rs holds it to pt on every media scene and tests/mis_check_upbp.rs \
+         its weights to the oracle",
+    ),
 ];
 
 /// The sphere holding a ball of chromatic forward-scattering medium (HG g = 0.7), the cube one of

@@ -281,6 +281,13 @@ pub fn check_record(scene: &Scene, r: &UpbpRecord, opts: &UpbpOptions, ratio: f6
     }
 }
 
+/// Sets `scene`'s film to the check's resolution.
+pub fn prepare_scene(scene: &mut Scene, opts: &UpbpOptions) {
+    scene.camera = scene
+        .camera
+        .with_resolution(opts.resolution, opts.resolution);
+}
+
 /// Samples and checks; `scene`'s film is set to the check's resolution first. Returns the report
 /// and a line per kind of technique (connections, pp3d, pb2d): paths checked, the largest
 /// relative mismatch, the paths failing.
@@ -289,18 +296,27 @@ pub fn check_scene(
     opts: &UpbpOptions,
     name: &str,
 ) -> Result<(Report, String), String> {
-    scene.camera = scene
-        .camera
-        .with_resolution(opts.resolution, opts.resolution);
+    prepare_scene(scene, opts);
     let (c, passes) = collect(scene, opts)?;
+    Ok(check_records(scene, &c.records, opts, (passes, c.too_long), name))
+}
+
+/// Checks every record (from `collect`, or altered by hand in tests); see `check_scene`.
+pub fn check_records(
+    scene: &Scene,
+    records: &[UpbpRecord],
+    opts: &UpbpOptions,
+    (passes, too_long): (u32, usize),
+    name: &str,
+) -> (Report, String) {
     let ratio = 1.0;
     let mut report = Report::new(name, "upbp".into(), opts.heuristic, opts.max_depth);
     report.slack = opts.slack;
     report.merging = true;
     report.passes = passes;
-    report.too_long = c.too_long;
+    report.too_long = too_long;
     let mut kinds = BTreeMap::new();
-    for r in &c.records {
+    for r in records {
         let v = check_record(scene, r, opts, ratio);
         let kind = match r.technique {
             VolumeTechnique::Connect(_) => "connections",
@@ -328,5 +344,5 @@ pub fn check_scene(
             "  upbp {kind}: {n} paths checked, largest relative mismatch {worst:.3e}, {bad} failing\n"
         );
     }
-    Ok((report.finish(), summary))
+    (report.finish(), summary)
 }
