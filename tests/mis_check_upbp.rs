@@ -26,7 +26,10 @@ fn options(scene: &lt_core::Scene, h: Heuristic) -> UpbpOptions {
 #[test]
 fn upbp_weights_match_the_oracle_on_every_media_scene() {
     let names = shipped_media_scene_names();
-    assert!(names.len() >= 5, "expected the media scenes, found {names:?}");
+    assert!(
+        names.len() >= 5,
+        "expected the media scenes, found {names:?}"
+    );
     let mut failed = Vec::new();
     for h in [Heuristic::Power, Heuristic::Balance] {
         for name in &names {
@@ -65,7 +68,10 @@ fn a_planted_merge_density_error_fails() {
     }
     let (report, summary) = check_records(&scene, &beam, &opts, counts, "hg-spot");
     println!("PB2D ×1.01:\n{summary}");
-    assert!(report.failures() > report.checked() / 4, "{report}{summary}");
+    assert!(
+        report.failures() > report.checked() / 4,
+        "{report}{summary}"
+    );
     // PP3D missing from the oracle's sum: the integrator's weights counted it.
     let mut missing = records;
     for r in &mut missing {
@@ -73,5 +79,8 @@ fn a_planted_merge_density_error_fails() {
     }
     let (report, summary) = check_records(&scene, &missing, &opts, counts, "hg-spot");
     println!("PP3D missing:\n{summary}");
-    assert!(report.failures() > report.checked() / 4, "{report}{summary}");
+    assert!(
+        report.failures() > report.checked() / 4,
+        "{report}{summary}"
+    );
 }

@@ -15,7 +15,7 @@ use std::path::PathBuf;
 pub struct MisCheckArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    /// Integrator whose weights are checked: pt, bdpt, lvc-bdpt, vcm or bpm (for eamis, its counts are
+    /// Integrator whose weights are checked: pt, bdpt, lvc-bdpt, vcm, bpm or upbp (for eamis, its counts are
     /// checked through vcm with `--no-vertex-connections --checkerboard-merging`).
     #[arg(long, default_value = "bdpt")]
     pub integrator: String,

@@ -133,7 +133,8 @@ fn random_walk(
     out.back_flight.clear();
     out.back_flight.resize(out.vertices.len(), 1.0);
     out.departure.clear();
-    out.departure.resize(out.vertices.len(), Departure::default());
+    out.departure
+        .resize(out.vertices.len(), Departure::default());
     out.exit = None;
     // How the walk left the last vertex along the segment being walked.
     let mut leave = Departure { beta, pdf_w: pdf };

@@ -135,7 +135,6 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
         }
     }
 
-
     /// The weight of a volumetric merge of photon path `y` (y_0 … y_i) with the camera side
     /// `cam` (z_0 … , its last the camera's x_i), `zx_back` the free flight of x_i → its camera
     /// predecessor walked back, `zx_rate` σ̂ at x_i. The densities are `Densities::volume_merged`'s.
@@ -292,7 +291,8 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
                 buf.clear();
                 buf.extend_from_slice(prefix);
                 buf.push(xv);
-                let back = scene.free_flight_density((&xv).into(), o.into(), Some(m), o.in_medium());
+                let back =
+                    scene.free_flight_density((&xv).into(), o.into(), Some(m), o.in_medium());
                 let rate = (scatter / pass) as f64;
                 let w = self.merge_weight(
                     scene,
@@ -345,7 +345,13 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         self.exit = camera.exit;
     }
 
-    fn emitter_weight(&self, scene: &Scene, path: &[PathVertex], f: JoinFlights, _: Vec2) -> Weight {
+    fn emitter_weight(
+        &self,
+        scene: &Scene,
+        path: &[PathVertex],
+        f: JoinFlights,
+        _: Vec2,
+    ) -> Weight {
         let (split, mut evals) = Split::reached(path);
         evals.flights = Some(f);
         let w = with_chain_in::<MEDIA, _>(scene, split, evals, self.pass.ratio, |chain, s| {
@@ -379,7 +385,12 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         let this = &*self;
         joins.join_subpath_in::<MEDIA>(scene, this.y, |c| {
             let s = c.light.len();
-            let junction = junction_rate(this.pass, scene, &c.camera[c.camera.len() - 1], &c.light[s - 1]);
+            let junction = junction_rate(
+                this.pass,
+                scene,
+                &c.camera[c.camera.len() - 1],
+                &c.light[s - 1],
+            );
             let (split, evals) = Split::connection(c, this.ly.nee);
             let w = with_chain_in::<MEDIA, _>(scene, split, evals, this.pass.ratio, |chain, s| {
                 connection_weight(this.pass, chain, s, (this.ly.rates, junction), &this.cam)

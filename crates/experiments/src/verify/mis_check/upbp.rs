@@ -298,7 +298,13 @@ pub fn check_scene(
 ) -> Result<(Report, String), String> {
     prepare_scene(scene, opts);
     let (c, passes) = collect(scene, opts)?;
-    Ok(check_records(scene, &c.records, opts, (passes, c.too_long), name))
+    Ok(check_records(
+        scene,
+        &c.records,
+        opts,
+        (passes, c.too_long),
+        name,
+    ))
 }
 
 /// Checks every record (from `collect`, or altered by hand in tests); see `check_scene`.
@@ -333,7 +339,13 @@ pub fn check_records(
             report.examples.push(format!(
                 "k={} {:?} weight={:.9e} oracle={:.9e} rel={:.3e} allowed={:.3e} Σw−1={:.3e} \
                  replay={:.3e}",
-                v.k, r.technique, r.weight, v.oracle, v.mismatch, v.allowed, v.sum_error,
+                v.k,
+                r.technique,
+                r.weight,
+                v.oracle,
+                v.mismatch,
+                v.allowed,
+                v.sum_error,
                 v.replay_error
             ));
         }
