@@ -723,9 +723,9 @@ const MEDIA_PASSES: [(&str, u32); 8] = [
     ("pp3d", 32),
     ("pb2d", 32),
     ("bb1d", 32),
-    // Its merges query every photon of the pass: 8 passes keep it near 1 CPU s per scene
+    // Its merges query every photon of the pass: 4 passes keep it near 0.5 CPU s per scene
     // (results/points-beams.md, "upbp").
-    ("upbp", 8),
+    ("upbp", 4),
 ];
 const MEDIA_DEFAULT_PASSES: u32 = 256;
 
