@@ -16,6 +16,7 @@ mod light_paths;
 mod material_grid;
 mod media;
 mod mis_check;
+mod mis_check_upbp;
 mod mis_check_vcm;
 mod mlt;
 mod partial_merge;

@@ -22,6 +22,7 @@ pub mod record;
 pub mod registry;
 pub mod render;
 pub mod subpath;
+pub mod upbp;
 // Volumetric density estimation: photon points gathered by points and by camera beams.
 pub mod volume_density;
 

@@ -12,6 +12,7 @@ use crate::photon::sppm::Sppm;
 use crate::unidirectional::light::{LightParams, LightTracer};
 use crate::unidirectional::pt::{Pt, PtParams};
 use crate::unidirectional::pt_bsdf::{PtBsdf, PtBsdfParams};
+use crate::upbp::Upbp;
 use crate::vcm::bpm::Bpm;
 use crate::vcm::eamis::Eamis;
 use crate::vcm::Vcm;
@@ -96,6 +97,9 @@ pub enum Weights {
     ConnectMerge { connections: bool },
     /// lvc-bdpt's: bdpt's techniques, connections counted N / L̄ times (`lvc_bdpt`).
     VertexCache,
+    /// upbp's: bdpt's connections, PP3D and PB2D under one MIS from the full path's densities
+    /// (`upbp::weights`; the oracle `lt_core::path::volume_merging`).
+    Volumetric,
     /// eamis's: vcm's full-path weights with the counts its pilot chose (`eamis`); `lt mis-check`
     /// holds those weights through vcm with the same counts (`vertex_connections`).
     EfficiencyAware,
@@ -256,6 +260,16 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         make: |s, r| Ok(Estimator::Consistent(Box::new(Bb1d::read(s, r)?))),
     },
     IntegratorInfo {
+        name: "upbp",
+        about: "unified points, beams and paths: bdpt's connections, volumetric photon points \
+                (PP3D) and camera beams (PB2D) under one MIS",
+        kind: Kind::Consistent,
+        weights: Weights::Volumetric,
+        source: include_str!("upbp/mod.rs"),
+        radius: Radius::Dimension(2),
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Upbp::read(s, r)?))),
+    },
+    IntegratorInfo {
         name: "pssmlt",
         about: "primary-sample-space Metropolis (Kelemen) over bdpt's or pt's samples; \
                 error bars from independent runs",
@@ -312,7 +326,9 @@ pub fn make_integrator(
 
 /// The integrators that walk participating media (`media/`); every other refuses a scene with
 /// media rather than render it silently wrong (issue 43, item 4).
-pub const HANDLES_MEDIA: &[&str] = &["pt", "pt-bsdf", "light", "bdpt", "pp3d", "pb2d", "bb1d"];
+pub const HANDLES_MEDIA: &[&str] = &[
+    "pt", "pt-bsdf", "light", "bdpt", "pp3d", "pb2d", "bb1d", "upbp",
+];
 
 /// One clear line for an integrator that cannot render the scene's media.
 fn refuse_media(name: &str, scene: &Scene) -> Result<(), String> {

@@ -71,6 +71,7 @@ mod path;
 pub mod scatter;
 pub mod subpath_mis;
 pub mod vertex;
+pub mod volume_merging;
 
 pub use correlation::Correlation;
 pub use densities::Densities;
@@ -80,3 +81,4 @@ pub use path::Path;
 pub use scatter::{scatter, Scatter};
 pub use subpath_mis::{CameraMis, LightMis, SubpathMis};
 pub use vertex::{geometry, PathVertex, VertexKind};
+pub use volume_merging::{VolumeRates, VolumeSet, VolumeTechnique};

@@ -32,7 +32,7 @@ enum Command {
     Compare(x::commands::compare::CompareArgs),
     /// Measure BVH and integrator throughput (results/bench.md).
     Bench(x::commands::bench::BenchArgs),
-    /// Check an integrator's MIS weights (pt, bdpt, lvc-bdpt, vcm, bpm; eamis's counts through vcm)
+    /// Check an integrator's MIS weights (pt, bdpt, lvc-bdpt, vcm, bpm, upbp; eamis's counts through vcm)
     /// against the from-scratch path-space oracle.
     MisCheck(x::commands::mis_check::MisCheckArgs),
     /// Render (or reuse from the cache) a long reference image of a scene.

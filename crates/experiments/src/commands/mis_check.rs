@@ -3,6 +3,7 @@
 
 use crate::verify::mis_check::pt_bdpt::{check_scene, Options, Which};
 use crate::verify::mis_check::tolerance::DEFAULT_SLACK;
+use crate::verify::mis_check::upbp::{self, UpbpOptions};
 use crate::verify::mis_check::vcm_bpm::{self, VcmOptions};
 use clap::Args;
 use lt_core::path::Heuristic;
@@ -14,7 +15,7 @@ use std::path::PathBuf;
 pub struct MisCheckArgs {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    /// Integrator whose weights are checked: pt, bdpt, lvc-bdpt, vcm or bpm (for eamis, its counts are
+    /// Integrator whose weights are checked: pt, bdpt, lvc-bdpt, vcm, bpm or upbp (for eamis, its counts are
     /// checked through vcm with `--no-vertex-connections --checkerboard-merging`).
     #[arg(long, default_value = "bdpt")]
     pub integrator: String,
@@ -51,6 +52,9 @@ pub struct MisCheckArgs {
     /// vcm, bpm: merging only in a checkerboard of pixels (eamis's per-pixel choice).
     #[arg(long)]
     pub checkerboard_merging: bool,
+    /// upbp: its `techniques` (all, or a comma-separated subset of bpt, pp3d, pb2d).
+    #[arg(long)]
+    pub techniques: Option<String>,
 }
 
 /// `lt mis-check`: the report, or an error carrying it when any check fails.
@@ -60,6 +64,7 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
         Weights::Connections => Which::Bdpt,
         Weights::VertexCache => Which::Lvc,
         Weights::ConnectMerge { connections } => return run_vcm_bpm(args, connections),
+        Weights::Volumetric => return run_upbp(args),
         Weights::EfficiencyAware => {
             return Err(format!(
                 "mis-check: {}'s weights are vcm's full-path weights with the counts its pilot \
@@ -121,6 +126,37 @@ pub fn run(args: &MisCheckArgs) -> Result<String, String> {
             report.failures(),
             report.checked()
         ))
+    }
+}
+
+/// `lt mis-check --integrator upbp`: connections, PP3D and PB2D through media.
+fn run_upbp(args: &MisCheckArgs) -> Result<String, String> {
+    let mut scene = lt_scene_io::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let mut opts = UpbpOptions::new(&scene);
+    if let Some(m) = &args.mis {
+        opts.heuristic = Heuristic::parse(m)?;
+    }
+    if let Some(d) = args.max_depth {
+        if d == 0 {
+            return Err("mis-check: max_depth must be at least 1".into());
+        }
+        opts.max_depth = d;
+    }
+    if let Some(t) = &args.techniques {
+        opts.techniques = t.clone();
+    }
+    opts.paths = args.paths;
+    opts.seed = args.seed;
+    opts.resolution = args.resolution.max(1);
+    opts.max_passes = args.max_passes;
+    opts.slack = args.slack;
+    let name = args.scene.display().to_string();
+    let (report, summary) = upbp::check_scene(&mut scene, &opts, &name)?;
+    let out = format!("{report}{summary}");
+    if report.passed() {
+        Ok(out)
+    } else {
+        Err(out)
     }
 }
 

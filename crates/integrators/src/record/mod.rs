@@ -49,6 +49,26 @@ pub struct Merged<'a> {
     pub radius: f32,
 }
 
+/// One path completed by a volumetric merge (`upbp`): a light medium vertex y_i found within the
+/// radius of the camera walk's medium vertex (PP3D) or of its segment (PB2D, the query point on
+/// the segment standing for the camera side's x_i).
+pub struct VolumeMerged<'a> {
+    /// PB2D (true) or PP3D (false).
+    pub beam: bool,
+    /// The merging vertex x_i (1 ≤ i ≤ k − 1).
+    pub i: usize,
+    /// The light subpath y_0 … y_i, the merged photon last.
+    pub light: &'a [PathVertex],
+    /// The camera side, camera first: x_k … x_i (the medium vertex, or the beam's query point).
+    pub camera: &'a [PathVertex],
+    pub weight: f64,
+    /// The unweighted contribution, normalised as added (kernel and 1/N included).
+    pub value: Color,
+    pub raster: Vec2,
+    /// The kernel's radius in this pass.
+    pub radius: f32,
+}
+
 /// What one stretch of a work item's time went to, for `crate::record::tally` (per-technique cost): the
 /// code since the previous lap. Connections are keyed as `Completed` paths are — s light
 /// vertices, t camera vertices, k = s + t − 1 segments (s = 0 at a camera walk of k + 1 vertices
@@ -75,6 +95,9 @@ pub trait Recorder {
     fn completed(&mut self, path: Completed);
     /// A path made by merging; recorders of connection-only integrators ignore it.
     fn merged(&mut self, _path: Merged) {}
+    /// A path made by a volumetric merge (`upbp`); other recorders ignore it.
+    #[inline]
+    fn volume_merged(&mut self, _path: VolumeMerged) {}
     /// The effective densities of every technique of the path reported next (`completed` or
     /// `merged`), where its weight was computed from the full path (`lt_core::path::camis`).
     #[inline]

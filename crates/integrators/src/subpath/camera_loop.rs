@@ -7,8 +7,9 @@
 //!   escaped to);
 //! - s = 1: next-event estimation from z_{t−1};
 //! - s ≥ 2: shadow rays to the light vertices the estimator chooses (`Joins`);
-//! - the estimator's own techniques at the vertex (VCM's merges) and along the segment that
-//!   reached it (none yet: the hook UPBP's beams and medium points need),
+//! - the estimator's own techniques at the vertex (VCM's merges, upbp's medium points) and along
+//!   the segment that reached it (upbp's camera beams; after the last vertex, along the segment
+//!   that left the scene: `after_walk`),
 //!
 //! each completed path reported to the recorder and each technique's time lapped. What differs
 //! between estimators is a [`CameraPolicy`]: which light vertices a camera vertex joins, the MIS
@@ -107,9 +108,26 @@ pub trait CameraPolicy {
     }
 
     /// The estimator's own techniques along the segment z_{t−2} → z_{t−1}, before any at
-    /// z_{t−1} (volumetric estimators' camera beams; none yet).
+    /// z_{t−1} (volumetric estimators' camera beams: `upbp`).
     #[inline]
     fn along_segment<R: Recorder>(
+        &mut self,
+        _scene: &Scene,
+        _z: &[PathVertex],
+        _sample: &mut SampleCtx<'_, R>,
+        _l: &mut Color,
+    ) {
+    }
+
+    /// The camera walk as a subpath (after `walked`): what segment techniques read besides the
+    /// vertices (through media, `Subpath::departure` and `Subpath::exit`; `upbp`).
+    #[inline]
+    fn camera_walk(&mut self, _scene: &Scene, _camera: &Subpath) {}
+
+    /// After every vertex's techniques: the estimator's own techniques along the walk's last
+    /// segment when it reached no vertex (`Subpath::exit`; `upbp`'s camera beams).
+    #[inline]
+    fn after_walk<R: Recorder>(
         &mut self,
         _scene: &Scene,
         _z: &[PathVertex],
@@ -323,6 +341,7 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
     let camera = &scratch.camera;
     let z = &camera.vertices;
     policy.walked(scene, z, raster);
+    policy.camera_walk(scene, camera);
     rec.begin_sample(pixel, film.weight);
     rec.lap(Work::CameraWalk);
     let reached = &mut scratch.reached;
@@ -368,6 +387,7 @@ pub fn camera_sample<P: CameraPolicy, R: Recorder>(
         }
         policy.at_vertex(scene, &z[..t], &mut ctx, &mut l);
     }
+    policy.after_walk(scene, z, &mut ctx, &mut l);
     // s = 0 at infinity: the walk left the scene after its last vertex.
     if let Some(esc) = camera.escape {
         if z.len() <= max_k {

@@ -32,7 +32,7 @@
 
 use super::media_step::{scatter_in_medium, NullCrossings};
 use super::walk::{self, camera_start, continue_subpath, light_start, reverse_density, Escape};
-use super::walk::{Subpath, WalkLimits, WalkStart};
+use super::walk::{Departure, Exit, Subpath, WalkLimits, WalkStart};
 use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::medium::{FreeFlight, Medium, MediumId};
@@ -170,6 +170,12 @@ fn random_walk(
     } = start;
     out.back_flight.clear();
     out.back_flight.resize(out.vertices.len(), 1.0);
+    out.departure.clear();
+    out.departure
+        .resize(out.vertices.len(), Departure::default());
+    out.exit = None;
+    // How the walk left the last vertex along the segment being walked.
+    let mut leave = Departure { beta, pdf_w: pdf };
     let endpoint = out.vertices.last().expect("the endpoint is pushed first");
     let mut medium = endpoint.medium_towards(scene, ray.d);
     let mut flight = Flight::leaving(false);
@@ -191,6 +197,7 @@ fn random_walk(
                     let reverse = flight.reverse_to(scene, &v, prev, medium);
                     out.vertices.push(v);
                     out.back_flight.push(reverse);
+                    out.departure.push(leave);
                     if beta == Color::ZERO || n + 1 >= limits.max_vertices {
                         return;
                     }
@@ -208,6 +215,7 @@ fn random_walk(
                         reverse_density(&before[n - 1], &v[0], pdf_rev_w) * flight.reverse;
                     pdf = ps.pdf;
                     ray = Ray::new(x, ps.wi);
+                    leave = Departure { beta, pdf_w: pdf };
                     flight = Flight::leaving(true);
                     crossings.reset();
                     continue;
@@ -226,6 +234,7 @@ fn random_walk(
             flight.first = false;
         }
         let Some(hit) = hit else {
+            out.exit = Some(Exit { dir: ray.d, leave });
             if mode == lt_core::bsdf::TransportMode::Radiance && !scene.infinite_lights.is_empty() {
                 // The light at infinity is reached through every piece passed: its density is
                 // the direction's times the pass probability (as `surface_through_media`).
@@ -257,6 +266,7 @@ fn random_walk(
         let reverse = flight.reverse_to(scene, &v, prev, medium);
         out.vertices.push(v);
         out.back_flight.push(reverse);
+        out.departure.push(leave);
         // A pane may be passed at the last vertex: passing it is a null event, no vertex
         // (`Scene::is_null_transmission`); only a reflection makes it one.
         let pane = scene.has_null_transmission(hit.material);
@@ -277,6 +287,7 @@ fn random_walk(
             // the segment goes on from the last real vertex, its densities times that.
             out.vertices.pop();
             out.back_flight.pop();
+            out.departure.pop();
             out.vertices[n - 1].pdf_rev = rev_before;
             flight.forward *= bs.pdf_w;
             flight.reverse *= bs.pdf_rev_w;
@@ -290,6 +301,7 @@ fn random_walk(
         }
         crossings.reset();
         pdf = bs.pdf_w;
+        leave = Departure { beta, pdf_w: pdf };
         flight = Flight::leaving(false);
     }
 }

@@ -160,6 +160,32 @@ pub struct Subpath {
     /// segment; a join patching the reverse density of the vertex before reads it here instead of
     /// walking the segment again. (Beside the vertices, not in them: a vertex is kept at 128 bytes.)
     pub back_flight: Vec<f32>,
+    /// Through media, one per vertex (empty otherwise): how the walk left the vertex before
+    /// along the segment that reached this one (throughput and direction density at the
+    /// segment's start; default at the endpoint). Volumetric estimators that integrate along a
+    /// segment (camera beams, `upbp`) read it: the segment's start throughput is not recoverable
+    /// from the vertex's β once a free flight's weight is stochastic (grids).
+    pub departure: Vec<Departure>,
+    /// Through media: the segment the walk took after its last vertex when it reached no vertex
+    /// (it left the scene), whatever the lights; `None` otherwise. Set by the media walk only.
+    pub exit: Option<Exit>,
+}
+
+/// How a walk left a vertex along one segment (`Subpath::departure`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Departure {
+    /// Throughput leaving the vertex (after its scattering and Russian roulette).
+    pub beta: Color,
+    /// Solid-angle density of the direction (the camera's `pdf_dir` for the primary ray).
+    pub pdf_w: f32,
+}
+
+/// The walk's last segment, which reached no vertex (`Subpath::exit`).
+#[derive(Clone, Copy, Debug)]
+pub struct Exit {
+    /// Unit direction from the last vertex.
+    pub dir: Vec3,
+    pub leave: Departure,
 }
 
 impl Subpath {
@@ -168,7 +194,15 @@ impl Subpath {
             vertices: Vec::with_capacity(n),
             escape: None,
             back_flight: Vec::new(),
+            departure: Vec::new(),
+            exit: None,
         }
+    }
+
+    /// `departure` of vertex `i` (default when the walk kept none: a surface walk).
+    #[inline]
+    pub fn departure(&self, i: usize) -> Departure {
+        self.departure.get(i).copied().unwrap_or_default()
     }
 
     /// `back_flight` of vertex `i` (1 when the walk kept none: a surface walk).

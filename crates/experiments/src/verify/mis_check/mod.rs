@@ -5,6 +5,7 @@
 //!   n_conn = N / L̄ times, `connection_count`), and bdpt's (lvc-bdpt's) replayed for every
 //!   technique of the path.
 //! - `vcm_bpm`: vcm's and bpm's (connections and merges), and their recursion replayed.
+//! - `upbp`: upbp's (connections, PP3D and PB2D through media), and its routine replayed.
 //! - `tolerance`: how far a weight may stray from the oracle's.
 //! - `report`: the one report both checkers fill, a row per path length.
 
@@ -13,6 +14,7 @@ use lt_core::Scene;
 pub mod pt_bdpt;
 pub mod report;
 pub mod tolerance;
+pub mod upbp;
 pub mod vcm_bpm;
 
 /// One clear line when `integrator`'s weights cannot be held to the oracle on `scene` because
@@ -22,7 +24,7 @@ pub mod vcm_bpm;
 /// unbiased, but not the path-space weights, whose BSDF-sampling density also carries the
 /// probability of passing the media to the light. The others refuse media scenes outright.
 pub fn refuse_media(scene: &Scene, integrator: &str) -> Result<(), String> {
-    if !scene.has_media || integrator == "bdpt" {
+    if !scene.has_media || integrator == "bdpt" || integrator == "upbp" {
         return Ok(());
     }
     if integrator == "pt" {

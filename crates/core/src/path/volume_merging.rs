@@ -1,0 +1,206 @@
+//! UPBP's volumetric techniques (Křivánek et al. 2014, §4–5) beside the connection techniques of
+//! [`Densities`], computed from scratch: the oracle `upbp`'s weights are held to.
+//!
+//! A path x0 … xk with a medium vertex x_i (1 ≤ i ≤ k−1) can also be made by
+//!
+//! - **point–point 3-D** (PP3D): the light subpath's x_i (a photon) found within r of the camera
+//!   subpath's x_i (the camera walk's medium vertex), a ball of volume (4/3)πr³:
+//!   p_P,i = N · (4/3)πr³ · ∏_{j≤i} l_j · ∏_{j≥i} c_j;
+//! - **point–beam 2-D** (PB2D): the photon found within r of the camera walk's segment
+//!   x_{i+1} → x_i as a beam (a disk of area πr² across it), the query point integrated along
+//!   the beam with T evaluated, not sampled. The camera side no longer samples the distance to
+//!   x_i: instead of the free flight's scattering density at x_i (per unit length, inside c_i)
+//!   the beam covers x_i with the probability that the flight passes it (a short beam ends where
+//!   the walk's flight ended). So c_i becomes c_i / σ̂_i, σ̂_i = p_scatter / P_pass of the flight
+//!   x_{i+1} → x_i at x_i (`Scene::free_flight_density` with and without scattering; the pieces
+//!   before the last cancel): p_B,i = N · πr² · ∏_{j≤i} l_j · (c_i / σ̂_i) · ∏_{j>i} c_j.
+//!
+//! N is the number of light subpaths whose photons every camera subpath queries (a pass's), so
+//! against a connection (one per camera sample) the heuristics compare η_P = N (4/3)πr³ and
+//! η_B = N πr² times the products (as `merging`'s η = N π r² for surfaces). Every density is in
+//! the path's measure: a medium vertex's l_j, c_j per unit volume (no cosine), a surface's per
+//! unit area. The merged path has two x_i (light side y_i, camera side z or the beam's query
+//! point): as `Densities::merged`, with the two densities that join them taking their free
+//! flights (the light walk's segment y_i → y_{i−1} walked back, the camera's z → z_{t−2}).
+
+use super::densities::Densities;
+use super::mis::{oracle_weight, Heuristic};
+use super::path::Path;
+use super::vertex::PathVertex;
+use crate::scene::Scene;
+
+/// Which of UPBP's techniques an estimator runs, with the merges' counts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolumeSet {
+    /// bdpt's connections s ≥ 1 (s = 0, the camera walk hitting a light, always runs).
+    pub connections: bool,
+    /// η_P = N (4/3)πr³ of PP3D; 0 turns it off.
+    pub points_eta: f64,
+    /// η_B = N πr² of PB2D; 0 turns it off.
+    pub beams_eta: f64,
+}
+
+/// One technique of UPBP's family on a path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum VolumeTechnique {
+    /// Vertex connection (or a walk's own end) with s light vertices.
+    Connect(usize),
+    /// PP3D at the medium vertex x_i.
+    Point(usize),
+    /// PB2D at the medium vertex x_i.
+    Beam(usize),
+}
+
+/// Per vertex x_j of a path: whether it lies in a medium, and σ̂_j (module doc) of the camera
+/// direction's flight x_{j+1} → x_j (0 where no flight scatters: surfaces, endpoints).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeRates {
+    pub medium: Vec<bool>,
+    pub rate: Vec<f64>,
+}
+
+/// σ̂ of the flight `from` → `to` at `to`: its scattering density per unit length over its pass
+/// probability, from scratch (`Scene::free_flight_density`); 0 when `to` is no medium vertex.
+pub fn scatter_rate(scene: &Scene, from: &PathVertex, to: &PathVertex) -> f64 {
+    if !to.in_medium() {
+        return 0.0;
+    }
+    let m = from.medium_towards(scene, from.dir_to(to));
+    let scatter = scene.free_flight_density(from.into(), to.into(), m, true) as f64;
+    let pass = scene.free_flight_density(from.into(), to.into(), m, false) as f64;
+    if pass > 0.0 {
+        scatter / pass
+    } else {
+        0.0
+    }
+}
+
+/// The free-flight density of a walk from `from` reaching `to` (scattering there when it is a
+/// medium vertex), from scratch.
+fn free_flight(scene: &Scene, from: &PathVertex, to: &PathVertex) -> f64 {
+    let m = from.medium_towards(scene, from.dir_to(to));
+    scene.free_flight_density(from.into(), to.into(), m, to.in_medium()) as f64
+}
+
+impl VolumeRates {
+    /// The rates of `path` (x0 … xk) from scratch.
+    pub fn of_path(scene: &Scene, path: &Path) -> VolumeRates {
+        let v = &path.vertices;
+        let k = v.len() - 1;
+        let medium: Vec<bool> = v.iter().map(|x| x.in_medium()).collect();
+        let rate = (0..=k)
+            .map(|j| {
+                if j < k && medium[j] {
+                    scatter_rate(scene, &v[j + 1], &v[j])
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        VolumeRates { medium, rate }
+    }
+
+    /// The rates of a merged path (`light` = y_0 … y_i, `camera` = z_0 … z_{t−1}, its last the
+    /// camera side's x_i): x_j below i as the light side has them (x_{i−1} seen from y_i), x_i
+    /// and above as the camera side.
+    pub fn merged(scene: &Scene, light: &[PathVertex], camera: &[PathVertex]) -> VolumeRates {
+        let i = light.len() - 1;
+        let t = camera.len();
+        let at_light = VolumeRates::of_path(scene, &Path::from_subpaths(light, &camera[..t - 1]));
+        let at_camera = VolumeRates::of_path(scene, &Path::from_subpaths(&light[..i], camera));
+        let pick = |j: usize| if j < i { &at_light } else { &at_camera };
+        let k = at_light.rate.len() - 1;
+        VolumeRates {
+            medium: (0..=k).map(|j| pick(j).medium[j]).collect(),
+            rate: (0..=k).map(|j| pick(j).rate[j]).collect(),
+        }
+    }
+}
+
+impl Densities {
+    /// The densities of a path completed by a volumetric merge at x_i (PP3D or PB2D), from
+    /// scratch: `Densities::merged`, whose two joining densities take their free flights here.
+    pub fn volume_merged(scene: &Scene, light: &[PathVertex], camera: &[PathVertex]) -> Densities {
+        let mut d = Densities::merged(scene, light, camera);
+        let i = light.len() - 1;
+        let t = camera.len();
+        let k = d.k();
+        d.camera[i - 1] *= free_flight(scene, &light[i], &light[i - 1]);
+        if i + 1 < k {
+            d.light[i + 1] *= free_flight(scene, &camera[t - 1], &camera[t - 2]);
+        }
+        d
+    }
+
+    /// The effective densities the heuristics compare under `set`: n_s·p_s of the connection
+    /// techniques s = 0 … k+1 (zero for s ≥ 1 without connections), then η_P·p_P,i for
+    /// i = 0 … k, then η_B·p_B,i for i = 0 … k (module doc; zero where x_i is no medium vertex).
+    pub fn effective_upbp(&self, set: VolumeSet, rates: &VolumeRates) -> Vec<f64> {
+        let k = self.k();
+        let mut all = self.effective_all();
+        if !set.connections {
+            all.iter_mut().skip(1).for_each(|p| *p = 0.0);
+        }
+        let mergeable = |i: usize| i >= 1 && i < k && rates.medium[i];
+        let light_to = |i: usize| -> f64 { self.light[..=i].iter().product() };
+        let camera_from = |i: usize| -> f64 { self.camera[i..].iter().product() };
+        for i in 0..=k {
+            all.push(if mergeable(i) {
+                set.points_eta * light_to(i) * camera_from(i)
+            } else {
+                0.0
+            });
+        }
+        for i in 0..=k {
+            let r = rates.rate[i];
+            all.push(if mergeable(i) && r > 0.0 {
+                set.beams_eta * light_to(i) * (self.camera[i] / r) * camera_from(i + 1)
+            } else {
+                0.0
+            });
+        }
+        all
+    }
+
+    /// Where `technique` sits in `effective_upbp`'s list.
+    pub fn upbp_index(&self, technique: VolumeTechnique) -> usize {
+        let n = self.k() + 1;
+        match technique {
+            VolumeTechnique::Connect(s) => s,
+            VolumeTechnique::Point(i) => n + 1 + i,
+            VolumeTechnique::Beam(i) => 2 * n + 1 + i,
+        }
+    }
+
+    /// The weight of `technique` under `h` over every technique of `set`, by brute force over the
+    /// effective densities (`oracle_weight`).
+    pub fn upbp_weight(
+        &self,
+        set: VolumeSet,
+        rates: &VolumeRates,
+        technique: VolumeTechnique,
+        h: Heuristic,
+    ) -> f64 {
+        let all = self.effective_upbp(set, rates);
+        oracle_weight(&all, self.upbp_index(technique), h)
+    }
+
+    /// Every technique of `set` that can produce this path (positive effective density).
+    pub fn upbp_techniques(&self, set: VolumeSet, rates: &VolumeRates) -> Vec<VolumeTechnique> {
+        let all = self.effective_upbp(set, rates);
+        let n = self.k() + 1;
+        all.iter()
+            .enumerate()
+            .filter(|(_, &p)| p > 0.0)
+            .map(|(j, _)| {
+                if j <= n {
+                    VolumeTechnique::Connect(j)
+                } else if j <= 2 * n {
+                    VolumeTechnique::Point(j - n - 1)
+                } else {
+                    VolumeTechnique::Beam(j - 2 * n - 1)
+                }
+            })
+            .collect()
+    }
+}

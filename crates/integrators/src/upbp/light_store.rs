@@ -1,0 +1,173 @@
+//! A pass's light subpaths for `upbp`: walked through media (`media_walk::light_subpath_in`),
+//! kept whole (a merge's weight reads every density of the light side), with what the weights
+//! need per vertex besides the walk's densities (σ̂ of the camera direction's flight into it,
+//! next-event estimation's density of y_0), and their medium vertices indexed as photons for
+//! points (`PointGrid`) and for camera beams (`volume_density::beams::BeamGrid`).
+
+use super::weights::VertexRate;
+use crate::subpath::connect::nee_density;
+use crate::subpath::media_walk::light_subpath_in;
+use crate::subpath::walk::{Subpath, WalkLimits};
+use crate::volume_density::beams::BeamGrid;
+use lt_core::math::Vec3;
+use lt_core::path::volume_merging::scatter_rate;
+use lt_core::path::PathVertex;
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::spatial::PointGrid;
+use lt_core::Scene;
+use rayon::prelude::*;
+
+/// Light subpaths traced per parallel chunk (fixed: the stored order, hence every sum, does not
+/// depend on the thread count).
+const CHUNK: u64 = 256;
+
+/// One light subpath as a merge or a connection reads it.
+#[derive(Clone, Copy)]
+pub struct LightPath<'a> {
+    pub vertices: &'a [PathVertex],
+    /// `Subpath::back_flight` per vertex.
+    pub back_flight: &'a [f32],
+    /// Per vertex y_j: medium, and σ̂ of the flight y_{j+1} → y_j (0 at the last vertex: the
+    /// flight into it from a camera side is the join's or the merge's).
+    pub rates: &'a [VertexRate],
+    /// Next-event estimation's density of y_0 from y_1 (0 for a one-vertex subpath).
+    pub nee: f64,
+}
+
+#[derive(Default)]
+struct Chunk {
+    vertices: Vec<PathVertex>,
+    back_flight: Vec<f32>,
+    rates: Vec<VertexRate>,
+    starts: Vec<u32>,
+    nee: Vec<f64>,
+}
+
+/// A photon: light subpath `path`'s medium vertex `vertex` (≥ 1).
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonRef {
+    pub path: u32,
+    pub vertex: u32,
+}
+
+/// The pass's light subpaths and their photon indices.
+pub struct LightStore {
+    chunks: Vec<Chunk>,
+    pub photon_positions: Vec<Vec3>,
+    pub photons: Vec<PhotonRef>,
+    /// For PP3D (cells of 2 r_P).
+    pub points: Option<PointGrid>,
+    /// For PB2D (photon spheres of r_B).
+    pub beams: Option<BeamGrid>,
+}
+
+impl LightStore {
+    /// Traces light subpaths 0 … m−1 of `pass` (streams `Domain::Light`, item = index, as bdpt's)
+    /// and indexes their medium vertices for radii `r_points` (`None`: no PP3D) and `r_beams`.
+    pub fn trace(
+        scene: &Scene,
+        (seed, pass): (u64, u32),
+        m: u64,
+        limits: WalkLimits,
+        (r_points, r_beams): (Option<f32>, Option<f32>),
+    ) -> LightStore {
+        let n_chunks = m.div_ceil(CHUNK) as usize;
+        let chunks: Vec<Chunk> = (0..n_chunks)
+            .into_par_iter()
+            .map(|c| {
+                let mut chunk = Chunk::default();
+                chunk.starts.push(0);
+                let mut sub = Subpath::with_capacity(limits.max_vertices);
+                for j in c as u64 * CHUNK..((c as u64 + 1) * CHUNK).min(m) {
+                    let mut ls = Sampler::for_item(Domain::Light, seed, j, pass as u64);
+                    if scene.has_media {
+                        light_subpath_in::<true>(scene, &mut ls, limits, &mut sub);
+                    } else {
+                        light_subpath_in::<false>(scene, &mut ls, limits, &mut sub);
+                    }
+                    let y = &sub.vertices;
+                    chunk.vertices.extend_from_slice(y);
+                    chunk
+                        .back_flight
+                        .extend((0..y.len()).map(|i| sub.back_flight(i)));
+                    chunk.rates.extend((0..y.len()).map(|i| VertexRate {
+                        medium: y[i].in_medium(),
+                        rate: if i + 1 < y.len() {
+                            scatter_rate(scene, &y[i + 1], &y[i])
+                        } else {
+                            0.0
+                        },
+                    }));
+                    chunk.nee.push(if y.len() >= 2 {
+                        nee_density(scene, &y[0], &y[1])
+                    } else {
+                        0.0
+                    });
+                    chunk.starts.push(chunk.vertices.len() as u32);
+                }
+                chunk
+            })
+            .collect();
+        let mut store = LightStore {
+            chunks,
+            photon_positions: Vec::new(),
+            photons: Vec::new(),
+            points: None,
+            beams: None,
+        };
+        let (mut positions, mut photons) = (Vec::new(), Vec::new());
+        for path in 0..m as usize {
+            let y = store.path(path).vertices;
+            for (vertex, v) in y.iter().enumerate().skip(1) {
+                if v.in_medium() {
+                    positions.push(v.p);
+                    photons.push(PhotonRef {
+                        path: path as u32,
+                        vertex: vertex as u32,
+                    });
+                }
+            }
+        }
+        store.photon_positions = positions;
+        store.photons = photons;
+        if !store.photons.is_empty() {
+            store.points = r_points.map(|r| PointGrid::build(&store.photon_positions, 2.0 * r));
+            store.beams = r_beams.and_then(|r| BeamGrid::build(&store.photon_positions, r));
+        }
+        store
+    }
+
+    /// M, the light subpaths stored.
+    pub fn len(&self) -> usize {
+        self.chunks.iter().map(|c| c.nee.len()).sum()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Light subpath `j`.
+    pub fn path(&self, j: usize) -> LightPath<'_> {
+        let c = &self.chunks[j / CHUNK as usize];
+        let l = j % CHUNK as usize;
+        let (a, b) = (c.starts[l] as usize, c.starts[l + 1] as usize);
+        LightPath {
+            vertices: &c.vertices[a..b],
+            back_flight: &c.back_flight[a..b],
+            rates: &c.rates[a..b],
+            nee: c.nee[l],
+        }
+    }
+
+    /// The photon's light subpath up to it (y_0 … y_i).
+    pub fn photon(&self, p: PhotonRef) -> LightPath<'_> {
+        let full = self.path(p.path as usize);
+        let n = p.vertex as usize + 1;
+        LightPath {
+            vertices: &full.vertices[..n],
+            back_flight: &full.back_flight[..n],
+            rates: &full.rates[..n],
+            nee: full.nee,
+        }
+    }
+}

@@ -1,0 +1,451 @@
+//! `upbp` — unified points, beams and paths (Křivánek, Georgiev, Hachisuka, Vévoda, Šik,
+//! Nowrouzezahrai & Jarosz 2014), first cut: bdpt's connections through media and two of the
+//! volumetric density estimators under one MIS, on the one bidirectional camera loop
+//! (`subpath::camera_loop`, policy in `policy`):
+//!
+//! - `bpt`: every connection technique (s, t) as `bdpt` walks and joins them through media
+//!   (s = 0 always runs: the only technique for some paths);
+//! - `pp3d`: each medium vertex of the camera walk gathers the pass's photons (medium vertices of
+//!   all M light subpaths) within r_P, 3-D kernel 1/((4/3)π r_P³);
+//! - `pb2d`: each segment of the camera walk, as a short beam (the flight the walk sampled),
+//!   gathers the photons within r_B of it, 2-D kernel 1/(π r_B²), T evaluated along it.
+//!
+//! Weights: `weights` (full-path densities, the measures and η's stated there and in
+//! `lt_core::path::volume_merging`, the oracle). Not here yet: surface merges (vcm's), BB1D and
+//! BP2D, long beams, SmallUPBP's `previous`/`compatible` modes. Per pass, camera sample j pairs
+//! with light subpath j mod M for its connections (bdpt's pairing) and queries all M for merges;
+//! radii shrink per kernel dimension (`volume_density::schedule`): r_P,i = r₁ i^((α_P−1)/3),
+//! r_B,i = r₁ i^((α−1)/2). A scene without media has no photons: upbp is bdpt there.
+//!
+//! | key | type | default | meaning |
+//! |---|---|---|---|
+//! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
+//! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
+//! | `mis` | power/balance/none | power | heuristic over every technique |
+//! | `techniques` | all/bpt/pp3d/pb2d | all | comma-separated subset of bpt, pp3d, pb2d (SmallUPBP's names) |
+//! | `photons_per_pass` | u64 | the pixel count | light subpaths per pass (M) |
+//! | `radius` | f32 | — | initial radius r₁ in scene units (both kernels) |
+//! | `radius_scene` | f32 | 0.01 | initial radius as a fraction of the scene's bounding-sphere diameter |
+//! | `alpha` | f64 | 2/3 | PB2D's radius reduction: r_B,i = r₁ i^((α−1)/2) |
+//! | `alpha_points` | f64 | 4/7 | PP3D's radius reduction: r_P,i = r₁ i^((α_P−1)/3) |
+
+pub mod light_store;
+pub mod policy;
+pub mod weights;
+
+use crate::film::splat::{splat_pass_with, Pass, Splats, Worker};
+use crate::params::ParamReader;
+use crate::record::{NoRecord, Recorder, Work};
+use crate::subpath::camera_loop::{camera_sample, CameraScratch, Depths};
+use crate::subpath::connect::{splat_light_subpath_in, JoinFlights};
+use crate::subpath::strategy_weight::{with_chain_in, EndEvals, Split};
+use crate::subpath::walk::{Subpath, WalkLimits};
+use crate::volume_density::schedule::{balanced_alpha, radius_scale};
+use crate::volume_density::VolumeParams;
+use crate::{ProgressLog, Progressive, ProgressiveRun};
+use light_store::LightStore;
+use lt_core::math::PI;
+use lt_core::path::{Heuristic, VolumeSet};
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::Scene;
+use lt_estimators::Image;
+use policy::{connection_weight, junction_rate, PassData, Policy};
+
+/// Which of the techniques run (`techniques`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Techniques {
+    pub bpt: bool,
+    pub pp3d: bool,
+    pub pb2d: bool,
+}
+
+impl Techniques {
+    /// `all`, or a comma-separated subset of `bpt`, `pp3d`, `pb2d`.
+    pub fn parse(text: &str) -> Result<Techniques, String> {
+        if text.trim() == "all" {
+            return Ok(Techniques {
+                bpt: true,
+                pp3d: true,
+                pb2d: true,
+            });
+        }
+        let mut t = Techniques {
+            bpt: false,
+            pp3d: false,
+            pb2d: false,
+        };
+        for name in text.split([',', '+']) {
+            match name.trim() {
+                "bpt" => t.bpt = true,
+                "pp3d" => t.pp3d = true,
+                "pb2d" => t.pb2d = true,
+                other => {
+                    return Err(format!(
+                        "unknown technique '{other}' (known: all, or a comma-separated subset of \
+                         bpt, pp3d, pb2d)"
+                    ))
+                }
+            }
+        }
+        Ok(t)
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct UpbpParams {
+    pub volume: VolumeParams,
+    pub alpha_points: f64,
+    pub mis: Heuristic,
+    pub techniques: Techniques,
+}
+
+impl UpbpParams {
+    pub fn read(scene: &Scene, r: &ParamReader) -> Result<UpbpParams, String> {
+        let volume = VolumeParams::read(scene, r, "upbp", 2)?;
+        let alpha_points = r.get::<f64>("alpha_points")?.unwrap_or(balanced_alpha(3));
+        if !(alpha_points > 0.0 && alpha_points <= 1.0) {
+            return Err(format!(
+                "upbp: alpha_points must lie in (0, 1], got {alpha_points}"
+            ));
+        }
+        Ok(UpbpParams {
+            volume,
+            alpha_points,
+            mis: r
+                .get_with("mis", Heuristic::parse)?
+                .unwrap_or(Heuristic::Power),
+            techniques: r
+                .get_with("techniques", Techniques::parse)?
+                .unwrap_or(Techniques::parse("all")?),
+        })
+    }
+}
+
+pub struct Upbp {
+    pub params: UpbpParams,
+}
+
+impl Upbp {
+    pub fn read(scene: &Scene, r: &ParamReader) -> Result<Upbp, String> {
+        Ok(Upbp {
+            params: UpbpParams::read(scene, r)?,
+        })
+    }
+
+    /// M, light subpaths per pass.
+    pub fn light_paths(&self, scene: &Scene) -> u64 {
+        self.params
+            .volume
+            .photons_per_pass
+            .unwrap_or(scene.camera.pixel_count() as u64)
+    }
+
+    /// The radii (r_P, r_B) of pass `pass` (0-based).
+    pub fn radii(&self, pass: u32) -> (f32, f32) {
+        let v = &self.params.volume;
+        let rp = v.radius * radius_scale(pass + 1, self.alpha_points(), 3) as f32;
+        let rb = v.radius * radius_scale(pass + 1, v.alpha, 2) as f32;
+        (rp, rb)
+    }
+
+    fn alpha_points(&self) -> f64 {
+        self.params.alpha_points
+    }
+
+    /// The pass's light subpaths and the technique set with its η's.
+    pub fn setup(&self, scene: &Scene, seed: u64, pass: u32) -> (LightStore, PassSetup) {
+        let t = self.params.techniques;
+        let m = self.light_paths(scene);
+        let (rp, rb) = self.radii(pass);
+        let v = &self.params.volume;
+        let limits = WalkLimits::light(v.max_depth, v.rr_depth);
+        let radii = (t.pp3d.then_some(rp), t.pb2d.then_some(rb));
+        let store = LightStore::trace(scene, (seed, pass), m, limits, radii);
+        let (mf, rpf, rbf) = (m as f64, rp as f64, rb as f64);
+        let points_eta = if t.pp3d {
+            mf * 4.0 / 3.0 * PI as f64 * rpf * rpf * rpf
+        } else {
+            0.0
+        };
+        let beams_eta = if t.pb2d {
+            mf * PI as f64 * rbf * rbf
+        } else {
+            0.0
+        };
+        let setup = PassSetup {
+            set: VolumeSet {
+                connections: t.bpt,
+                points_eta,
+                beams_eta,
+            },
+            r_points: rp,
+            r_beams: rb,
+            light_paths: m,
+        };
+        (store, setup)
+    }
+
+    fn scratch(&self) -> Scratch {
+        let d = self.params.volume.max_depth as usize;
+        Scratch {
+            camera: CameraScratch::new(self.params.volume.max_depth),
+            light: Subpath::with_capacity(d),
+        }
+    }
+
+    /// Work item i (0 … max(N, M)−1): pixel i (i < N) with light subpath i mod M, splatting light
+    /// subpath i (i < M) by light tracing.
+    pub fn item<R: Recorder>(
+        &self,
+        scene: &Scene,
+        (data, pass): (&PassData, Pass),
+        i: u64,
+        worker: &mut Worker<'_, Scratch, R>,
+    ) {
+        if scene.has_media {
+            self.item_in::<true, R>(scene, (data, pass), i, worker)
+        } else {
+            self.item_in::<false, R>(scene, (data, pass), i, worker)
+        }
+    }
+
+    fn item_in<const MEDIA: bool, R: Recorder>(
+        &self,
+        scene: &Scene,
+        (data, pass): (&PassData, Pass),
+        i: u64,
+        worker: &mut Worker<'_, Scratch, R>,
+    ) {
+        let n = scene.camera.pixel_count() as u64;
+        let m = data.store.len() as u64;
+        let Worker {
+            splats,
+            scratch,
+            rec,
+        } = worker;
+        rec.begin_item(i);
+        let ly = data.store.path((i % m) as usize);
+        let y = &mut scratch.light;
+        y.vertices.clear();
+        y.vertices.extend_from_slice(ly.vertices);
+        y.back_flight.clear();
+        y.back_flight.extend_from_slice(ly.back_flight);
+        rec.lap(Work::LightWalk);
+        if i < m && data.set.connections {
+            let mut lens = Sampler::for_item(Domain::Lens, pass.seed, i, pass.pass as u64);
+            let scale = 1.0 / m as f32;
+            let rec = &mut **rec;
+            let yv = ly.vertices;
+            splat_light_subpath_in::<MEDIA, R>(
+                scene,
+                yv,
+                data.max_k,
+                scale,
+                &mut lens,
+                splats,
+                rec,
+                |s, c| {
+                    let camera_only = [c.camera];
+                    let split = Split {
+                        light: &yv[..s],
+                        camera: &camera_only,
+                        light_nee: ly.nee,
+                    };
+                    let flights = JoinFlights {
+                        edge: c.flights,
+                        light_back: ly.back_flight[s - 1],
+                        camera_back: 1.0,
+                    };
+                    let evals = EndEvals {
+                        light_end: c.eval,
+                        camera_end: None,
+                        flights: Some(flights),
+                    };
+                    let junction = junction_rate(data, scene, &c.camera, &yv[s - 1]);
+                    let w = with_chain_in::<MEDIA, _>(scene, split, evals, data.ratio, |ch, s| {
+                        connection_weight(data, ch, s, (ly.rates, junction), &[])
+                    });
+                    (w, None)
+                },
+            );
+        }
+        if i >= n {
+            return;
+        }
+        let mut policy = Policy::<MEDIA>::new(data, &scratch.light, ly);
+        let depths = Depths {
+            max_depth: self.params.volume.max_depth,
+            rr_depth: self.params.volume.rr_depth,
+        };
+        let l = camera_sample(
+            scene,
+            (pass, i),
+            depths,
+            &mut policy,
+            &mut scratch.camera,
+            &mut **rec,
+        );
+        splats.add_to_pixel(i as u32, l);
+    }
+
+    /// One pass's image and invalid-sample count.
+    pub fn render_pass(&self, scene: &Scene, data: &PassData, pass: Pass) -> (Image, u64) {
+        let cam = &scene.camera;
+        let items = (cam.pixel_count() as u64).max(data.store.len() as u64);
+        splat_pass_with(
+            cam.width as usize,
+            cam.height as usize,
+            items,
+            CHUNK,
+            || self.scratch(),
+            |i, splats, scratch| {
+                let mut worker = Worker {
+                    splats,
+                    scratch,
+                    rec: &mut NoRecord,
+                };
+                self.item(scene, (data, pass), i, &mut worker)
+            },
+        )
+    }
+
+    /// One pass with every path reported to `rec` (for `lt mis-check`), item by item on one
+    /// thread; the image is discarded. Returns the pass's setup.
+    pub fn record_pass<R: Recorder>(
+        &self,
+        scene: &Scene,
+        seed: u64,
+        pass: u32,
+        rec: &mut R,
+    ) -> PassSetup {
+        let (store, setup) = self.setup(scene, seed, pass);
+        let data = setup.data(self, scene, &store);
+        let cam = &scene.camera;
+        let mut scratch = self.scratch();
+        let mut splats = Splats::new(cam.width, cam.height);
+        let mut worker = Worker {
+            splats: &mut splats,
+            scratch: &mut scratch,
+            rec,
+        };
+        let items = (cam.pixel_count() as u64).max(store.len() as u64);
+        for i in 0..items {
+            self.item(scene, (&data, Pass { seed, pass }), i, &mut worker);
+        }
+        setup
+    }
+}
+
+/// Work items per splat chunk (fixed: the image does not depend on the thread count).
+const CHUNK: u64 = 256;
+
+/// Per-thread buffers.
+pub struct Scratch {
+    camera: CameraScratch,
+    light: Subpath,
+}
+
+/// What a pass decided: the technique set with its η's, the radii, M.
+#[derive(Clone, Copy, Debug)]
+pub struct PassSetup {
+    pub set: VolumeSet,
+    pub r_points: f32,
+    pub r_beams: f32,
+    pub light_paths: u64,
+}
+
+impl PassSetup {
+    fn data<'a>(&self, upbp: &Upbp, scene: &Scene, store: &'a LightStore) -> PassData<'a> {
+        let m = self.light_paths as f64;
+        let norm = |eta: f64| if eta > 0.0 { (1.0 / eta) as f32 } else { 0.0 };
+        PassData {
+            store,
+            set: self.set,
+            h: upbp.params.mis,
+            ratio: m / scene.camera.pixel_count() as f64,
+            max_k: upbp.params.volume.max_depth as usize,
+            r_points: self.r_points,
+            r_beams: self.r_beams,
+            point_norm: norm(self.set.points_eta),
+            beam_norm: norm(self.set.beams_eta),
+        }
+    }
+}
+
+impl Progressive for Upbp {
+    fn name(&self) -> &'static str {
+        "upbp"
+    }
+
+    fn start<'a>(&'a self, scene: &'a Scene, seed: u64) -> Box<dyn ProgressiveRun + 'a> {
+        let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+        Box::new(Run {
+            upbp: self,
+            scene,
+            seed,
+            sum: Image::new(w, h),
+            passes: 0,
+            log: ProgressLog::default(),
+        })
+    }
+}
+
+/// A run of `upbp`: the sum of its pass images.
+struct Run<'a> {
+    upbp: &'a Upbp,
+    scene: &'a Scene,
+    seed: u64,
+    sum: Image,
+    passes: u32,
+    log: ProgressLog,
+}
+
+impl ProgressiveRun for Run<'_> {
+    fn pass(&mut self, pass: u32) -> u64 {
+        let (store, setup) = self.upbp.setup(self.scene, self.seed, pass);
+        let data = setup.data(self.upbp, self.scene, &store);
+        let p = Pass {
+            seed: self.seed,
+            pass,
+        };
+        let (image, invalid) = self.upbp.render_pass(self.scene, &data, p);
+        for (s, v) in self.sum.data.iter_mut().zip(&image.data) {
+            for c in 0..3 {
+                s[c] += v[c];
+            }
+        }
+        self.passes += 1;
+        let r1 = self.upbp.params.volume.radius as f64;
+        self.log.photon_paths.push(setup.light_paths);
+        self.log.radius_scale.push(setup.r_beams as f64 / r1);
+        self.log.mean_radius.push(setup.r_beams as f64);
+        self.log.facts.retain(|(k, _)| !k.starts_with("last pass"));
+        self.log.facts.push((
+            "last pass volume photons".into(),
+            format!(
+                "{} (r_P {:.4e}, r_B {:.4e})",
+                store.photons.len(),
+                setup.r_points,
+                setup.r_beams
+            ),
+        ));
+        invalid
+    }
+
+    fn estimate(&self) -> Image {
+        let mut img = self.sum.clone();
+        if self.passes > 0 {
+            let k = 1.0 / self.passes as f64;
+            for px in img.data.iter_mut() {
+                for c in px.iter_mut() {
+                    *c *= k;
+                }
+            }
+        }
+        img
+    }
+
+    fn log(&self) -> ProgressLog {
+        self.log.clone()
+    }
+}

@@ -1,0 +1,89 @@
+//! `upbp`'s MIS weights from the full path's densities: bdpt's connection techniques (through
+//! `lt_core::path::Chain`, from the walks' stored densities) and the volumetric merges PP3D and
+//! PB2D at every medium vertex (`lt_core::path::volume_merging` states their densities). One
+//! routine weighs every technique, so `lt mis-check` replays it on the oracle's densities.
+//!
+//! Measures: l_j, c_j per unit volume at a medium vertex (no cosine), per unit area at a surface
+//! (the walks' `pdf_fwd`/`pdf_rev`). PP3D at x_i counts η_P = N·(4/3)πr_P³ times
+//! ∏_{j≤i} l_j ∏_{j≥i} c_j; PB2D counts η_B = N·πr_B² times the same product with c_i divided
+//! by σ̂_i (`VertexRate::rate`), the flight's scattering density over its pass probability at x_i:
+//! the beam covers x_i with the pass probability where the walk stopped there with the
+//! scattering density.
+
+use lt_core::path::{Chain, Heuristic, VolumeSet, VolumeTechnique};
+
+/// Per path vertex x_j: in a medium, and σ̂_j of the camera direction's flight into it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct VertexRate {
+    pub medium: bool,
+    /// σ̂_j (0 where no flight scatters into x_j).
+    pub rate: f64,
+}
+
+/// Longest path (segments) weighed on the stack.
+const STACK_K: usize = 24;
+
+/// The weight of `technique` on the path whose densities `chain` holds (`vol[j]` for each x_j),
+/// under `h` over every technique of `set`.
+pub fn weight(
+    chain: &Chain,
+    vol: &[VertexRate],
+    set: &VolumeSet,
+    technique: VolumeTechnique,
+    h: Heuristic,
+) -> f64 {
+    let k = chain.k();
+    let n = 3 * (k + 2);
+    let mut stack = [0.0f64; 3 * (STACK_K + 2)];
+    let mut heap = Vec::new();
+    let p: &mut [f64] = if k <= STACK_K {
+        &mut stack[..n]
+    } else {
+        heap.resize(n, 0.0);
+        &mut heap
+    };
+    effective(chain, vol, set, p);
+    let own = match technique {
+        VolumeTechnique::Connect(s) => p[s],
+        VolumeTechnique::Point(i) => p[k + 2 + i],
+        VolumeTechnique::Beam(i) => p[2 * (k + 2) + i],
+    };
+    if !(own > 0.0) {
+        return 0.0;
+    }
+    for x in p.iter_mut() {
+        *x /= own;
+    }
+    h.weight_from_ratios(p)
+}
+
+/// n·p of every technique into `out` (3 (k + 2) entries): connections s = 0 … k+1, PP3D at
+/// x_0 … x_{k+1}, PB2D at x_0 … x_{k+1} (the last of each never valid).
+fn effective(chain: &Chain, vol: &[VertexRate], set: &VolumeSet, out: &mut [f64]) {
+    let k = chain.k();
+    for s in 0..=k + 1 {
+        out[s] = if s == 0 || set.connections {
+            chain.sample_count(s) * chain.technique(s)
+        } else {
+            0.0
+        };
+    }
+    // Prefix products of the light side and suffix products of the camera side.
+    let (l, c) = (chain.light, chain.camera);
+    let mut light_to = 1.0;
+    for i in 0..=k + 1 {
+        let (point, beam) = (&mut 0.0, &mut 0.0);
+        if i <= k {
+            light_to *= l[i];
+        }
+        if i >= 1 && i < k && vol[i].medium {
+            let camera_from: f64 = c[i..].iter().product();
+            *point = set.points_eta * light_to * camera_from;
+            if vol[i].rate > 0.0 {
+                *beam = set.beams_eta * light_to * camera_from / vol[i].rate;
+            }
+        }
+        out[k + 2 + i] = *point;
+        out[2 * (k + 2) + i] = *beam;
+    }
+}

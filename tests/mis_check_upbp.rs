@@ -1,0 +1,86 @@
+//! `lt mis-check --integrator upbp` as a test: on every shipped media scene, upbp's weights
+//! (connections, PP3D and PB2D under one MIS; power and balance) agree with the from-scratch
+//! oracle (`lt_core::path::volume_merging`) and its own routine's weights over a path's
+//! techniques sum to one. Plus proof that the check fails on a merge density off by 1 % and on
+//! a technique missing from the sum.
+
+use lt_core::path::Heuristic;
+use lt_experiments::verify::mis_check::upbp::{
+    check_records, check_scene, collect, prepare_scene, UpbpOptions, UpbpRecord,
+};
+use lt_tests::{shipped_media_scene_names, shipped_scene};
+
+/// Paths per (length, technique), up to 5 segments, few passes: every oracle density through
+/// media walks its segments, so the quota is small; a 1 % density error fails most merged paths
+/// of a class (below), so 20 per class keep the check's power.
+fn options(scene: &lt_core::Scene, h: Heuristic) -> UpbpOptions {
+    let mut o = UpbpOptions::new(scene);
+    o.heuristic = h;
+    o.paths = 20;
+    o.max_depth = 5;
+    o.max_passes = 8;
+    o.seed = 7;
+    o
+}
+
+#[test]
+fn upbp_weights_match_the_oracle_on_every_media_scene() {
+    let names = shipped_media_scene_names();
+    assert!(
+        names.len() >= 5,
+        "expected the media scenes, found {names:?}"
+    );
+    let mut failed = Vec::new();
+    for h in [Heuristic::Power, Heuristic::Balance] {
+        for name in &names {
+            let mut scene = shipped_scene(name, None);
+            let opts = options(&scene, h);
+            let (report, summary) = check_scene(&mut scene, &opts, name).unwrap();
+            println!("{name} {h:?}:\n{summary}");
+            assert!(report.merges() > 0, "{name}: no merged paths\n{report}");
+            if !report.passed() {
+                failed.push(format!("{report}{summary}"));
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+/// Records of hg-spot (a spot light in a medium ball: every kind of technique is common).
+fn hg_spot_records() -> (lt_core::Scene, UpbpOptions, Vec<UpbpRecord>, (u32, usize)) {
+    let mut scene = shipped_scene("media/hg-spot", None);
+    let opts = options(&scene, Heuristic::Power);
+    prepare_scene(&mut scene, &opts);
+    let (c, passes) = collect(&scene, &opts).unwrap();
+    (scene, opts, c.records, (passes, c.too_long))
+}
+
+#[test]
+fn a_planted_merge_density_error_fails() {
+    let (scene, opts, records, counts) = hg_spot_records();
+    let (report, _) = check_records(&scene, &records, &opts, counts, "hg-spot");
+    assert!(report.passed(), "{report}");
+    // PB2D's density ×1.01 in the oracle's sum against the integrator's.
+    let mut beam = records.clone();
+    for r in &mut beam {
+        let set = r.set.as_mut().unwrap();
+        set.beams_eta *= 1.01;
+    }
+    let (report, summary) = check_records(&scene, &beam, &opts, counts, "hg-spot");
+    println!("PB2D ×1.01:\n{summary}");
+    assert!(
+        report.failures() > report.checked() / 4,
+        "{report}{summary}"
+    );
+    // PP3D missing from the oracle's sum: the integrator's weights counted it.
+    let mut missing = records;
+    for r in &mut missing {
+        r.set.as_mut().unwrap().points_eta = 0.0;
+    }
+    let (report, summary) = check_records(&scene, &missing, &opts, counts, "hg-spot");
+    println!("PP3D missing:\n{summary}");
+    assert!(
+        report.failures() > report.checked() / 4,
+        "{report}{summary}"
+    );
+}
