@@ -43,4 +43,17 @@ impl Image {
     pub fn same_size(&self, other: &Image) -> bool {
         self.width == other.width && self.height == other.height
     }
+
+    /// The mean of `passes` images whose sum this is (the sum itself when `passes` is 0):
+    /// every value times 1/`passes`, as the progressive estimators report their passes' mean.
+    pub fn mean_of_passes(&self, passes: u32) -> Image {
+        let mut img = self.clone();
+        if passes > 0 {
+            let k = 1.0 / passes as f64;
+            for c in img.data.iter_mut().flatten() {
+                *c *= k;
+            }
+        }
+        img
+    }
 }

@@ -235,16 +235,7 @@ impl ProgressiveRun for VolumeRun<'_> {
     }
 
     fn estimate(&self) -> Image {
-        let mut img = self.sum.clone();
-        if self.passes > 0 {
-            let k = 1.0 / self.passes as f64;
-            for px in img.data.iter_mut() {
-                for c in px.iter_mut() {
-                    *c *= k;
-                }
-            }
-        }
-        img
+        self.sum.mean_of_passes(self.passes)
     }
 
     fn log(&self) -> ProgressLog {
