@@ -145,7 +145,9 @@ impl Base {
         };
         scratch.clear_picked(lengths, scene);
         let n = scene.camera.pixel_count() as u64;
-        with_space(space, || picked_item(b, scene, pick_pixel(n), 1, true, scratch));
+        with_space(space, || {
+            picked_item(b, scene, pick_pixel(n), 1, true, scratch)
+        });
         importance.clear();
         let mut invalid = scratch.item.invalid();
         let total = |splats: &Splats, scale: f32| -> f64 {
@@ -210,7 +212,11 @@ fn picked_item(
         film_weight: 1.0,
         film: scene.camera.film(),
         out: &mut scratch.picked,
-        every: if every { Some(&mut scratch.every) } else { None },
+        every: if every {
+            Some(&mut scratch.every)
+        } else {
+            None
+        },
     };
     let mut worker = Worker {
         splats: &mut scratch.item,
