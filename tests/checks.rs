@@ -2,7 +2,7 @@
 //! why they are one binary and which stay apart). Run one file's checks with, for example,
 //! `cargo test --release --test checks agreement::`. The crates' own integration tests live here
 //! too, under `integrators::` and `scene_io::` (tests/integrators/, tests/scene_io/): a binary per
-//! crate would cost a thin-LTO link each for a few seconds of tests.
+//! crate would cost a compile and link each for a few seconds of tests.
 
 // The statistics here walk blocks × channels of several parallel arrays at once (run means,
 // references, weights); index loops say that plainest.
@@ -18,6 +18,7 @@ mod media;
 mod mis_check;
 mod mis_check_upbp;
 mod mis_check_vcm;
+mod mitsuba_suite;
 mod mlt;
 mod partial_merge;
 mod photon_estimates;

@@ -232,18 +232,20 @@ fn every_integrator_cube_furnace() {
     }
 }
 
+/// Every integrator at both scales and on both shapes, the shape paired with each scale
+/// alternating from one integrator to the next (half the renders of every pairing: what goes wrong
+/// at a scale, an offset or a roulette threshold, goes wrong on either shape).
 #[test]
 fn every_integrator_furnace_is_scale_invariant() {
-    for info in INTEGRATORS {
-        for scale in [1e-3, 1e6] {
+    for (i, info) in INTEGRATORS.iter().enumerate() {
+        for (j, scale) in [1e-3, 1e6].into_iter().enumerate() {
             // mmlt's 8 runs of 32 passes leave it ≈ 2.7 % (1.9 % at 64): it keeps 64.
             let passes = if info.name == "mmlt" {
                 64
             } else {
                 passes_for(info.name, SCALED_PASSES)
             };
-            check_with(info.name, true, scale, passes);
-            check_with(info.name, false, scale, passes);
+            check_with(info.name, (i + j) % 2 == 0, scale, passes);
         }
     }
 }

@@ -24,7 +24,7 @@ fn passes(name: &str) -> u32 {
 
 #[test]
 fn translated_cornell_box_renders_the_same() {
-    let scene = shipped_scene("cornell-box", Some((64, 64)));
+    let scene = shipped_scene("cornell-box", Some((32, 32)));
     // Picked up by name as soon as they are registered (the table's row type is not relied on).
     let names: Vec<&str> = CHECKED
         .into_iter()
@@ -84,7 +84,7 @@ fn cornell_file_at(offset: f64, dir: &std::path::Path) -> lt_core::Scene {
     let src = lt_tests::scenes_dir().join("xml/cornell-box.xml");
     let text = std::fs::read_to_string(&src).unwrap().replace(
         r#"<default name="res" value="256"/>"#,
-        r#"<default name="res" value="64"/>"#,
+        r#"<default name="res" value="32"/>"#,
     );
     let o = format!("{offset:?}");
     // The sensor's look-at moves by hand; every shape's to_world gains a translate.

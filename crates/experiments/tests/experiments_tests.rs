@@ -1,5 +1,5 @@
-//! lt-experiments's integration tests as one binary: each test binary costs a thin-LTO link of the
-//! crate and its dependencies (tens of seconds on 2 cores in CI), and in one binary the files'
+//! lt-experiments's integration tests as one binary: each test binary costs a compile and a link of the
+//! crate and its dependencies (seconds to tens of seconds on 2 cores in CI), and in one binary the files'
 //! tests also run side by side. One file's tests:
 //! `cargo test --release -p lt-experiments --test experiments_tests <file>::`.
 //!
