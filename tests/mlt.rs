@@ -6,7 +6,10 @@
 //!    independent runs of each Metropolis estimator (each with its own bootstrap, so the
 //!    normalisation's error is inside the spread) against bdpt's passes, Student-t and Šidák over
 //!    every block × channel × comparison (`agreement_t`).
-//! 2. **Coverage.** A Markov chain's passes are correlated, so the spread of passes understates
+//! 2. **Chain starts.** MMLT's chains start at bootstrap points resampled ∝ the picked
+//!    strategy's I_k, which draws from a chain's target only if the chain, evaluating its one
+//!    strategy alone, gets that same I_k at the point: checked bit for bit per point and length.
+//! 3. **Coverage.** A Markov chain's passes are correlated, so the spread of passes understates
 //!    a run's error; independent runs do not. On a tiny film, per (pixel, run): the interval of
 //!    run r from its own passes (t quantile, P − 1 degrees of freedom) and from the other runs'
 //!    spread (leave-one-out, t with R − 2), each widened by bdpt's reference error, against bdpt's
@@ -19,9 +22,13 @@
 //!    per batch can only understate the correlation), and ESS's share of it must be significant
 //!    (against ESS/P = 1), both paired over runs.
 
+use lt_core::primary_space::PrimarySpace;
 use lt_estimators::agreement::{agreement_t, sidak_threshold};
 use lt_estimators::running::RunningImage;
 use lt_estimators::{naive_interval_coverage, Image};
+use lt_integrators::metropolis::mmlt::Mmlt;
+use lt_integrators::metropolis::target::{Restrict, Sample};
+use lt_integrators::params::ParamReader;
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
 use lt_tests::{render_blocks, shipped_scene};
 use std::ops::ControlFlow;
@@ -80,6 +87,48 @@ fn metropolis_agrees_with_bdpt_on_shipped_scenes() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn mmlt_chain_starts_hold_their_bootstrap_value() {
+    for name in SCENES {
+        let scene = shipped_scene(name, Some((16, 16)));
+        let params = IntegratorParams::new();
+        let mmlt = Mmlt::read(&scene, &ParamReader::new("mmlt", &params)).unwrap();
+        let base = &mmlt.base;
+        let mut scratch = base.scratch(&scene);
+        // A bootstrap point: a fresh large step on its own stream (`chain::Keys`).
+        let point = |i: u64| {
+            let mut space = PrimarySpace::new(7, i, 0.01);
+            space.start_iteration(true);
+            space
+        };
+        let (mut importance, mut sample, mut lit) = (Vec::new(), Sample::default(), 0);
+        for i in 0..256 {
+            base.evaluate_lengths(&scene, &mut point(i), &mut scratch, &mut importance);
+            for (k, at) in (1..).zip(&importance) {
+                let mut space = point(i);
+                base.evaluate_start(
+                    &scene,
+                    Restrict::Length(k),
+                    &mut space,
+                    &mut scratch,
+                    &mut sample,
+                );
+                assert_eq!(
+                    sample.importance.to_bits(),
+                    at.picked.to_bits(),
+                    "{name}, point {i}, length {k}: a chain starts at I {} where the bootstrap \
+                     resampled it by {}",
+                    sample.importance,
+                    at.picked
+                );
+                lit += (at.picked > 0.0) as usize;
+            }
+        }
+        // Enough lit states that the check saw every kind of strategy.
+        assert!(lit >= 64, "{name}: only {lit} lit (point, length) pairs");
+    }
 }
 
 /// Student-t two-sided 95 % quantile with `dof` degrees of freedom (Cornish–Fisher series from

@@ -97,10 +97,15 @@ impl PrimarySpace {
         self.len_before = self.coords.len();
     }
 
-    /// Reads the iteration's coordinates again from the first (a test replays what samplers drew).
-    #[cfg(test)]
-    pub(crate) fn rewind_draws(&mut self) {
+    /// Reads the iteration's coordinates again from the first: a replay of what samplers drew
+    /// (MMLT's chain start re-reads a bootstrap point's coordinates for one strategy).
+    pub fn rewind_draws(&mut self) {
         self.drawn = [0; STREAMS];
+    }
+
+    /// Reads `stream`'s coordinates of this iteration again from its first.
+    pub fn rewind_stream(&mut self, stream: usize) {
+        self.drawn[stream] = 0;
     }
 
     /// The proposal becomes the chain's state.
@@ -229,6 +234,17 @@ pub fn with_space<T>(space: &mut PrimarySpace, f: impl FnOnce() -> T) -> T {
     INSTALLED.with(|i| i.set(true));
     let _guard = Uninstall(space);
     f()
+}
+
+/// Rewinds `stream` of the installed space (`PrimarySpace::rewind_stream`): the next sampler
+/// reading it starts again from its first coordinate (MMLT's bootstrap gives every strategy the
+/// connection numbers its chain would read).
+pub fn rewind_installed(stream: usize) {
+    SPACE.with(|c| {
+        if let Some(s) = c.borrow_mut().as_mut() {
+            s.rewind_stream(stream)
+        }
+    })
 }
 
 /// Whether a space is installed on this thread.

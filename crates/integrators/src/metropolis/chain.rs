@@ -109,19 +109,19 @@ impl ChainSet {
         (set, invalid)
     }
 
-    /// MMLT's bootstrap: `bootstrap` uniform points, each one bdpt sample giving I_k for every
-    /// length k = 1 … `lengths` (`Base::evaluate_lengths`), so each b̂_k averages all the points
-    /// rather than its 1/`lengths` share, and b̂_k averages each point's sum over all strategies
-    /// (`LengthImportance::all_strategies`), while chains start ∝ the picked strategy's I_k.
-    /// Returns the sets (length k's keyed `set: k`) and the invalid values dropped.
+    /// MMLT's bootstrap: `bootstrap` uniform points, each one pair of full walks giving I_k for
+    /// every length k = 1 … `base.lengths()` (`Base::evaluate_lengths`), so each b̂_k averages
+    /// all the points rather than its 1/lengths share, and b̂_k averages each point's sum over all
+    /// strategies (`LengthImportance::all_strategies`), while chains start ∝ the picked
+    /// strategy's I_k. Returns the sets (length k's keyed `set: k`) and the invalid values dropped.
     pub fn bootstrap_lengths(
         base: &Base,
         scene: &Scene,
-        lengths: usize,
         bootstrap: u64,
         sigma: f32,
         seed: u64,
     ) -> (Vec<ChainSet>, u64) {
+        let lengths = base.lengths();
         let shared = Keys {
             seed,
             set: 0,
@@ -134,8 +134,7 @@ impl ChainSet {
                 |scratch, i| {
                     let mut space = shared.bootstrap_point(i, sigma);
                     let mut importance = Vec::with_capacity(lengths);
-                    let bad =
-                        base.evaluate_lengths(scene, lengths, &mut space, scratch, &mut importance);
+                    let bad = base.evaluate_lengths(scene, &mut space, scratch, &mut importance);
                     (importance, bad)
                 },
             )
@@ -204,7 +203,7 @@ impl ChainSet {
                     // Replays bootstrap point i exactly, then mutates on the chain's own stream.
                     let mut space = keys.bootstrap_point(i, sigma);
                     let mut current = Sample::default();
-                    base.evaluate(scene, restrict, &mut space, scratch, &mut current);
+                    base.evaluate_start(scene, restrict, &mut space, scratch, &mut current);
                     space.accept();
                     space.reseed(keys.seed, keys.chain(j as u64));
                     Chain { space, current }

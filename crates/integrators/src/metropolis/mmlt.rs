@@ -1,11 +1,12 @@
 //! `mmlt` — multiplexed Metropolis light transport (Hachisuka, Kaplanyan & Dachsbacher 2014):
 //! one chain set per path length k (1 … `max_depth` segments), each state choosing one bdpt
 //! strategy (s, t = k + 1 − s) from its own primary number and contributing that strategy's
-//! MIS-weighted value times k + 1 (`target`). The lengths share one bootstrap: each of its points
-//! is one bdpt sample, which holds every length's I_k (the same number picks each length's
-//! strategy), so every b̂_k averages all `bootstrap` points; a pass's N mutations are shared ∝ b̂_k.
-//! bdpt's walks run in full and the chosen strategy is kept (through bdpt's recorder hook), so
-//! a mutation costs a bdpt sample, not one strategy's. Consistent: error bars from `--runs K`.
+//! MIS-weighted value times k + 1 (`target`). A mutation evaluates that strategy alone
+//! (`strategy`): a camera walk of t vertices and a light walk of s vertices from the state's
+//! camera and light streams, one connection, bdpt's MIS weight. The lengths share one bootstrap:
+//! each of its points walks both subpaths in full once and reads every length's strategies from
+//! them (the same number picks each length's strategy), so every b̂_k averages all `bootstrap`
+//! points; a pass's N mutations are shared ∝ b̂_k. Consistent: error bars from `--runs K`.
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
@@ -14,7 +15,7 @@
 //! | `mis` | power/balance | power | heuristic over bdpt's strategies |
 //! | `p_large` | f32 | 0.3 | probability of a large step (an independent proposal) |
 //! | `sigma` | f32 | 0.01 | standard deviation of a small step per primary coordinate |
-//! | `bootstrap` | u64 | the pixel count | independent points (bdpt samples), each giving every length's I_k, estimating the b_k |
+//! | `bootstrap` | u64 | the pixel count | independent points (full walks, every strategy joined), each giving every length's I_k, estimating the b_k |
 //! | `chains` | u64 | 256 | at most this many chains per path length, fewer when its share of a pass's mutations is smaller |
 
 use super::chain::ChainSet;
@@ -69,7 +70,6 @@ impl Progressive for Mmlt {
         let (sets, bad) = ChainSet::bootstrap_lengths(
             &self.base,
             scene,
-            self.max_depth.max(1) as usize,
             bootstrap_size(scene, &p),
             p.mutations.sigma,
             seed,

@@ -12,12 +12,14 @@
 //! error bar is too narrow by √(ESS/P).
 //!
 //! - `target`: u ↦ F(u), the base integrator's per-path code run on a chain's numbers;
+//! - `strategy`: one bdpt strategy (s, t) alone, MMLT's state (walks of s and t vertices);
 //! - `chain`: the chains, bootstrap, expected-value splats;
 //! - `pssmlt`, `mmlt`: the two integrators (their key tables).
 
 pub mod chain;
 pub mod mmlt;
 pub mod pssmlt;
+pub mod strategy;
 pub mod target;
 
 use crate::params::ParamReader;

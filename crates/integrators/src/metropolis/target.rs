@@ -8,21 +8,22 @@
 //!
 //! MMLT (Hachisuka et al. 2014) restricts F to paths of k segments and one strategy (s, t),
 //! s + t = k + 1, chosen by u's third number uniformly among the k + 1 bdpt samples (t ≥ 1):
-//! F_k(u) = N (k + 1) · w_{s,t} f / p_{s,t}, bdpt's own MIS-weighted contribution of that strategy
-//! (read through the `Recorder` bdpt reports every completed path to), so Σ_k E_u[F_k] is bdpt's
-//! image again. One bdpt sample on u holds every F_k(u) at once (the same third number picks
-//! each length's strategy), so MMLT's bootstrap reads all lengths from one evaluation
-//! (`evaluate_lengths`). It holds every strategy's value too, so b_k = E_u[I_k(u)] is estimated
-//! by the expectation over the strategy number in closed form: E_s[(k + 1) I_{s,k}] =
-//! Σ_s I_{s,k}, bdpt's own length-k luminance (Rao–Blackwellised over s: same mean, never more
-//! variance), while the chains still start from the one picked strategy ∝ I_k(u).
+//! F_k(u) = N (k + 1) · w_{s,t} f / p_{s,t}, bdpt's MIS-weighted contribution of that strategy,
+//! evaluated alone (`strategy::one_strategy`: walks of exactly s and t vertices, one join), so
+//! Σ_k E_u[F_k] is bdpt's image again. MMLT's bootstrap reads every length and every strategy
+//! of a point from one pair of full walks (`evaluate_lengths`, `strategy::every_strategy`), the
+//! picked strategy's value bit for bit what the chain's evaluation gives. b_k = E_u[I_k(u)] is
+//! estimated by the expectation over the strategy number in closed form: E_s[(k + 1) I_{s,k}] =
+//! Σ_s I_{s,k}, the point's length-k luminance over all strategies (Rao–Blackwellised over s:
+//! same mean, never more variance), while the chains still start from the one picked strategy
+//! ∝ I_k(u).
 
+use super::strategy::{every_strategy, one_strategy, Rules, Walks};
 use crate::bidirectional::bdpt::{self, Bdpt};
 use crate::film::pixel::{pixel_sample, weighted};
 use crate::film::splat::{Pass, Splats, Worker};
-use crate::record::{Completed, NoRecord, Recorder};
+use crate::record::NoRecord;
 use crate::unidirectional::pt::Pt;
-use lt_core::camera::FilmFilter;
 use lt_core::math::{luminance, Color};
 use lt_core::primary_space::{next_installed, with_space, PrimarySpace};
 use lt_core::sampling::{Domain, Sampler};
@@ -53,24 +54,30 @@ pub struct Sample {
 /// Per-thread buffers of an evaluation.
 pub struct Scratch {
     bdpt: Option<bdpt::Scratch>,
+    /// One strategy's walks (MMLT; bdpt base only).
+    walks: Option<Walks>,
     item: Splats,
-    /// The kept strategy's splats per path length (one buffer for a single length).
-    picked: Vec<Splats>,
-    /// Every strategy's splats per path length (MMLT's bootstrap only).
-    every: Vec<Splats>,
 }
 
 impl Base {
     pub fn scratch(&self, scene: &Scene) -> Scratch {
         let (w, h) = (scene.camera.width, scene.camera.height);
+        let (bdpt, walks) = match self {
+            Base::Bdpt(b) => (Some(b.scratch()), Some(Walks::new(b.params.max_depth))),
+            Base::Pt(_) => (None, None),
+        };
         Scratch {
-            bdpt: match self {
-                Base::Bdpt(b) => Some(b.scratch()),
-                Base::Pt(_) => None,
-            },
+            bdpt,
+            walks,
             item: Splats::new(w, h),
-            picked: Vec::new(),
-            every: Vec::new(),
+        }
+    }
+
+    /// MMLT's path lengths: 1 … max_depth (at least one).
+    pub fn lengths(&self) -> usize {
+        match self {
+            Base::Bdpt(b) => b.params.max_depth.max(1) as usize,
+            Base::Pt(_) => 1,
         }
     }
 
@@ -84,9 +91,13 @@ impl Base {
         scratch: &mut Scratch,
         out: &mut Sample,
     ) -> u64 {
-        scratch.clear_picked(1, scene);
+        scratch.item.clear();
         let n = scene.camera.pixel_count() as u64;
-        let mut scale = n as f32;
+        // MMLT's strategy already carries N (k + 1) (`strategy::Walks::add`).
+        let scale = match restrict {
+            Restrict::Full => n as f32,
+            Restrict::Length(_) => 1.0,
+        };
         with_space(space, || {
             let pixel = pick_pixel(n);
             match (self, restrict) {
@@ -109,33 +120,56 @@ impl Base {
                     b.item(scene, Pass { seed: 0, pass: 0 }, pixel, &mut worker);
                 }
                 (Base::Bdpt(b), Restrict::Length(k)) => {
-                    scale *= (k + 1) as f32;
-                    picked_item(b, scene, pixel, k, false, scratch);
+                    let s = pick_strategy(next_installed(0), k);
+                    let walks = scratch.walks.as_mut().expect("mmlt walks");
+                    let rules = rules(b);
+                    one_strategy(
+                        scene,
+                        rules,
+                        pixel,
+                        (s, k + 1 - s),
+                        walks,
+                        &mut scratch.item,
+                    );
                 }
             }
         });
-        let taken = match restrict {
-            Restrict::Length(_) => &scratch.picked[0],
-            Restrict::Full => &scratch.item,
-        };
         out.splats.clear();
         out.importance = 0.0;
-        for &(p, c) in taken.entries() {
+        for &(p, c) in scratch.item.entries() {
             let c = c * scale;
             out.importance += luminance(c).max(0.0) as f64;
             out.splats.push((p, c));
         }
-        scratch.item.invalid() + scratch.picked[0].invalid()
+        scratch.item.invalid()
     }
 
-    /// I_k(u) for every length k = 1 … `lengths` from one bdpt sample on u, into `importance`
+    /// A chain's first state, at a bootstrap point `space` holds fresh from its large step: for
+    /// MMLT, the point's coordinates are first drawn in the bootstrap's order
+    /// (`evaluate_lengths`, whose walks read them first), then read again for the one strategy,
+    /// so the state's I is the bootstrap's `picked` it was resampled by.
+    pub fn evaluate_start(
+        &self,
+        scene: &Scene,
+        restrict: Restrict,
+        space: &mut PrimarySpace,
+        scratch: &mut Scratch,
+        out: &mut Sample,
+    ) {
+        if let Restrict::Length(_) = restrict {
+            self.evaluate_lengths(scene, space, scratch, &mut Vec::new());
+            space.rewind_draws();
+        }
+        self.evaluate(scene, restrict, space, scratch, out);
+    }
+
+    /// I_k(u) for every length k = 1 … `lengths()` from one pair of walks on u, into `importance`
     /// (k − 1 indexed): `picked` is what `evaluate` with `Restrict::Length(k)` gives for the same
     /// u, bit for bit; `all_strategies` is Σ_s of the strategies' I_{s,k}, the expectation of
     /// `picked` over u's strategy number. Returns the invalid values dropped. Only for a bdpt base.
     pub fn evaluate_lengths(
         &self,
         scene: &Scene,
-        lengths: usize,
         space: &mut PrimarySpace,
         scratch: &mut Scratch,
         importance: &mut Vec<LengthImportance>,
@@ -143,25 +177,38 @@ impl Base {
         let Base::Bdpt(b) = self else {
             panic!("per-length evaluation needs a bdpt base")
         };
-        scratch.clear_picked(lengths, scene);
-        let n = scene.camera.pixel_count() as u64;
-        with_space(space, || {
-            picked_item(b, scene, pick_pixel(n), 1, true, scratch)
-        });
+        let lengths = self.lengths();
         importance.clear();
-        let mut invalid = scratch.item.invalid();
-        let total = |splats: &Splats, scale: f32| -> f64 {
-            splats.entries().iter().fold(0.0, |acc, &(_, c)| {
-                acc + luminance(c * scale).max(0.0) as f64
-            })
-        };
-        for (i, (picked, every)) in scratch.picked.iter().zip(&scratch.every).enumerate() {
-            importance.push(LengthImportance {
-                picked: total(picked, n as f32 * (i + 2) as f32),
-                all_strategies: total(every, n as f32),
-            });
-            invalid += picked.invalid();
-        }
+        importance.resize(lengths, LengthImportance::default());
+        let n = scene.camera.pixel_count() as u64;
+        let mut invalid = 0;
+        let walks = scratch.walks.as_mut().expect("mmlt walks");
+        with_space(space, || {
+            let pixel = pick_pixel(n);
+            let v = next_installed(0);
+            every_strategy(
+                scene,
+                rules(b),
+                pixel,
+                lengths,
+                walks,
+                &mut scratch.item,
+                |k, s, splats| {
+                    // Summed as `evaluate` sums one strategy's splats (scale 1): the same bits.
+                    let i = splats
+                        .entries()
+                        .iter()
+                        .fold(0.0, |acc, &(_, c)| acc + luminance(c).max(0.0) as f64);
+                    let at = &mut importance[k - 1];
+                    // I_{s,k} without the (k + 1) of the chain's target.
+                    at.all_strategies += i / (k + 1) as f64;
+                    if s == pick_strategy(v, k) {
+                        at.picked = i;
+                    }
+                    invalid += splats.invalid();
+                },
+            );
+        });
         invalid
     }
 }
@@ -175,55 +222,16 @@ pub struct LengthImportance {
     pub all_strategies: f64,
 }
 
-impl Scratch {
-    /// Empties the item's splats and `lengths` per-length buffers.
-    fn clear_picked(&mut self, lengths: usize, scene: &Scene) {
-        self.item.clear();
-        let (w, h) = (scene.camera.width, scene.camera.height);
-        if self.picked.len() < lengths {
-            self.picked.resize_with(lengths, || Splats::new(w, h));
-        }
-        self.picked.truncate(lengths);
-        self.picked.iter_mut().for_each(Splats::clear);
-        if self.every.len() < lengths {
-            self.every.resize_with(lengths, || Splats::new(w, h));
-        }
-        self.every.truncate(lengths);
-        self.every.iter_mut().for_each(Splats::clear);
-    }
+/// MMLT's strategy at length k from u's strategy number v: s = ⌊v (k + 1)⌋, uniform over 0 … k.
+fn pick_strategy(v: f32, k: usize) -> usize {
+    ((v * (k + 1) as f32) as usize).min(k)
 }
 
-/// Runs bdpt's item for `pixel` on the installed space, keeping for each length k ≥ `first_k`
-/// (k − `first_k` indexing `scratch.picked`) the one strategy the space's next stream-0 number
-/// picks: s = ⌊v (k + 1)⌋; with `every`, each length's strategies all in `scratch.every` too.
-fn picked_item(
-    b: &Bdpt,
-    scene: &Scene,
-    pixel: u64,
-    first_k: usize,
-    every: bool,
-    scratch: &mut Scratch,
-) {
-    let v = next_installed(0);
-    let mut pick = Pick {
-        first_k,
-        v,
-        pixel: pixel as u32,
-        film_weight: 1.0,
-        film: scene.camera.film(),
-        out: &mut scratch.picked,
-        every: if every {
-            Some(&mut scratch.every)
-        } else {
-            None
-        },
-    };
-    let mut worker = Worker {
-        splats: &mut scratch.item,
-        scratch: scratch.bdpt.as_mut().expect("bdpt scratch"),
-        rec: &mut pick,
-    };
-    b.item(scene, Pass { seed: 0, pass: 0 }, pixel, &mut worker);
+fn rules(b: &Bdpt) -> Rules {
+    Rules {
+        rr_depth: b.params.rr_depth,
+        mis: b.params.mis,
+    }
 }
 
 /// A pixel uniformly from stream 0's next two numbers (48 bits, so every pixel of any film has the
@@ -234,58 +242,4 @@ fn pick_pixel(n: u64) -> u64 {
     let lo = next_installed(0) as f64;
     let u = hi + lo * (1.0 / (1u64 << 24) as f64);
     ((u * n as f64) as u64).min(n - 1)
-}
-
-/// Keeps, per path length k, the one strategy (s, t = k + 1 − s) a sample chose, from everything
-/// bdpt reports: its weighted value where bdpt would add it (the pixel's own estimate times the
-/// film weight for t ≥ 2; through the film filter at the splat position for light tracing, t = 1).
-struct Pick<'a> {
-    /// The length `out[0]` holds; `out[i]` holds length `first_k + i`.
-    first_k: usize,
-    /// The strategy number: s = ⌊v (k + 1)⌋ at length k.
-    v: f32,
-    pixel: u32,
-    film_weight: f32,
-    film: &'a FilmFilter,
-    out: &'a mut [Splats],
-    /// Every strategy's value per length, indexed as `out` (MMLT's bootstrap).
-    every: Option<&'a mut Vec<Splats>>,
-}
-
-impl Recorder for Pick<'_> {
-    const ACTIVE: bool = true;
-
-    fn begin_sample(&mut self, _pixel: u64, film_weight: f32) {
-        self.film_weight = film_weight;
-    }
-
-    fn completed(&mut self, path: Completed) {
-        let k = path.light.len() + path.camera.len() - 1;
-        let Some(out) = k
-            .checked_sub(self.first_k)
-            .and_then(|i| self.out.get_mut(i))
-        else {
-            return;
-        };
-        if path.weight <= 0.0 {
-            return;
-        }
-        let c = path.value * path.weight as f32;
-        let light_traced = k + 1 - path.s < 2;
-        let (pixel, film_weight, film) = (self.pixel, self.film_weight, self.film);
-        let add = |splats: &mut Splats| {
-            if light_traced {
-                splats.add_filtered(film, path.raster, c);
-            } else {
-                splats.add_to_pixel(pixel, weighted(c, film_weight));
-            }
-        };
-        if let Some(every) = self.every.as_deref_mut() {
-            add(&mut every[k - self.first_k]);
-        }
-        let s = ((self.v * (k + 1) as f32) as usize).min(k);
-        if path.s == s {
-            add(out);
-        }
-    }
 }
