@@ -73,7 +73,7 @@ impl PhotonBeams {
 }
 
 /// Where a ray from `o` along unit `d` leaves the sphere (c, r); 0 if it never is inside.
-fn sphere_exit(o: Vec3, d: Vec3, c: Vec3, r: f32) -> f32 {
+pub fn sphere_exit(o: Vec3, d: Vec3, c: Vec3, r: f32) -> f32 {
     let oc = o - c;
     let b = oc.dot(d);
     let disc = b * b - (oc.length_squared() - r * r);
