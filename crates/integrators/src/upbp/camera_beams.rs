@@ -19,8 +19,8 @@
 //! with the walk's density of reaching it, scattering there), the light side at the photon or
 //! at x' (likewise, from y_{i−1}).
 
+use super::light_beams::Back;
 use super::policy::{medium_of, near_sin, without_sigma_s, MergeSide, Policy};
-use super::rates::back_and_rate;
 use crate::record::{Recorder, VolumeMerged};
 use crate::subpath::camera_loop::SampleCtx;
 use crate::subpath::connect::nee_density;
@@ -34,7 +34,8 @@ use lt_core::scene::{ConnectionEnd, Crossing, MediumPiece};
 use lt_core::Scene;
 
 /// One medium piece of a camera beam: from `a` (at distance 0 of the piece) along the beam's
-/// direction for `len`, with T and P_pass of the segment's pieces before it.
+/// direction for `len`, with T and P_pass of the segment's pieces before it and the flight back
+/// to the segment's start.
 struct Piece<'m> {
     m: u32,
     mm: &'m Medium,
@@ -42,14 +43,17 @@ struct Piece<'m> {
     len: f32,
     t_before: Color,
     p_before: f32,
+    back: Back,
 }
 
 /// The camera side's end at distance `s` of `piece`: the beam's value there (β_leave T/P_pass),
-/// its vertex x (walk densities of reaching it), and σ̂ of the beam's flight at x.
+/// its vertex x (walk densities of reaching it), σ̂ of the beam's flight at x, and the flight
+/// back from x to the beam's start with σ̂ there (`Back::at`).
 struct CameraPoint {
     value: Color,
     vertex: PathVertex,
     rate: f64,
+    back: (f64, f64),
 }
 
 impl<const MEDIA: bool> Policy<'_, MEDIA> {
@@ -82,8 +86,10 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
             pieces.push(piece)
         });
         let (mut t_before, mut p_before) = (Color::ONE, 1.0f32);
+        let mut back = Back::start(o.in_medium());
         for piece in pieces {
             let Some(m) = piece.medium else {
+                back = back.after(None, piece.a, piece.b);
                 continue;
             };
             let mm = &scene.media[m as usize];
@@ -96,6 +102,7 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
                     len,
                     t_before,
                     p_before,
+                    back,
                 };
                 if points {
                     self.photons_near(scene, prefix, (&pc, dir), leave, ctx, l);
@@ -104,6 +111,7 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
                     self.beams_near(scene, prefix, (&pc, dir), leave, ctx, l);
                 }
             }
+            back = back.after(Some(mm), piece.a, piece.b);
             t_before *= mm.transmittance(piece.a, piece.b);
             p_before *= mm.free_flight_density(piece.a, piece.b, false);
         }
@@ -129,19 +137,8 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
             value,
             vertex,
             rate: (scatter / pass) as f64,
+            back: piece.back.at(piece.mm, x, piece.a),
         })
-    }
-
-    /// The camera side of a merge whose x_i is `x` (in `self.buf` after `prefix`): the free
-    /// flight back to the prefix's last vertex and, when BB1D runs, σ̂ᴸ there of the flight from x.
-    fn camera_side_back(&self, scene: &Scene, x: &PathVertex, o: &PathVertex) -> (f64, f64) {
-        if self.pass.needs.light {
-            back_and_rate(scene, x, o)
-        } else {
-            let m = x.medium_towards(scene, x.dir_to(o));
-            let back = scene.free_flight_density(x.into(), o.into(), m, o.in_medium());
-            (back as f64, 0.0)
-        }
     }
 
     /// PB2D: the photons within r_B of `piece`.
@@ -196,7 +193,7 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
             buf.clear();
             buf.extend_from_slice(prefix);
             buf.push(cp.vertex);
-            let (back, near) = self.camera_side_back(scene, &cp.vertex, o);
+            let (back, near) = cp.back;
             let light = MergeSide {
                 vertices: y.vertices,
                 back: y.back_flight[i] as f64,
@@ -317,8 +314,8 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
                     buf.clear();
                     buf.extend_from_slice(prefix);
                     buf.push(cp.vertex);
-                    let (back_l, near_l) = back_and_rate(scene, &xlv, yp);
-                    let (back_c, near_c) = self.camera_side_back(scene, &cp.vertex, o);
+                    let (back_l, near_l) = src.back.at(piece.mm, xl, b.origin);
+                    let (back_c, near_c) = cp.back;
                     // y_1 is the beam's point when the beam leaves the light.
                     let nee = if i == 1 {
                         nee_density(scene, &light_buf[0], &xlv)

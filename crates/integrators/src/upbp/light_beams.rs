@@ -17,13 +17,81 @@ use lt_core::Scene;
 
 /// Where a photon beam came from: light subpath `path`'s segment into vertex `vertex` (= its
 /// length when the segment left the scene), the pass probability of the segment's pieces
-/// before this one, and the direction density with which y_{vertex−1} chose the segment.
+/// before this one, and the direction density with which y_{vertex−1} chose the segment; and
+/// for the flight from a point of the beam back to y_{vertex−1} (a merge's weight reads it), the
+/// reverse densities of those pieces (`back`) and where it ends (`Back`).
 #[derive(Clone, Copy, Debug)]
 pub struct BeamRef {
     pub path: u32,
     pub vertex: u32,
     pub p_before: f32,
     pub pdf_w: f32,
+    pub back: Back,
+}
+
+/// The flight from a point of a beam piece back to the segment's start, walked over the pieces
+/// found when the segment was (as the walks' `Flight` does): the product of the reverse
+/// densities of the pieces before this one, whether this piece is the first (the reverse walk
+/// scatters at its start when that is a medium vertex), and σ̂ of the reverse walk at the start
+/// when it ends in another piece (`first_rate`, 0 when the start lies on no medium).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Back {
+    pub before: f32,
+    pub first: bool,
+    pub start_in_medium: bool,
+    pub first_rate: f32,
+}
+
+impl Back {
+    /// The reverse flight from `x` (in this piece of medium `mm`, starting at `a`) to the
+    /// segment's start, and σ̂ there (0 at a surface or the camera).
+    pub fn at(&self, mm: &lt_core::medium::Medium, x: Vec3, a: Vec3) -> (f64, f64) {
+        let scatter = self.first && self.start_in_medium;
+        let d = mm.free_flight_density(x, a, scatter);
+        let rate = if !self.start_in_medium {
+            0.0
+        } else if self.first {
+            let pass = mm.free_flight_density(x, a, false);
+            if pass > 0.0 {
+                (d / pass) as f64
+            } else {
+                0.0
+            }
+        } else {
+            self.first_rate as f64
+        };
+        ((self.before * d) as f64, rate)
+    }
+
+    /// The state for the next piece after the piece a → b of medium `mm` (`None`: vacuum).
+    pub fn after(self, mm: Option<&lt_core::medium::Medium>, a: Vec3, b: Vec3) -> Back {
+        let mut next = Back {
+            first: false,
+            ..self
+        };
+        if let Some(mm) = mm {
+            let scatter = self.first && self.start_in_medium;
+            next.before *= mm.free_flight_density(b, a, scatter);
+            if scatter {
+                let pass = mm.free_flight_density(b, a, false);
+                next.first_rate = if pass > 0.0 {
+                    mm.free_flight_density(b, a, true) / pass
+                } else {
+                    0.0
+                };
+            }
+        }
+        next
+    }
+
+    pub fn start(start_in_medium: bool) -> Back {
+        Back {
+            before: 1.0,
+            first: true,
+            start_in_medium,
+            first_rate: 0.0,
+        }
+    }
 }
 
 /// The beams (`PhotonBeam::power` = β_leave T_before / P_before at the piece's start) and their
@@ -76,8 +144,10 @@ impl LightBeams {
         });
         let (c, r) = scene.bounding_sphere;
         let (mut t_before, mut p_before) = (Color::ONE, 1.0f32);
+        let mut back = Back::start(from.in_medium());
         for piece in pieces {
             let Some(m) = piece.medium else {
+                back = back.after(None, piece.a, piece.b);
                 continue;
             };
             let mm = &scene.media[m as usize];
@@ -99,8 +169,10 @@ impl LightBeams {
                     vertex,
                     p_before,
                     pdf_w: leave.pdf_w,
+                    back,
                 });
             }
+            back = back.after(Some(mm), piece.a, piece.b);
             t_before *= mm.transmittance(piece.a, piece.b);
             p_before *= mm.free_flight_density(piece.a, piece.b, false);
         }

@@ -70,13 +70,13 @@ pub struct LightStore {
 impl LightStore {
     /// Traces light subpaths 0 … m−1 of `pass` (streams `Domain::Light`, item = index, as bdpt's)
     /// and indexes their medium vertices for radii `r_points` (`None`: no PP3D) and `r_beams`
-    /// (no PB2D), their segments through media for `r_beam_beams` (no BB1D); `needs`: the
-    /// rates the weights read.
+    /// (no PB2D), the segments through media of the first M_BB for `r_beam_beams` = (r_BB, M_BB)
+    /// (no BB1D); `needs`: the rates the weights read.
     pub fn trace(
         scene: &Scene,
         (seed, pass): (u64, u32),
         (m, limits, needs): (u64, WalkLimits, Needs),
-        (r_points, r_beams, r_beam_beams): (Option<f32>, Option<f32>, Option<f32>),
+        (r_points, r_beams, r_beam_beams): (Option<f32>, Option<f32>, Option<(f32, u64)>),
     ) -> LightStore {
         let n_chunks = m.div_ceil(CHUNK) as usize;
         let chunks: Vec<Chunk> = (0..n_chunks)
@@ -100,7 +100,7 @@ impl LightStore {
                     chunk
                         .rates
                         .extend((0..y.len()).map(|i| light_vertex(scene, y, i, needs)));
-                    if r_beam_beams.is_some() && scene.has_media {
+                    if r_beam_beams.is_some_and(|(_, m_bb)| j < m_bb) && scene.has_media {
                         chunk.beams.add_path(scene, j as u32, &sub);
                     }
                     chunk.nee.push(if y.len() >= 2 {
@@ -114,7 +114,7 @@ impl LightStore {
             })
             .collect();
         let mut chunks = chunks;
-        let light_beams = r_beam_beams.map(|r| {
+        let light_beams = r_beam_beams.map(|(r, _)| {
             let mut all = LightBeams::default();
             for c in &mut chunks {
                 all.append(std::mem::take(&mut c.beams));

@@ -33,6 +33,7 @@
 //! | `alpha` | f64 | 2/3 | PB2D's radius reduction: r_B,i = r₁ i^((α−1)/2) |
 //! | `alpha_points` | f64 | 4/7 | PP3D's radius reduction: r_P,i = r₁ i^((α_P−1)/3) |
 //! | `alpha_beam_beams` | f64 | 4/5 | BB1D's radius reduction: r_BB,i = r₁ i^(α_BB−1) |
+//! | `beam_paths` | u64 | ⌈M/8⌉ | light subpaths (the pass's first) whose segments are BB1D's photon beams |
 
 pub mod camera_beams;
 pub mod light_beams;
@@ -109,6 +110,8 @@ pub struct UpbpParams {
     pub volume: VolumeParams,
     pub alpha_points: f64,
     pub alpha_beam_beams: f64,
+    /// `beam_paths` (None: ⌈M/8⌉).
+    pub beam_paths: Option<u64>,
     pub mis: Heuristic,
     pub techniques: Techniques,
 }
@@ -130,10 +133,15 @@ impl UpbpParams {
                 "upbp: alpha_beam_beams must lie in (0, 1], got {alpha_beam_beams}"
             ));
         }
+        let beam_paths = r.get::<u64>("beam_paths")?;
+        if beam_paths == Some(0) {
+            return Err("upbp: beam_paths must be at least 1".into());
+        }
         Ok(UpbpParams {
             volume,
             alpha_points,
             alpha_beam_beams,
+            beam_paths,
             mis: r
                 .get_with("mis", Heuristic::parse)?
                 .unwrap_or(Heuristic::Power),
@@ -161,6 +169,14 @@ impl Upbp {
             .volume
             .photons_per_pass
             .unwrap_or(scene.camera.pixel_count() as u64)
+    }
+
+    /// M_BB, the light subpaths whose segments are photon beams: a beam reaches every camera
+    /// beam that passes it, so far fewer than M keep BB1D's variance near the others' at a
+    /// fraction of the query cost (its density counts M_BB, not M).
+    pub fn beam_paths(&self, scene: &Scene) -> u64 {
+        let m = self.light_paths(scene);
+        self.params.beam_paths.unwrap_or(m.div_ceil(8)).min(m)
     }
 
     /// The radii (r_P, r_B, r_BB) of pass `pass` (0-based).
@@ -194,7 +210,12 @@ impl Upbp {
         } else {
             0.0
         };
-        let beam_beams_eta = if t.bb1d { mf * 2.0 * rbb as f64 } else { 0.0 };
+        let m_bb = self.beam_paths(scene);
+        let beam_beams_eta = if t.bb1d {
+            m_bb as f64 * 2.0 * rbb as f64
+        } else {
+            0.0
+        };
         let set = VolumeSet {
             connections: t.bpt,
             points_eta,
@@ -204,7 +225,7 @@ impl Upbp {
         let radii = (
             t.pp3d.then_some(rp),
             t.pb2d.then_some(rb),
-            t.bb1d.then_some(rbb),
+            t.bb1d.then_some((rbb, m_bb)),
         );
         let needs = Needs::of(&set);
         let store = LightStore::trace(scene, (seed, pass), (m, limits, needs), radii);

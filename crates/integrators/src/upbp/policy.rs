@@ -166,9 +166,27 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
         let i = yv.len() - 1;
         let t = zv.len();
         let k = i + t - 1;
-        let (mut l, mut c) = (vec![0.0f64; k + 1], vec![0.0f64; k + 1]);
-        let mut conn = vec![false; k + 1];
-        let mut vol = vec![VertexRate::default(); k + 1];
+        // On the stack up to STACK vertices (every shipped depth), else on the heap.
+        const STACK: usize = 33;
+        let n = k + 1;
+        let (mut l_st, mut c_st) = ([0.0f64; STACK], [0.0f64; STACK]);
+        let (mut conn_st, mut vol_st) = ([false; STACK], [VertexRate::default(); STACK]);
+        let (mut l_h, mut c_h, mut conn_h, mut vol_h);
+        let (l, c, conn, vol): (&mut [f64], &mut [f64], &mut [bool], &mut [VertexRate]) =
+            if n <= STACK {
+                (
+                    &mut l_st[..n],
+                    &mut c_st[..n],
+                    &mut conn_st[..n],
+                    &mut vol_st[..n],
+                )
+            } else {
+                l_h = vec![0.0f64; n];
+                c_h = vec![0.0f64; n];
+                conn_h = vec![false; n];
+                vol_h = vec![VertexRate::default(); n];
+                (&mut l_h, &mut c_h, &mut conn_h, &mut vol_h)
+            };
         for j in 0..=k {
             if j <= i {
                 l[j] = yv[j].pdf_fwd as f64;
@@ -233,14 +251,14 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
         c[k] = 1.0;
         l[k] = 0.0;
         let chain = Chain {
-            light: &l,
-            camera: &c,
+            light: l,
+            camera: c,
             nee: light.nee,
-            connectable: &conn,
+            connectable: conn,
             light_tracing_ratio: self.pass.ratio,
         };
         let p = self.pass;
-        weight(&chain, &vol, &p.set, technique, p.h)
+        weight(&chain, vol, &p.set, technique, p.h)
     }
 }
 

@@ -27,18 +27,6 @@ impl Needs {
     }
 }
 
-/// The free flight of `from` → `to` walked (scattering at `to` when it is a medium vertex) and
-/// σ̂ there (0 at a surface): one walk more than the flight alone, the pass probability.
-pub fn back_and_rate(scene: &Scene, from: &PathVertex, to: &PathVertex) -> (f64, f64) {
-    let m = from.medium_towards(scene, from.dir_to(to));
-    let back = scene.free_flight_density(from.into(), to.into(), m, to.in_medium()) as f64;
-    if !to.in_medium() {
-        return (back, 0.0);
-    }
-    let pass = scene.free_flight_density(from.into(), to.into(), m, false) as f64;
-    (back, if pass > 0.0 { back / pass } else { 0.0 })
-}
-
 /// Vertex `j` of a walk `v` (walk order): σ̂ of the walk's own flight v_{j−1} → v_j when
 /// `forward`, of the flight v_{j+1} → v_j walked back when `backward`, and sin θ_j between them
 /// when `sin` (each 0 where the neighbour is missing or v_j lies on no medium).
