@@ -1,8 +1,8 @@
 //! `lt mis-check --integrator upbp` as a test: on every shipped media scene, upbp's weights
-//! (connections, PP3D and PB2D under one MIS; power and balance) agree with the from-scratch
-//! oracle (`lt_core::path::volume_merging`) and its own routine's weights over a path's
-//! techniques sum to one. Plus proof that the check fails on a merge density off by 1 % and on
-//! a technique missing from the sum.
+//! (connections, PP3D, PB2D and BB1D under one MIS; power and balance) agree with the
+//! from-scratch oracle (`lt_core::path::volume_merging`) and its own routine's weights over a
+//! path's techniques sum to one. Plus proof that the check fails on a merge density off by 1 %
+//! (PB2D's, BB1D's) and on a technique missing from the sum.
 
 use lt_core::path::Heuristic;
 use lt_experiments::verify::mis_check::upbp::{
@@ -11,14 +11,15 @@ use lt_experiments::verify::mis_check::upbp::{
 use lt_tests::{shipped_media_scene_names, shipped_scene};
 
 /// Paths per (length, technique), up to 5 segments, few passes: every oracle density through
-/// media walks its segments, so the quota is small; a 1 % density error fails most merged paths
-/// of a class (below), so 20 per class keep the check's power.
+/// media walks its segments, so the quota is small; a 1 % density error fails nearly every
+/// merged path of a class (below: 195 of 195 BB1D paths at 20 per class), so 12 per class keep
+/// the check's power with BB1D's class added at the same cost as three classes at 20.
 fn options(scene: &lt_core::Scene, h: Heuristic) -> UpbpOptions {
     let mut o = UpbpOptions::new(scene);
     o.heuristic = h;
-    o.paths = 20;
+    o.paths = 12;
     o.max_depth = 5;
-    o.max_passes = 8;
+    o.max_passes = 6;
     o.seed = 7;
     o
 }
@@ -52,7 +53,7 @@ fn hg_spot_records() -> (lt_core::Scene, UpbpOptions, Vec<UpbpRecord>, (u32, usi
     let opts = options(&scene, Heuristic::Power);
     prepare_scene(&mut scene, &opts);
     let (c, passes) = collect(&scene, &opts).unwrap();
-    (scene, opts, c.records, (passes, c.too_long))
+    (scene, opts, c.records, (passes, c.counts.too_long))
 }
 
 #[test]
@@ -68,6 +69,17 @@ fn a_planted_merge_density_error_fails() {
     }
     let (report, summary) = check_records(&scene, &beam, &opts, counts, "hg-spot");
     println!("PB2D ×1.01:\n{summary}");
+    assert!(
+        report.failures() > report.checked() / 4,
+        "{report}{summary}"
+    );
+    // BB1D's density ×1.01 likewise.
+    let mut beam_beam = records.clone();
+    for r in &mut beam_beam {
+        r.set.as_mut().unwrap().beam_beams_eta *= 1.01;
+    }
+    let (report, summary) = check_records(&scene, &beam_beam, &opts, counts, "hg-spot");
+    println!("BB1D ×1.01:\n{summary}");
     assert!(
         report.failures() > report.checked() / 4,
         "{report}{summary}"

@@ -14,6 +14,19 @@
 //!   the walk's flight ended). So c_i becomes c_i / σ̂_i, σ̂_i = p_scatter / P_pass of the flight
 //!   x_{i+1} → x_i at x_i (`Scene::free_flight_density` with and without scattering; the pieces
 //!   before the last cancel): p_B,i = N · πr² · ∏_{j≤i} l_j · (c_i / σ̂_i) · ∏_{j>i} c_j.
+//! - **beam–beam 1-D** (BB1D): the light walk's segment x_{i−1} → x_i as a short photon beam
+//!   (it covers a point with the probability P_pass that the light's flight passes it) within r
+//!   of the camera walk's segment x_{i+1} → x_i as a short camera beam, both integrated along,
+//!   T evaluated on each. Neither side samples the distance to x_i: l_i / σ̂ᴸ_i (σ̂ᴸ_i of the
+//!   light's flight x_{i−1} → x_i at x_i) and c_i / σ̂_i. Jarosz et al. 2011's beam × beam
+//!   estimate counts a pair of beams k(u)/sin θ (k(u) = 1/(2r) across the lines' separation u,
+//!   θ the angle between them; `volume_density::beam_beam`): a contribution of the form
+//!   f · d_L² d_C² / (p_ω,L p_ω,C · 2r sin θ), the d² the two segments' lengths to x_i, so its
+//!   density in the volume measure of x_i is
+//!   p_BB,i = N · 2r · sin θ_i · ∏_{j≤i} l_j · (c_i / σ̂_i) · ∏_{j>i} c_j / σ̂ᴸ_i
+//!   (l_i / σ̂ᴸ_i = p_ω,L P_pass / d_L², c_i / σ̂_i alike: per unit area across each beam, and
+//!   2r sin θ turns their product into a volume density: the box across u times the Jacobian
+//!   of (s, t) → the plane of the two lines).
 //!
 //! N is the number of light subpaths whose photons every camera subpath queries (a pass's), so
 //! against a connection (one per camera sample) the heuristics compare η_P = N (4/3)πr³ and
@@ -38,6 +51,8 @@ pub struct VolumeSet {
     pub points_eta: f64,
     /// η_B = N πr² of PB2D; 0 turns it off.
     pub beams_eta: f64,
+    /// η_BB = N · 2r of BB1D; 0 turns it off.
+    pub beam_beams_eta: f64,
 }
 
 /// One technique of UPBP's family on a path.
@@ -49,14 +64,27 @@ pub enum VolumeTechnique {
     Point(usize),
     /// PB2D at the medium vertex x_i.
     Beam(usize),
+    /// BB1D at the medium vertex x_i.
+    BeamBeam(usize),
 }
 
-/// Per vertex x_j of a path: whether it lies in a medium, and σ̂_j (module doc) of the camera
-/// direction's flight x_{j+1} → x_j (0 where no flight scatters: surfaces, endpoints).
+/// Per vertex x_j of a path: whether it lies in a medium, σ̂_j (module doc) of the camera
+/// direction's flight x_{j+1} → x_j (0 where no flight scatters: surfaces, endpoints), σ̂ᴸ_j of
+/// the light direction's flight x_{j−1} → x_j, and sin θ_j between those two flights.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VolumeRates {
     pub medium: Vec<bool>,
     pub rate: Vec<f64>,
+    pub light_rate: Vec<f64>,
+    pub sin: Vec<f64>,
+}
+
+/// sin θ between the flights from `a` into `x` and from `b` into `x` (the lines' angle: the
+/// order does not matter).
+pub fn sin_between(a: &PathVertex, x: &PathVertex, b: &PathVertex) -> f64 {
+    let (u, v) = (x.dir_to(a), x.dir_to(b));
+    let c = u.cross(v);
+    (c.dot(c) as f64).sqrt()
 }
 
 /// σ̂ of the flight `from` → `to` at `to`: its scattering density per unit length over its pass
@@ -97,12 +125,38 @@ impl VolumeRates {
                 }
             })
             .collect();
-        VolumeRates { medium, rate }
+        let light_rate = (0..=k)
+            .map(|j| {
+                if j > 0 && medium[j] {
+                    scatter_rate(scene, &v[j - 1], &v[j])
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let sin = (0..=k)
+            .map(|j| {
+                if j > 0 && j < k && medium[j] {
+                    sin_between(&v[j - 1], &v[j], &v[j + 1])
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        VolumeRates {
+            medium,
+            rate,
+            light_rate,
+            sin,
+        }
     }
 
     /// The rates of a merged path (`light` = y_0 … y_i, `camera` = z_0 … z_{t−1}, its last the
-    /// camera side's x_i): x_j below i as the light side has them (x_{i−1} seen from y_i), x_i
-    /// and above as the camera side.
+    /// camera side's x_i), each from the side its density is read from (`Densities::merged`):
+    /// σ̂_j below i from the light side (x_{i−1} seen from y_i), from i up from the camera side;
+    /// σ̂ᴸ_j up to i from the light side, above from the camera side; sin θ_j below i from the
+    /// light side, above from the camera side, and at x_i between the two beams themselves
+    /// (y_{i−1} → y_i and z_{t−2} → z_{t−1}).
     pub fn merged(scene: &Scene, light: &[PathVertex], camera: &[PathVertex]) -> VolumeRates {
         let i = light.len() - 1;
         let t = camera.len();
@@ -110,9 +164,23 @@ impl VolumeRates {
         let at_camera = VolumeRates::of_path(scene, &Path::from_subpaths(&light[..i], camera));
         let pick = |j: usize| if j < i { &at_light } else { &at_camera };
         let k = at_light.rate.len() - 1;
+        let mut sin: Vec<f64> = (0..=k).map(|j| pick(j).sin[j]).collect();
+        let (u, v) = (
+            light[i].dir_to(&light[i - 1]),
+            camera[t - 1].dir_to(&camera[t - 2]),
+        );
+        let c = u.cross(v);
+        sin[i] = (c.dot(c) as f64).sqrt();
         VolumeRates {
             medium: (0..=k).map(|j| pick(j).medium[j]).collect(),
             rate: (0..=k).map(|j| pick(j).rate[j]).collect(),
+            light_rate: (0..=k)
+                .map(|j| {
+                    let side = if j <= i { &at_light } else { &at_camera };
+                    side.light_rate[j]
+                })
+                .collect(),
+            sin,
         }
     }
 }
@@ -134,7 +202,8 @@ impl Densities {
 
     /// The effective densities the heuristics compare under `set`: n_s·p_s of the connection
     /// techniques s = 0 … k+1 (zero for s ≥ 1 without connections), then η_P·p_P,i for
-    /// i = 0 … k, then η_B·p_B,i for i = 0 … k (module doc; zero where x_i is no medium vertex).
+    /// i = 0 … k, then η_B·p_B,i, then η_BB·p_BB,i for i = 0 … k (module doc; zero where x_i is
+    /// no medium vertex).
     pub fn effective_upbp(&self, set: VolumeSet, rates: &VolumeRates) -> Vec<f64> {
         let k = self.k();
         let mut all = self.effective_all();
@@ -159,6 +228,18 @@ impl Densities {
                 0.0
             });
         }
+        for i in 0..=k {
+            let (r, rl, sin) = (rates.rate[i], rates.light_rate[i], rates.sin[i]);
+            all.push(if mergeable(i) && r > 0.0 && rl > 0.0 {
+                set.beam_beams_eta
+                    * sin
+                    * (light_to(i) / rl)
+                    * (self.camera[i] / r)
+                    * camera_from(i + 1)
+            } else {
+                0.0
+            });
+        }
         all
     }
 
@@ -169,6 +250,7 @@ impl Densities {
             VolumeTechnique::Connect(s) => s,
             VolumeTechnique::Point(i) => n + 1 + i,
             VolumeTechnique::Beam(i) => 2 * n + 1 + i,
+            VolumeTechnique::BeamBeam(i) => 3 * n + 1 + i,
         }
     }
 
@@ -197,8 +279,10 @@ impl Densities {
                     VolumeTechnique::Connect(j)
                 } else if j <= 2 * n {
                     VolumeTechnique::Point(j - n - 1)
-                } else {
+                } else if j <= 3 * n {
                     VolumeTechnique::Beam(j - 2 * n - 1)
+                } else {
+                    VolumeTechnique::BeamBeam(j - 3 * n - 1)
                 }
             })
             .collect()

@@ -53,11 +53,9 @@ pub struct Merged<'a> {
 /// radius of the camera walk's medium vertex (PP3D) or of its segment (PB2D, the query point on
 /// the segment standing for the camera side's x_i).
 pub struct VolumeMerged<'a> {
-    /// PB2D (true) or PP3D (false).
-    pub beam: bool,
-    /// The merging vertex x_i (1 ≤ i ≤ k − 1).
-    pub i: usize,
-    /// The light subpath y_0 … y_i, the merged photon last.
+    /// PP3D, PB2D or BB1D at the merging vertex x_i (1 ≤ i ≤ k − 1).
+    pub technique: lt_core::path::VolumeTechnique,
+    /// The light subpath y_0 … y_i, the merged photon (or the photon beam's point) last.
     pub light: &'a [PathVertex],
     /// The camera side, camera first: x_k … x_i (the medium vertex, or the beam's query point).
     pub camera: &'a [PathVertex],

@@ -1,16 +1,18 @@
 //! A pass's light subpaths for `upbp`: walked through media (`media_walk::light_subpath_in`),
 //! kept whole (a merge's weight reads every density of the light side), with what the weights
 //! need per vertex besides the walk's densities (σ̂ of the camera direction's flight into it,
-//! next-event estimation's density of y_0), and their medium vertices indexed as photons for
-//! points (`PointGrid`) and for camera beams (`volume_density::beams::BeamGrid`).
+//! next-event estimation's density of y_0), their medium vertices indexed as photons for
+//! points (`PointGrid`) and for camera beams (`volume_density::beams::BeamGrid`), and their
+//! segments through media as photon beams for BB1D (`light_beams`).
 
+use super::light_beams::LightBeams;
+use super::rates::{light_vertex, Needs};
 use super::weights::VertexRate;
 use crate::subpath::connect::nee_density;
 use crate::subpath::media_walk::light_subpath_in;
 use crate::subpath::walk::{Subpath, WalkLimits};
 use crate::volume_density::beams::BeamGrid;
 use lt_core::math::Vec3;
-use lt_core::path::volume_merging::scatter_rate;
 use lt_core::path::PathVertex;
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::spatial::PointGrid;
@@ -27,8 +29,9 @@ pub struct LightPath<'a> {
     pub vertices: &'a [PathVertex],
     /// `Subpath::back_flight` per vertex.
     pub back_flight: &'a [f32],
-    /// Per vertex y_j: medium, and σ̂ of the flight y_{j+1} → y_j (0 at the last vertex: the
-    /// flight into it from a camera side is the join's or the merge's).
+    /// Per vertex y_j (`rates::light_vertex`): medium, σ̂ of the flight y_{j+1} → y_j, σ̂ᴸ of
+    /// y_{j−1} → y_j, sin θ_j (σ̂ and sin θ are 0 at the last vertex: the flight into it from a
+    /// camera side is the join's or the merge's).
     pub rates: &'a [VertexRate],
     /// Next-event estimation's density of y_0 from y_1 (0 for a one-vertex subpath).
     pub nee: f64,
@@ -41,6 +44,7 @@ struct Chunk {
     rates: Vec<VertexRate>,
     starts: Vec<u32>,
     nee: Vec<f64>,
+    beams: LightBeams,
 }
 
 /// A photon: light subpath `path`'s medium vertex `vertex` (≥ 1).
@@ -59,17 +63,20 @@ pub struct LightStore {
     pub points: Option<PointGrid>,
     /// For PB2D (photon spheres of r_B).
     pub beams: Option<BeamGrid>,
+    /// For BB1D: the light subpaths' segments through media as short photon beams.
+    pub light_beams: Option<LightBeams>,
 }
 
 impl LightStore {
     /// Traces light subpaths 0 … m−1 of `pass` (streams `Domain::Light`, item = index, as bdpt's)
-    /// and indexes their medium vertices for radii `r_points` (`None`: no PP3D) and `r_beams`.
+    /// and indexes their medium vertices for radii `r_points` (`None`: no PP3D) and `r_beams`
+    /// (no PB2D), the segments through media of the first M_BB for `r_beam_beams` = (r_BB, M_BB)
+    /// (no BB1D); `needs`: the rates the weights read.
     pub fn trace(
         scene: &Scene,
         (seed, pass): (u64, u32),
-        m: u64,
-        limits: WalkLimits,
-        (r_points, r_beams): (Option<f32>, Option<f32>),
+        (m, limits, needs): (u64, WalkLimits, Needs),
+        (r_points, r_beams, r_beam_beams): (Option<f32>, Option<f32>, Option<(f32, u64)>),
     ) -> LightStore {
         let n_chunks = m.div_ceil(CHUNK) as usize;
         let chunks: Vec<Chunk> = (0..n_chunks)
@@ -90,14 +97,12 @@ impl LightStore {
                     chunk
                         .back_flight
                         .extend((0..y.len()).map(|i| sub.back_flight(i)));
-                    chunk.rates.extend((0..y.len()).map(|i| VertexRate {
-                        medium: y[i].in_medium(),
-                        rate: if i + 1 < y.len() {
-                            scatter_rate(scene, &y[i + 1], &y[i])
-                        } else {
-                            0.0
-                        },
-                    }));
+                    chunk
+                        .rates
+                        .extend((0..y.len()).map(|i| light_vertex(scene, y, i, needs)));
+                    if r_beam_beams.is_some_and(|(_, m_bb)| j < m_bb) && scene.has_media {
+                        chunk.beams.add_path(scene, j as u32, &sub);
+                    }
                     chunk.nee.push(if y.len() >= 2 {
                         nee_density(scene, &y[0], &y[1])
                     } else {
@@ -108,12 +113,22 @@ impl LightStore {
                 chunk
             })
             .collect();
+        let mut chunks = chunks;
+        let light_beams = r_beam_beams.map(|(r, _)| {
+            let mut all = LightBeams::default();
+            for c in &mut chunks {
+                all.append(std::mem::take(&mut c.beams));
+            }
+            all.build_index(r);
+            all
+        });
         let mut store = LightStore {
             chunks,
             photon_positions: Vec::new(),
             photons: Vec::new(),
             points: None,
             beams: None,
+            light_beams,
         };
         let (mut positions, mut photons) = (Vec::new(), Vec::new());
         for path in 0..m as usize {

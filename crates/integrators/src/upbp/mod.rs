@@ -1,6 +1,6 @@
 //! `upbp` — unified points, beams and paths (Křivánek, Georgiev, Hachisuka, Vévoda, Šik,
-//! Nowrouzezahrai & Jarosz 2014), first cut: bdpt's connections through media and two of the
-//! volumetric density estimators under one MIS, on the one bidirectional camera loop
+//! Nowrouzezahrai & Jarosz 2014): bdpt's connections through media and three of the volumetric
+//! density estimators under one MIS, on the one bidirectional camera loop
 //! (`subpath::camera_loop`, policy in `policy`):
 //!
 //! - `bpt`: every connection technique (s, t) as `bdpt` walks and joins them through media
@@ -8,29 +8,38 @@
 //! - `pp3d`: each medium vertex of the camera walk gathers the pass's photons (medium vertices of
 //!   all M light subpaths) within r_P, 3-D kernel 1/((4/3)π r_P³);
 //! - `pb2d`: each segment of the camera walk, as a short beam (the flight the walk sampled),
-//!   gathers the photons within r_B of it, 2-D kernel 1/(π r_B²), T evaluated along it.
+//!   gathers the photons within r_B of it, 2-D kernel 1/(π r_B²), T evaluated along it;
+//! - `bb1d`: the same short camera beams gather the light subpaths' segments through media as
+//!   short photon beams (`light_beams`) within r_BB, 1-D kernel 1/(2 r_BB) over sin θ, T
+//!   evaluated along both (`camera_beams`).
 //!
 //! Weights: `weights` (full-path densities, the measures and η's stated there and in
-//! `lt_core::path::volume_merging`, the oracle). Not here yet: surface merges (vcm's), BB1D and
-//! BP2D, long beams, SmallUPBP's `previous`/`compatible` modes. Per pass, camera sample j pairs
+//! `lt_core::path::volume_merging`, the oracle). Not here yet: surface merges (vcm's), BP2D,
+//! long beams, SmallUPBP's `previous`/`compatible` modes. Per pass, camera sample j pairs
 //! with light subpath j mod M for its connections (bdpt's pairing) and queries all M for merges;
 //! radii shrink per kernel dimension (`volume_density::schedule`): r_P,i = r₁ i^((α_P−1)/3),
-//! r_B,i = r₁ i^((α−1)/2). A scene without media has no photons: upbp is bdpt there.
+//! r_B,i = r₁ i^((α−1)/2), r_BB,i = r₁ i^(α_BB−1). A scene without media has no photons: upbp
+//! is bdpt there.
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
 //! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `mis` | power/balance/none | power | heuristic over every technique |
-//! | `techniques` | all/bpt/pp3d/pb2d | all | comma-separated subset of bpt, pp3d, pb2d (SmallUPBP's names) |
+//! | `techniques` | all/bpt/pp3d/pb2d/bb1d | all | comma-separated subset of bpt, pp3d, pb2d, bb1d (SmallUPBP's names) |
 //! | `photons_per_pass` | u64 | the pixel count | light subpaths per pass (M) |
 //! | `radius` | f32 | — | initial radius r₁ in scene units (both kernels) |
 //! | `radius_scene` | f32 | 0.01 | initial radius as a fraction of the scene's bounding-sphere diameter |
 //! | `alpha` | f64 | 2/3 | PB2D's radius reduction: r_B,i = r₁ i^((α−1)/2) |
 //! | `alpha_points` | f64 | 4/7 | PP3D's radius reduction: r_P,i = r₁ i^((α_P−1)/3) |
+//! | `alpha_beam_beams` | f64 | 4/5 | BB1D's radius reduction: r_BB,i = r₁ i^(α_BB−1) |
+//! | `beam_paths` | u64 | ⌈M/8⌉ | light subpaths (the pass's first) whose segments are BB1D's photon beams |
 
+pub mod camera_beams;
+pub mod light_beams;
 pub mod light_store;
 pub mod policy;
+pub mod rates;
 pub mod weights;
 
 use crate::film::splat::{splat_pass_with, Pass, Splats, Worker};
@@ -49,7 +58,8 @@ use lt_core::path::{Heuristic, VolumeSet};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
 use lt_estimators::Image;
-use policy::{connection_weight, junction_rate, PassData, Policy};
+use policy::{connection_weight, PassData, Policy};
+use rates::{junction, Needs};
 
 /// Which of the techniques run (`techniques`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,32 +67,36 @@ pub struct Techniques {
     pub bpt: bool,
     pub pp3d: bool,
     pub pb2d: bool,
+    pub bb1d: bool,
 }
 
 impl Techniques {
-    /// `all`, or a comma-separated subset of `bpt`, `pp3d`, `pb2d`.
+    /// `all`, or a comma-separated subset of `bpt`, `pp3d`, `pb2d`, `bb1d`.
     pub fn parse(text: &str) -> Result<Techniques, String> {
         if text.trim() == "all" {
             return Ok(Techniques {
                 bpt: true,
                 pp3d: true,
                 pb2d: true,
+                bb1d: true,
             });
         }
         let mut t = Techniques {
             bpt: false,
             pp3d: false,
             pb2d: false,
+            bb1d: false,
         };
         for name in text.split([',', '+']) {
             match name.trim() {
                 "bpt" => t.bpt = true,
                 "pp3d" => t.pp3d = true,
                 "pb2d" => t.pb2d = true,
+                "bb1d" => t.bb1d = true,
                 other => {
                     return Err(format!(
                         "unknown technique '{other}' (known: all, or a comma-separated subset of \
-                         bpt, pp3d, pb2d)"
+                         bpt, pp3d, pb2d, bb1d)"
                     ))
                 }
             }
@@ -95,6 +109,9 @@ impl Techniques {
 pub struct UpbpParams {
     pub volume: VolumeParams,
     pub alpha_points: f64,
+    pub alpha_beam_beams: f64,
+    /// `beam_paths` (None: ⌈M/8⌉).
+    pub beam_paths: Option<u64>,
     pub mis: Heuristic,
     pub techniques: Techniques,
 }
@@ -108,9 +125,23 @@ impl UpbpParams {
                 "upbp: alpha_points must lie in (0, 1], got {alpha_points}"
             ));
         }
+        let alpha_beam_beams = r
+            .get::<f64>("alpha_beam_beams")?
+            .unwrap_or(balanced_alpha(1));
+        if !(alpha_beam_beams > 0.0 && alpha_beam_beams <= 1.0) {
+            return Err(format!(
+                "upbp: alpha_beam_beams must lie in (0, 1], got {alpha_beam_beams}"
+            ));
+        }
+        let beam_paths = r.get::<u64>("beam_paths")?;
+        if beam_paths == Some(0) {
+            return Err("upbp: beam_paths must be at least 1".into());
+        }
         Ok(UpbpParams {
             volume,
             alpha_points,
+            alpha_beam_beams,
+            beam_paths,
             mis: r
                 .get_with("mis", Heuristic::parse)?
                 .unwrap_or(Heuristic::Power),
@@ -140,12 +171,21 @@ impl Upbp {
             .unwrap_or(scene.camera.pixel_count() as u64)
     }
 
-    /// The radii (r_P, r_B) of pass `pass` (0-based).
-    pub fn radii(&self, pass: u32) -> (f32, f32) {
+    /// M_BB, the light subpaths whose segments are photon beams: a beam reaches every camera
+    /// beam that passes it, so far fewer than M keep BB1D's variance near the others' at a
+    /// fraction of the query cost (its density counts M_BB, not M).
+    pub fn beam_paths(&self, scene: &Scene) -> u64 {
+        let m = self.light_paths(scene);
+        self.params.beam_paths.unwrap_or(m.div_ceil(8)).min(m)
+    }
+
+    /// The radii (r_P, r_B, r_BB) of pass `pass` (0-based).
+    pub fn radii(&self, pass: u32) -> (f32, f32, f32) {
         let v = &self.params.volume;
         let rp = v.radius * radius_scale(pass + 1, self.alpha_points(), 3) as f32;
         let rb = v.radius * radius_scale(pass + 1, v.alpha, 2) as f32;
-        (rp, rb)
+        let rbb = v.radius * radius_scale(pass + 1, self.params.alpha_beam_beams, 1) as f32;
+        (rp, rb, rbb)
     }
 
     fn alpha_points(&self) -> f64 {
@@ -156,11 +196,9 @@ impl Upbp {
     pub fn setup(&self, scene: &Scene, seed: u64, pass: u32) -> (LightStore, PassSetup) {
         let t = self.params.techniques;
         let m = self.light_paths(scene);
-        let (rp, rb) = self.radii(pass);
+        let (rp, rb, rbb) = self.radii(pass);
         let v = &self.params.volume;
         let limits = WalkLimits::light(v.max_depth, v.rr_depth);
-        let radii = (t.pp3d.then_some(rp), t.pb2d.then_some(rb));
-        let store = LightStore::trace(scene, (seed, pass), m, limits, radii);
         let (mf, rpf, rbf) = (m as f64, rp as f64, rb as f64);
         let points_eta = if t.pp3d {
             mf * 4.0 / 3.0 * PI as f64 * rpf * rpf * rpf
@@ -172,14 +210,30 @@ impl Upbp {
         } else {
             0.0
         };
+        let m_bb = self.beam_paths(scene);
+        let beam_beams_eta = if t.bb1d {
+            m_bb as f64 * 2.0 * rbb as f64
+        } else {
+            0.0
+        };
+        let set = VolumeSet {
+            connections: t.bpt,
+            points_eta,
+            beams_eta,
+            beam_beams_eta,
+        };
+        let radii = (
+            t.pp3d.then_some(rp),
+            t.pb2d.then_some(rb),
+            t.bb1d.then_some((rbb, m_bb)),
+        );
+        let needs = Needs::of(&set);
+        let store = LightStore::trace(scene, (seed, pass), (m, limits, needs), radii);
         let setup = PassSetup {
-            set: VolumeSet {
-                connections: t.bpt,
-                points_eta,
-                beams_eta,
-            },
+            set,
             r_points: rp,
             r_beams: rb,
+            r_beam_beams: rbb,
             light_paths: m,
         };
         (store, setup)
@@ -261,9 +315,16 @@ impl Upbp {
                         camera_end: None,
                         flights: Some(flights),
                     };
-                    let junction = junction_rate(data, scene, &c.camera, &yv[s - 1]);
+                    let camera_end = rates::camera_vertex(scene, &camera_only, 0, data.needs);
+                    let (y_end, c_end) = junction(
+                        scene,
+                        (&yv[..s], &camera_only),
+                        (ly.rates[s - 1], camera_end),
+                        data.needs,
+                    );
+                    let ends = [(s - 1, y_end), (s, c_end)];
                     let w = with_chain_in::<MEDIA, _>(scene, split, evals, data.ratio, |ch, s| {
-                        connection_weight(data, ch, s, (ly.rates, junction), &[])
+                        connection_weight(data, ch, s, (ly.rates, &[]), &ends)
                     });
                     (w, None)
                 },
@@ -351,6 +412,7 @@ pub struct PassSetup {
     pub set: VolumeSet,
     pub r_points: f32,
     pub r_beams: f32,
+    pub r_beam_beams: f32,
     pub light_paths: u64,
 }
 
@@ -366,8 +428,11 @@ impl PassSetup {
             max_k: upbp.params.volume.max_depth as usize,
             r_points: self.r_points,
             r_beams: self.r_beams,
+            r_beam_beams: self.r_beam_beams,
             point_norm: norm(self.set.points_eta),
             beam_norm: norm(self.set.beams_eta),
+            beam_beam_norm: norm(self.set.beam_beams_eta),
+            needs: Needs::of(&self.set),
         }
     }
 }
@@ -429,6 +494,17 @@ impl ProgressiveRun for Run<'_> {
                 setup.r_beams
             ),
         ));
+        if let Some(b) = &store.light_beams {
+            self.log.facts.push((
+                "last pass photon beams".into(),
+                format!(
+                    "{} (r_BB {:.4e}, {} bytes with index)",
+                    b.beams.len(),
+                    setup.r_beam_beams,
+                    b.bytes()
+                ),
+            ));
+        }
         invalid
     }
 

@@ -1,22 +1,15 @@
 //! `upbp`'s policy in the one bidirectional camera loop (`subpath::camera_loop`): bdpt's
 //! connections (s = 0, next-event estimation, joins to the paired light subpath), PP3D at every
-//! medium vertex of the camera walk (`at_vertex`), PB2D along every segment of it (`along_segment`,
-//! and `after_walk` for the segment that left the scene), all weighed by `weights::weight` from
-//! the full path's densities.
+//! medium vertex of the camera walk (`at_vertex`), PB2D and BB1D along every segment of it
+//! (`along_segment`, and `after_walk` for the segment that left the scene: `camera_beams`), all
+//! weighed by `weights::weight` from the full path's densities.
 //!
-//! **PB2D's estimate** (a short camera beam: the segment the walk sampled, z_{t−2} → z_{t−1}, or
-//! to infinity when it left the scene). Per medium piece of the segment (`Scene::
-//! for_each_medium_piece`), each photon y_i of the piece's medium within r_B of it, at x its
-//! projection on the beam, contributes
-//!
-//!   β_leave · T(z_{t−2}, x) / P_pass(z_{t−2}, x) · σs(x) f_p(−ω, ω_y) · (β_y / σs(y_i)) / (N π r_B²),
-//!
-//! β_leave the walk's throughput leaving z_{t−2} (`Subpath::departure`): the beam covers x when
-//! the sampled flight passes it, with probability P_pass, and T is evaluated (deterministic, as
-//! `volume_density::beams`). **PP3D** at the medium vertex z (β_z holding σs(z)):
-//! β_z f_p(ω_z, ω_y) (β_y / σs(y_i)) / (N (4/3)π r_P³).
+//! **PP3D** at the medium vertex z (β_z holding σs(z)), per photon y_i within r_P:
+//! β_z f_p(ω_z, ω_y) (β_y / σs(y_i)) / (N (4/3)π r_P³). PB2D's and BB1D's estimates are
+//! `camera_beams`'s.
 
 use super::light_store::{LightPath, LightStore};
+use super::rates::{camera_vertex, junction, Needs};
 use super::weights::{weight, VertexRate};
 use crate::record::{Recorder, VolumeMerged};
 use crate::subpath::camera_loop::{CameraPolicy, Joins, SampleCtx, Weight};
@@ -24,13 +17,11 @@ use crate::subpath::connect::JoinFlights;
 use crate::subpath::strategy_weight::{with_chain_in, Split};
 use crate::subpath::walk::{Departure, Exit, Subpath};
 use lt_core::bsdf::BsdfEval;
-use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::path::scatter::connectable_inside;
-use lt_core::path::volume_merging::scatter_rate;
 use lt_core::path::{Chain, Heuristic, PathVertex, VertexKind, VolumeSet, VolumeTechnique};
 use lt_core::sampling::Sampler;
-use lt_core::scene::{ConnectionEnd, Crossing, MediumPiece};
+use lt_core::scene::ConnectionEnd;
 use lt_core::Scene;
 
 /// What every camera sample of a pass shares.
@@ -43,18 +34,13 @@ pub struct PassData<'a> {
     pub max_k: usize,
     pub r_points: f32,
     pub r_beams: f32,
-    /// 1 / (M (4/3)π r_P³) and 1 / (M π r_B²).
+    pub r_beam_beams: f32,
+    /// 1 / (M (4/3)π r_P³), 1 / (M π r_B²) and 1 / (M 2 r_BB).
     pub point_norm: f32,
     pub beam_norm: f32,
-}
-
-/// σ̂ at light vertex `y` of the flight from `from`, when PB2D runs and `y` is a medium vertex.
-pub fn junction_rate(pass: &PassData, scene: &Scene, from: &PathVertex, y: &PathVertex) -> f64 {
-    if pass.set.beams_eta > 0.0 && y.in_medium() {
-        scatter_rate(scene, from, y)
-    } else {
-        0.0
-    }
+    pub beam_beam_norm: f32,
+    /// The rates the weights read (`rates::Needs`).
+    pub needs: Needs,
 }
 
 /// The policy of one camera sample.
@@ -63,37 +49,40 @@ pub struct Policy<'a, const MEDIA: bool> {
     /// The paired light subpath, as a `Subpath` for the loop's joins and as stored.
     pub y: &'a Subpath,
     pub ly: LightPath<'a>,
-    /// Per camera vertex: medium and σ̂ of the walk's flight into it.
+    /// Per camera vertex: `rates::camera_vertex`.
     pub cam: Vec<VertexRate>,
     pub back_flight: Vec<f32>,
     pub departure: Vec<Departure>,
     pub exit: Option<Exit>,
     /// A camera side with a beam's query point last.
     pub buf: Vec<PathVertex>,
+    /// A light side with a photon beam's point last.
+    pub light_buf: Vec<PathVertex>,
 }
 
 /// `v / σs` per channel, zero where σs is (β is zero there too): a photon's power as
 /// `volume_density::photons` keeps it.
-fn without_sigma_s(v: Color, sigma_s: Color) -> Color {
+pub fn without_sigma_s(v: Color, sigma_s: Color) -> Color {
     Color::select(sigma_s.cmpgt(Color::ZERO), v / sigma_s, Color::ZERO)
 }
 
-fn medium_of(v: &PathVertex) -> Option<u32> {
+pub fn medium_of(v: &PathVertex) -> Option<u32> {
     match v.kind {
         VertexKind::Medium { medium } => Some(medium as u32),
         _ => None,
     }
 }
 
-/// The weight of connection technique s on `chain`, whose x_j is light vertex j below s (`light`;
-/// `junction` the σ̂ of x_{s−1} seen from x_s) and camera vertex k − j from s up (`cam`, the
-/// camera walk's; for s = 0, x_0 is the light the walk reached).
+/// The weight of connection technique s on `chain`, whose x_j is light vertex j below s (`light`)
+/// and camera vertex k − j from s up (`cam`, the camera walk's; for s = 0, x_0 is the light the
+/// walk reached); `ends` replace the rates of the path's vertices they name (the junction's two
+/// ends, whose rates depend on the other end: `rates::junction`).
 pub fn connection_weight(
     pass: &PassData,
     chain: &Chain,
     s: usize,
-    (light, junction): (&[VertexRate], f64),
-    cam: &[VertexRate],
+    (light, cam): (&[VertexRate], &[VertexRate]),
+    ends: &[(usize, VertexRate)],
 ) -> f64 {
     let k = chain.k();
     let mut stack = [VertexRate::default(); 32];
@@ -105,20 +94,47 @@ pub fn connection_weight(
         &mut heap
     };
     for (j, v) in vol.iter_mut().enumerate() {
-        *v = if j + 1 < s {
-            light[j]
-        } else if j + 1 == s {
-            VertexRate {
-                medium: light[j].medium,
-                rate: junction,
-            }
+        *v = if j < s {
+            light.get(j).copied().unwrap_or_default()
         } else if (s > 0 || j > 0) && k - j < cam.len() {
             cam[k - j]
         } else {
             VertexRate::default()
         };
     }
+    for &(j, v) in ends {
+        if j <= k {
+            vol[j] = v;
+        }
+    }
     weight(chain, vol, &pass.set, VolumeTechnique::Connect(s), pass.h)
+}
+
+/// One side of a volumetric merge at x_i: its vertices (the side's x_i last), the free flight
+/// of x_i → the side's vertex before walked back, the side's stored rates (per vertex of its
+/// walk), σ̂ at the vertex before x_i of the flight from x_i (the other direction's), and σ̂ at
+/// x_i of the side's own flight into it, sin θ at the vertex before x_i (its neighbours there:
+/// its own vertex before and x_i; a walk's last vertex has none stored); for the light side,
+/// next-event estimation's density of y_0 from y_1.
+pub struct MergeSide<'a> {
+    pub vertices: &'a [PathVertex],
+    pub back: f64,
+    pub rates: &'a [VertexRate],
+    pub near_rate: f64,
+    pub end_rate: f64,
+    pub near_sin: f64,
+    pub nee: f64,
+}
+
+/// sin θ at the vertex before the last of `side` (0 when BB1D does not run, or it has no
+/// vertex before it).
+pub fn near_sin(side: &[PathVertex], needs: super::rates::Needs) -> f64 {
+    let n = side.len();
+    if needs.light && n >= 3 && side[n - 2].in_medium() {
+        lt_core::path::volume_merging::sin_between(&side[n - 3], &side[n - 2], &side[n - 1])
+    } else {
+        0.0
+    }
 }
 
 impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
@@ -132,193 +148,117 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
             departure: Vec::new(),
             exit: None,
             buf: Vec::new(),
+            light_buf: Vec::new(),
         }
     }
 
-    /// The weight of a volumetric merge of photon path `y` (y_0 … y_i) with the camera side
-    /// `cam` (z_0 … , its last the camera's x_i), `zx_back` the free flight of x_i → its camera
-    /// predecessor walked back, `zx_rate` σ̂ at x_i. The densities are `Densities::volume_merged`'s.
-    fn merge_weight(
+    /// The weight of a volumetric merge of light side `light` (y_0 … y_i) with camera side `cam`
+    /// (z_0 …, its last the camera's x_i). The densities are `Densities::volume_merged`'s, the
+    /// rates `VolumeRates::merged`'s.
+    pub fn merge_weight(
         &self,
         scene: &Scene,
-        y: LightPath,
-        cam: &[PathVertex],
-        (zx_back, zx_rate): (f64, f64),
+        light: MergeSide,
+        cam: MergeSide,
         technique: VolumeTechnique,
     ) -> f64 {
-        let yv = y.vertices;
+        let (yv, zv) = (light.vertices, cam.vertices);
         let i = yv.len() - 1;
-        let t = cam.len();
+        let t = zv.len();
         let k = i + t - 1;
-        let (mut light, mut camera) = (vec![0.0f64; k + 1], vec![0.0f64; k + 1]);
-        let mut conn = vec![false; k + 1];
-        let mut vol = vec![VertexRate::default(); k + 1];
+        // On the stack up to STACK vertices (every shipped depth), else on the heap.
+        const STACK: usize = 33;
+        let n = k + 1;
+        let (mut l_st, mut c_st) = ([0.0f64; STACK], [0.0f64; STACK]);
+        let (mut conn_st, mut vol_st) = ([false; STACK], [VertexRate::default(); STACK]);
+        let (mut l_h, mut c_h, mut conn_h, mut vol_h);
+        let (l, c, conn, vol): (&mut [f64], &mut [f64], &mut [bool], &mut [VertexRate]) =
+            if n <= STACK {
+                (
+                    &mut l_st[..n],
+                    &mut c_st[..n],
+                    &mut conn_st[..n],
+                    &mut vol_st[..n],
+                )
+            } else {
+                l_h = vec![0.0f64; n];
+                c_h = vec![0.0f64; n];
+                conn_h = vec![false; n];
+                vol_h = vec![VertexRate::default(); n];
+                (&mut l_h, &mut c_h, &mut conn_h, &mut vol_h)
+            };
         for j in 0..=k {
             if j <= i {
-                light[j] = yv[j].pdf_fwd as f64;
+                l[j] = yv[j].pdf_fwd as f64;
             }
             if j + 2 <= i {
-                camera[j] = yv[j].pdf_rev as f64;
+                c[j] = yv[j].pdf_rev as f64;
             }
             if j >= i {
-                camera[j] = cam[k - j].pdf_fwd as f64;
+                c[j] = zv[k - j].pdf_fwd as f64;
             }
             if j >= i + 2 {
-                light[j] = cam[k - j].pdf_rev as f64;
+                l[j] = zv[k - j].pdf_rev as f64;
             }
             conn[j] = match j.cmp(&i) {
                 std::cmp::Ordering::Less => connectable_inside(scene, &yv[j]),
                 std::cmp::Ordering::Equal => true,
-                std::cmp::Ordering::Greater => connectable_inside(scene, &cam[k - j]),
+                std::cmp::Ordering::Greater => connectable_inside(scene, &zv[k - j]),
             };
             vol[j] = match j.cmp(&i) {
-                std::cmp::Ordering::Less => y.rates[j],
-                std::cmp::Ordering::Equal => VertexRate {
-                    medium: true,
-                    rate: zx_rate,
-                },
-                std::cmp::Ordering::Greater => {
-                    if k - j < self.cam.len() {
-                        self.cam[k - j]
-                    } else {
-                        VertexRate::default()
+                std::cmp::Ordering::Less => {
+                    let mut v = light.rates[j];
+                    if j + 1 == i {
+                        v.rate = light.near_rate;
+                        v.sin = light.near_sin;
                     }
+                    v
+                }
+                std::cmp::Ordering::Equal => {
+                    let (u, w) = (yv[i].dir_to(&yv[i - 1]), zv[t - 1].dir_to(&zv[t - 2]));
+                    let x = u.cross(w);
+                    VertexRate {
+                        medium: true,
+                        rate: cam.end_rate,
+                        light_rate: light.end_rate,
+                        sin: (x.dot(x) as f64).sqrt(),
+                    }
+                }
+                std::cmp::Ordering::Greater => {
+                    let mut v = cam.rates.get(k - j).copied().unwrap_or_default();
+                    if j == i + 1 {
+                        v.light_rate = cam.near_rate;
+                        v.sin = cam.near_sin;
+                    }
+                    v
                 }
             };
         }
-        let (y_i, zx) = (&yv[i], &cam[t - 1]);
+        let (y_i, zx) = (&yv[i], &zv[t - 1]);
         let medium = medium_of(zx).expect("a volumetric merge's camera side is a medium vertex");
         let phase = scene.media[medium as usize].phase();
         // c_{i−1}: the camera side's phase function sampling ω_y, in y_{i−1}'s measure from y_i.
-        camera[i - 1] = if i == 1 && yv[0].is_delta_light() {
+        c[i - 1] = if i == 1 && yv[0].is_delta_light() {
             0.0
         } else {
             let pdf = phase.pdf(zx.wo, y_i.wo);
-            y_i.convert_density(pdf, &yv[i - 1]) as f64 * y.back_flight[i] as f64
+            y_i.convert_density(pdf, &yv[i - 1]) as f64 * light.back
         };
         if i + 1 < k {
             let pdf = phase.pdf(y_i.wo, zx.wo);
-            light[i + 1] = zx.convert_density(pdf, &cam[t - 2]) as f64 * zx_back;
+            l[i + 1] = zx.convert_density(pdf, &zv[t - 2]) as f64 * cam.back;
         }
-        camera[k] = 1.0;
-        light[k] = 0.0;
+        c[k] = 1.0;
+        l[k] = 0.0;
         let chain = Chain {
-            light: &light,
-            camera: &camera,
-            nee: y.nee,
-            connectable: &conn,
+            light: l,
+            camera: c,
+            nee: light.nee,
+            connectable: conn,
             light_tracing_ratio: self.pass.ratio,
         };
         let p = self.pass;
-        weight(&chain, &vol, &p.set, technique, p.h)
-    }
-
-    /// PB2D along the segment from `prefix`'s last vertex in direction `dir` up to `end`, left
-    /// with `leave`.
-    #[allow(clippy::too_many_arguments)]
-    fn beam<R: Recorder>(
-        &mut self,
-        scene: &Scene,
-        prefix: &[PathVertex],
-        (dir, end): (Vec3, ConnectionEnd),
-        leave: Departure,
-        ctx: &mut SampleCtx<'_, R>,
-        l: &mut Color,
-    ) {
-        let p = self.pass;
-        let Some(grid) = p.store.beams.as_ref() else {
-            return;
-        };
-        if p.set.beams_eta == 0.0 || prefix.len() >= p.max_k || leave.beta == Color::ZERO {
-            return;
-        }
-        let o = &prefix[prefix.len() - 1];
-        let mut pieces: Vec<MediumPiece> = Vec::new();
-        let m0 = o.medium_towards(scene, dir);
-        scene.for_each_medium_piece(o.into(), end, m0, Crossing::Everything, |piece| {
-            pieces.push(piece)
-        });
-        let r2 = p.r_beams * p.r_beams;
-        let (mut t_before, mut p_before) = (Color::ONE, 1.0f32);
-        let mut buf = std::mem::take(&mut self.buf);
-        for piece in pieces {
-            let Some(m) = piece.medium else {
-                continue;
-            };
-            let mm = &scene.media[m as usize];
-            let len = (piece.b - piece.a).length();
-            if !(len > 0.0) {
-                continue;
-            }
-            let phase = mm.phase();
-            let ray = Ray::new(piece.a, dir);
-            grid.for_each_along(&ray, len, |idx, t_lo, t_hi| {
-                let ph = p.store.photons[idx as usize];
-                let i = ph.vertex as usize;
-                if i + prefix.len() > p.max_k {
-                    return;
-                }
-                let y = p.store.photon(ph);
-                let yv = &y.vertices[i];
-                if medium_of(yv) != Some(m as u32) {
-                    return;
-                }
-                let to = p.store.photon_positions[idx as usize] - piece.a;
-                let tp = to.dot(dir);
-                if !(tp >= t_lo && tp < t_hi && tp < len) {
-                    return;
-                }
-                if (to - dir * tp).length_squared() > r2 {
-                    return;
-                }
-                let x = piece.a + dir * tp;
-                let pass = p_before * mm.free_flight_density(piece.a, x, false);
-                let scatter = p_before * mm.free_flight_density(piece.a, x, true);
-                if !(pass > 0.0 && scatter > 0.0) {
-                    return;
-                }
-                let tr = t_before * mm.transmittance(piece.a, x);
-                let power = without_sigma_s(yv.beta, mm.sigma_s(yv.p));
-                let value = leave.beta * tr / pass
-                    * mm.sigma_s(x)
-                    * phase.eval(-dir, yv.wo)
-                    * power
-                    * p.beam_norm;
-                if value == Color::ZERO {
-                    return;
-                }
-                let xv = PathVertex::medium(m, x, -dir, value, leave.pdf_w, scatter, o);
-                buf.clear();
-                buf.extend_from_slice(prefix);
-                buf.push(xv);
-                let back =
-                    scene.free_flight_density((&xv).into(), o.into(), Some(m), o.in_medium());
-                let rate = (scatter / pass) as f64;
-                let w = self.merge_weight(
-                    scene,
-                    y,
-                    &buf,
-                    (back as f64, rate),
-                    VolumeTechnique::Beam(i),
-                );
-                if R::ACTIVE {
-                    ctx.rec.volume_merged(VolumeMerged {
-                        beam: true,
-                        i,
-                        light: y.vertices,
-                        camera: &buf,
-                        weight: w,
-                        value,
-                        raster: ctx.raster,
-                        radius: p.r_beams,
-                    });
-                }
-                *l += value * w as f32;
-            });
-            t_before *= mm.transmittance(piece.a, piece.b);
-            p_before *= mm.free_flight_density(piece.a, piece.b, false);
-        }
-        self.buf = buf;
+        weight(&chain, vol, &p.set, technique, p.h)
     }
 }
 
@@ -327,15 +267,10 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
 
     fn camera_walk(&mut self, scene: &Scene, camera: &Subpath) {
         let z = &camera.vertices;
+        let needs = self.pass.needs;
         self.cam.clear();
-        self.cam.extend((0..z.len()).map(|j| VertexRate {
-            medium: z[j].in_medium(),
-            rate: if j >= 1 && z[j].in_medium() {
-                scatter_rate(scene, &z[j - 1], &z[j])
-            } else {
-                0.0
-            },
-        }));
+        self.cam
+            .extend((0..z.len()).map(|j| camera_vertex(scene, z, j, needs)));
         self.back_flight.clear();
         self.back_flight
             .extend((0..z.len()).map(|j| camera.back_flight(j)));
@@ -354,8 +289,21 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     ) -> Weight {
         let (split, mut evals) = Split::reached(path);
         evals.flights = Some(f);
+        let n = path.len();
+        // x_1's rates towards x_0: the walk's own when it hit x_0 (a vertex of its walk); from a
+        // light at infinity, found here.
+        let mut ends = [(usize::MAX, VertexRate::default())];
+        if n >= 2 && path[n - 1].is_infinite() && n - 2 < self.cam.len() {
+            let (_, z) = junction(
+                scene,
+                (&path[n - 1..], &path[..n - 1]),
+                (VertexRate::default(), self.cam[n - 2]),
+                self.pass.needs,
+            );
+            ends[0] = (1, z);
+        }
         let w = with_chain_in::<MEDIA, _>(scene, split, evals, self.pass.ratio, |chain, s| {
-            connection_weight(self.pass, chain, s, (&[], 0.0), &self.cam)
+            connection_weight(self.pass, chain, s, (&[], &self.cam), &ends)
         });
         (w, None)
     }
@@ -370,9 +318,16 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     ) -> Weight {
         let (split, mut evals) = Split::next_event(z, x0, camera_end);
         evals.flights = Some(f);
-        let light = [VertexRate::default()];
+        let t = z.len();
+        let (y, c) = junction(
+            scene,
+            (std::slice::from_ref(x0), z),
+            (VertexRate::default(), self.cam[t - 1]),
+            self.pass.needs,
+        );
+        let ends = [(0, y), (1, c)];
         let w = with_chain_in::<MEDIA, _>(scene, split, evals, self.pass.ratio, |chain, s| {
-            connection_weight(self.pass, chain, s, (&light, 0.0), &self.cam)
+            connection_weight(self.pass, chain, s, (&[], &self.cam), &ends)
         });
         (w, None)
     }
@@ -384,16 +339,17 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     fn connect<R: Recorder>(&mut self, scene: &Scene, joins: &mut Joins<'_, R>, _: &mut Sampler) {
         let this = &*self;
         joins.join_subpath_in::<MEDIA>(scene, this.y, |c| {
-            let s = c.light.len();
-            let junction = junction_rate(
-                this.pass,
+            let (s, t) = (c.light.len(), c.camera.len());
+            let (y, z) = junction(
                 scene,
-                &c.camera[c.camera.len() - 1],
-                &c.light[s - 1],
+                (c.light, c.camera),
+                (this.ly.rates[s - 1], this.cam[t - 1]),
+                this.pass.needs,
             );
+            let ends = [(s - 1, y), (s, z)];
             let (split, evals) = Split::connection(c, this.ly.nee);
             let w = with_chain_in::<MEDIA, _>(scene, split, evals, this.pass.ratio, |chain, s| {
-                connection_weight(this.pass, chain, s, (this.ly.rates, junction), &this.cam)
+                connection_weight(this.pass, chain, s, (this.ly.rates, &this.cam), &ends)
             });
             (w, None)
         });
@@ -417,8 +373,6 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         }
         let mm = &scene.media[m as usize];
         let phase = mm.phase();
-        let zx_back = self.back_flight[t - 1] as f64;
-        let zx_rate = self.cam[t - 1].rate;
         let positions = &p.store.photon_positions;
         grid.for_each_within(positions, zv.p, p.r_points, |idx, _| {
             let ph = p.store.photons[idx as usize];
@@ -436,11 +390,28 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
             if value == Color::ZERO {
                 return;
             }
-            let w = self.merge_weight(scene, y, z, (zx_back, zx_rate), VolumeTechnique::Point(i));
+            let light = MergeSide {
+                vertices: y.vertices,
+                back: y.back_flight[i] as f64,
+                rates: y.rates,
+                near_rate: y.rates[i - 1].rate,
+                end_rate: y.rates[i].light_rate,
+                near_sin: y.rates[i - 1].sin,
+                nee: y.nee,
+            };
+            let cam = MergeSide {
+                vertices: z,
+                back: self.back_flight[t - 1] as f64,
+                rates: &self.cam,
+                near_rate: self.cam[t - 2].light_rate,
+                end_rate: self.cam[t - 1].rate,
+                near_sin: self.cam[t - 2].sin,
+                nee: 0.0,
+            };
+            let w = self.merge_weight(scene, light, cam, VolumeTechnique::Point(i));
             if R::ACTIVE {
                 ctx.rec.volume_merged(VolumeMerged {
-                    beam: false,
-                    i,
+                    technique: VolumeTechnique::Point(i),
                     light: y.vertices,
                     camera: z,
                     weight: w,
@@ -466,7 +437,7 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         let t = z.len();
         let (a, b) = (&z[t - 2], &z[t - 1]);
         let leave = self.departure[t - 1];
-        self.beam(scene, &z[..t - 1], (a.dir_to(b), b.into()), leave, ctx, l);
+        self.camera_beam(scene, &z[..t - 1], (a.dir_to(b), b.into()), leave, ctx, l);
     }
 
     fn after_walk<R: Recorder>(
@@ -485,6 +456,6 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
             ng: Vec3::ZERO,
             infinite: true,
         };
-        self.beam(scene, z, (exit.dir, far), exit.leave, ctx, l);
+        self.camera_beam(scene, z, (exit.dir, far), exit.leave, ctx, l);
     }
 }

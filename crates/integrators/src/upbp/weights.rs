@@ -8,16 +8,22 @@
 //! ∏_{j≤i} l_j ∏_{j≥i} c_j; PB2D counts η_B = N·πr_B² times the same product with c_i divided
 //! by σ̂_i (`VertexRate::rate`), the flight's scattering density over its pass probability at x_i:
 //! the beam covers x_i with the pass probability where the walk stopped there with the
-//! scattering density.
+//! scattering density. BB1D counts η_BB = N·2r times sin θ_i and the product with both l_i and
+//! c_i divided by their σ̂'s (`light_rate`, `rate`): both walks' segments are beams.
 
 use lt_core::path::{Chain, Heuristic, VolumeSet, VolumeTechnique};
 
-/// Per path vertex x_j: in a medium, and σ̂_j of the camera direction's flight into it.
+/// Per path vertex x_j: in a medium, σ̂_j of the camera direction's flight into it, σ̂ᴸ_j of the
+/// light direction's, and sin θ_j between the two flights (`lt_core::path::VolumeRates`).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct VertexRate {
     pub medium: bool,
     /// σ̂_j (0 where no flight scatters into x_j).
     pub rate: f64,
+    /// σ̂ᴸ_j of the flight x_{j−1} → x_j (0 where none scatters).
+    pub light_rate: f64,
+    /// sin θ_j between the flights x_{j−1} → x_j and x_{j+1} → x_j.
+    pub sin: f64,
 }
 
 /// Longest path (segments) weighed on the stack.
@@ -33,8 +39,8 @@ pub fn weight(
     h: Heuristic,
 ) -> f64 {
     let k = chain.k();
-    let n = 3 * (k + 2);
-    let mut stack = [0.0f64; 3 * (STACK_K + 2)];
+    let n = BLOCKS * (k + 2);
+    let mut stack = [0.0f64; BLOCKS * (STACK_K + 2)];
     let mut heap = Vec::new();
     let p: &mut [f64] = if k <= STACK_K {
         &mut stack[..n]
@@ -47,6 +53,7 @@ pub fn weight(
         VolumeTechnique::Connect(s) => p[s],
         VolumeTechnique::Point(i) => p[k + 2 + i],
         VolumeTechnique::Beam(i) => p[2 * (k + 2) + i],
+        VolumeTechnique::BeamBeam(i) => p[3 * (k + 2) + i],
     };
     if !(own > 0.0) {
         return 0.0;
@@ -57,8 +64,11 @@ pub fn weight(
     h.weight_from_ratios(p)
 }
 
-/// n·p of every technique into `out` (3 (k + 2) entries): connections s = 0 … k+1, PP3D at
-/// x_0 … x_{k+1}, PB2D at x_0 … x_{k+1} (the last of each never valid).
+/// Technique families: connections, PP3D, PB2D, BB1D.
+const BLOCKS: usize = 4;
+
+/// n·p of every technique into `out` (4 (k + 2) entries): connections s = 0 … k+1, PP3D, PB2D
+/// and BB1D at x_0 … x_{k+1} (the last of each never valid).
 fn effective(chain: &Chain, vol: &[VertexRate], set: &VolumeSet, out: &mut [f64]) {
     let k = chain.k();
     for s in 0..=k + 1 {
@@ -72,18 +82,26 @@ fn effective(chain: &Chain, vol: &[VertexRate], set: &VolumeSet, out: &mut [f64]
     let (l, c) = (chain.light, chain.camera);
     let mut light_to = 1.0;
     for i in 0..=k + 1 {
-        let (point, beam) = (&mut 0.0, &mut 0.0);
+        let (point, beam, beam_beam) = (&mut 0.0, &mut 0.0, &mut 0.0);
         if i <= k {
             light_to *= l[i];
         }
         if i >= 1 && i < k && vol[i].medium {
             let camera_from: f64 = c[i..].iter().product();
             *point = set.points_eta * light_to * camera_from;
-            if vol[i].rate > 0.0 {
-                *beam = set.beams_eta * light_to * camera_from / vol[i].rate;
+            let v = vol[i];
+            if v.rate > 0.0 {
+                *beam = set.beams_eta * light_to * camera_from / v.rate;
+                if v.light_rate > 0.0 {
+                    *beam_beam = set.beam_beams_eta
+                        * v.sin
+                        * (light_to / v.light_rate)
+                        * (camera_from / v.rate);
+                }
             }
         }
         out[k + 2 + i] = *point;
         out[2 * (k + 2) + i] = *beam;
+        out[3 * (k + 2) + i] = *beam_beam;
     }
 }

@@ -62,7 +62,7 @@ impl<'a> BeamBeamQuery<'a> {
 
 /// The closest points of two lines o_c + s ω_c and o_b + t ω_b (unit directions): (s, t, the
 /// distance between them, sin θ); `None` when (nearly) parallel.
-fn closest_points(oc: Vec3, wc: Vec3, ob: Vec3, wb: Vec3) -> Option<(f32, f32, f32, f32)> {
+pub fn closest_points(oc: Vec3, wc: Vec3, ob: Vec3, wb: Vec3) -> Option<(f32, f32, f32, f32)> {
     let cos = wc.dot(wb);
     let sin2 = 1.0 - cos * cos;
     if !(sin2 > MIN_SIN * MIN_SIN) {

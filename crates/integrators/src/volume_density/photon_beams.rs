@@ -12,8 +12,8 @@
 //! each path counted once, as with points.
 //!
 //! **The index.** A uniform grid (`cell_frame.rs`) of cells ≥ 2r, each beam listed in every cell
-//! within r of its segment (the 3×3×3 neighbourhood of each cell its segment crosses, kept when
-//! the cell's circumscribed ball meets the beam's radius-r capsule). A camera beam walks the
+//! within r of its segment (per cell its segment crosses, the cells of the bounding box of the
+//! segment's piece in that cell grown by r: at most 2 per axis). A camera beam walks the
 //! grid and counts a photon beam only in the cell whose t interval holds its closest point
 //! (`beam_beam.rs`), which lies within r of the photon beam, so the photon beam is listed there.
 
@@ -73,7 +73,7 @@ impl PhotonBeams {
 }
 
 /// Where a ray from `o` along unit `d` leaves the sphere (c, r); 0 if it never is inside.
-fn sphere_exit(o: Vec3, d: Vec3, c: Vec3, r: f32) -> f32 {
+pub fn sphere_exit(o: Vec3, d: Vec3, c: Vec3, r: f32) -> f32 {
     let oc = o - c;
     let b = oc.dot(d);
     let disc = b * b - (oc.length_squared() - r * r);
@@ -107,7 +107,7 @@ impl LightRecord for PhotonBeams {
     }
 }
 
-/// The grid's longest side in cells at most. A beam is listed in ~9 cells per cell it crosses,
+/// The grid's longest side in cells at most. A beam is listed in ~4 cells per cell it crosses,
 /// so memory grows with this; 64 keeps a pass of 10⁴ beams near 10 MB.
 const MAX_CELLS_PER_AXIS: f32 = 64.0;
 
@@ -130,9 +130,10 @@ impl BeamIndex {
         // A margin past r: DDA boundaries carry rounding, and closest points must stay inside.
         let margin = Vec3::splat(r * 1.01 + 1e-4 * (hi - lo).max_element());
         let frame = CellFrame::new(lo - margin, hi + margin, 2.0 * r, MAX_CELLS_PER_AXIS);
-        // A cell is kept when its centre lies within r + its circumscribed radius of the segment
-        // (with slack for rounding): every point within r of the beam is in a kept cell.
-        let reach = r * 1.01 + frame.cell * 0.8661;
+        // Every point within r of the beam lies within r of the piece of the beam in some cell
+        // the beam crosses: the cells of that piece's bounding box grown by r (with slack for
+        // rounding) hold them all, at most 2 per axis as cells are ≥ 2r.
+        let reach = Vec3::splat(r * 1.01 + 1e-5 * frame.cell);
         let mut stamp = vec![u32::MAX; frame.cell_count()];
         let mut call = 0u32;
         let lists = CellLists::build(frame, beams.len(), |i, emit| {
@@ -140,26 +141,15 @@ impl BeamIndex {
             call += 1;
             let b = &beams[i];
             let ray = Ray::new(b.origin, b.dir);
-            frame.for_cells_along(&ray, b.length, |_, c, _, _| {
-                for dz in -1..=1 {
-                    for dy in -1..=1 {
-                        for dx in -1..=1 {
-                            let n = [c[0] + dx, c[1] + dy, c[2] + dz];
-                            if (0..3).any(|k| n[k] < 0 || n[k] >= frame.dims[k]) {
-                                continue;
-                            }
-                            let cell = frame.index(n);
-                            if stamp[cell] == call {
-                                continue;
-                            }
-                            let p = frame.centre(n);
-                            if distance_to_segment(p, b.origin, b.dir, b.length) <= reach {
-                                stamp[cell] = call;
-                                emit(cell);
-                            }
-                        }
+            frame.for_cells_along(&ray, b.length, |_, _, t_lo, t_hi| {
+                let p0 = b.origin + b.dir * t_lo;
+                let p1 = b.origin + b.dir * t_hi.min(b.length);
+                frame.for_cells_of_box(p0.min(p1) - reach, p0.max(p1) + reach, |cell| {
+                    if stamp[cell] != call {
+                        stamp[cell] = call;
+                        emit(cell);
                     }
-                }
+                });
             });
         });
         Some(BeamIndex { lists })
@@ -169,10 +159,4 @@ impl BeamIndex {
     pub fn bytes(&self) -> usize {
         self.lists.bytes()
     }
-}
-
-/// The distance from `p` to the segment o + t d, t ∈ [0, len] (d unit).
-fn distance_to_segment(p: Vec3, o: Vec3, d: Vec3, len: f32) -> f32 {
-    let t = (p - o).dot(d).clamp(0.0, len);
-    (p - (o + d * t)).length()
 }

@@ -5,13 +5,15 @@
 //!   n_conn = N / L̄ times, `connection_count`), and bdpt's (lvc-bdpt's) replayed for every
 //!   technique of the path.
 //! - `vcm_bpm`: vcm's and bpm's (connections and merges), and their recursion replayed.
-//! - `upbp`: upbp's (connections, PP3D and PB2D through media), and its routine replayed.
+//! - `upbp`: upbp's (connections, PP3D, PB2D and BB1D through media), and its routine replayed.
+//! - `quota`: how many recorded paths the vcm and upbp checkers keep per (length, technique).
 //! - `tolerance`: how far a weight may stray from the oracle's.
 //! - `report`: the one report both checkers fill, a row per path length.
 
 use lt_core::Scene;
 
 pub mod pt_bdpt;
+pub mod quota;
 pub mod report;
 pub mod tolerance;
 pub mod upbp;

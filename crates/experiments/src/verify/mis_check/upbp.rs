@@ -1,17 +1,20 @@
 //! `lt mis-check --integrator upbp`: the weights `upbp` applied to the paths it completed — by a
-//! connection, by a photon point at a camera medium vertex (PP3D) or by a photon near a camera
-//! beam (PB2D) — against the from-scratch oracle (`Densities::upbp_weight`,
-//! `lt_core::path::volume_merging`: every connection technique, PP3D and PB2D at every medium
-//! vertex, each density rebuilt from the path's positions), and the partition of unity of the
+//! connection, by a photon point at a camera medium vertex (PP3D), by a photon near a camera
+//! beam (PB2D) or by a photon beam near a camera beam (BB1D) — against the from-scratch oracle
+//! (`Densities::upbp_weight`, `lt_core::path::volume_merging`: every connection technique, PP3D,
+//! PB2D and BB1D at every medium vertex, each density and rate rebuilt from the path's
+//! positions), and the partition of unity of the
 //! integrator's own routine (`upbp::weights::weight`) replayed on the oracle's densities over
 //! every technique that can make the path.
 //!
 //! A merged path has two x_i (the photon y_i and the camera side's medium vertex or beam query
-//! point), as vcm's merges (`vcm_bpm`); the oracle takes the light side from the photon's path
-//! and the camera side from the camera's (`Densities::volume_merged`). The tolerance is derived
-//! from the rounding of the vertices as for connections (`tolerance::derived_tolerance`), the
-//! rates σ̂ held at the unperturbed path's.
+//! point; for BB1D the photon beam's point y_i), as vcm's merges (`vcm_bpm`); the oracle takes
+//! the light side from the photon's path and the camera side from the camera's
+//! (`Densities::volume_merged`, `VolumeRates::merged`). The tolerance is derived from the
+//! rounding of the vertices as for connections (`tolerance::derived_tolerance`), the rates σ̂
+//! and sin θ held at the unperturbed path's.
 
+use super::quota::QuotaCounts;
 use super::report::{Report, Verdict};
 use super::tolerance::{derived_tolerance, relative, weight_error_bound, DEFAULT_SLACK};
 use lt_core::path::volume_merging::VolumeRates;
@@ -94,45 +97,35 @@ impl UpbpRecord {
 
 /// Keeps up to `quota` paths per (k, technique).
 pub struct UpbpCollector {
-    quota: usize,
-    max_depth: usize,
-    counts: BTreeMap<(usize, VolumeTechnique), usize>,
+    pub counts: QuotaCounts<VolumeTechnique>,
     pub records: Vec<UpbpRecord>,
-    pub too_long: usize,
+}
+
+/// The report's kind of a technique: connections, or which volumetric estimator.
+pub fn kind(t: &VolumeTechnique) -> &'static str {
+    match t {
+        VolumeTechnique::Connect(_) => "connections",
+        VolumeTechnique::Point(_) => "pp3d",
+        VolumeTechnique::Beam(_) => "pb2d",
+        VolumeTechnique::BeamBeam(_) => "bb1d",
+    }
 }
 
 impl UpbpCollector {
     fn keep(&mut self, k: usize, t: VolumeTechnique) -> bool {
-        if k > self.max_depth || k == 0 {
-            self.too_long += 1;
-            return false;
-        }
-        let n = self.counts.entry((k, t)).or_insert(0);
-        if *n >= self.quota {
-            return false;
-        }
-        *n += 1;
-        true
+        self.counts.keep(k, t)
     }
 
     /// Every length has its quota of each kind of technique seen so far.
     fn full(&self) -> bool {
-        let kinds = |k: usize| {
-            let of = |f: fn(&VolumeTechnique) -> bool| {
-                self.counts
-                    .iter()
-                    .filter(|((kk, t), _)| *kk == k && f(t))
-                    .map(|(_, n)| n)
-                    .sum::<usize>()
-            };
-            [
-                of(|t| matches!(t, VolumeTechnique::Connect(_))),
-                of(|t| matches!(t, VolumeTechnique::Point(_))),
-                of(|t| matches!(t, VolumeTechnique::Beam(_))),
-            ]
-        };
-        (1..=self.max_depth).all(|k| kinds(k).iter().all(|&n| n == 0 || n >= self.quota))
-            && !self.records.is_empty()
+        let c = &self.counts;
+        let kinds = ["connections", "pp3d", "pb2d", "bb1d"];
+        (1..=c.max_depth()).all(|k| {
+            kinds.iter().all(|&name| {
+                let n = c.of_length(k, |t| kind(t) == name);
+                n == 0 || n >= c.quota()
+            })
+        }) && !self.records.is_empty()
     }
 }
 
@@ -155,11 +148,7 @@ impl Recorder for UpbpCollector {
 
     fn volume_merged(&mut self, p: VolumeMerged) {
         let k = p.light.len() + p.camera.len() - 2;
-        let t = if p.beam {
-            VolumeTechnique::Beam(p.i)
-        } else {
-            VolumeTechnique::Point(p.i)
-        };
+        let t = p.technique;
         if self.keep(k, t) {
             self.records.push(UpbpRecord {
                 technique: t,
@@ -177,11 +166,8 @@ impl Recorder for UpbpCollector {
 pub fn collect(scene: &Scene, opts: &UpbpOptions) -> Result<(UpbpCollector, u32), String> {
     let upbp = opts.integrator(scene)?;
     let mut c = UpbpCollector {
-        quota: opts.paths,
-        max_depth: opts.max_depth as usize,
-        counts: BTreeMap::new(),
+        counts: QuotaCounts::new(opts.paths, opts.max_depth as usize),
         records: Vec::new(),
-        too_long: 0,
     };
     let mut passes = 0;
     while passes < opts.max_passes && !(passes >= 2 && c.full()) {
@@ -209,11 +195,13 @@ fn oracle(scene: &Scene, r: &UpbpRecord, ratio: f64) -> (Densities, VolumeRates)
     (d, rates)
 }
 
-/// The report's name for a technique: PP3D and PB2D at x_i as merges at x_i.
+/// The report's name for a technique: PP3D, PB2D and BB1D at x_i as merges at x_i.
 fn as_reported(t: VolumeTechnique) -> Technique {
     match t {
         VolumeTechnique::Connect(s) => Technique::Connect(s),
-        VolumeTechnique::Point(i) | VolumeTechnique::Beam(i) => Technique::Merge(i),
+        VolumeTechnique::Point(i) | VolumeTechnique::Beam(i) | VolumeTechnique::BeamBeam(i) => {
+            Technique::Merge(i)
+        }
     }
 }
 
@@ -248,11 +236,13 @@ pub fn check_record(scene: &Scene, r: &UpbpRecord, opts: &UpbpOptions, ratio: f6
     };
     let allowed = derived_tolerance(bound, opts.slack);
     let techniques = d.upbp_techniques(set, &rates);
-    let vol: Vec<VertexRate> = rates
-        .medium
-        .iter()
-        .zip(&rates.rate)
-        .map(|(&medium, &rate)| VertexRate { medium, rate })
+    let vol: Vec<VertexRate> = (0..rates.medium.len())
+        .map(|j| VertexRate {
+            medium: rates.medium[j],
+            rate: rates.rate[j],
+            light_rate: rates.light_rate[j],
+            sin: rates.sin[j],
+        })
         .collect();
     let chain = d.chain();
     let mut sum = 0.0;
@@ -289,7 +279,7 @@ pub fn prepare_scene(scene: &mut Scene, opts: &UpbpOptions) {
 }
 
 /// Samples and checks; `scene`'s film is set to the check's resolution first. Returns the report
-/// and a line per kind of technique (connections, pp3d, pb2d): paths checked, the largest
+/// and a line per kind of technique (connections, pp3d, pb2d, bb1d): paths checked, the largest
 /// relative mismatch, the paths failing.
 pub fn check_scene(
     scene: &mut Scene,
@@ -302,7 +292,7 @@ pub fn check_scene(
         scene,
         &c.records,
         opts,
-        (passes, c.too_long),
+        (passes, c.counts.too_long),
         name,
     ))
 }
@@ -324,12 +314,9 @@ pub fn check_records(
     let mut kinds = BTreeMap::new();
     for r in records {
         let v = check_record(scene, r, opts, ratio);
-        let kind = match r.technique {
-            VolumeTechnique::Connect(_) => "connections",
-            VolumeTechnique::Point(_) => "pp3d",
-            VolumeTechnique::Beam(_) => "pb2d",
-        };
-        let e = kinds.entry(kind).or_insert((0usize, 0.0f64, 0usize));
+        let e = kinds
+            .entry(kind(&r.technique))
+            .or_insert((0usize, 0.0f64, 0usize));
         e.0 += 1;
         e.1 = e.1.max(v.mismatch);
         e.2 += (v.over() || v.sum_fails()) as usize;

@@ -14,6 +14,7 @@
 //! subpaths moved within their rounding boxes: y_i and z separately, since a merge's weight reads
 //! the light vertex's incoming direction through z's BSDF.
 
+use super::quota::QuotaCounts;
 pub use super::report::Report;
 use super::report::Verdict;
 use super::tolerance::{derived_tolerance, relative, weight_error_bound, DEFAULT_SLACK};
@@ -28,7 +29,6 @@ use lt_integrators::splat::{Pass, Splats, Worker};
 use lt_integrators::vcm::engine::{
     initial_radius, pixel_of, Engine, MergeMask, PassInputs, VcmParams,
 };
-use std::collections::BTreeMap;
 
 /// What to sample and how to judge it.
 #[derive(Clone, Copy, Debug)]
@@ -151,11 +151,8 @@ impl VcmRecord {
 
 /// Keeps up to `quota` paths per (k, technique).
 pub struct VcmCollector {
-    quota: usize,
-    max_depth: usize,
-    counts: BTreeMap<(usize, Technique), usize>,
+    pub counts: QuotaCounts<Technique>,
     pub records: Vec<VcmRecord>,
-    pub too_long: usize,
     eta: f64,
     /// The pixels that merge (`VcmOptions::checkerboard_merging`).
     mask: Option<MergeMask>,
@@ -173,27 +170,13 @@ impl VcmCollector {
     }
 
     fn keep(&mut self, k: usize, t: Technique) -> bool {
-        if k > self.max_depth || k == 0 {
-            self.too_long += 1;
-            return false;
-        }
-        let n = self.counts.entry((k, t)).or_insert(0);
-        if *n >= self.quota {
-            return false;
-        }
-        *n += 1;
-        true
+        self.counts.keep(k, t)
     }
 
+    /// Every length has `quota` paths, whatever their techniques.
     fn full(&self) -> bool {
-        (1..=self.max_depth).all(|k| {
-            self.counts
-                .iter()
-                .filter(|((kk, _), _)| *kk == k)
-                .map(|(_, n)| n)
-                .sum::<usize>()
-                >= self.quota
-        })
+        let c = &self.counts;
+        (1..=c.max_depth()).all(|k| c.of_length(k, |_| true) >= c.quota())
     }
 }
 
@@ -247,11 +230,8 @@ pub fn collect(scene: &Scene, opts: &VcmOptions) -> (VcmCollector, u32) {
     engine.merge_mask = mask.clone();
     let r0 = initial_radius(scene, params.radius);
     let mut c = VcmCollector {
-        quota: opts.paths,
-        max_depth: opts.max_depth as usize,
-        counts: BTreeMap::new(),
+        counts: QuotaCounts::new(opts.paths, opts.max_depth as usize),
         records: Vec::new(),
-        too_long: 0,
         eta: 0.0,
         mask,
         width: cam.width,
@@ -388,7 +368,7 @@ pub fn check_record(
 pub fn check_scene(scene: &mut Scene, opts: &VcmOptions, name: &str) -> Report {
     prepare_scene(scene, opts);
     let (c, passes) = collect(scene, opts);
-    check_records(scene, &c.records, opts, passes, c.too_long, name)
+    check_records(scene, &c.records, opts, passes, c.counts.too_long, name)
 }
 
 /// Checks every record (from `collect`, or altered by hand in tests).

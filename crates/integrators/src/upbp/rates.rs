@@ -1,0 +1,122 @@
+//! The per-vertex inputs of `weights::weight` besides the walks' densities: σ̂ of each flight
+//! into a medium vertex (its scattering density over its pass probability there, the pieces
+//! before the last cancelling: `lt_core::path::volume_merging::scatter_rate`, which the oracle
+//! uses) and sin θ between the two flights at it. Computed only for the techniques that read
+//! them: σ̂ of the camera direction for PB2D and BB1D, the light direction's and sin θ for BB1D.
+
+use super::weights::VertexRate;
+use lt_core::path::volume_merging::{scatter_rate, sin_between};
+use lt_core::path::{PathVertex, VolumeSet};
+use lt_core::Scene;
+
+/// Which rates the pass's techniques read.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Needs {
+    /// σ̂ of the camera direction (PB2D, BB1D).
+    pub camera: bool,
+    /// σ̂ of the light direction and sin θ (BB1D).
+    pub light: bool,
+}
+
+impl Needs {
+    pub fn of(set: &VolumeSet) -> Needs {
+        Needs {
+            camera: set.beams_eta > 0.0 || set.beam_beams_eta > 0.0,
+            light: set.beam_beams_eta > 0.0,
+        }
+    }
+}
+
+/// Vertex `j` of a walk `v` (walk order): σ̂ of the walk's own flight v_{j−1} → v_j when
+/// `forward`, of the flight v_{j+1} → v_j walked back when `backward`, and sin θ_j between them
+/// when `sin` (each 0 where the neighbour is missing or v_j lies on no medium).
+pub fn along_walk(
+    scene: &Scene,
+    v: &[PathVertex],
+    j: usize,
+    (forward, backward, sin): (bool, bool, bool),
+) -> (f64, f64, f64) {
+    if !v[j].in_medium() {
+        return (0.0, 0.0, 0.0);
+    }
+    let has_next = j + 1 < v.len();
+    let f = if forward && j >= 1 {
+        scatter_rate(scene, &v[j - 1], &v[j])
+    } else {
+        0.0
+    };
+    let b = if backward && has_next {
+        scatter_rate(scene, &v[j + 1], &v[j])
+    } else {
+        0.0
+    };
+    let s = if sin && j >= 1 && has_next {
+        sin_between(&v[j - 1], &v[j], &v[j + 1])
+    } else {
+        0.0
+    };
+    (f, b, s)
+}
+
+/// The rates of light walk vertex `j` (`y`): σ̂ᴸ its own direction, σ̂ the camera's.
+pub fn light_vertex(scene: &Scene, y: &[PathVertex], j: usize, needs: Needs) -> VertexRate {
+    let (f, b, s) = along_walk(scene, y, j, (needs.light, needs.camera, needs.light));
+    VertexRate {
+        medium: y[j].in_medium(),
+        rate: b,
+        light_rate: f,
+        sin: s,
+    }
+}
+
+/// The rates of camera walk vertex `j` (`z`): σ̂ its own direction, σ̂ᴸ the light's.
+pub fn camera_vertex(scene: &Scene, z: &[PathVertex], j: usize, needs: Needs) -> VertexRate {
+    let (f, b, s) = along_walk(scene, z, j, (needs.camera, needs.light, needs.light));
+    VertexRate {
+        medium: z[j].in_medium(),
+        rate: f,
+        light_rate: b,
+        sin: s,
+    }
+}
+
+/// A connection's two ends (`light` = y_0 … y_{s−1}, `camera` = z_0 … z_{t−1}, the camera's
+/// in camera order), each end's rates with the other end as its neighbour: y_{s−1}'s σ̂ from
+/// z_{t−1} and sin θ, z_{t−1}'s σ̂ᴸ from y_{s−1} and sin θ. `stored` are the walks' own rates
+/// of the two ends (the directions their walks took).
+pub fn junction(
+    scene: &Scene,
+    (light, camera): (&[PathVertex], &[PathVertex]),
+    (light_stored, camera_stored): (VertexRate, VertexRate),
+    needs: Needs,
+) -> (VertexRate, VertexRate) {
+    let (s, t) = (light.len(), camera.len());
+    let (y, z) = (&light[s - 1], &camera[t - 1]);
+    let mut ly = light_stored;
+    let mut cz = camera_stored;
+    if y.in_medium() {
+        ly.rate = if needs.camera {
+            scatter_rate(scene, z, y)
+        } else {
+            0.0
+        };
+        ly.sin = if needs.light && s >= 2 {
+            sin_between(&light[s - 2], y, z)
+        } else {
+            0.0
+        };
+    }
+    if z.in_medium() {
+        cz.light_rate = if needs.light {
+            scatter_rate(scene, y, z)
+        } else {
+            0.0
+        };
+        cz.sin = if needs.light && t >= 2 {
+            sin_between(y, z, &camera[t - 2])
+        } else {
+            0.0
+        };
+    }
+    (ly, cz)
+}
