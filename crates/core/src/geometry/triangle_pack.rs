@@ -56,8 +56,11 @@ impl TrianglePack {
         let (ax_, ay_, az_) = (rel(0, kx), rel(0, ky), rel(0, kz));
         let (bx_, by_, bz_) = (rel(1, kx), rel(1, ky), rel(1, kz));
         let (cx_, cy_, cz_) = (rel(2, kx), rel(2, ky), rel(2, kz));
-        let mut t_out = [f32::INFINITY; PACK];
-        let mut zero_edge = [false; PACK];
+        // Stage 1, the sheared vertices and edge functions; most packs stop here, every lane
+        // outside its triangle (the scalar test's first early exit).
+        let mut sx = [[0.0f32; PACK]; 6]; // ax, ay, bx, by, cx, cy
+        let mut e = [[0.0f32; PACK]; 3]; // u, v, w
+        let (mut zero_edge, mut inside) = (0u32, 0u32);
         for i in 0..PACK {
             let (ax, ay) = (ax_[i] - s.x * az_[i], ay_[i] - s.y * az_[i]);
             let (bx, by) = (bx_[i] - s.x * bz_[i], by_[i] - s.y * bz_[i]);
@@ -65,39 +68,50 @@ impl TrianglePack {
             let u = cx * by - cy * bx;
             let v = ax * cy - ay * cx;
             let w = bx * ay - by * ax;
-            zero_edge[i] = (u == 0.0) | (v == 0.0) | (w == 0.0);
             let mixed = ((u < 0.0) | (v < 0.0) | (w < 0.0)) & ((u > 0.0) | (v > 0.0) | (w > 0.0));
-            let det = u + v + w;
-            let degenerate = (det == 0.0) | !det.is_finite();
-            let (az, bz, cz) = (s.z * az_[i], s.z * bz_[i], s.z * cz_[i]);
-            let t_scaled = u * az + v * bz + w * cz;
-            let in_range = if det < 0.0 {
-                (t_scaled < 0.0) & (t_scaled > t_max * det)
-            } else {
-                (t_scaled > 0.0) & (t_scaled < t_max * det)
-            };
-            let inv = 1.0 / det;
-            let t = t_scaled * inv;
-            // The rounding bound below which a hit is a re-hit of the origin's own surface
-            // (pbrt-v4 §6.8.7), as in the scalar test.
-            let max_z = az.abs().max(bz.abs()).max(cz.abs());
-            let max_x = ax.abs().max(bx.abs()).max(cx.abs());
-            let max_y = ay.abs().max(by.abs()).max(cy.abs());
-            let delta_z = gamma(3) * max_z;
-            let delta_x = gamma(5) * (max_x + max_z);
-            let delta_y = gamma(5) * (max_y + max_z);
-            let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-            let max_e = u.abs().max(v.abs()).max(w.abs());
-            let delta_t =
-                3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv.abs();
-            let hit = !mixed & !degenerate & in_range & !(t <= delta_t);
-            t_out[i] = if hit { t } else { f32::INFINITY };
+            zero_edge |= (((u == 0.0) | (v == 0.0) | (w == 0.0)) as u32) << i;
+            inside |= (!mixed as u32) << i;
+            [sx[0][i], sx[1][i], sx[2][i], sx[3][i], sx[4][i], sx[5][i]] = [ax, ay, bx, by, cx, cy];
+            [e[0][i], e[1][i], e[2][i]] = [u, v, w];
+        }
+        let mut t_out = [f32::INFINITY; PACK];
+        if inside & !zero_edge != 0 {
+            for i in 0..PACK {
+                let [ax, ay, bx, by, cx, cy] = sx.map(|row| row[i]);
+                let [u, v, w] = e.map(|row| row[i]);
+                let det = u + v + w;
+                let degenerate = (det == 0.0) | !det.is_finite();
+                let (az, bz, cz) = (s.z * az_[i], s.z * bz_[i], s.z * cz_[i]);
+                let t_scaled = u * az + v * bz + w * cz;
+                let in_range = if det < 0.0 {
+                    (t_scaled < 0.0) & (t_scaled > t_max * det)
+                } else {
+                    (t_scaled > 0.0) & (t_scaled < t_max * det)
+                };
+                let inv = 1.0 / det;
+                let t = t_scaled * inv;
+                // The rounding bound below which a hit is a re-hit of the origin's own surface
+                // (pbrt-v4 §6.8.7), as in the scalar test.
+                let max_z = az.abs().max(bz.abs()).max(cz.abs());
+                let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+                let max_y = ay.abs().max(by.abs()).max(cy.abs());
+                let delta_z = gamma(3) * max_z;
+                let delta_x = gamma(5) * (max_x + max_z);
+                let delta_y = gamma(5) * (max_y + max_z);
+                let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+                let max_e = u.abs().max(v.abs()).max(w.abs());
+                let delta_t = 3.0
+                    * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e)
+                    * inv.abs();
+                let hit = ((inside >> i) & 1 != 0) & !degenerate & in_range & !(t <= delta_t);
+                t_out[i] = if hit { t } else { f32::INFINITY };
+            }
         }
         // Lanes whose edge function rounded to zero take the scalar test's double-precision path.
-        for (i, &z) in zero_edge.iter().enumerate() {
-            if z {
-                t_out[i] = intersect_triangle(r, t_max, &self.vertices(i)).0;
-            }
+        while zero_edge != 0 {
+            let i = zero_edge.trailing_zeros() as usize;
+            zero_edge &= zero_edge - 1;
+            t_out[i] = intersect_triangle(r, t_max, &self.vertices(i)).0;
         }
         t_out
     }

@@ -76,6 +76,8 @@ pub struct WideBvh {
     magnitude: f32,
     /// Stack entries a traversal may need: 7 per level below the root, plus one.
     stack_need: usize,
+    leaf_max: u32,
+    sort_occluded: bool,
     isa: Isa,
 }
 
@@ -181,10 +183,39 @@ impl WideBvh {
             others: Vec::new(),
             magnitude,
             stack_need: 0,
+            leaf_max: std::env::var("LT_WIDE_LEAF")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(8),
+            sort_occluded: std::env::var_os("LT_WIDE_SORT").is_some(),
             isa: isa.min(Isa::Avx2),
         };
-        let depth = w.collapse(&bvh2, prims, 0);
+        let counts = Self::subtree_counts(&bvh2);
+        let depth = w.collapse(&bvh2, &counts, prims, 0);
         w.stack_need = 7 * depth + 1;
+        if std::env::var_os("LT_WIDE_STATS").is_some() {
+            let lanes: usize = w
+                .pack_ids
+                .iter()
+                .map(|ids| ids.iter().filter(|&&i| i != u32::MAX).count())
+                .sum();
+            let kids: usize = w
+                .nodes
+                .iter()
+                .map(|n| {
+                    n.child
+                        .iter()
+                        .zip(0..)
+                        .filter(|&(_, s)| n.lo[0][s] <= n.hi[0][s])
+                        .count()
+                })
+                .sum();
+            eprintln!(
+                "wide: {} primitives, {} nodes ({:.2} children each), depth {depth}, {} leaves, {} packs ({:.2} triangles each), {} others",
+                prims.len(), w.nodes.len(), kids as f64 / w.nodes.len() as f64, w.leaves.len(), w.packs.len(),
+                lanes as f64 / w.packs.len().max(1) as f64, w.others.len()
+            );
+        }
         w
     }
 
@@ -193,9 +224,12 @@ impl WideBvh {
     }
 
     /// Makes a wide node of binary node `n` (a leaf root becomes its only child); returns the
-    /// wide subtree's depth in levels of inner nodes.
-    fn collapse(&mut self, b: &Bvh2, prims: &[Primitive], n: usize) -> usize {
-        let mut kids = if b.nodes[n].is_leaf() {
+    /// wide subtree's depth in levels of inner nodes. `counts` is every binary node's number of
+    /// primitives: a subtree of at most `leaf_max` becomes one leaf.
+    fn collapse(&mut self, b: &Bvh2, counts: &[u32], prims: &[Primitive], n: usize) -> usize {
+        let leaf_max = self.leaf_max;
+        let leafy = |k: usize| b.nodes[k].is_leaf() || counts[k] <= leaf_max;
+        let mut kids = if leafy(n) {
             vec![n]
         } else {
             let f = b.nodes[n].first_index as usize;
@@ -204,7 +238,7 @@ impl WideBvh {
         // Open the inner child of largest surface area (the likeliest to be hit) until full.
         while kids.len() < WIDTH {
             let widest = (0..kids.len())
-                .filter(|&i| !b.nodes[kids[i]].is_leaf())
+                .filter(|&i| !leafy(kids[i]))
                 .max_by(|&i, &j| {
                     let area = |k: usize| b.nodes[kids[k]].aabb.half_area();
                     area(i).total_cmp(&area(j))
@@ -217,29 +251,58 @@ impl WideBvh {
         self.nodes.push(EMPTY_NODE);
         let mut depth = 1;
         for (slot, &k) in kids.iter().enumerate() {
-            let node = &b.nodes[k];
-            let child = if node.is_leaf() {
-                LEAF | self.leaf(b, prims, node.first_index, node.prim_count)
+            let child = if leafy(k) {
+                LEAF | self.leaf(b, prims, k)
             } else {
                 let child = self.nodes.len() as u32;
-                depth = depth.max(1 + self.collapse(b, prims, k));
+                depth = depth.max(1 + self.collapse(b, counts, prims, k));
                 child
             };
-            let w = &mut self.nodes[index];
+            let (w, aabb) = (&mut self.nodes[index], b.nodes[k].aabb);
             for a in 0..3 {
-                w.lo[a][slot] = node.aabb.min[a];
-                w.hi[a][slot] = node.aabb.max[a];
+                w.lo[a][slot] = aabb.min[a];
+                w.hi[a][slot] = aabb.max[a];
             }
             w.child[slot] = child;
         }
         depth
     }
 
-    fn leaf(&mut self, b: &Bvh2, prims: &[Primitive], first: u32, count: u32) -> u32 {
-        let ids = &b.primitive_indices[first as usize..(first + count) as usize];
+    /// Every binary node's number of primitives.
+    fn subtree_counts(b: &Bvh2) -> Vec<u32> {
+        fn count(b: &Bvh2, n: usize, out: &mut [u32]) -> u32 {
+            let node = &b.nodes[n];
+            out[n] = if node.is_leaf() {
+                node.prim_count
+            } else {
+                let f = node.first_index as usize;
+                count(b, f, out) + count(b, f + 1, out)
+            };
+            out[n]
+        }
+        let mut out = vec![0; b.nodes.len()];
+        count(b, 0, &mut out);
+        out
+    }
+
+    /// The primitives of binary subtree `n`, in its leaves' order.
+    fn subtree_primitives(b: &Bvh2, n: usize, out: &mut Vec<u32>) {
+        let node = &b.nodes[n];
+        let f = node.first_index as usize;
+        if node.is_leaf() {
+            out.extend_from_slice(&b.primitive_indices[f..f + node.prim_count as usize]);
+        } else {
+            Self::subtree_primitives(b, f, out);
+            Self::subtree_primitives(b, f + 1, out);
+        }
+    }
+
+    fn leaf(&mut self, b: &Bvh2, prims: &[Primitive], n: usize) -> u32 {
+        let mut ids = Vec::new();
+        Self::subtree_primitives(b, n, &mut ids);
         let (mut triangles, mut tri_ids) = (Vec::new(), Vec::new());
         let others_start = self.others.len() as u32;
-        for &i in ids {
+        for &i in &ids {
             match prims[i as usize] {
                 Primitive::Triangle { p, .. } => {
                     triangles.push(p);
@@ -359,26 +422,8 @@ impl WideBvh {
         let mut node = 0usize;
         loop {
             let n = &self.nodes[node];
-            let (t_enter, mut mask) = slabs.test(n, cap(&best, ray.t_max));
-            // The hit children sorted by entry distance, farthest first (insertion sort of ≤ 8).
-            let mut sorted = [(0u32, 0.0f32); WIDTH];
-            let mut count = 0;
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let entry = (n.child[i], t_enter[i]);
-                let mut j = count;
-                while j > 0 && sorted[j - 1].1 < entry.1 {
-                    sorted[j] = sorted[j - 1];
-                    j -= 1;
-                }
-                sorted[j] = entry;
-                count += 1;
-            }
-            for &e in &sorted[..count] {
-                stack[sp] = MaybeUninit::new(e);
-                sp += 1;
-            }
+            let (t_enter, mask) = slabs.test(n, cap(&best, ray.t_max));
+            push_nearest_last(stack, &mut sp, n, &t_enter, mask);
             loop {
                 if sp == 0 {
                     return best;
@@ -422,12 +467,16 @@ impl WideBvh {
         let mut node = 0usize;
         loop {
             let n = &self.nodes[node];
-            let (_, mut mask) = slabs.test(n, t_max);
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                stack[sp] = MaybeUninit::new((n.child[i], 0.0));
-                sp += 1;
+            let (t_enter, mut mask) = slabs.test(n, t_max);
+            if self.sort_occluded {
+                push_nearest_last(stack, &mut sp, n, &t_enter, mask);
+            } else {
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack[sp] = MaybeUninit::new((n.child[i], 0.0));
+                    sp += 1;
+                }
             }
             loop {
                 if sp == 0 {
@@ -457,6 +506,36 @@ impl WideBvh {
                 }
             }
         }
+    }
+}
+
+/// Pushes the children in `mask` sorted by entry distance, farthest first, so the nearest is
+/// popped first (an insertion sort of at most 8).
+#[inline(always)]
+fn push_nearest_last(
+    stack: &mut [Entry],
+    sp: &mut usize,
+    n: &Node,
+    t_enter: &[f32; WIDTH],
+    mut mask: u32,
+) {
+    let mut sorted = [(0u32, 0.0f32); WIDTH];
+    let mut count = 0;
+    while mask != 0 {
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        let entry = (n.child[i], t_enter[i]);
+        let mut j = count;
+        while j > 0 && sorted[j - 1].1 < entry.1 {
+            sorted[j] = sorted[j - 1];
+            j -= 1;
+        }
+        sorted[j] = entry;
+        count += 1;
+    }
+    for &e in &sorted[..count] {
+        stack[*sp] = MaybeUninit::new(e);
+        *sp += 1;
     }
 }
 
