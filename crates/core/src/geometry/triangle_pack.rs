@@ -1,20 +1,25 @@
-//! Eight triangles against one ray at once: the wide BVH's leaves (`wide.rs`). Each lane performs
-//! `triangle::intersect_triangle`'s IEEE operations in its order (Rust neither fuses nor
-//! reassociates them), so a lane's distance is the scalar test's bit for bit. The one branch the
-//! lanes cannot share — an edge function that rounds to exactly zero, re-evaluated in double
-//! precision — sends that lane to the scalar test itself.
+//! Eight triangles against one ray at once: the wide BVH's leaves (`wide.rs`). The vectorised
+//! part is the watertight test's first stage — shear the vertices, evaluate the three edge
+//! functions, reject lanes whose signs differ — with each lane performing
+//! `triangle::intersect_triangle`'s IEEE operations in its order (Rust and the intrinsics neither
+//! fuse nor reassociate them), so a lane it rejects is one the scalar test rejects. The few
+//! lanes left (the ray passes inside the triangle, or an edge function rounded to exactly zero and
+//! the scalar test would re-evaluate it in double precision) are finished by `intersect_triangle`
+//! itself, so every distance is the scalar test's bit for bit.
 
 use super::triangle::{intersect_triangle, ShearedRay};
-use crate::math::{gamma, Vec3};
+use crate::math::Vec3;
 
 /// Triangles per pack: one AVX2 vector, two SSE ones.
 pub const PACK: usize = 8;
 
 /// Up to `PACK` triangles component by component: `v[3 j + axis][lane]` is coordinate `axis` of
-/// vertex j. Empty lanes hold NaN, which every comparison of the test rejects.
+/// vertex j. Empty lanes hold NaN and are masked out by `lanes`.
 #[derive(Clone, Debug)]
 pub struct TrianglePack {
     v: [[f32; PACK]; 9],
+    /// A bit per occupied lane.
+    lanes: u32,
 }
 
 impl TrianglePack {
@@ -28,7 +33,10 @@ impl TrianglePack {
                 }
             }
         }
-        TrianglePack { v }
+        TrianglePack {
+            v,
+            lanes: (1u32 << triangles.len()) - 1,
+        }
     }
 
     fn vertices(&self, lane: usize) -> [Vec3; 3] {
@@ -42,78 +50,103 @@ impl TrianglePack {
         [c(0), c(1), c(2)]
     }
 
-    /// Each lane's `intersect_triangle(r, t_max, p).0`: its distance in (0, t_max), or +∞.
+    /// Each lane's `intersect_triangle(r, t_max, p).0`: its distance in (0, t_max), or +∞, with
+    /// the first stage in portable loops.
     #[inline(always)]
     pub fn distances(&self, r: &ShearedRay, t_max: f32) -> [f32; PACK] {
+        self.finish(r, t_max, self.candidates(r))
+    }
+
+    /// `distances` with the first stage in AVX2 intrinsics.
+    ///
+    /// # Safety
+    /// The CPU must run AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub unsafe fn distances_avx2(&self, r: &ShearedRay, t_max: f32) -> [f32; PACK] {
+        self.finish(r, t_max, self.candidates_avx2(r))
+    }
+
+    /// The scalar test on the lanes in `candidates`; +∞ elsewhere.
+    #[inline(always)]
+    fn finish(&self, r: &ShearedRay, t_max: f32, mut candidates: u32) -> [f32; PACK] {
+        let mut t = [f32::INFINITY; PACK];
+        while candidates != 0 {
+            let lane = candidates.trailing_zeros() as usize;
+            candidates &= candidates - 1;
+            t[lane] = intersect_triangle(r, t_max, &self.vertices(lane)).0;
+        }
+        t
+    }
+
+    /// The occupied lanes the first stage does not reject: edge functions not of mixed sign, or
+    /// one of them exactly zero.
+    #[inline(always)]
+    fn candidates(&self, r: &ShearedRay) -> u32 {
         let [kx, ky, kz] = r.k;
         let (o, s) = (r.o, r.s);
-        // The vertex coordinates relative to the origin along the shear's axes, as
-        // `a = p[0] - r.o; a[kx]` computes them.
-        let rel = |j: usize, k: usize| -> [f32; PACK] {
-            let row = &self.v[3 * j + k];
-            std::array::from_fn(|i| row[i] - o[k])
-        };
-        let (ax_, ay_, az_) = (rel(0, kx), rel(0, ky), rel(0, kz));
-        let (bx_, by_, bz_) = (rel(1, kx), rel(1, ky), rel(1, kz));
-        let (cx_, cy_, cz_) = (rel(2, kx), rel(2, ky), rel(2, kz));
-        // Stage 1, the sheared vertices and edge functions; most packs stop here, every lane
-        // outside its triangle (the scalar test's first early exit).
-        let mut sx = [[0.0f32; PACK]; 6]; // ax, ay, bx, by, cx, cy
-        let mut e = [[0.0f32; PACK]; 3]; // u, v, w
-        let (mut zero_edge, mut inside) = (0u32, 0u32);
+        let row = |j: usize, k: usize| &self.v[3 * j + k];
+        let (pax, pay, paz) = (row(0, kx), row(0, ky), row(0, kz));
+        let (pbx, pby, pbz) = (row(1, kx), row(1, ky), row(1, kz));
+        let (pcx, pcy, pcz) = (row(2, kx), row(2, ky), row(2, kz));
+        let mut keep = 0u32;
         for i in 0..PACK {
-            let (ax, ay) = (ax_[i] - s.x * az_[i], ay_[i] - s.y * az_[i]);
-            let (bx, by) = (bx_[i] - s.x * bz_[i], by_[i] - s.y * bz_[i]);
-            let (cx, cy) = (cx_[i] - s.x * cz_[i], cy_[i] - s.y * cz_[i]);
+            // a = p[0] − o, then a[kx] − s.x · a[kz], …, as the scalar test.
+            let (az, bz, cz) = (paz[i] - o[kz], pbz[i] - o[kz], pcz[i] - o[kz]);
+            let (ax, ay) = ((pax[i] - o[kx]) - s.x * az, (pay[i] - o[ky]) - s.y * az);
+            let (bx, by) = ((pbx[i] - o[kx]) - s.x * bz, (pby[i] - o[ky]) - s.y * bz);
+            let (cx, cy) = ((pcx[i] - o[kx]) - s.x * cz, (pcy[i] - o[ky]) - s.y * cz);
             let u = cx * by - cy * bx;
             let v = ax * cy - ay * cx;
             let w = bx * ay - by * ax;
             let mixed = ((u < 0.0) | (v < 0.0) | (w < 0.0)) & ((u > 0.0) | (v > 0.0) | (w > 0.0));
-            zero_edge |= (((u == 0.0) | (v == 0.0) | (w == 0.0)) as u32) << i;
-            inside |= (!mixed as u32) << i;
-            [sx[0][i], sx[1][i], sx[2][i], sx[3][i], sx[4][i], sx[5][i]] = [ax, ay, bx, by, cx, cy];
-            [e[0][i], e[1][i], e[2][i]] = [u, v, w];
+            let zero = (u == 0.0) | (v == 0.0) | (w == 0.0);
+            keep |= ((!mixed | zero) as u32) << i;
         }
-        let mut t_out = [f32::INFINITY; PACK];
-        if inside & !zero_edge != 0 {
-            for i in 0..PACK {
-                let [ax, ay, bx, by, cx, cy] = sx.map(|row| row[i]);
-                let [u, v, w] = e.map(|row| row[i]);
-                let det = u + v + w;
-                let degenerate = (det == 0.0) | !det.is_finite();
-                let (az, bz, cz) = (s.z * az_[i], s.z * bz_[i], s.z * cz_[i]);
-                let t_scaled = u * az + v * bz + w * cz;
-                let in_range = if det < 0.0 {
-                    (t_scaled < 0.0) & (t_scaled > t_max * det)
-                } else {
-                    (t_scaled > 0.0) & (t_scaled < t_max * det)
-                };
-                let inv = 1.0 / det;
-                let t = t_scaled * inv;
-                // The rounding bound below which a hit is a re-hit of the origin's own surface
-                // (pbrt-v4 §6.8.7), as in the scalar test.
-                let max_z = az.abs().max(bz.abs()).max(cz.abs());
-                let max_x = ax.abs().max(bx.abs()).max(cx.abs());
-                let max_y = ay.abs().max(by.abs()).max(cy.abs());
-                let delta_z = gamma(3) * max_z;
-                let delta_x = gamma(5) * (max_x + max_z);
-                let delta_y = gamma(5) * (max_y + max_z);
-                let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-                let max_e = u.abs().max(v.abs()).max(w.abs());
-                let delta_t = 3.0
-                    * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e)
-                    * inv.abs();
-                let hit = ((inside >> i) & 1 != 0) & !degenerate & in_range & !(t <= delta_t);
-                t_out[i] = if hit { t } else { f32::INFINITY };
-            }
-        }
-        // Lanes whose edge function rounded to zero take the scalar test's double-precision path.
-        while zero_edge != 0 {
-            let i = zero_edge.trailing_zeros() as usize;
-            zero_edge &= zero_edge - 1;
-            t_out[i] = intersect_triangle(r, t_max, &self.vertices(i)).0;
-        }
-        t_out
+        keep & self.lanes
+    }
+
+    /// `candidates` in AVX2 intrinsics: the same operations on the same operands, in the same
+    /// order, so the same lanes.
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn candidates_avx2(&self, r: &ShearedRay) -> u32 {
+        use std::arch::x86_64::*;
+        let [kx, ky, kz] = r.k;
+        let (o, s) = (r.o, r.s);
+        // SAFETY: each row is PACK = 8 contiguous f32.
+        let load = |j: usize, k: usize| unsafe { _mm256_loadu_ps(self.v[3 * j + k].as_ptr()) };
+        let (sx, sy) = (_mm256_set1_ps(s.x), _mm256_set1_ps(s.y));
+        let (ox, oy, oz) = (
+            _mm256_set1_ps(o[kx]),
+            _mm256_set1_ps(o[ky]),
+            _mm256_set1_ps(o[kz]),
+        );
+        let shear = |j: usize| {
+            let z = _mm256_sub_ps(load(j, kz), oz);
+            let x = _mm256_sub_ps(_mm256_sub_ps(load(j, kx), ox), _mm256_mul_ps(sx, z));
+            let y = _mm256_sub_ps(_mm256_sub_ps(load(j, ky), oy), _mm256_mul_ps(sy, z));
+            (x, y)
+        };
+        let ((ax, ay), (bx, by), (cx, cy)) = (shear(0), shear(1), shear(2));
+        let edge = |p: __m256, q: __m256, r: __m256, t: __m256| {
+            _mm256_sub_ps(_mm256_mul_ps(p, q), _mm256_mul_ps(r, t))
+        };
+        let u = edge(cx, by, cy, bx);
+        let v = edge(ax, cy, ay, cx);
+        let w = edge(bx, ay, by, ax);
+        let zero = _mm256_setzero_ps();
+        let any = |f: fn(__m256, __m256) -> __m256| {
+            _mm256_or_ps(_mm256_or_ps(f(u, zero), f(v, zero)), f(w, zero))
+        };
+        let neg = any(|a, b| _mm256_cmp_ps::<_CMP_LT_OQ>(a, b));
+        let pos = any(|a, b| _mm256_cmp_ps::<_CMP_GT_OQ>(a, b));
+        let is_zero = any(|a, b| _mm256_cmp_ps::<_CMP_EQ_OQ>(a, b));
+        let mixed = _mm256_movemask_ps(_mm256_and_ps(neg, pos)) as u32;
+        let zeros = _mm256_movemask_ps(is_zero) as u32;
+        (!mixed | zeros) & self.lanes
     }
 }
 
@@ -170,6 +203,12 @@ mod tests {
                     };
                     let r = ShearedRay::new(o, d);
                     let lanes = pack.distances(&r, t_max);
+                    #[cfg(target_arch = "x86_64")]
+                    if std::arch::is_x86_feature_detected!("avx2") {
+                        // SAFETY: checked just above.
+                        let avx2 = unsafe { pack.distances_avx2(&r, t_max) };
+                        assert_eq!(avx2.map(f32::to_bits), lanes.map(f32::to_bits));
+                    }
                     for (i, tri) in tris.iter().enumerate() {
                         let t = intersect_triangle(&r, t_max, tri).0;
                         hits += t.is_finite() as usize;

@@ -30,6 +30,8 @@ use std::mem::MaybeUninit;
 
 /// Children per node: one AVX2 vector of boxes.
 const WIDTH: usize = 8;
+/// Ize's factor on a slab's exit distance, which three relative roundings may have lowered.
+const EXIT_SCALE: f32 = 1.0 + 4.0 * gamma(3);
 /// A child reference with this bit set names a leaf, else an inner node.
 const LEAF: u32 = 1 << 31;
 /// Box widening, relative to the scene's and the origin's magnitude: 256 ulps of 1.
@@ -120,11 +122,14 @@ impl Slabs {
     }
 
     /// Each child's entry distance and a mask of the children whose widened box the ray meets
-    /// within [0, t_cap].
+    /// within [0, t_cap]; in AVX2 intrinsics when `AVX2` (the caller runs AVX2).
     #[inline(always)]
-    fn test(&self, n: &Node, t_cap: f32) -> ([f32; WIDTH], u32) {
-        // Ize's factor: the exit distance rounded down by at most three relative roundings.
-        const EXIT_SCALE: f32 = 1.0 + 4.0 * gamma(3);
+    fn test<const AVX2: bool>(&self, n: &Node, t_cap: f32) -> ([f32; WIDTH], u32) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX2 {
+            // SAFETY: `AVX2` is only set inside functions compiled for AVX2.
+            return unsafe { self.test_avx2(n, t_cap) };
+        }
         let bounds = |a: usize| {
             if self.negative[a] {
                 (&n.hi[a], &n.lo[a])
@@ -149,6 +154,45 @@ impl Slabs {
             mask |= ((enter <= exit * EXIT_SCALE) as u32) << i;
         }
         (t_enter, mask)
+    }
+
+    /// `test` in AVX2 intrinsics (the same bound, up to the order of NaN-free max/min).
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn test_avx2(&self, n: &Node, t_cap: f32) -> ([f32; WIDTH], u32) {
+        use std::arch::x86_64::*;
+        let slab = |b: &[f32; WIDTH], off: f32, inv: f32| {
+            // SAFETY: `b` is WIDTH = 8 contiguous f32.
+            let b = unsafe { _mm256_loadu_ps(b.as_ptr()) };
+            _mm256_mul_ps(_mm256_add_ps(b, _mm256_set1_ps(off)), _mm256_set1_ps(inv))
+        };
+        let axis = |a: usize| {
+            let (near, far) = if self.negative[a] {
+                (&n.hi[a], &n.lo[a])
+            } else {
+                (&n.lo[a], &n.hi[a])
+            };
+            (
+                slab(near, self.near_offset[a], self.inv[a]),
+                slab(far, self.far_offset[a], self.inv[a]),
+            )
+        };
+        let ((nx, fx), (ny, fy), (nz, fz)) = (axis(0), axis(1), axis(2));
+        let enter = _mm256_max_ps(
+            _mm256_max_ps(nx, ny),
+            _mm256_max_ps(nz, _mm256_setzero_ps()),
+        );
+        let exit = _mm256_min_ps(
+            _mm256_min_ps(fx, fy),
+            _mm256_min_ps(fz, _mm256_set1_ps(t_cap)),
+        );
+        let exit = _mm256_mul_ps(exit, _mm256_set1_ps(EXIT_SCALE));
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit);
+        let mut t_enter = [0.0f32; WIDTH];
+        // SAFETY: `t_enter` is WIDTH = 8 contiguous f32.
+        unsafe { _mm256_storeu_ps(t_enter.as_mut_ptr(), enter) };
+        (t_enter, _mm256_movemask_ps(hit) as u32)
     }
 }
 
@@ -362,7 +406,7 @@ impl WideBvh {
         match self.isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 | Isa::Avx512 => unsafe { self.closest_avx2(prims, ray, s, stack) },
-            _ => self.closest_in(prims, ray, s, stack),
+            _ => self.closest_in::<false>(prims, ray, s, stack),
         }
     }
 
@@ -378,7 +422,7 @@ impl WideBvh {
         match self.isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 | Isa::Avx512 => unsafe { self.occluded_avx2(prims, ray, s, stack) },
-            _ => self.occluded_in(prims, ray, s, stack),
+            _ => self.occluded_in::<false>(prims, ray, s, stack),
         }
     }
 
@@ -391,7 +435,7 @@ impl WideBvh {
         s: &ShearedRay,
         stack: &mut [Entry],
     ) -> PrimHit {
-        self.closest_in(prims, ray, s, stack)
+        self.closest_in::<true>(prims, ray, s, stack)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -403,13 +447,13 @@ impl WideBvh {
         s: &ShearedRay,
         stack: &mut [Entry],
     ) -> bool {
-        self.occluded_in(prims, ray, s, stack)
+        self.occluded_in::<true>(prims, ray, s, stack)
     }
 
     /// Nearest child first: a node's hit children are pushed farthest first, and an entry whose
     /// entry distance is beyond the bound when popped is dropped.
     #[inline(always)]
-    fn closest_in(
+    fn closest_in<const AVX2: bool>(
         &self,
         prims: &[Primitive],
         ray: &Ray,
@@ -422,7 +466,7 @@ impl WideBvh {
         let mut node = 0usize;
         loop {
             let n = &self.nodes[node];
-            let (t_enter, mask) = slabs.test(n, cap(&best, ray.t_max));
+            let (t_enter, mask) = slabs.test::<AVX2>(n, cap(&best, ray.t_max));
             push_nearest_last(stack, &mut sp, n, &t_enter, mask);
             loop {
                 if sp == 0 {
@@ -440,7 +484,11 @@ impl WideBvh {
                 }
                 let leaf = &self.leaves[(child & !LEAF) as usize];
                 for p in leaf.packs.clone() {
-                    let ts = self.packs[p as usize].distances(sheared, cap(&best, ray.t_max));
+                    let ts = pack_distances::<AVX2>(
+                        &self.packs[p as usize],
+                        sheared,
+                        cap(&best, ray.t_max),
+                    );
                     take_hits(&mut best, &ts, &self.pack_ids[p as usize]);
                 }
                 for &i in &self.others[leaf.others.start as usize..leaf.others.end as usize] {
@@ -454,7 +502,7 @@ impl WideBvh {
 
     /// Stops at the first blocker; children in any order.
     #[inline(always)]
-    fn occluded_in(
+    fn occluded_in<const AVX2: bool>(
         &self,
         prims: &[Primitive],
         ray: &Ray,
@@ -467,7 +515,7 @@ impl WideBvh {
         let mut node = 0usize;
         loop {
             let n = &self.nodes[node];
-            let (t_enter, mut mask) = slabs.test(n, t_max);
+            let (t_enter, mut mask) = slabs.test::<AVX2>(n, t_max);
             if self.sort_occluded {
                 push_nearest_last(stack, &mut sp, n, &t_enter, mask);
             } else {
@@ -491,7 +539,7 @@ impl WideBvh {
                 }
                 let leaf = &self.leaves[(child & !LEAF) as usize];
                 for p in leaf.packs.clone() {
-                    let ts = self.packs[p as usize].distances(sheared, t_max);
+                    let ts = pack_distances::<AVX2>(&self.packs[p as usize], sheared, t_max);
                     if ts.iter().fold(false, |any, &t| any | (t < f32::INFINITY)) {
                         return true;
                     }
@@ -537,6 +585,21 @@ fn push_nearest_last(
         stack[*sp] = MaybeUninit::new(e);
         *sp += 1;
     }
+}
+
+/// `TrianglePack::distances`, in AVX2 intrinsics when `AVX2` (the caller runs AVX2).
+#[inline(always)]
+fn pack_distances<const AVX2: bool>(
+    pack: &TrianglePack,
+    r: &ShearedRay,
+    t_max: f32,
+) -> [f32; PACK] {
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        // SAFETY: `AVX2` is only set inside functions compiled for AVX2.
+        return unsafe { pack.distances_avx2(r, t_max) };
+    }
+    pack.distances(r, t_max)
 }
 
 /// A traversal stack entry: a child reference and its entry distance.
