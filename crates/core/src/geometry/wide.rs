@@ -34,6 +34,9 @@ const WIDTH: usize = 8;
 const EXIT_SCALE: f32 = 1.0 + 4.0 * gamma(3);
 /// A child reference with this bit set names a leaf, else an inner node.
 const LEAF: u32 = 1 << 31;
+/// A binary subtree of at most this many primitives becomes one leaf: one triangle pack. (4 and
+/// 8 measured alike on veach-bidir, 12 slower: results/bench.md, "wide BVH".)
+const LEAF_MAX: u32 = PACK as u32;
 /// Box widening, relative to the scene's and the origin's magnitude: 256 ulps of 1.
 const PAD: f32 = 1.0 / 65536.0;
 /// The best distance so far, scaled up by this, bounds further tests: far beyond the rounding of
@@ -78,8 +81,6 @@ pub struct WideBvh {
     magnitude: f32,
     /// Stack entries a traversal may need: 7 per level below the root, plus one.
     stack_need: usize,
-    leaf_max: u32,
-    sort_occluded: bool,
     isa: Isa,
 }
 
@@ -227,39 +228,11 @@ impl WideBvh {
             others: Vec::new(),
             magnitude,
             stack_need: 0,
-            leaf_max: std::env::var("LT_WIDE_LEAF")
-                .ok()
-                .and_then(|v| v.parse().ok())
-                .unwrap_or(8),
-            sort_occluded: std::env::var_os("LT_WIDE_SORT").is_some(),
             isa: isa.min(Isa::Avx2),
         };
         let counts = Self::subtree_counts(&bvh2);
         let depth = w.collapse(&bvh2, &counts, prims, 0);
         w.stack_need = 7 * depth + 1;
-        if std::env::var_os("LT_WIDE_STATS").is_some() {
-            let lanes: usize = w
-                .pack_ids
-                .iter()
-                .map(|ids| ids.iter().filter(|&&i| i != u32::MAX).count())
-                .sum();
-            let kids: usize = w
-                .nodes
-                .iter()
-                .map(|n| {
-                    n.child
-                        .iter()
-                        .zip(0..)
-                        .filter(|&(_, s)| n.lo[0][s] <= n.hi[0][s])
-                        .count()
-                })
-                .sum();
-            eprintln!(
-                "wide: {} primitives, {} nodes ({:.2} children each), depth {depth}, {} leaves, {} packs ({:.2} triangles each), {} others",
-                prims.len(), w.nodes.len(), kids as f64 / w.nodes.len() as f64, w.leaves.len(), w.packs.len(),
-                lanes as f64 / w.packs.len().max(1) as f64, w.others.len()
-            );
-        }
         w
     }
 
@@ -269,10 +242,9 @@ impl WideBvh {
 
     /// Makes a wide node of binary node `n` (a leaf root becomes its only child); returns the
     /// wide subtree's depth in levels of inner nodes. `counts` is every binary node's number of
-    /// primitives: a subtree of at most `leaf_max` becomes one leaf.
+    /// primitives: a subtree of at most `LEAF_MAX` becomes one leaf.
     fn collapse(&mut self, b: &Bvh2, counts: &[u32], prims: &[Primitive], n: usize) -> usize {
-        let leaf_max = self.leaf_max;
-        let leafy = |k: usize| b.nodes[k].is_leaf() || counts[k] <= leaf_max;
+        let leafy = |k: usize| b.nodes[k].is_leaf() || counts[k] <= LEAF_MAX;
         let mut kids = if leafy(n) {
             vec![n]
         } else {
@@ -500,7 +472,7 @@ impl WideBvh {
         }
     }
 
-    /// Stops at the first blocker; children in any order.
+    /// Stops at the first blocker.
     #[inline(always)]
     fn occluded_in<const AVX2: bool>(
         &self,
@@ -515,17 +487,10 @@ impl WideBvh {
         let mut node = 0usize;
         loop {
             let n = &self.nodes[node];
-            let (t_enter, mut mask) = slabs.test::<AVX2>(n, t_max);
-            if self.sort_occluded {
-                push_nearest_last(stack, &mut sp, n, &t_enter, mask);
-            } else {
-                while mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    stack[sp] = MaybeUninit::new((n.child[i], 0.0));
-                    sp += 1;
-                }
-            }
+            // Nearest first here too: a blocker near the origin ends the search sooner
+            // (measured 0.8× the CPU of slot order on veach-bidir's shadow rays).
+            let (t_enter, mask) = slabs.test::<AVX2>(n, t_max);
+            push_nearest_last(stack, &mut sp, n, &t_enter, mask);
             loop {
                 if sp == 0 {
                     return false;
