@@ -1,7 +1,8 @@
-//! The ray cores at the level of images. The flat core (`lt_core::geometry::flat`): every
-//! registered integrator on every shipped scene gives the same image bit for bit whether rays are
-//! tested one primitive at a time (`flat-scalar`, the reference) or in the vectorised loops at
-//! every width the CPU runs (`LT_FLAT_ISA`). Embree (`geometry::embree`), whose traversal may name
+//! The ray cores at the level of images. The flat core (`lt_core::geometry::flat`) and the wide
+//! BVH (`geometry::wide`): every registered integrator on every shipped scene gives the same image
+//! bit for bit whether rays are tested one primitive at a time (`flat-scalar`, the reference), in
+//! the flat core's vectorised loops at every width the CPU runs (`LT_FLAT_ISA`), or through the
+//! wide BVH. Embree (`geometry::embree`), whose traversal may name
 //! another primitive at a tie: every unbiased integrator on every shipped scene and Bitterli's three agrees
 //! with the BVH's render within its own standard errors. The ray-level tests are in
 //! `geometry::accel`; these show nothing downstream of a hit depends on the core.
@@ -54,7 +55,7 @@ fn images() -> Vec<(String, Vec<u64>)> {
 }
 
 #[test]
-fn vectorised_flat_core_renders_the_scalar_references_images_bit_for_bit() {
+fn vectorised_flat_and_wide_cores_render_the_scalar_references_images_bit_for_bit() {
     let _core = CORE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     set_ray_core(RayCore::FlatScalar);
     let reference = images();
@@ -73,6 +74,14 @@ fn vectorised_flat_core_renders_the_scalar_references_images_bit_for_bit() {
         }
     }
     std::env::remove_var("LT_FLAT_ISA");
+    // The wide BVH at the width the CPU picks (every width is held to the reference at ray level
+    // in `geometry::accel`).
+    set_ray_core(RayCore::Wide);
+    for ((who, bits), (_, expected)) in images().iter().zip(&reference) {
+        assert!(who.contains("wide"), "{who}: expected the wide core");
+        assert!(bits == expected, "{who}: differs from the scalar reference");
+    }
+    set_ray_core(RayCore::Auto);
 }
 
 /// Shipped scenes at 24² and Bitterli's three (`-D integrator=path`) at 32², each loaded under the

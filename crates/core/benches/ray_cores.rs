@@ -1,4 +1,5 @@
-//! `cargo bench -p lt-core --bench ray_cores`: where the flat ray core stops beating the BVH.
+//! `cargo bench -p lt-core --bench ray_cores`: where the flat ray core stops beating the BVH, and
+//! (`-- scaling`) the BVH, wide and Embree cores on 10³–10⁶ triangles.
 //! Closest hits and occlusion of 100 000 rays from inside a box of N parallelograms (its six
 //! walls plus N − 6 random ones inside: the shape of a Cornell box with more furniture), of N/2
 //! parallelograms and N/2 spheres, or of N triangles (the walls as triangle pairs), with each
@@ -43,6 +44,11 @@ enum Kind {
 /// The walls of [-1, 1]³ and random primitives of size ~0.3 inside, `n` in all: parallelograms,
 /// every other one a sphere, or triangles (then the walls are triangle pairs too).
 fn scene(n: usize, kind: Kind, seed: u64) -> Vec<Primitive> {
+    scene_sized(n, kind, seed, 0.3)
+}
+
+/// `scene` with primitives of size `size`.
+fn scene_sized(n: usize, kind: Kind, seed: u64, size: f32) -> Vec<Primitive> {
     let mut r = Pcg32::new(seed, 0x5851_f42d_4c95_7f2d);
     let mut prims = Vec::new();
     for axis in 0..3 {
@@ -71,7 +77,7 @@ fn scene(n: usize, kind: Kind, seed: u64) -> Vec<Primitive> {
         let shape = prims.len() as u32;
         let c = point(&mut r, 0.8);
         if kind == Kind::Triangles {
-            let (a, b) = (direction(&mut r) * 0.3, direction(&mut r) * 0.3);
+            let (a, b) = (direction(&mut r) * size, direction(&mut r) * size);
             prims.push(Primitive::Triangle {
                 p: [c, c + a, c + b],
                 shape,
@@ -84,7 +90,7 @@ fn scene(n: usize, kind: Kind, seed: u64) -> Vec<Primitive> {
                 shape,
             });
         } else {
-            let q = Parallelogram::new(c, direction(&mut r) * 0.3, direction(&mut r) * 0.3);
+            let q = Parallelogram::new(c, direction(&mut r) * size, direction(&mut r) * size);
             prims.push(Primitive::Quad { q, shape, index: 0 });
         }
     }
@@ -139,5 +145,48 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+/// 10³–10⁶ random triangles inside the box, their size shrinking as 1/√n so that their total area
+/// (and so what a ray meets) stays that of 1 000 triangles of size 0.3.
+fn scaling(c: &mut Criterion) {
+    let rays = rays(2);
+    let short: Vec<Ray> = rays.iter().map(|r| Ray { t_max: 0.5, ..*r }).collect();
+    let cores: Vec<RayCore> = [RayCore::Bvh, RayCore::Embree, RayCore::Wide]
+        .into_iter()
+        .filter(|c| c.available())
+        .collect();
+    for n in [1_000, 10_000, 100_000, 1_000_000] {
+        let prims = scene_sized(n, Kind::Triangles, 1, 0.3 * (1000.0 / n as f32).sqrt());
+        let mut group = c.benchmark_group(format!("scaling/{n}"));
+        group.throughput(Throughput::Elements(RAYS as u64));
+        group.sample_size(10);
+        for &core in &cores {
+            let accel = Accel::build_with(prims.clone(), core);
+            group.bench_with_input(
+                BenchmarkId::new("closest", accel.describe()),
+                &rays,
+                |b, rays| {
+                    b.iter(|| {
+                        rays.iter()
+                            .filter(|ray| accel.intersect(black_box(ray)).is_some())
+                            .count()
+                    })
+                },
+            );
+            group.bench_with_input(
+                BenchmarkId::new("occluded", accel.describe()),
+                &short,
+                |b, rays| {
+                    b.iter(|| {
+                        rays.iter()
+                            .filter(|ray| accel.occluded(black_box(ray)))
+                            .count()
+                    })
+                },
+            );
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench, scaling);
 criterion_main!(benches);

@@ -88,7 +88,7 @@ pub struct Flat {
 
 /// The smaller of two candidate hits by (distance, primitive index).
 #[inline(always)]
-fn nearer(a: PrimHit, t: f32, prim: u32) -> PrimHit {
+pub(super) fn nearer(a: PrimHit, t: f32, prim: u32) -> PrimHit {
     if t < a.t || (t == a.t && prim < a.prim) {
         PrimHit { t, prim }
     } else {
@@ -101,7 +101,7 @@ fn nearer(a: PrimHit, t: f32, prim: u32) -> PrimHit {
 /// with fewer instructions). A function, not a closure: a closure is not inlined into the
 /// target-feature functions.
 #[inline(always)]
-fn take_hits<const W: usize>(best: &mut PrimHit, ts: &[f32; W], ids: &[u32]) {
+pub(super) fn take_hits<const W: usize>(best: &mut PrimHit, ts: &[f32; W], ids: &[u32]) {
     let mut hits = ts
         .iter()
         .enumerate()
@@ -113,7 +113,7 @@ fn take_hits<const W: usize>(best: &mut PrimHit, ts: &[f32; W], ids: &[u32]) {
     }
 }
 
-const NONE: PrimHit = PrimHit {
+pub(super) const NONE: PrimHit = PrimHit {
     t: f32::INFINITY,
     prim: u32::MAX,
 };

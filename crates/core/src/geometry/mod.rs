@@ -12,6 +12,8 @@ pub mod sdf;
 pub mod soa;
 pub mod sphere;
 pub mod triangle;
+pub mod triangle_pack;
+pub mod wide;
 
 pub use accel::{set_ray_core, Accel, RayCore};
 pub use primitive::{PrimHit, Primitive};

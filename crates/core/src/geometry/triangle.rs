@@ -8,9 +8,9 @@ use crate::math::{gamma, Vec3};
 /// The per-ray part of the test, computed once and reused for every triangle the ray meets.
 #[derive(Clone, Copy, Debug)]
 pub struct ShearedRay {
-    o: Vec3,
-    k: [usize; 3],
-    s: Vec3,
+    pub(super) o: Vec3,
+    pub(super) k: [usize; 3],
+    pub(super) s: Vec3,
 }
 
 impl ShearedRay {

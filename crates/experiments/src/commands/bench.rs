@@ -26,7 +26,7 @@ pub struct BenchArgs {
     pub threads: usize,
     #[arg(long, default_value_t = 8)]
     pub max_depth: u32,
-    /// Ray cores to measure side by side (auto, bvh, flat, flat-scalar); each scene is loaded
+    /// Ray cores to measure side by side (auto, bvh, flat, flat-scalar, wide, embree); each scene is loaded
     /// once per core. Default: the global --ray-core.
     #[arg(long, value_delimiter = ',', value_parser = parse_core)]
     pub ray_cores: Vec<RayCore>,
