@@ -557,6 +557,38 @@ mod tests {
             .collect()
     }
 
+    /// Every core of `cores` answers each ray exactly as `scalar` does: the same distance and
+    /// primitive, the same occlusion. Returns how many closest hits were ties between primitives.
+    fn assert_same_hits(
+        scalar: &Accel,
+        cores: &[Accel],
+        prims: &[Primitive],
+        rays: &[Ray],
+        scale: f32,
+    ) -> usize {
+        let mut ties = 0;
+        for ray in rays {
+            let b = scalar.intersect(ray);
+            for c in cores {
+                assert_eq!(
+                    c.intersect(ray).map(|h| (h.t.to_bits(), h.prim)),
+                    b.map(|h| (h.t.to_bits(), h.prim)),
+                    "scale {scale}, ray {ray:?}"
+                );
+                assert_eq!(c.occluded(ray), scalar.occluded(ray), "ray {ray:?}");
+            }
+            if let Some(h) = b {
+                let r = ShearedRay::new(ray.o, ray.d);
+                let at_t = prims
+                    .iter()
+                    .filter(|p| p.intersect(&r, ray.o, ray.d, ray.t_max) == h.t)
+                    .count();
+                ties += (at_t > 1) as usize;
+            }
+        }
+        ties
+    }
+
     /// The vectorised flat test is the scalar one, bit for bit, at every width the CPU runs: the
     /// same distance, the same primitive (ties at shared edges included), the same occlusion, at
     /// every scale.
@@ -581,25 +613,8 @@ mod tests {
                 RayCore::Flat
             );
             assert_eq!(scalar.core(), RayCore::FlatScalar);
-            for ray in test_rays(&mut s, &prims, scale, 20_000, true) {
-                let b = scalar.intersect(&ray);
-                for w in &wide {
-                    assert_eq!(
-                        w.intersect(&ray).map(|h| (h.t.to_bits(), h.prim)),
-                        b.map(|h| (h.t.to_bits(), h.prim)),
-                        "scale {scale}, ray {ray:?}"
-                    );
-                    assert_eq!(w.occluded(&ray), scalar.occluded(&ray), "ray {ray:?}");
-                }
-                if let Some(h) = b {
-                    let r = ShearedRay::new(ray.o, ray.d);
-                    let at_t = prims
-                        .iter()
-                        .filter(|p| p.intersect(&r, ray.o, ray.d, ray.t_max) == h.t)
-                        .count();
-                    ties += (at_t > 1) as usize;
-                }
-            }
+            let rays = test_rays(&mut s, &prims, scale, 20_000, true);
+            ties += assert_same_hits(&scalar, &wide, &prims, &rays, scale);
         }
         // The edge- and corner-aimed rays must actually exercise the tie-break.
         assert!(ties > 100, "only {ties} ties");
@@ -629,25 +644,8 @@ mod tests {
                 Accel::build_with(prims.clone(), RayCore::Wide).core(),
                 RayCore::Wide
             );
-            for ray in test_rays(&mut s, &prims, scale, 6000, true) {
-                let b = scalar.intersect(&ray);
-                for w in &wide {
-                    assert_eq!(
-                        w.intersect(&ray).map(|h| (h.t.to_bits(), h.prim)),
-                        b.map(|h| (h.t.to_bits(), h.prim)),
-                        "scale {scale}, ray {ray:?}"
-                    );
-                    assert_eq!(w.occluded(&ray), scalar.occluded(&ray), "ray {ray:?}");
-                }
-                if let Some(h) = b {
-                    let r = ShearedRay::new(ray.o, ray.d);
-                    let at_t = prims
-                        .iter()
-                        .filter(|p| p.intersect(&r, ray.o, ray.d, ray.t_max) == h.t)
-                        .count();
-                    ties += (at_t > 1) as usize;
-                }
-            }
+            let rays = test_rays(&mut s, &prims, scale, 6000, true);
+            ties += assert_same_hits(&scalar, &wide, &prims, &rays, scale);
         }
         assert!(ties > 30, "only {ties} ties");
     }

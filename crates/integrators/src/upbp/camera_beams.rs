@@ -21,6 +21,8 @@
 
 use super::light_beams::Back;
 use super::policy::{medium_of, near_sin, without_sigma_s, MergeSide, Policy};
+use super::rates::Needs;
+use super::weights::VertexRate;
 use crate::record::{Recorder, VolumeMerged};
 use crate::subpath::camera_loop::SampleCtx;
 use crate::subpath::connect::nee_density;
@@ -54,6 +56,27 @@ struct CameraPoint {
     vertex: PathVertex,
     rate: f64,
     back: (f64, f64),
+}
+
+impl CameraPoint {
+    /// The camera's side of a merge at this point: `vertices` the camera subpath ending in it.
+    fn side<'a>(
+        &self,
+        vertices: &'a [PathVertex],
+        rates: &'a [VertexRate],
+        needs: Needs,
+    ) -> MergeSide<'a> {
+        let (back, near_rate) = self.back;
+        MergeSide {
+            vertices,
+            back,
+            rates,
+            near_rate,
+            end_rate: self.rate,
+            near_sin: near_sin(vertices, needs),
+            nee: 0.0,
+        }
+    }
 }
 
 impl<const MEDIA: bool> Policy<'_, MEDIA> {
@@ -193,25 +216,8 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
             buf.clear();
             buf.extend_from_slice(prefix);
             buf.push(cp.vertex);
-            let (back, near) = cp.back;
-            let light = MergeSide {
-                vertices: y.vertices,
-                back: y.back_flight[i] as f64,
-                rates: y.rates,
-                near_rate: y.rates[i - 1].rate,
-                end_rate: y.rates[i].light_rate,
-                near_sin: y.rates[i - 1].sin,
-                nee: y.nee,
-            };
-            let cam = MergeSide {
-                vertices: &buf,
-                back,
-                rates: &self.cam,
-                near_rate: near,
-                end_rate: cp.rate,
-                near_sin: near_sin(&buf, p.needs),
-                nee: 0.0,
-            };
+            let light = MergeSide::stored_photon(y, i);
+            let cam = cp.side(&buf, &self.cam, p.needs);
             let technique = VolumeTechnique::Beam(i);
             let w = self.merge_weight(scene, light, cam, technique);
             debug_assert_eq!(buf.len(), t);
@@ -315,7 +321,6 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
                     buf.extend_from_slice(prefix);
                     buf.push(cp.vertex);
                     let (back_l, near_l) = src.back.at(piece.mm, xl, b.origin);
-                    let (back_c, near_c) = cp.back;
                     // y_1 is the beam's point when the beam leaves the light.
                     let nee = if i == 1 {
                         nee_density(scene, &light_buf[0], &xlv)
@@ -331,15 +336,7 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
                         near_sin: near_sin(&light_buf, p.needs),
                         nee,
                     };
-                    let cam = MergeSide {
-                        vertices: &buf,
-                        back: back_c,
-                        rates: &self.cam,
-                        near_rate: near_c,
-                        end_rate: cp.rate,
-                        near_sin: near_sin(&buf, p.needs),
-                        nee: 0.0,
-                    };
+                    let cam = cp.side(&buf, &self.cam, p.needs);
                     let technique = VolumeTechnique::BeamBeam(i);
                     let w = self.merge_weight(scene, light, cam, technique);
                     if R::ACTIVE {

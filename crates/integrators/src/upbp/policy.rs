@@ -126,6 +126,22 @@ pub struct MergeSide<'a> {
     pub nee: f64,
 }
 
+impl<'a> MergeSide<'a> {
+    /// A stored photon's side: light path `y` up to its vertex `i`, rates and flights as the
+    /// light walk recorded them (PP3D and PB2D merge photons as stored).
+    pub fn stored_photon(y: LightPath<'a>, i: usize) -> MergeSide<'a> {
+        MergeSide {
+            vertices: y.vertices,
+            back: y.back_flight[i] as f64,
+            rates: y.rates,
+            near_rate: y.rates[i - 1].rate,
+            end_rate: y.rates[i].light_rate,
+            near_sin: y.rates[i - 1].sin,
+            nee: y.nee,
+        }
+    }
+}
+
 /// sin θ at the vertex before the last of `side` (0 when BB1D does not run, or it has no
 /// vertex before it).
 pub fn near_sin(side: &[PathVertex], needs: super::rates::Needs) -> f64 {
@@ -390,15 +406,7 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
             if value == Color::ZERO {
                 return;
             }
-            let light = MergeSide {
-                vertices: y.vertices,
-                back: y.back_flight[i] as f64,
-                rates: y.rates,
-                near_rate: y.rates[i - 1].rate,
-                end_rate: y.rates[i].light_rate,
-                near_sin: y.rates[i - 1].sin,
-                nee: y.nee,
-            };
+            let light = MergeSide::stored_photon(y, i);
             let cam = MergeSide {
                 vertices: z,
                 back: self.back_flight[t - 1] as f64,
