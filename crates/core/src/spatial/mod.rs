@@ -137,19 +137,54 @@ impl PointGrid {
         self.cell
     }
 
+    /// Every point's index in bucket order, the order in which queries meet them. Points stored
+    /// in this order (and the grid built again over them) lie next to their grid neighbours in
+    /// memory, so a query reads a few contiguous runs instead of scattered points; the rebuilt
+    /// grid's buckets then hold consecutive indices.
+    pub fn bucket_order(&self) -> &[u32] {
+        &self.indices
+    }
+
     /// Calls `f(index, squared distance)` for every point with `|p - q|² <= r²` (computed exactly
     /// as `(p - q).length_squared() <= r * r` in f32), each exactly once, in a deterministic order:
     /// cells by z, then y, then x, indices increasing within a cell. Works for any `r >= 0`; when
     /// the covered cell range has more cells than the table has buckets, it scans every point in
     /// bucket order instead (still each once, still deterministic).
-    pub fn for_each_within(&self, points: &[Vec3], q: Vec3, r: f32, mut f: impl FnMut(u32, f32)) {
+    pub fn for_each_within(&self, points: &[Vec3], q: Vec3, r: f32, f: impl FnMut(u32, f32)) {
         debug_assert_eq!(
             points.len(),
             self.len(),
             "points differ from those built over"
         );
         debug_assert!(r >= 0.0);
-        let r2 = r * r;
+        self.for_each_within_bounds(points, q, r, r * r, f);
+    }
+
+    /// As `for_each_within`, for the points with `|p - q|² <= r2` (the test made against `r2`
+    /// itself, so a caller holding squared radii gets exactly its own test, with no square root
+    /// rounded in between).
+    pub fn for_each_within_squared(
+        &self,
+        points: &[Vec3],
+        q: Vec3,
+        r2: f32,
+        f: impl FnMut(u32, f32),
+    ) {
+        debug_assert!(r2 >= 0.0);
+        // cell_range pads r by a relative 1e-5, far more than sqrt's half-ulp rounding.
+        self.for_each_within_bounds(points, q, r2.sqrt(), r2, f);
+    }
+
+    /// Visits the cells within `r` of `q` and calls `f` for their points with `d² <= r2`
+    /// (`r2` ≤ r² up to rounding).
+    fn for_each_within_bounds(
+        &self,
+        points: &[Vec3],
+        q: Vec3,
+        r: f32,
+        r2: f32,
+        mut f: impl FnMut(u32, f32),
+    ) {
         let Some((lo, hi)) = self.cell_range(q, r) else {
             return;
         };

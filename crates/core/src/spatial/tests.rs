@@ -436,3 +436,41 @@ fn build_and_queries_do_not_depend_on_thread_count() {
     assert!(v1.len() > 1000);
     assert_eq!(v1, v4);
 }
+
+#[test]
+fn within_squared_tests_against_r2_itself() {
+    // r² is each query's exact squared distance to another point: that point lies on the
+    // boundary, and a test against sqrt(r²)² would lose it whenever the root rounds down.
+    let points = random_points(21, 2000, Vec3::ZERO, Vec3::ONE);
+    let grid = PointGrid::build(&points, 0.1);
+    let mut on_boundary = 0;
+    for i in (0..points.len()).step_by(7) {
+        let q = points[i];
+        let r2 = (points[(i * 31 + 5) % points.len()] - q).length_squared();
+        let mut got = Vec::new();
+        grid.for_each_within_squared(&points, q, r2, |k, d2| got.push((k, d2)));
+        got.sort_unstable_by_key(|e| e.0);
+        let want: Vec<(u32, f32)> = (0..points.len() as u32)
+            .map(|k| (k, (points[k as usize] - q).length_squared()))
+            .filter(|&(_, d2)| d2 <= r2)
+            .collect();
+        assert_eq!(got, want, "q = {q:?}, r2 = {r2}");
+        on_boundary += (r2.sqrt() * r2.sqrt() < r2) as u32;
+    }
+    assert!(on_boundary > 0, "no query had a root that rounds down");
+}
+
+#[test]
+fn points_stored_in_bucket_order_index_in_order() {
+    let points = random_points(22, 3000, Vec3::ZERO, Vec3::ONE);
+    let order = PointGrid::build(&points, 0.05).bucket_order().to_vec();
+    let mut seen = order.clone();
+    seen.sort_unstable();
+    assert_eq!(seen, (0..points.len() as u32).collect::<Vec<_>>());
+    let sorted: Vec<Vec3> = order.iter().map(|&i| points[i as usize]).collect();
+    let regrid = PointGrid::build(&sorted, 0.05);
+    assert_eq!(
+        regrid.bucket_order(),
+        (0..points.len() as u32).collect::<Vec<_>>()
+    );
+}

@@ -1,18 +1,20 @@
 //! Progressive photon mapping's shared machinery, owned by neither `ppm` nor `sppm`: per-pixel
-//! statistics that persist across passes, and one pass of "push" — trace a batch of photon
-//! paths, find for every photon the visible points whose radius it falls in (the core's
-//! `PointGrid` over the visible points), and add its contribution to them.
+//! statistics that persist across passes, and one pass of photons — trace a batch of photon
+//! paths, then let every visible point gather the photons within its own radius (the core's
+//! `PointGrid` over the photons) and add their contribution.
 //!
-//! Determinism: photons are pushed in parallel chunks, each writing a list of (visible point,
-//! contribution) in photon order; the lists are then applied in chunk order, so every pixel sums
-//! the same terms in the same order for any thread count.
+//! Determinism: each visible point sums its photons in batch order (found in grid order, then
+//! sorted by batch index), so every pixel sums the same terms in the same order for any thread
+//! count and any storage order. An earlier version pushed each photon into the visible points
+//! around it, which sums the same terms in the same order (the images kept their bits) but read
+//! visible points scattered over a pixel-ordered array; gathering walks the pixels in order.
 //!
 //! The per-pass estimate of pixel j with the global schedule is (Knaus & Zwicker 2011, eq. 7)
 //! D_i + Σ_p K_{rᵢ}(x_j − x_p) β_j f β_p / M, averaged over passes (D: emission and next-event
 //! estimation). With the local update, Hachisuka et al.'s flux τ ← (τ + Φ) r²_new / r² and the
 //! pixel's estimate is D̄ + τ / (N_e π r²), N_e the photon paths traced so far.
 
-use crate::density::photons::{trace_photons, Kernel, Photon, PhotonOptions};
+use crate::density::photons::{trace_photons, GatherPoint, Kernel, Photon, PhotonOptions};
 use crate::density::radius::{global_scale2, power_scale2, read_alpha, InitialRadius, Update};
 use crate::density::visible::{CameraPrefix, Direct};
 use crate::params::ParamReader;
@@ -84,9 +86,6 @@ pub struct ProgressiveState {
     photon_paths: u64,
     pub log: ProgressLog,
 }
-
-/// Photon chunk of the push: contributions are listed per chunk and applied in chunk order.
-const PUSH_CHUNK: usize = 2048;
 
 fn add(a: &mut [f64; 3], c: Color) {
     a[0] += c.x as f64;
@@ -175,48 +174,31 @@ impl ProgressiveState {
         self.photon_paths += paths;
         self.log.photon_paths.push(paths);
 
-        // Push: each photon finds the visible points whose disk holds it.
+        // Gather: each visible point sums the photons within its own radius.
         let r_max = radii2.iter().fold(0.0f32, |m, &r2| m.max(r2)).sqrt();
-        let mut phi = vec![Color::ZERO; positions.len()];
-        let mut m = vec![0u32; positions.len()];
+        let mut gathered = vec![(Color::ZERO, 0u32); positions.len()];
         if r_max > 0.0 && !batch.photons.is_empty() {
-            // Cells of 2·r_max: a query ball of radius r_max then meets at most 2 cells per axis
-            // (8, against up to 27 with cells of r_max): +24 % sppm/ppm passes/s on cornell-box
-            // (results/bench.md). Each visible point still sums its photons in photon order, so
-            // the image keeps its bits.
-            let grid = PointGrid::build(&positions, 2.0 * r_max);
-            let points = IndexedPoints {
-                prefixes,
-                pixel_of: &pixel_of,
-                positions: &positions,
-                radii2: &radii2,
-                grid: &grid,
-                r_max,
-            };
-            let lists: Vec<Vec<(u32, Color)>> = batch
-                .positions
-                .par_chunks(PUSH_CHUNK)
-                .zip(batch.photons.par_chunks(PUSH_CHUNK))
-                .map(|(ps, phs)| {
-                    let mut list = Vec::new();
-                    for (xp, ph) in ps.iter().zip(phs) {
-                        push_one(scene, &points, params, *xp, ph, &mut list);
-                    }
-                    list
+            // Cells of 2·r_max: a ball of radius r ≤ r_max meets at most 2 cells per axis.
+            let photons = GridPhotons::new(&batch.positions, &batch.photons, 2.0 * r_max);
+            pixel_of
+                .par_iter()
+                .zip(&positions)
+                .zip(&radii2)
+                .map_init(Vec::new, |found, ((&j, &q), &r2)| {
+                    let gp = &prefixes[j as usize]
+                        .vp
+                        .as_ref()
+                        .expect("indexed points have a visible point")
+                        .gp;
+                    gather_one(scene, &photons, params, gp, q, r2, found)
                 })
-                .collect();
-            for list in lists {
-                for (k, c) in list {
-                    phi[k as usize] += c;
-                    m[k as usize] += 1;
-                }
-            }
+                .collect_into_vec(&mut gathered);
         }
 
         // Per-pixel updates.
         for (k, &j) in pixel_of.iter().enumerate() {
             let px = &mut self.pixels[j as usize];
-            let c = phi[k];
+            let (c, mk) = gathered[k];
             if !is_valid_color(c) {
                 invalid += 1;
                 continue;
@@ -228,7 +210,7 @@ impl ProgressiveState {
                     add(&mut px.photons, c * s as f32);
                 }
                 Update::Local => {
-                    let mk = m[k] as f64;
+                    let mk = mk as f64;
                     if mk > 0.0 {
                         let shrink = (px.n + params.alpha * mk) / (px.n + mk);
                         for (t, ci) in px.tau.iter_mut().zip([c.x, c.y, c.z]) {
@@ -264,49 +246,55 @@ impl ProgressiveState {
     }
 }
 
-/// A pass's visible points as the photon push sees them: point k lies at `positions[k]` with
-/// squared radius `radii2[k]` and belongs to pixel `pixel_of[k]` (whose prefix holds it),
-/// indexed by `grid`; `r_max` is the largest radius.
-struct IndexedPoints<'a> {
-    prefixes: &'a [CameraPrefix],
-    pixel_of: &'a [u32],
-    positions: &'a [Vec3],
-    radii2: &'a [f32],
-    grid: &'a PointGrid,
-    r_max: f32,
+/// A pass's photons stored in the grid's bucket order, so that the photons one query meets lie
+/// together in memory: stored photon s is the batch's photon `original[s]`, at `positions[s]`.
+struct GridPhotons {
+    positions: Vec<Vec3>,
+    records: Vec<Photon>,
+    original: Vec<u32>,
+    grid: PointGrid,
 }
 
-/// One photon (at `xp`)'s contributions to the visible points within their radii (appended to
-/// `list`).
+impl GridPhotons {
+    fn new(positions: &[Vec3], records: &[Photon], cell: f32) -> GridPhotons {
+        let original = PointGrid::build(positions, cell).bucket_order().to_vec();
+        let sorted: Vec<Vec3> = original.iter().map(|&i| positions[i as usize]).collect();
+        GridPhotons {
+            records: original.iter().map(|&i| records[i as usize]).collect(),
+            grid: PointGrid::build(&sorted, cell),
+            positions: sorted,
+            original,
+        }
+    }
+}
+
+/// The visible point `gp` (at `q`, squared radius `r2`)'s photon sum Σ_p K(d²) β f β_p, before
+/// the 1/(N π r²), and how many photons it took. Photons are summed in batch order, so the sum
+/// does not depend on how they are stored. `found` is scratch.
 #[inline]
-fn push_one(
+fn gather_one(
     scene: &Scene,
-    points: &IndexedPoints,
+    photons: &GridPhotons,
     params: &ProgressiveParams,
-    xp: Vec3,
-    ph: &Photon,
-    list: &mut Vec<(u32, Color)>,
-) {
-    let IndexedPoints {
-        prefixes,
-        pixel_of,
-        positions,
-        radii2,
-        grid,
-        r_max,
-    } = *points;
-    grid.for_each_within(positions, xp, r_max, |k, d2| {
-        let r2 = radii2[k as usize];
-        if !(d2 <= r2) {
-            return;
-        }
+    gp: &GatherPoint,
+    q: Vec3,
+    r2: f32,
+    found: &mut Vec<(u32, u32, f32)>,
+) -> (Color, u32) {
+    found.clear();
+    photons
+        .grid
+        .for_each_within_squared(&photons.positions, q, r2, |s, d2| {
+            found.push((photons.original[s as usize], s, d2));
+        });
+    found.sort_unstable_by_key(|&(i, _, _)| i);
+    let (mut sum, mut taken) = (Color::ZERO, 0);
+    for &(_, s, d2) in found.iter() {
         let w = params.kernel.shape(d2, r2);
-        let vp = prefixes[pixel_of[k as usize] as usize]
-            .vp
-            .as_ref()
-            .expect("indexed points have a visible point");
-        if let Some(v) = vp.gp.photon_value(scene, ph, params.max_depth) {
-            list.push((k, vp.gp.beta * v * w));
+        if let Some(v) = gp.photon_value(scene, &photons.records[s as usize], params.max_depth) {
+            sum += gp.beta * v * w;
+            taken += 1;
         }
-    });
+    }
+    (sum, taken)
 }
