@@ -5,6 +5,12 @@ Cornell box) as a pbrt-v4 scene, for the side-by-side runs against pbrt-v4 (issu
 
     pbrt_scene.py SCENE.toml OUT.pbrt [--integrator path|bdpt|mlt|sppm] [--spp N]
         [--width W] [--exr OUT.exr] [--sampler zsobol|independent] [--set TYPE:NAME=VALUE ...]
+    pbrt_scene.py SCENE.xml OUT.pbrt [the same] [-D KEY=VALUE ...] [--ggx-for-beckmann]
+        --lt-xml LT.xml
+
+A Mitsuba XML scene (Bitterli's veach-bidir and its kind; pbrt_from_mitsuba.py says which
+subset) is converted too; LT.xml is the copy lt must render (file names absolute, and with
+--ggx-for-beckmann its Beckmann conductors made GGX, the one distribution pbrt-v4's conductor has).
 
 --set adds integrator parameters in pbrt's own words, e.g. `--set float:sigma=0.01`,
 `--set integer:bootstrapsamples=100000`, `--set float:radius=0.01`.
@@ -69,6 +75,43 @@ def mesh(points, indices, m):
             f'    "point3 P" [ {nums(p)} ]\n')
 
 
+def integrator_param(kv):
+    key, _, v = kv.partition("=")
+    kind, _, name = key.partition(":")
+    if not name or kind not in ("integer", "float", "bool", "string"):
+        fail(f"--set {kv}: expected TYPE:NAME=VALUE with TYPE integer, float, bool or string")
+    val = f'"{v}"' if kind == "string" else v
+    return f'"{kind} {name}" [ {val} ]'
+
+
+def write_atomically(path, text):
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def from_mitsuba(a, extra):
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import pbrt_from_mitsuba as pm
+
+    if not a.lt_xml:
+        fail("a Mitsuba XML scene needs --lt-xml (the copy lt renders)")
+    defines = {}
+    for kv in a.defines:
+        k, eq, v = kv.partition("=")
+        if not eq:
+            fail(f"-D {kv}: expected KEY=VALUE")
+        defines[k] = v
+    try:
+        pbrt, lt_xml = pm.convert(a.scene, defines, a.integrator, a.spp, a.width, a.exr,
+                                  a.sampler, extra, a.ggx_for_beckmann)
+    except pm.Refused as e:
+        fail(str(e))
+    write_atomically(a.out, pbrt)
+    write_atomically(a.lt_xml, lt_xml)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("scene")
@@ -79,7 +122,13 @@ def main():
     ap.add_argument("--exr", default="pbrt.exr")
     ap.add_argument("--sampler", default="zsobol", choices=["zsobol", "independent"])
     ap.add_argument("--set", action="append", default=[])
+    ap.add_argument("-D", dest="defines", action="append", default=[])
+    ap.add_argument("--ggx-for-beckmann", action="store_true")
+    ap.add_argument("--lt-xml")
     a = ap.parse_args()
+    extra = [integrator_param(kv) for kv in a.set]
+    if a.scene.endswith(".xml"):
+        return from_mitsuba(a, extra)
     with open(a.scene, "rb") as f:
         s = tomllib.load(f)
     mats = s.get("materials", {})
@@ -102,14 +151,7 @@ def main():
     depth = int(s.get("render", {}).get("max_depth", 8)) - 1
     if depth < 0:
         fail(f"{a.scene}: max_depth must be at least 1")
-    params = [f'"integer maxdepth" [ {depth} ]']
-    for kv in a.set:
-        key, _, v = kv.partition("=")
-        kind, _, name = key.partition(":")
-        if not name or kind not in ("integer", "float", "bool", "string"):
-            fail(f"--set {kv}: expected TYPE:NAME=VALUE with TYPE integer, float, bool or string")
-        val = f'"{v}"' if kind == "string" else v
-        params.append(f'"{kind} {name}" [ {val} ]')
+    params = [f'"integer maxdepth" [ {depth} ]'] + extra
     out = [
         f"# Written by pbrt_scene.py from {a.scene}.\n",
         "Scale -1 1 1\n",
@@ -139,10 +181,7 @@ def main():
             out.append(f'  AreaLightSource "diffuse" "rgb L" [ {nums(sh["emission"])} ]\n')
         out.append("  " + mesh(*(QUAD if kind == "quad" else CUBE), m))
         out.append("AttributeEnd\n")
-    tmp = a.out + ".tmp"
-    with open(tmp, "w") as f:
-        f.writelines(out)
-    os.replace(tmp, a.out)
+    write_atomically(a.out, "".join(out))
 
 
 if __name__ == "__main__":
