@@ -167,8 +167,13 @@ def _mesh(ps, ns, uvs, tris, m, face_normals):
 def convert(path, defines, integrator, spp, width, exr, sampler, extra, ggx_for_beckmann):
     """The pbrt-v4 scene text for the Mitsuba XML at `path`, and the XML text lt should render
     (the same file, or its GGX variant)."""
-    src = open(path).read()
-    root = ET.fromstring(src)
+    try:
+        src = open(path).read()
+        root = ET.fromstring(src)
+    except OSError as e:
+        raise Refused(f"{path}: cannot read: {e.strerror}")
+    except ET.ParseError as e:
+        raise Refused(f"{path}:{e.position[0]}: not well-formed XML ({e})")
     params = _Params(root, defines)
     base = os.path.dirname(os.path.abspath(path))
     sensors = root.findall("sensor")

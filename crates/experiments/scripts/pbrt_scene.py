@@ -108,6 +108,8 @@ def from_mitsuba(a, extra):
                                   a.sampler, extra, a.ggx_for_beckmann)
     except pm.Refused as e:
         fail(str(e))
+    except (ValueError, TypeError, AttributeError) as e:
+        fail(f"{a.scene}: a value the converter could not read ({e})")
     write_atomically(a.out, pbrt)
     write_atomically(a.lt_xml, lt_xml)
 
