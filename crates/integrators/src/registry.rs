@@ -185,7 +185,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
     },
     IntegratorInfo {
         name: "ppm",
-        about: "progressive photon mapping: fixed visible points, photon passes pushed into them",
+        about: "progressive photon mapping: fixed visible points gathering each photon pass",
         kind: Kind::Consistent,
         weights: Weights::None,
         source: include_str!("photon/ppm.rs"),
