@@ -145,6 +145,24 @@ impl PointGrid {
         &self.indices
     }
 
+    /// Reorders `points`, and `payload` alike, into bucket order and builds the grid over them;
+    /// returns it with `original`, where `original[s]` is the index stored point s had. Within a
+    /// bucket the points keep their relative order, so every query meets the same points in the
+    /// same order as the grid over the unordered points would have (an order-dependent sum over
+    /// a query keeps its bits), while the points it meets now lie together in memory: the
+    /// photon-mapping family's queries were bound by cache misses on scattered points.
+    pub fn build_reordered<T: Copy>(
+        points: &mut Vec<Vec3>,
+        payload: &mut Vec<T>,
+        cell: f32,
+    ) -> (PointGrid, Vec<u32>) {
+        assert_eq!(points.len(), payload.len(), "one payload per point");
+        let original = PointGrid::build(points, cell).bucket_order().to_vec();
+        *points = original.iter().map(|&i| points[i as usize]).collect();
+        *payload = original.iter().map(|&i| payload[i as usize]).collect();
+        (PointGrid::build(points, cell), original)
+    }
+
     /// Calls `f(index, squared distance)` for every point with `|p - q|² <= r²` (computed exactly
     /// as `(p - q).length_squared() <= r * r` in f32), each exactly once, in a deterministic order:
     /// cells by z, then y, then x, indices increasing within a cell. Works for any `r >= 0`; when

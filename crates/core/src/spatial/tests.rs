@@ -461,16 +461,24 @@ fn within_squared_tests_against_r2_itself() {
 }
 
 #[test]
-fn points_stored_in_bucket_order_index_in_order() {
+fn reordered_points_are_met_in_the_same_order() {
     let points = random_points(22, 3000, Vec3::ZERO, Vec3::ONE);
-    let order = PointGrid::build(&points, 0.05).bucket_order().to_vec();
-    let mut seen = order.clone();
-    seen.sort_unstable();
-    assert_eq!(seen, (0..points.len() as u32).collect::<Vec<_>>());
-    let sorted: Vec<Vec3> = order.iter().map(|&i| points[i as usize]).collect();
-    let regrid = PointGrid::build(&sorted, 0.05);
+    let grid = PointGrid::build(&points, 0.05);
+    let (mut sorted, mut payload) = (points.clone(), (0..3000u32).collect::<Vec<_>>());
+    let (regrid, original) = PointGrid::build_reordered(&mut sorted, &mut payload, 0.05);
+    assert_eq!(payload, original);
     assert_eq!(
         regrid.bucket_order(),
         (0..points.len() as u32).collect::<Vec<_>>()
     );
+    let mut r = rng(23);
+    for _ in 0..200 {
+        let q = in_box(&mut r, Vec3::ZERO, Vec3::ONE);
+        let (mut before, mut after) = (Vec::new(), Vec::new());
+        grid.for_each_within(&points, q, 0.07, |i, d2| before.push((i, d2)));
+        regrid.for_each_within(&sorted, q, 0.07, |s, d2| {
+            after.push((original[s as usize], d2))
+        });
+        assert_eq!(before, after, "q = {q:?}");
+    }
 }

@@ -179,7 +179,7 @@ impl ProgressiveState {
         let mut gathered = vec![(Color::ZERO, 0u32); positions.len()];
         if r_max > 0.0 && !batch.photons.is_empty() {
             // Cells of 2·r_max: a ball of radius r ≤ r_max meets at most 2 cells per axis.
-            let photons = GridPhotons::new(&batch.positions, &batch.photons, 2.0 * r_max);
+            let photons = GridPhotons::new(batch.positions, batch.photons, 2.0 * r_max);
             pixel_of
                 .par_iter()
                 .zip(&positions)
@@ -256,14 +256,13 @@ struct GridPhotons {
 }
 
 impl GridPhotons {
-    fn new(positions: &[Vec3], records: &[Photon], cell: f32) -> GridPhotons {
-        let original = PointGrid::build(positions, cell).bucket_order().to_vec();
-        let sorted: Vec<Vec3> = original.iter().map(|&i| positions[i as usize]).collect();
+    fn new(mut positions: Vec<Vec3>, mut records: Vec<Photon>, cell: f32) -> GridPhotons {
+        let (grid, original) = PointGrid::build_reordered(&mut positions, &mut records, cell);
         GridPhotons {
-            records: original.iter().map(|&i| records[i as usize]).collect(),
-            grid: PointGrid::build(&sorted, cell),
-            positions: sorted,
+            positions,
+            records,
             original,
+            grid,
         }
     }
 }
