@@ -1,10 +1,11 @@
 //! How rays find primitives. Small scenes without triangles (every shipped one but the mesh-light
 //! box) test all their primitives at once in vectorised loops (`flat.rs`); the others use one
-//! obvhs compressed-wide BVH over every primitive:
+//! BVH over every primitive (our 8-wide one, `wide.rs`, where AVX2 runs and the scene has at most
+//! `WIDE_MAX_PRIMITIVES`; obvhs's compressed-wide one otherwise):
 //! triangles, parallelograms and analytic spheres live in the same structure, so a scene pays only
 //! for the kinds it has. Either way the closest hit is the primitive's own distance, unrounded.
 
-use super::flat::{self, Flat};
+use super::flat::{self, Flat, Isa};
 use super::primitive::{PrimHit, Primitive};
 use super::ray::Ray;
 use super::triangle::ShearedRay;
@@ -26,7 +27,7 @@ use std::sync::atomic::{AtomicU8, Ordering};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RayCore {
     /// `Flat` for scenes of at most `FLAT_MAX_PRIMITIVES` parallelograms and spheres and no
-    /// triangles, `Bvh` otherwise.
+    /// triangles, else `Wide` up to `WIDE_MAX_PRIMITIVES` where the CPU has AVX2, else `Bvh`.
     Auto,
     Bvh,
     /// Every primitive tested against every ray, in vectorised loops (`flat.rs`).
@@ -43,6 +44,11 @@ pub enum RayCore {
 /// Above this many primitives a BVH beats testing them all (`benches/ray_cores.rs`; results/bench.md,
 /// "The flat core against the BVH").
 pub const FLAT_MAX_PRIMITIVES: usize = 64;
+
+/// Up to this many primitives `Auto` picks the wide BVH over obvhs's: the largest size at which
+/// it measured faster on both closest hits and occlusion (results/bench.md, "wide BVH": 0.38× and
+/// 0.68× at 10⁵ triangles, 1.58× and 1.97× at 10⁶).
+pub const WIDE_MAX_PRIMITIVES: usize = 100_000;
 
 impl RayCore {
     pub const ALL: [RayCore; 6] = [
@@ -202,6 +208,12 @@ impl Accel {
             // Triangles are tested one by one in the flat core, which made a Cornell box with an
             // 8-triangle light 30 % slower than the BVH (results/bench.md).
             RayCore::Auto if prims.len() <= FLAT_MAX_PRIMITIVES && !has_triangles => RayCore::Flat,
+            // The 8-wide tree beats obvhs's up to 10⁵ triangles where AVX2 runs its box and edge
+            // tests (results/bench.md, "wide BVH"; results/bench-peers.md, round 6 of
+            // "Participating media"); past that its full-precision nodes fall out of cache.
+            RayCore::Auto if prims.len() <= WIDE_MAX_PRIMITIVES && Isa::widest() >= Isa::Avx2 => {
+                RayCore::Wide
+            }
             RayCore::Auto => RayCore::Bvh,
             c => c,
         };
@@ -254,7 +266,7 @@ impl Accel {
         }
     }
 
-    /// The structure in use: `Bvh`, `Flat` or `FlatScalar` (never `Auto`).
+    /// The structure in use (never `Auto`).
     pub fn core(&self) -> RayCore {
         match self.structure {
             Structure::Bvh { .. } => RayCore::Bvh,
@@ -730,14 +742,16 @@ mod tests {
     }
 
     #[test]
-    fn auto_picks_flat_for_small_scenes_without_triangles_and_the_bvh_otherwise() {
+    fn auto_picks_flat_for_small_scenes_without_triangles_and_a_tree_otherwise() {
         let mut s = Sampler::new(5, 0, 0);
         let few = random_primitives(&mut s, FLAT_MAX_PRIMITIVES as u32, 1.0);
         let many = random_primitives(&mut s, FLAT_MAX_PRIMITIVES as u32 + 1, 1.0);
-        assert_eq!(
-            Accel::build_with(few.clone(), RayCore::Auto).core(),
+        let tree = if Isa::widest() >= Isa::Avx2 {
+            RayCore::Wide
+        } else {
             RayCore::Bvh
-        );
+        };
+        assert_eq!(Accel::build_with(few.clone(), RayCore::Auto).core(), tree);
         let no_triangles: Vec<Primitive> = few
             .into_iter()
             .filter(|p| !matches!(p, Primitive::Triangle { .. }))
@@ -746,7 +760,7 @@ mod tests {
             Accel::build_with(no_triangles, RayCore::Auto).core(),
             RayCore::Flat
         );
-        assert_eq!(Accel::build_with(many, RayCore::Auto).core(), RayCore::Bvh);
+        assert_eq!(Accel::build_with(many, RayCore::Auto).core(), tree);
         assert_eq!(
             Accel::build_with(Vec::new(), RayCore::Flat)
                 .intersect(&Ray::new(Vec3::ZERO, Vec3::X))

@@ -43,7 +43,8 @@ impl Isa {
             .unwrap_or(preferred)
     }
 
-    fn widest() -> Isa {
+    /// The widest instruction set this CPU runs, whatever `LT_FLAT_ISA` says.
+    pub(crate) fn widest() -> Isa {
         #[cfg(target_arch = "x86_64")]
         {
             if std::arch::is_x86_feature_detected!("avx512f") {

@@ -20,7 +20,7 @@ struct Cli {
     #[command(flatten)]
     load: x::load_args::LoadArgs,
     /// How rays find primitives: auto (flat for scenes of at most 64 primitives and no triangles,
-    /// else bvh), bvh, flat (every primitive tested, vectorised), flat-scalar (the same, one at
+    /// else wide up to 100,000 primitives on a CPU with AVX2, else bvh), bvh, flat (every primitive tested, vectorised), flat-scalar (the same, one at
     /// a time: the reference, bit for bit the same hits), wide (an 8-wide BVH with triangles
     /// tested 8 at a time: the same hits as flat-scalar) or embree (Intel's Embree 3, where the
     /// build found it). See results/bench.md.
