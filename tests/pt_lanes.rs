@@ -73,7 +73,7 @@ fn bitterli(name: &str) -> lt_core::Scene {
 
 #[test]
 fn lanes_give_the_scalar_pt_image_bit_for_bit_on_every_shipped_scene() {
-    let mut names = shipped_scene_names();
+    let names = shipped_scene_names();
     for name in &names {
         same_image(name, &shipped_scene(name, Some(RESOLUTION)), &[]);
     }
