@@ -24,6 +24,7 @@ mod partial_merge;
 mod photon_estimates;
 mod points_beams;
 mod pt_agreement;
+mod pt_lanes;
 mod robustness;
 mod runs;
 mod side_images;

@@ -10,7 +10,6 @@ use crate::photon::pm::{Pm, PmParams};
 use crate::photon::ppm::Ppm;
 use crate::photon::sppm::Sppm;
 use crate::unidirectional::light::{LightParams, LightTracer};
-use crate::unidirectional::pt::{Pt, PtParams};
 use crate::unidirectional::pt_bsdf::{PtBsdf, PtBsdfParams};
 use crate::upbp::Upbp;
 use crate::vcm::bpm::Bpm;
@@ -113,11 +112,7 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         weights: Weights::PathTracing,
         source: include_str!("unidirectional/pt.rs"),
         radius: Radius::None,
-        make: |s, r| {
-            Ok(Estimator::Unbiased(Box::new(Pt {
-                params: PtParams::read(s, r)?,
-            })))
-        },
+        make: crate::unidirectional::pt_lanes::make,
     },
     IntegratorInfo {
         name: "pt-bsdf",

@@ -5,3 +5,4 @@
 pub mod light;
 pub mod pt;
 pub mod pt_bsdf;
+pub mod pt_lanes;

@@ -16,6 +16,7 @@
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `mis` | power/balance | power | heuristic combining NEE and BSDF sampling |
 //! | `techniques` | both/light/bsdf | both | NEE and BSDF sampling, NEE only, or BSDF sampling only |
+//! | `lanes` | 1/8 | 1 | paths walked together: 8 runs `pt_lanes` (same image bit for bit, no media) |
 
 use crate::film::pixel::pixel_pass;
 use crate::params::ParamReader;

@@ -1,0 +1,222 @@
+//! One batch of up to `LANES` pixels walked bounce by bounce, following `Pt::radiance` (without a
+//! recorder) step for step: each step runs over the live lanes, the scene queries per lane
+//! through the scalar functions, the arithmetic of the estimate through the lane kernels.
+
+use super::kernels::{self, NextEventLanes};
+use super::state::{ColorLanes, Mask, PathLanes, LANES};
+use crate::film::pixel::{pixel_sample, weighted};
+use crate::pt::{Pt, Techniques};
+use crate::subpath::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
+use lt_core::bsdf::TransportMode;
+use lt_core::geometry::Ray;
+use lt_core::math::Color;
+use lt_core::math::Vec3;
+use lt_core::sampling::{Domain, Sampler};
+use lt_core::scene::SurfaceHit;
+use lt_core::Scene;
+
+/// The estimates of pixels `first .. first + n` (n ≤ `LANES`) of pass `pass` of the run seeded
+/// by `seed`, weighted by the film filter as `film::pixel::pixel_pass` weighs them; `None` where
+/// the filter's offset left the film (`pixel_pass` then leaves the pixel at zero).
+pub fn run_batch(
+    pt: &Pt,
+    scene: &Scene,
+    (seed, pass): (u64, u32),
+    first: u64,
+    n: usize,
+) -> Vec<Option<Color>> {
+    let mut lanes = start(scene, (seed, pass), first, n);
+    let nee = pt.params.techniques != Techniques::Bsdf;
+    let rules = WalkRules::camera(pt.params.rr_depth);
+    let mut hits: [Option<SurfaceHit>; LANES] = [None; LANES];
+    for depth in 1..=pt.params.max_depth {
+        if !lanes.alive.iter().any(|&a| a) {
+            break;
+        }
+        for i in live(&lanes.alive) {
+            hits[i] = scene.intersect(&lanes.ray[i]);
+        }
+        escape(pt, scene, &mut lanes, &hits);
+        emitters(pt, scene, &mut lanes, &hits);
+        if depth == pt.params.max_depth {
+            break;
+        }
+        if nee {
+            next_event(pt, scene, &mut lanes, &hits);
+        }
+        scatter(scene, &mut lanes, &hits, &rules, depth);
+    }
+    (0..n)
+        .map(|i| {
+            lanes.samplers[i]
+                .as_ref()
+                .map(|_| weighted(lanes.l.get(i), lanes.film_weight[i]))
+        })
+        .collect()
+}
+
+/// The live lanes' indices.
+fn live(alive: &Mask) -> impl Iterator<Item = usize> + '_ {
+    (0..LANES).filter(move |&i| alive[i])
+}
+
+/// Each lane's pixel stream, film position and camera ray (`pixel_pass`, then the first lines of
+/// `Pt::radiance`).
+fn start(scene: &Scene, (seed, pass): (u64, u32), first: u64, n: usize) -> PathLanes {
+    let mut samplers: [Option<Sampler>; LANES] = std::array::from_fn(|_| None);
+    let mut film_weight = [0.0f32; LANES];
+    let mut alive = [false; LANES];
+    let ray = std::array::from_fn(|i| {
+        if i >= n {
+            return idle_ray();
+        }
+        let pixel = first + i as u64;
+        let mut s = Sampler::for_item(Domain::Camera, seed, pixel, pass as u64);
+        let Some(film) = pixel_sample(scene, pixel, &mut s) else {
+            return idle_ray();
+        };
+        let ray = scene.camera.sample_ray(film.raster, &mut s);
+        film_weight[i] = film.weight;
+        alive[i] = true;
+        samplers[i] = Some(s);
+        ray
+    });
+    PathLanes {
+        prev_p: ray.map(|r: Ray| r.o),
+        alive,
+        samplers,
+        film_weight,
+        ray,
+        beta: ColorLanes::splat(Color::ONE),
+        l: ColorLanes::splat(Color::ZERO),
+        prev_pdf_w: [0.0; LANES],
+        prev_delta: [true; LANES],
+    }
+}
+
+/// The ray slot of a lane without a sample (never traced).
+fn idle_ray() -> Ray {
+    Ray::new(Vec3::ZERO, Vec3::Z)
+}
+
+/// Lanes whose ray left the scene: lights at infinity complete them and they retire
+/// (`Pt::radiance`'s `None` arm of `scene.intersect`; per lane, scalar).
+fn escape(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<SurfaceHit>; LANES]) {
+    for i in live(&lanes.alive.clone()) {
+        if hits[i].is_some() {
+            continue;
+        }
+        let d = lanes.ray[i].d;
+        let (beta, prev_p) = (lanes.beta.get(i), lanes.prev_p[i]);
+        let (prev_delta, prev_pdf_w) = (lanes.prev_delta[i], lanes.prev_pdf_w[i]);
+        let le = escaped_radiance(scene, d, |li| {
+            let light_pdf = scene.light_sampler.pmf(li as usize)
+                * scene.lights[li as usize].pdf_li(prev_p, d, d, -d);
+            pt.hit_weights(prev_delta, prev_pdf_w, light_pdf).0
+        });
+        lanes.l.set(i, lanes.l.get(i) + beta * le);
+        lanes.alive[i] = false;
+    }
+}
+
+/// Lanes that hit an emitter add its radiance under the MIS weight against next-event estimation
+/// (scene queries per lane, `kernels::hit_weight` and `kernels::add_emitted` across lanes).
+fn emitters(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<SurfaceHit>; LANES]) {
+    let mut lit = [false; LANES];
+    let mut le = ColorLanes::default();
+    let mut light_pdf = [0.0f32; LANES];
+    for i in live(&lanes.alive) {
+        let Some(hit) = &hits[i] else { continue };
+        let Some(li) = hit.light else { continue };
+        let light = &scene.lights[li as usize];
+        let e = light.emitted(hit.ng, -lanes.ray[i].d, hit.uv);
+        if e == Color::ZERO {
+            continue;
+        }
+        lit[i] = true;
+        le.set(i, e);
+        light_pdf[i] = scene.light_sampler.pmf(li as usize)
+            * light.pdf_li(lanes.prev_p[i], lanes.ray[i].d, hit.p, hit.ng);
+    }
+    if !lit.iter().any(|&x| x) {
+        return;
+    }
+    let w = kernels::hit_weight(pt, &lanes.prev_delta, &lanes.prev_pdf_w, &light_pdf);
+    kernels::add_emitted(&mut lanes.l, &lit, &lanes.beta, &le, &w);
+}
+
+/// Next-event estimation at every live non-delta vertex: `Pt::direct_light`'s draws and queries
+/// per lane, its weight and sum through `kernels::add_next_event`.
+fn next_event(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<SurfaceHit>; LANES]) {
+    let mut ran = [false; LANES];
+    let mut ne = NextEventLanes::default();
+    for i in live(&lanes.alive) {
+        let Some(hit) = &hits[i] else { continue };
+        if scene.material_is_delta(hit.material) {
+            continue;
+        }
+        ran[i] = true;
+        let sampler = lanes.samplers[i]
+            .as_mut()
+            .expect("a live lane has a stream");
+        let Some((li, pmf, _)) = scene.light_sampler.sample(sampler.next_f32()) else {
+            continue;
+        };
+        let u = sampler.next_2d();
+        let Some(ls) = scene.lights[li].sample_li(hit.p, u) else {
+            continue;
+        };
+        if ls.radiance == Color::ZERO || ls.pdf_w == 0.0 {
+            continue;
+        }
+        let sf = hit.shading_frame();
+        let wo = -lanes.ray[i].d;
+        let ev = scene
+            .material(hit.material)
+            .eval(&sf, wo, ls.wi, TransportMode::Radiance);
+        if ev.f_cos == Color::ZERO || !scene.visible_light(hit, &ls) {
+            continue;
+        }
+        ne.found[i] = true;
+        ne.f_cos.set(i, ev.f_cos);
+        ne.radiance.set(i, ls.radiance);
+        ne.light_pdf[i] = pmf * ls.pdf_w;
+        ne.bsdf_pdf[i] = ev.pdf_w;
+        ne.weight_one[i] = ls.delta || pt.params.techniques == Techniques::Light;
+    }
+    kernels::add_next_event(pt, &mut lanes.l, &ran, &lanes.beta, &ne);
+}
+
+/// Each live lane samples its BSDF, updates its throughput and plays Russian roulette
+/// (`continue_path`, per lane); lanes that stop retire.
+fn scatter(
+    scene: &Scene,
+    lanes: &mut PathLanes,
+    hits: &[Option<SurfaceHit>; LANES],
+    rules: &WalkRules,
+    depth: u32,
+) {
+    for i in live(&lanes.alive.clone()) {
+        let Some(hit) = &hits[i] else { continue };
+        let sf = hit.shading_frame();
+        let at = WalkPoint {
+            hit,
+            sf: &sf,
+            wo: -lanes.ray[i].d,
+        };
+        let sampler = lanes.samplers[i]
+            .as_mut()
+            .expect("a live lane has a stream");
+        let mut beta = lanes.beta.get(i);
+        let next = continue_path(scene, &at, rules, &mut beta, depth, sampler);
+        lanes.beta.set(i, beta);
+        let Some(bs) = next else {
+            lanes.alive[i] = false;
+            continue;
+        };
+        lanes.prev_pdf_w[i] = bs.pdf_w;
+        lanes.prev_delta[i] = bs.delta;
+        lanes.prev_p[i] = hit.p;
+        lanes.ray[i] = hit.spawn_ray(bs.wi);
+    }
+}

@@ -1,0 +1,105 @@
+//! `pt` with `lanes=8`: the same estimator as `pt` (`unidirectional::pt`), run eight pixel
+//! samples at a time, bounce by bounce, over a structure-of-arrays path state (issue 47, item 3;
+//! first cut).
+//!
+//! Each lane is one pixel's camera sample drawing from exactly the stream the scalar `pt` uses
+//! for it (`Sampler::for_item(Domain::Camera, seed, pixel, pass)`), and every lane kernel does the
+//! same IEEE operations in the same order as the scalar code it mirrors (no FMA, no SIMD
+//! approximations of transcendental functions), so the image is the scalar `pt`'s bit for bit —
+//! which is the whole test (`tests/pt_lanes.rs`). The scalar `pt` stays the reference.
+//!
+//! What runs lane-wide and what per lane (first cut):
+//! - lane kernels (`kernels.rs`): the MIS weights of emitter hits and of next-event estimation
+//!   (power heuristic), and the radiance and throughput arithmetic that adds them to the estimate;
+//! - per lane, through the scalar functions (`driver.rs`): camera rays, `Scene::intersect` and
+//!   shadow rays, light and BSDF sampling and evaluation, Russian roulette, lights at infinity.
+//!
+//! Next steps (results/bench.md): a packet query through the wide BVH for the 8 rays of a bounce,
+//! and lane kernels for the diffuse BSDF and the area light's `sample_li`, with the scalar step
+//! kept as the per-lane fallback for other materials and lights.
+//!
+//! Participating media are not handled: `lanes=8` on a scene with media is refused in one line
+//! (`registry`).
+
+mod driver;
+mod kernels;
+mod state;
+
+use crate::params::ParamReader;
+use crate::pt::{Pt, PtParams};
+use crate::{Estimator, Integrator};
+use lt_core::math::is_valid_color;
+use lt_core::Scene;
+use lt_estimators::Image;
+use rayon::prelude::*;
+use state::LANES;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// `pt`'s constructor (registry): its keys, and `lanes` — 1 (the scalar `pt`, default) or 8
+/// (this module). A scene with media is refused in one line under `lanes=8`: the lanes walk
+/// surfaces only.
+pub fn make(scene: &Scene, r: &ParamReader) -> Result<Estimator, String> {
+    let params = PtParams::read(scene, r)?;
+    let lanes = r
+        .get_with("lanes", |v| match v {
+            "1" => Ok(false),
+            "8" => Ok(true),
+            _ => Err(format!("'{v}' is not a lane width (known: 1, {LANES})")),
+        })?
+        .unwrap_or(false);
+    if !lanes {
+        return Ok(Estimator::Unbiased(Box::new(Pt { params })));
+    }
+    if scene.has_media {
+        return Err(format!(
+            "pt: lanes={LANES} does not handle participating media yet; the scene has {} media \
+             (lanes=1 renders it)",
+            scene.media.len()
+        ));
+    }
+    Ok(Estimator::Unbiased(Box::new(PtLanes::new(params))))
+}
+
+pub struct PtLanes {
+    pub pt: Pt,
+}
+
+impl PtLanes {
+    pub fn new(params: PtParams) -> PtLanes {
+        PtLanes { pt: Pt { params } }
+    }
+}
+
+impl Integrator for PtLanes {
+    fn name(&self) -> &'static str {
+        "pt"
+    }
+
+    /// `film::pixel::pixel_pass`, with each row's pixels walked in batches of `LANES`.
+    fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
+        let w = scene.camera.width as usize;
+        let h = scene.camera.height as usize;
+        let mut img = Image::new(w, h);
+        let invalid = AtomicU64::new(0);
+        img.data.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            let mut bad = 0;
+            for (c, batch) in row.chunks_mut(LANES).enumerate() {
+                let first = (y * w + c * LANES) as u64;
+                let estimates =
+                    driver::run_batch(&self.pt, scene, (seed, pass), first, batch.len());
+                for (px, c) in batch.iter_mut().zip(estimates) {
+                    let Some(c) = c else { continue };
+                    if is_valid_color(c) {
+                        *px = [c.x as f64, c.y as f64, c.z as f64];
+                    } else {
+                        bad += 1;
+                    }
+                }
+            }
+            if bad > 0 {
+                invalid.fetch_add(bad, Ordering::Relaxed);
+            }
+        });
+        (img, invalid.into_inner())
+    }
+}
