@@ -219,6 +219,7 @@ fn committed_radius_shrinkage_claims_hold_within_their_intervals() {
     for study in [
         "radius-shrinkage",
         "radius-shrinkage-plane",
+        "radius-shrinkage-media",
         "unbiased-vs-consistent",
     ] {
         let path = root.join(format!("results/{study}/rates.csv"));
