@@ -313,23 +313,36 @@ fn bidir_figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result
         true,
     )?;
     let ratio = ep.rel.estimate / eb.rel.estimate;
-    let separated = eb.rel.hi < ep.rel.lo && eb.flip.hi < ep.flip.lo;
+    let flip_ratio = ep.flip.estimate / eb.flip.estimate;
+    let rel_apart = eb.rel.hi < ep.rel.lo;
+    let flip_apart = eb.flip.hi < ep.flip.lo;
+    // pt's error here is a few bright fireflies (caustic paths through the lamp's glass): its
+    // relMSE is heavy-tailed, and K runs may not bound its mean even when every image shows it.
+    let verdict = match (rel_apart, flip_apart) {
+        (true, true) => format!(
+            "holds: at equal CPU time pt's relMSE is {}× bdpt's and its FLIP {}× (both intervals \
+             apart)",
+            num(ratio),
+            num(flip_ratio)
+        ),
+        (false, true) => format!(
+            "holds to the eye: at equal CPU time pt's FLIP is {}× bdpt's, the intervals apart; \
+             pt's relMSE is {}× bdpt's by its mean, but its interval reaches below bdpt's: pt's \
+             error is a few fireflies whose mean {} runs cannot bound",
+            num(flip_ratio),
+            num(ratio),
+            b.runs
+        ),
+        _ => format!(
+            "is not shown at this budget: pt's relMSE is {}× bdpt's and its FLIP {}×, the \
+             intervals overlapping",
+            num(ratio),
+            num(flip_ratio)
+        ),
+    };
     out.para(&format!(
         "**Verdict (figure 1).** Veach's claim — bidirectional sampling renders the room lit \
-         from the lamp's shade far better than path tracing in the same time — {}: at equal CPU \
-         time pt's relMSE is {:.1}× bdpt's and its FLIP {:.1}× ({}).",
-        if separated {
-            "holds"
-        } else {
-            "is not shown at this budget"
-        },
-        ratio,
-        ep.flip.estimate / eb.flip.estimate,
-        if separated {
-            "both intervals apart"
-        } else {
-            "the intervals overlap"
-        }
+         from the lamp's shade far better than path tracing in the same time — {verdict}."
     ));
     let name = stem(&scene);
     let notes = [
@@ -521,11 +534,11 @@ fn mis_figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result<(
         let power = &rel[3];
         let robust = power.lo <= rel[best_single].hi;
         verdicts.push(format!(
-            "on {label} the power heuristic's relMSE is {:.2}× the better single technique's \
-             ({}) and {:.2}× the worse one's ({}){}; balance/power = {:.2}",
-            power.estimate / rel[best_single].estimate,
+            "on {label} the power heuristic's relMSE is {}× the better single technique's \
+             ({}) and {}× the worse one's ({}){}; balance/power = {:.2}",
+            num(power.estimate / rel[best_single].estimate),
             VEACH[best_single].0,
-            power.estimate / rel[worst_single].estimate,
+            num(power.estimate / rel[worst_single].estimate),
             VEACH[worst_single].0,
             if robust {
                 ", within the better one's interval or below it"
@@ -589,7 +602,8 @@ fn mis_figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result<(
     )?;
     out.para(&format!(
         "**Verdict (figure 2).** Veach & Guibas's claim — MIS is never much worse than the \
-         better single technique and far better than the worse — {}.",
+         better single technique and far better than the worse — holds where the power heuristic's interval reaches the \
+         better one's: {}.",
         verdicts.join("; ")
     ));
     Ok(())
