@@ -474,3 +474,66 @@ fn plane_study_matches_its_exact_model() {
     assert!(check_claims(&d.join("rates.csv")) > 0);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The committed figures (results/figures/, `lt study figures`): every mean lies in its own
+/// interval, and each verdict the summary states is the one its CSV's intervals give — figure 1
+/// "holds" exactly when bdpt's relMSE and FLIP intervals lie below pt's and "holds to the eye"
+/// when only its FLIP interval does; figure 2 calls the power
+/// heuristic "within the better one's interval or below it" exactly on the scenes where its
+/// relMSE interval reaches down to the better single technique's. Reads committed files only.
+#[test]
+fn committed_figures_verdicts_follow_their_intervals() {
+    let root = lt_tests::scenes_dir().parent().unwrap().to_path_buf();
+    let dir = root.join("results/figures");
+    let summary = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    let get = |r: &HashMap<String, String>, c: &str| -> f64 {
+        r[c].parse().unwrap_or_else(|e| panic!("{c}: {e}: {r:?}"))
+    };
+    let bidir = csv(&dir.join("bidir.csv"));
+    let mis = csv(&dir.join("mis.csv"));
+    for r in bidir.iter().chain(&mis) {
+        for m in ["relMSE", "FLIP"] {
+            let (v, lo, hi) = (
+                get(r, m),
+                get(r, &format!("{m} lo")),
+                get(r, &format!("{m} hi")),
+            );
+            assert!(lo <= v && v <= hi, "{m} outside its interval: {r:?}");
+        }
+    }
+    let row = |who: &str| bidir.iter().find(|r| r["integrator"] == who).unwrap();
+    let (pt, bdpt) = (row("pt"), row("bdpt"));
+    let rel_apart = get(bdpt, "relMSE hi") < get(pt, "relMSE lo");
+    let flip_apart = get(bdpt, "FLIP hi") < get(pt, "FLIP lo");
+    let holds = summary.contains("— holds: at equal CPU");
+    let to_the_eye = summary.contains("— holds to the eye: at equal CPU");
+    assert_eq!(holds, rel_apart && flip_apart, "figure 1's verdict");
+    assert_eq!(to_the_eye, flip_apart && !rel_apart, "figure 1's verdict");
+    let mut robust = 0;
+    let mut scenes: Vec<&str> = mis.iter().map(|r| r["scene"].as_str()).collect();
+    scenes.dedup();
+    for s in &scenes {
+        let t = |name: &str| {
+            mis.iter()
+                .find(|r| r["scene"] == *s && r["technique"] == name)
+                .unwrap_or_else(|| panic!("{s}: no {name}"))
+        };
+        let (bsdf, light) = (t("BSDF sampling only"), t("light sampling only"));
+        let better = if get(bsdf, "relMSE") <= get(light, "relMSE") {
+            bsdf
+        } else {
+            light
+        };
+        if get(t("MIS, power heuristic"), "relMSE lo") <= get(better, "relMSE hi") {
+            robust += 1;
+        }
+    }
+    assert_eq!(scenes.len(), 1, "figure 2's scene");
+    assert_eq!(
+        summary
+            .matches(", within the better one's interval or below it")
+            .count(),
+        robust,
+        "figure 2's verdicts"
+    );
+}

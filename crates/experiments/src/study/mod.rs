@@ -10,6 +10,7 @@
 pub mod context;
 pub mod convergence;
 pub mod equal_time;
+pub mod figures;
 pub mod lecture;
 pub mod metrics;
 pub mod metropolis;
