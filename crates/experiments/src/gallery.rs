@@ -161,7 +161,7 @@ pub struct Entry<'a> {
     pub label: &'a str,
     pub note: String,
     pub image: &'a Image,
-    pub stem: &'a str,
+    pub stem: String,
 }
 
 /// Writes every image as the preview `study_dir/<stem>.jpg` and the lossless
@@ -305,13 +305,13 @@ mod tests {
                 label: "reference",
                 note: String::new(),
                 image: &img,
-                stem: "g/ref",
+                stem: "g/ref".into(),
             },
             &[Entry {
                 label: "pt",
                 note: "MSE 0".into(),
                 image: &img,
-                stem: "g/pt",
+                stem: "g/pt".into(),
             }],
             Some(4),
         )

@@ -151,11 +151,7 @@ fn equal_time(results: &Path) -> Manifest {
             label: name,
             note: format!("{name}: 10 s"),
             image: img,
-            stem: match name {
-                "pt" => "gallery/pt",
-                "bdpt" => "gallery/bdpt",
-                _ => "gallery/vcm",
-            },
+            stem: format!("gallery/{name}"),
         })
         .collect();
     let g = write_gallery(
@@ -166,7 +162,7 @@ fn equal_time(results: &Path) -> Manifest {
             label: "reference",
             note: "bdpt, 4096 spp".into(),
             image: &reference,
-            stem: "gallery/reference",
+            stem: "gallery/reference".into(),
         },
         &items,
         Some(12),

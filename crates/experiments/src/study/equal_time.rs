@@ -177,21 +177,15 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
                 ]);
                 images.push((i, img, format!("{passes} spp, MSE {}", num(m))));
             }
-            let stems: Vec<String> = images
-                .iter()
-                .map(|(i, _, _)| format!("gallery/{name}/{mode}-{i}"))
-                .collect();
             let entries: Vec<Entry> = images
                 .iter()
-                .zip(&stems)
-                .map(|((i, img, note), s)| Entry {
+                .map(|(i, img, note)| Entry {
                     label: i,
                     note: note.clone(),
                     image: img,
-                    stem: s,
+                    stem: format!("gallery/{name}/{mode}-{i}"),
                 })
                 .collect();
-            let ref_stem = format!("gallery/{name}/reference");
             let g = write_gallery(
                 &out.dir,
                 &format!("{name}, {title}"),
@@ -203,7 +197,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
                     label: "reference",
                     note: format!("{} {}", reference.integrator, reference.passes),
                     image: &reference.image,
-                    stem: &ref_stem,
+                    stem: format!("gallery/{name}/reference"),
                 },
                 &entries,
                 Some((scale.width / 4).max(4)),
@@ -245,17 +239,14 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             ]);
             imgs.push((label, img, format!("MSE {}", num(m))));
         }
-        let stems: Vec<String> = (0..imgs.len())
-            .map(|k| format!("gallery/veach-mis/{k}"))
-            .collect();
         let entries: Vec<Entry> = imgs
             .iter()
-            .zip(&stems)
-            .map(|((l, img, note), s)| Entry {
+            .enumerate()
+            .map(|(k, (l, img, note))| Entry {
                 label: l,
                 note: note.clone(),
                 image: img,
-                stem: s,
+                stem: format!("gallery/veach-mis/{k}"),
             })
             .collect();
         let g = write_gallery(
@@ -268,7 +259,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
                 label: "reference",
                 note: reference.integrator.clone(),
                 image: &reference.image,
-                stem: "gallery/veach-mis/reference",
+                stem: "gallery/veach-mis/reference".into(),
             },
             &entries,
             Some((scale.width / 4).max(4)),

@@ -366,21 +366,15 @@ fn bidir_figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result
             ),
         ),
     ];
-    let stems: Vec<String> = notes
-        .iter()
-        .map(|(i, _, _)| format!("gallery/{name}/{i}"))
-        .collect();
     let entries: Vec<Entry> = notes
         .iter()
-        .zip(&stems)
-        .map(|((i, img, note), s)| Entry {
+        .map(|(i, img, note)| Entry {
             label: i,
             note: note.clone(),
             image: img,
-            stem: s,
+            stem: format!("gallery/{name}/{i}"),
         })
         .collect();
-    let ref_stem = format!("gallery/{name}/reference");
     let g = write_gallery(
         &out.dir,
         "Figure 1: veach-bidir, pt against bdpt at equal CPU time",
@@ -393,7 +387,7 @@ fn bidir_figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result
             label: "reference",
             note: format!("{} {}", reference.integrator, reference.passes),
             image: &reference.image,
-            stem: &ref_stem,
+            stem: format!("gallery/{name}/reference"),
         },
         &entries,
         Some((b.width / 4).max(4)),
@@ -444,20 +438,16 @@ fn pyramid_gallery(ctx: &StudyContext, out: &mut StudyOutput) -> Result<(), Stri
             images.push((format!("s={s}, t={t}"), img));
         }
         let sum = sum.ok_or("empty pyramid row")?;
-        let stems: Vec<String> = (0..images.len())
-            .map(|i| format!("gallery/pyramid/k{k}-{i}"))
-            .collect();
         let entries: Vec<Entry> = images
             .iter()
-            .zip(&stems)
-            .map(|((l, img), st)| Entry {
+            .enumerate()
+            .map(|(i, (l, img))| Entry {
                 label: l,
                 note: "MIS-weighted".into(),
                 image: img,
-                stem: st,
+                stem: format!("gallery/pyramid/k{k}-{i}"),
             })
             .collect();
-        let ref_stem = format!("gallery/pyramid/k{k}-sum");
         let g = write_gallery(
             &out.dir,
             &format!("Figure 1b: bdpt's path pyramid on veach-bidir, paths of {k} segments"),
@@ -471,7 +461,7 @@ fn pyramid_gallery(ctx: &StudyContext, out: &mut StudyOutput) -> Result<(), Stri
                 label: "sum",
                 note: format!("all paths of {k} segments"),
                 image: &sum,
-                stem: &ref_stem,
+                stem: format!("gallery/pyramid/k{k}-sum"),
             },
             &entries,
             None,
@@ -547,21 +537,15 @@ fn mis_figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result<(
             },
             rel[2].estimate / power.estimate
         ));
-        let stems: Vec<String> = shown
-            .iter()
-            .map(|(k, _, _, _)| format!("gallery/mis-{name}/{k}"))
-            .collect();
         let entries: Vec<Entry> = shown
             .iter()
-            .zip(&stems)
-            .map(|((_, l, img, note), s)| Entry {
+            .map(|(k, l, img, note)| Entry {
                 label: l,
                 note: note.clone(),
                 image: img,
-                stem: s,
+                stem: format!("gallery/mis-{name}/{k}"),
             })
             .collect();
-        let ref_stem = format!("gallery/mis-{name}/reference");
         let g = write_gallery(
             &out.dir,
             &format!("Figure 2: Veach's MIS comparison on {label}, equal samples"),
@@ -574,7 +558,7 @@ fn mis_figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result<(
                 label: "reference",
                 note: format!("{} {}", reference.integrator, reference.passes),
                 image: &reference.image,
-                stem: &ref_stem,
+                stem: format!("gallery/mis-{name}/reference"),
             },
             &entries,
             Some((b.width / 4).max(4)),
