@@ -193,12 +193,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
                     "Reference: {} × {} passes of {}.",
                     reference.runs, reference.passes, reference.integrator
                 ),
-                &Entry {
-                    label: "reference",
-                    note: format!("{} {}", reference.integrator, reference.passes),
-                    image: &reference.image,
-                    stem: format!("gallery/{name}/reference"),
-                },
+                &reference.gallery_entry(format!("gallery/{name}/reference")),
                 &entries,
                 Some((scale.width / 4).max(4)),
             )?;

@@ -383,12 +383,7 @@ fn bidir_figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result
             num(budget_s),
             reference.passes
         ),
-        &Entry {
-            label: "reference",
-            note: format!("{} {}", reference.integrator, reference.passes),
-            image: &reference.image,
-            stem: format!("gallery/{name}/reference"),
-        },
+        &reference.gallery_entry(format!("gallery/{name}/reference")),
         &entries,
         Some((b.width / 4).max(4)),
     )?;
@@ -554,12 +549,7 @@ fn mis_figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result<(
                  by the balance and the power heuristic. Reference: {} passes of {}.",
                 b.mis_passes, reference.passes, reference.integrator
             ),
-            &Entry {
-                label: "reference",
-                note: format!("{} {}", reference.integrator, reference.passes),
-                image: &reference.image,
-                stem: format!("gallery/mis-{name}/reference"),
-            },
+            &reference.gallery_entry(format!("gallery/mis-{name}/reference")),
             &entries,
             Some((b.width / 4).max(4)),
         )?;

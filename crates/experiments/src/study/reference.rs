@@ -4,6 +4,7 @@
 //! studies subtract it (E[(I − R̂)²] = E[(I − R)²] + Var R̂ for independent I and R̂).
 
 use super::Scale;
+use crate::gallery::Entry;
 use crate::runs::{RunEntry, RunSpec};
 use lt_estimators::Image;
 use std::path::Path;
@@ -79,6 +80,16 @@ pub struct Reference {
 }
 
 impl Reference {
+    /// The reference as a gallery's first image, noted by its integrator and passes.
+    pub fn gallery_entry(&self, stem: String) -> Entry<'_> {
+        Entry {
+            label: "reference",
+            note: format!("{} {}", self.integrator, self.passes),
+            image: &self.image,
+            stem,
+        }
+    }
+
     pub fn from_entry(e: &RunEntry) -> Result<Reference, String> {
         let image = e.image()?;
         let se = e.std_error()?.ok_or_else(|| {
