@@ -1,4 +1,4 @@
-//! `cargo bench -p lt-core --bench ray_cores`: where the flat ray core stops beating the BVH, and
+//! `cargo bench -p lt-core --features bench --bench ray_cores`: where the flat ray core stops beating the BVH, and
 //! (`-- scaling`) the BVH, wide and Embree cores on 10³–10⁶ triangles.
 //! Closest hits and occlusion of 100 000 rays from inside a box of N parallelograms (its six
 //! walls plus N − 6 random ones inside: the shape of a Cornell box with more furniture), of N/2

@@ -1,4 +1,4 @@
-//! `cargo bench -p lt-core --bench spatial`: PointGrid against a Vec sorted by cell key (one
+//! `cargo bench -p lt-core --features bench --bench spatial`: PointGrid against a Vec sorted by cell key (one
 //! binary search per row of cells) on photon-like points: 250k on the five walls of a 2×2×2 box,
 //! gathered by 1M radius queries of ≈50 neighbours each (one thread).
 

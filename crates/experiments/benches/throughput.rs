@@ -1,4 +1,4 @@
-//! `cargo bench -p lt-experiments`: raw BVH traversal and integrator throughput on the shipped
+//! `cargo bench -p lt-experiments --features bench`: raw BVH traversal and integrator throughput on the shipped
 //! scenes. `lt bench` prints the same figures as a table for results/bench.md.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};

@@ -14,7 +14,7 @@
 //!
 //! Inputs are assumed free of NaN (positions, query points and radii).
 //!
-//! Measured on the workload of `cargo bench -p lt-core --bench spatial` (250k photon-like points
+//! Measured on the workload of `cargo bench -p lt-core --features bench --bench spatial` (250k photon-like points
 //! in random order on the five walls of a 2×2×2 box, 1M queries of radius 0.035 finding 48
 //! neighbours on average, cell 2r; best of 4 interleaved rounds on a loaded 2-core machine): the
 //! grid builds in 1.1 ms on 2 threads against 9.7 ms for a Vec sorted by cell key (parallel sort),
