@@ -15,6 +15,7 @@ mod furnace;
 mod light_paths;
 mod material_grid;
 mod media;
+mod media_figures;
 mod mis_check;
 mod mis_check_upbp;
 mod mis_check_vcm;

@@ -23,6 +23,7 @@
 
 mod axis;
 mod chart;
+pub mod heatmap;
 mod look;
 
 pub use axis::{format_number, format_power};

@@ -131,6 +131,10 @@ pub fn findings(results: &Path) -> Result<Vec<Finding>, String> {
             fs.push(convergence(&rows));
         }
     }
+    // The media papers' three claims (issue 45, item 4), when their study's verdicts exist.
+    if let Ok(rows) = csv(&results.join("media-figures/verdicts.csv")) {
+        fs.push(media_figures(&rows));
+    }
     Ok(fs)
 }
 
@@ -215,6 +219,31 @@ fn convergence(rows: &[HashMap<String, String>]) -> Finding {
             } else {
                 none.join(", ")
             },
+        ),
+    }
+}
+
+/// Finding 5: each media figure's claim, verdict and the numbers that decide it
+/// (results/media-figures/verdicts.csv; tests/media_figures.rs recomputes each verdict).
+fn media_figures(rows: &[HashMap<String, String>]) -> Finding {
+    let said: Vec<String> = rows
+        .iter()
+        .map(|r| {
+            format!(
+                "({}) {}: **{}** — {}.",
+                r["figure"], r["claim"], r["verdict"], r["numbers"]
+            )
+        })
+        .collect();
+    Finding {
+        title: "The media papers' claims at equal time: points or beams, upbp or one estimator, \
+                which radius",
+        folder: "media-figures",
+        figure: "radius-heatmap",
+        text: format!(
+            "Jarosz et al. 2011 and Křivánek et al. 2014 on our media scenes, 8 independent runs \
+             per cell at equal CPU time, relMSE with 95 % intervals. {}",
+            said.join(" ")
         ),
     }
 }

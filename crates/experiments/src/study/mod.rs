@@ -12,6 +12,7 @@ pub mod convergence;
 pub mod equal_time;
 pub mod figures;
 pub mod lecture;
+pub mod media_figures;
 pub mod metrics;
 pub mod metropolis;
 pub mod output;

@@ -2,6 +2,7 @@
 //! order all read it. Adding a study is one entry here (and its module).
 
 use super::context::StudyContext;
+use super::media_figures;
 use super::scale::Scale;
 use super::{
     convergence, equal_time, figures, metropolis, per_length, radius_media, radius_plane,
@@ -97,6 +98,14 @@ pub const STUDIES: &[StudyInfo] = &[
         listed: false,
         specs: |scale, _| metropolis::specs(scale),
         run: metropolis::run,
+    },
+    // Not in `all`: about a core-quarter-hour of renders (results/media-figures/summary.md).
+    // Run it by name.
+    StudyInfo {
+        name: media_figures::NAME,
+        listed: false,
+        specs: media_figures::specs,
+        run: media_figures::run,
     },
     StudyInfo {
         name: "smoke",
