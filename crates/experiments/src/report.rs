@@ -13,6 +13,7 @@
 pub mod findings;
 mod html;
 mod markdown;
+pub mod overview;
 pub mod slim;
 
 use crate::image_io::write_atomic;
@@ -20,7 +21,7 @@ use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::study::registry::STUDIES;
 use std::path::{Path, PathBuf};
 
-pub use html::{images_in_page, SELFCHECK_ID};
+pub use html::{images_in_page, images_when_opened, SELFCHECK_ID};
 
 /// The page's file name inside the results folder.
 pub const INDEX_FILE: &str = "index.html";
@@ -32,6 +33,8 @@ pub struct StudyDir {
     pub manifest: Result<Manifest, String>,
     /// The summary's Markdown, or why there is none to show.
     pub summary: Result<String, String>,
+    /// The equal-time study's compact table (`overview`), or why it could not be read.
+    pub overview: Option<Result<overview::Overview, String>>,
 }
 
 /// Every sub-folder of `results` holding a manifest, in report order: the studies' table order
@@ -70,10 +73,15 @@ pub fn find_studies(results: &Path) -> Result<Vec<StudyDir>, String> {
                 }
                 Err(_) => Ok(String::new()),
             };
+            let overview = match &manifest {
+                Ok(m) => overview::of_study(&dir, m),
+                Err(_) => None,
+            };
             StudyDir {
                 folder,
                 manifest,
                 summary,
+                overview,
             }
         })
         .collect())
@@ -101,6 +109,9 @@ pub fn write_report(results: &Path) -> Result<PathBuf, String> {
             }
         }
         if let Err(e) = &s.summary {
+            eprintln!("warning: {e}");
+        }
+        if let Some(Err(e)) = &s.overview {
             eprintln!("warning: {e}");
         }
     }
