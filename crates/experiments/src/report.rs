@@ -26,6 +26,13 @@ pub use html::{images_in_page, images_when_opened, SELFCHECK_ID};
 /// The page's file name inside the results folder.
 pub const INDEX_FILE: &str = "index.html";
 
+/// The lecture's slides (`crates/experiments/scripts/slides_manifests.py` writes their
+/// manifests), in the order the page shows them.
+const SLIDES: [&str; 2] = ["seed-slides", "sppm-slides"];
+
+/// What writes the slides' manifests (from their committed renders and tables).
+const SLIDES_SCRIPT: &str = "python3 crates/experiments/scripts/slides_manifests.py";
+
 /// One study folder as the page shows it: its manifest, or why it could not be read.
 pub struct StudyDir {
     /// The folder's name inside the results folder (what links are relative to).
@@ -38,7 +45,8 @@ pub struct StudyDir {
 }
 
 /// Every sub-folder of `results` holding a manifest, in report order: the studies' table order
-/// (`study::registry::STUDIES`), then any other folder by name.
+/// (`study::registry::STUDIES`, the lecture's slides after the figures), then any other folder
+/// by name.
 pub fn find_studies(results: &Path) -> Result<Vec<StudyDir>, String> {
     let entries = std::fs::read_dir(results)
         .map_err(|e| format!("cannot read results folder {}: {e}", results.display()))?;
@@ -52,11 +60,13 @@ pub fn find_studies(results: &Path) -> Result<Vec<StudyDir>, String> {
             }
         }
     }
+    // The lecture's slides right after the field's figures, which they sit beside.
     let rank = |f: &str| {
-        STUDIES
-            .iter()
-            .position(|s| s.name == f)
-            .unwrap_or(STUDIES.len())
+        let study = |name: &str| STUDIES.iter().position(|s| s.name == name);
+        match SLIDES.iter().position(|s| *s == f) {
+            Some(k) => (study("figures").unwrap_or(STUDIES.len()), 1 + k),
+            None => (study(f).unwrap_or(STUDIES.len()), 0),
+        }
     };
     folders.sort_by(|a, b| rank(a).cmp(&rank(b)).then_with(|| a.cmp(b)));
     Ok(folders

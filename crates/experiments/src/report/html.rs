@@ -200,10 +200,16 @@ fn study(h: &mut String, s: &StudyDir) {
         esc(&m.title),
         esc(&m.scale)
     );
+    // The lecture's slides are no study: their manifests come from a script.
+    let made_by = if super::SLIDES.contains(&m.study.as_str()) {
+        super::SLIDES_SCRIPT.to_string()
+    } else {
+        format!("lt study {}", m.study)
+    };
     let _ = writeln!(
         h,
-        "<p class=\"meta\"><code>lt study {}</code> · folder <a href=\"{}\">{}/</a></p>",
-        esc(&m.study),
+        "<p class=\"meta\"><code>{}</code> · folder <a href=\"{}\">{}/</a></p>",
+        esc(&made_by),
         url(&s.folder, ""),
         esc(&s.folder)
     );

@@ -220,7 +220,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
                 })
             })
             .collect();
-        let (scene_rows, galleries) = scene_galleries(ctx, scale, &out.dir, scene, &plan)?;
+        let (scene_rows, galleries) = scene_galleries(ctx, scale, &out.dir, scene, &plan, true)?;
         rows.extend(scene_rows);
         out.manifest.galleries.extend(galleries);
     }
@@ -301,20 +301,23 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
 
 /// One scene's galleries (one per comparison of `plan`, in `MODES` order) and its table rows:
 /// `plan` holds (mode, integrator, passes, budget CPU s). Writes the full-size previews under
-/// `gallery_dir` and the equal-time thumbnails (`thumb`).
+/// `gallery_dir` and, when `thumbs`, the equal-time thumbnails (`thumb`).
 fn scene_galleries(
     ctx: &StudyContext,
     scale: &Scale,
     dir: &Path,
     scene: &Path,
     plan: &[(&str, &str, u32, f64)],
+    thumbs: bool,
 ) -> Result<(Vec<Vec<String>>, Vec<Gallery>), String> {
     let name = stem(scene);
     let reference = ctx.reference_at(scale, scene, None)?;
-    write_thumb(
-        &dir.join(thumb(&name, "reference")),
-        &srgb8(&reference.image),
-    )?;
+    if thumbs {
+        write_thumb(
+            &dir.join(thumb(&name, "reference")),
+            &srgb8(&reference.image),
+        )?;
+    }
     let mut rows = Vec::new();
     let mut galleries = Vec::new();
     for (mode, title) in MODES {
@@ -327,7 +330,7 @@ fn scene_galleries(
             let e = ctx.run(&spec)?;
             let img = e.image()?;
             let m = mse(&img, &reference);
-            if mode == "time" {
+            if thumbs && mode == "time" {
                 write_thumb(
                     &dir.join(thumb(&name, &format!("{mode}-{i}"))),
                     &srgb8(&img),
@@ -388,10 +391,10 @@ fn scene_gallery(
     )
 }
 
-/// `lt study equal-time --scene X …`: the full-size galleries of the named scenes (and their
-/// thumbnails), rendered at the pass counts the study's table records, so the images are the
-/// ones its numbers describe whatever this machine's timings. The table, summary and manifest
-/// are left as they are; the renders go through the cache.
+/// `lt study equal-time --scene X …`: the full-size galleries of the named scenes, rendered at
+/// the pass counts the study's table records, so the images are the ones its numbers describe
+/// whatever this machine's timings. The table, summary, manifest and committed thumbnails are
+/// left as they are; the renders go through the cache.
 pub fn regenerate(ctx: &StudyContext, scenes: &[String]) -> Result<(), String> {
     let scale = &ctx.scale.gallery();
     let dir = ctx.study_dir(NAME);
@@ -470,8 +473,26 @@ pub fn regenerate(ctx: &StudyContext, scenes: &[String]) -> Result<(), String> {
                 dir.display()
             ));
         }
-        ctx.say(&format!("equal-time: the full-size galleries of {wanted}"));
-        scene_galleries(ctx, scale, &dir, scene, &plan)?;
+        let (rows, _) = scene_galleries(ctx, scale, &dir, scene, &plan, false)?;
+        // The images are the table's when their MSE is (the code that renders them may have
+        // changed since the table was written): say how many agree.
+        let mse = table.columns.iter().position(|c| c == "MSE");
+        let key = |r: &[String]| (r[0].clone(), r[1].clone(), r[2].clone());
+        let agree = rows
+            .iter()
+            .filter(|r| {
+                table
+                    .rows
+                    .iter()
+                    .any(|t| key(t) == key(r) && mse.is_some_and(|m| t.get(m) == r.get(7)))
+            })
+            .count();
+        eprintln!(
+            "{wanted}: full-size galleries written to {}; MSE as the table has it for {agree} \
+             of {} images (the others were rendered by different code)",
+            dir.join(gallery_dir(wanted)).display(),
+            rows.len()
+        );
     }
     Ok(())
 }
