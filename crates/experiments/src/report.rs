@@ -13,6 +13,7 @@
 pub mod findings;
 mod html;
 mod markdown;
+pub mod overview;
 pub mod slim;
 
 use crate::image_io::write_atomic;
@@ -20,10 +21,17 @@ use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::study::registry::STUDIES;
 use std::path::{Path, PathBuf};
 
-pub use html::{images_in_page, SELFCHECK_ID};
+pub use html::{images_in_page, images_when_opened, SELFCHECK_ID};
 
 /// The page's file name inside the results folder.
 pub const INDEX_FILE: &str = "index.html";
+
+/// The lecture's slides (`crates/experiments/scripts/slides_manifests.py` writes their
+/// manifests), in the order the page shows them.
+const SLIDES: [&str; 2] = ["seed-slides", "sppm-slides"];
+
+/// What writes the slides' manifests (from their committed renders and tables).
+const SLIDES_SCRIPT: &str = "python3 crates/experiments/scripts/slides_manifests.py";
 
 /// One study folder as the page shows it: its manifest, or why it could not be read.
 pub struct StudyDir {
@@ -32,10 +40,13 @@ pub struct StudyDir {
     pub manifest: Result<Manifest, String>,
     /// The summary's Markdown, or why there is none to show.
     pub summary: Result<String, String>,
+    /// The equal-time study's compact table (`overview`), or why it could not be read.
+    pub overview: Option<Result<overview::Overview, String>>,
 }
 
 /// Every sub-folder of `results` holding a manifest, in report order: the studies' table order
-/// (`study::registry::STUDIES`), then any other folder by name.
+/// (`study::registry::STUDIES`, the lecture's slides after the figures), then any other folder
+/// by name.
 pub fn find_studies(results: &Path) -> Result<Vec<StudyDir>, String> {
     let entries = std::fs::read_dir(results)
         .map_err(|e| format!("cannot read results folder {}: {e}", results.display()))?;
@@ -49,11 +60,13 @@ pub fn find_studies(results: &Path) -> Result<Vec<StudyDir>, String> {
             }
         }
     }
+    // The lecture's slides right after the field's figures, which they sit beside.
     let rank = |f: &str| {
-        STUDIES
-            .iter()
-            .position(|s| s.name == f)
-            .unwrap_or(STUDIES.len())
+        let study = |name: &str| STUDIES.iter().position(|s| s.name == name);
+        match SLIDES.iter().position(|s| *s == f) {
+            Some(k) => (study("figures").unwrap_or(STUDIES.len()), 1 + k),
+            None => (study(f).unwrap_or(STUDIES.len()), 0),
+        }
     };
     folders.sort_by(|a, b| rank(a).cmp(&rank(b)).then_with(|| a.cmp(b)));
     Ok(folders
@@ -70,10 +83,15 @@ pub fn find_studies(results: &Path) -> Result<Vec<StudyDir>, String> {
                 }
                 Err(_) => Ok(String::new()),
             };
+            let overview = match &manifest {
+                Ok(m) => overview::of_study(&dir, m),
+                Err(_) => None,
+            };
             StudyDir {
                 folder,
                 manifest,
                 summary,
+                overview,
             }
         })
         .collect())
@@ -101,6 +119,9 @@ pub fn write_report(results: &Path) -> Result<PathBuf, String> {
             }
         }
         if let Err(e) = &s.summary {
+            eprintln!("warning: {e}");
+        }
+        if let Some(Err(e)) = &s.overview {
             eprintln!("warning: {e}");
         }
     }

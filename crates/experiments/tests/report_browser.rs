@@ -18,7 +18,8 @@ use lt_estimators::Image;
 use lt_experiments::gallery::{write_gallery, Entry};
 use lt_experiments::manifest::{Figure, Manifest, Table};
 use lt_experiments::plot::{write_chart, Chart, Series, Style};
-use lt_experiments::report::{images_in_page, write_report, SELFCHECK_ID};
+use lt_experiments::report::{images_in_page, images_when_opened, write_report, SELFCHECK_ID};
+use lt_experiments::study::equal_time::{thumb, write_thumb, GALLERIES_CSV};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -113,7 +114,10 @@ fn convergence(results: &Path) -> Manifest {
     m
 }
 
-/// An equal-time-like study: one gallery (reference + three estimates, a crop), no summary.
+/// An equal-time-like study: a shown gallery (reference + three estimates, a crop), no summary,
+/// and the compact table of two scenes (`report::overview`): `box`, whose full-size gallery
+/// exists (its row opens it), and `door`, whose gallery is named but not there (its row says
+/// how to make it).
 fn equal_time(results: &Path) -> Manifest {
     let dir = results.join("equal-time");
     let (w, h) = (64, 48);
@@ -144,34 +148,90 @@ fn equal_time(results: &Path) -> Manifest {
     };
     let estimates = [noisy(0.4, 1), noisy(0.2, 2), noisy(0.05, 3)];
     let names = ["pt", "bdpt", "vcm"];
-    let items: Vec<Entry> = estimates
-        .iter()
-        .zip(names)
-        .map(|(img, name)| Entry {
-            label: name,
-            note: format!("{name}: 10 s"),
-            image: img,
-            stem: format!("gallery/{name}"),
-        })
-        .collect();
-    let g = write_gallery(
-        &dir,
-        "cornell-box at equal time",
-        "10 s each",
-        &Entry {
-            label: "reference",
-            note: "bdpt, 4096 spp".into(),
-            image: &reference,
-            stem: "gallery/reference".into(),
-        },
-        &items,
-        Some(12),
-    )
-    .unwrap();
+    let gallery = |stem: &dyn Fn(&str) -> String, title: &str| {
+        let items: Vec<Entry> = estimates
+            .iter()
+            .zip(names)
+            .map(|(img, name)| Entry {
+                label: name,
+                note: format!("{name}: 10 s"),
+                image: img,
+                stem: stem(name),
+            })
+            .collect();
+        write_gallery(
+            &dir,
+            title,
+            "10 s each",
+            &Entry {
+                label: "reference",
+                note: "bdpt, 4096 spp".into(),
+                image: &reference,
+                stem: stem("reference"),
+            },
+            &items,
+            Some(12),
+        )
+        .unwrap()
+    };
     let mut m = Manifest::new("equal-time", "Equal time", "test");
-    m.galleries.push(g);
+    m.galleries.push(gallery(
+        &|n| format!("mis/{n}"),
+        "cornell-box at equal time",
+    ));
+    // The compact table: its CSV, thumbnails, and the scenes' on-demand galleries.
+    let mut csv =
+        String::from("scene,comparison,integrator,passes,CPU s,budget CPU s,wall s,MSE\n");
+    for scene in ["box", "door"] {
+        for (k, name) in names.iter().enumerate() {
+            csv.push_str(&format!(
+                "{scene},equal time,{name},{},1.0,1.1,2.0,0.0{k}1\n",
+                16 >> k
+            ));
+        }
+        let g = gallery(
+            &|n| {
+                format!(
+                    "gallery/{scene}/{}",
+                    if n == "reference" {
+                        n.to_string()
+                    } else {
+                        format!("time-{n}")
+                    }
+                )
+            },
+            &format!("{scene}, equal time"),
+        );
+        for i in std::iter::once(&g.reference).chain(&g.items) {
+            let what = Path::new(&i.image).file_stem().unwrap().to_str().unwrap();
+            let rgb = image::open(dir.join(&i.image)).unwrap().into_rgb8();
+            write_thumb(&dir.join(thumb(scene, what)), &rgb).unwrap();
+        }
+        m.galleries.push(g);
+    }
+    std::fs::remove_dir_all(dir.join("gallery/door")).unwrap();
+    std::fs::write(dir.join(GALLERIES_CSV), csv).unwrap();
+    m.tables.push(Table {
+        title: "Equal samples and equal time".into(),
+        caption: String::new(),
+        csv: GALLERIES_CSV.into(),
+        columns: vec![],
+        rows: vec![],
+    });
     m.write(&dir).unwrap();
     m
+}
+
+/// `<img` tags in the page as loaded: those inside a `<template>` (a row's on-demand
+/// galleries) are not.
+fn img_tags_shown(html: &str) -> usize {
+    let mut n = 0;
+    let mut rest = html;
+    while let Some(t) = rest.find("<template") {
+        n += rest[..t].matches("<img ").count();
+        rest = &rest[t + rest[t..].find("</template>").unwrap()..];
+    }
+    n + rest.matches("<img ").count()
 }
 
 /// Chromium's DOM of `url` after the page settled, or None when there is no browser.
@@ -288,9 +348,18 @@ fn report_page_loads_cleanly_in_chromium_and_the_check_can_fail() {
     assert!(html.contains("src=\"convergence/mse_spp.svg\""));
     assert!(html.contains("href=\"convergence/efficiency.csv\""));
     assert!(!html.contains("http://") && !html.contains("https://"));
-    let expected: usize = manifests.iter().map(images_in_page).sum();
-    assert_eq!(expected, 2 + (5 + 3));
-    assert_eq!(html.matches("<img ").count(), expected);
+    let dir = |m: &Manifest| results.join(&m.study);
+    let expected: usize = manifests.iter().map(|m| images_in_page(m, &dir(m))).sum();
+    // Two charts, the shown gallery, the compact table's 2 × (1 + 3) thumbnails.
+    assert_eq!(expected, 2 + (5 + 3) + 2 * (1 + 3));
+    assert_eq!(img_tags_shown(&html), expected);
+    // Opening every row adds box's gallery; door's images are not there.
+    let opened: usize = manifests
+        .iter()
+        .map(|m| images_when_opened(m, &dir(m)))
+        .sum();
+    assert_eq!(opened, 5 + 3);
+    assert!(html.contains("lt study equal-time --scale test --scene door"));
 
     if chromium().is_none() {
         let msg = "\n\n!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!\n\
@@ -324,12 +393,24 @@ fn report_page_loads_cleanly_in_chromium_and_the_check_can_fail() {
             "images that did not decode{fragment}: {}",
             check.json
         );
-        assert_eq!(check.images as usize, expected, "{}", check.json);
+        let shown = if fragment == "#exercise" {
+            expected + opened
+        } else {
+            expected
+        };
+        assert_eq!(check.images as usize, shown, "{}", check.json);
         if fragment == "#exercise" {
             assert!(
                 dom.contains("data-exercised=\"1\""),
                 "the exercise did not run"
             );
+            // box's row opened its gallery, door's says how to make it.
+            // (Counted on the rows: the page's CSS names the state too.)
+            let rows = |state: &str| {
+                dom.matches(&format!("<tr class=\"detail\" data-state=\"{state}\">"))
+                    .count()
+            };
+            assert_eq!((rows("shown"), rows("absent")), (1, 1), "{dom}");
         }
     }
 

@@ -20,13 +20,14 @@ pub fn run(args: &ReportArgs) -> Result<(), String> {
         let s = crate::report::slim::slim(&args.results)?;
         println!(
             "{} PNGs ({:.1} MB) now JPEG previews ({:.1} MB); {} crops moved to full/; \
-             {} charts re-encoded, {:.1} MB saved",
+             {} charts re-encoded, {:.1} MB saved; {} thumbnails made",
             s.previews,
             s.png_bytes as f64 / 1e6,
             s.jpeg_bytes as f64 / 1e6,
             s.crops,
             s.charts,
-            s.chart_bytes_saved as f64 / 1e6
+            s.chart_bytes_saved as f64 / 1e6,
+            s.thumbs
         );
     }
     let path = write_report(&args.results)?;

@@ -35,6 +35,10 @@ pub struct StudyArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// equal-time only: make the full-size galleries of this scene (repeatable), at the pass
+    /// counts the study's table records; the table and summary are left as they are.
+    #[arg(long)]
+    pub scene: Vec<String>,
     /// Test hook: fail after this many new renders, as an interruption would.
     #[arg(long, hide = true)]
     pub stop_after: Option<u64>,
@@ -77,11 +81,21 @@ impl StudyArgs {
 
 pub fn run(args: &StudyArgs) -> Result<(), String> {
     registry::resolve(&args.name)?;
+    if !args.scene.is_empty() && args.name != crate::study::equal_time::NAME {
+        return Err(format!(
+            "--scene applies to `lt study equal-time` only, not to `{}`",
+            args.name
+        ));
+    }
     let started = Instant::now();
     let setup = args.setup();
     let results = setup.results.clone();
     let ctx = StudyContext::new(&setup)?;
-    run_named(&args.name, &ctx)?;
+    if args.scene.is_empty() {
+        run_named(&args.name, &ctx)?;
+    } else {
+        crate::study::equal_time::regenerate(&ctx, &args.scene)?;
+    }
     let (built, reused) = ctx.counts();
     ctx.finish();
     if args.name == "all" {

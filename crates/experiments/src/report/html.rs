@@ -2,9 +2,11 @@
 //! file (`page.css`, `page.js`, `selfcheck.js`).
 
 use super::markdown;
+use super::overview;
 use super::StudyDir;
 use crate::manifest::{Crop, Figure, Gallery, GalleryImage, Manifest, Table};
 use std::fmt::Write;
+use std::path::Path;
 
 const CSS: &str = include_str!("page.css");
 const PAGE_JS: &str = include_str!("page.js");
@@ -13,14 +15,35 @@ const SELFCHECK_JS: &str = include_str!("selfcheck.js");
 /// The id of the hidden `<pre>` the self-check writes its JSON into.
 pub const SELFCHECK_ID: &str = "lt-selfcheck";
 
-/// How many `<img>` elements the page shows for one manifest (not counting images its summary's
-/// Markdown shows): one per figure; per gallery the wipe stage's two, the zoom's two, and one
-/// thumbnail each for the reference and every item.
-pub fn images_in_page(m: &Manifest) -> usize {
-    m.figures.len() + m.galleries.iter().map(|g| 5 + g.items.len()).sum::<usize>()
+/// How many `<img>` elements the page shows for the manifest `m` of study folder `dir` (not
+/// counting images its summary's Markdown shows): one per figure; per gallery the wipe stage's
+/// two, the zoom's two, and one thumbnail each for the reference and every item; the compact
+/// table's thumbnails (`overview`) instead of the galleries it opens on demand.
+pub fn images_in_page(m: &Manifest, dir: &Path) -> usize {
+    let shown: usize = m
+        .galleries
+        .iter()
+        .filter(|g| !overview::on_demand(m, g))
+        .map(|g| 5 + g.items.len())
+        .sum();
+    let table = match overview::of_study(dir, m) {
+        Some(Ok(o)) => overview::images(&o),
+        _ => 0,
+    };
+    m.figures.len() + shown + table
 }
 
-/// Every file a manifest names (relative to its study folder).
+/// The `<img>` elements the compact table's rows add once opened (`index.html#exercise` opens
+/// them all): the galleries of the scenes whose full-size images exist under `dir`.
+pub fn images_when_opened(m: &Manifest, dir: &Path) -> usize {
+    match overview::of_study(dir, m) {
+        Some(Ok(o)) => overview::images_when_opened(dir, m, &o),
+        _ => 0,
+    }
+}
+
+/// Every file a manifest names (relative to its study folder) that must be there: the full-size
+/// galleries the compact table opens on demand are left out.
 pub fn files_named(m: &Manifest) -> Vec<&str> {
     let mut out: Vec<&str> = Vec::new();
     if !m.summary.is_empty() {
@@ -35,7 +58,7 @@ pub fn files_named(m: &Manifest) -> Vec<&str> {
             out.push(&t.csv);
         }
     }
-    for g in &m.galleries {
+    for g in m.galleries.iter().filter(|g| !overview::on_demand(m, g)) {
         out.push(&g.reference.image);
         out.extend(g.items.iter().map(|i| i.image.as_str()));
     }
@@ -177,10 +200,16 @@ fn study(h: &mut String, s: &StudyDir) {
         esc(&m.title),
         esc(&m.scale)
     );
+    // The lecture's slides are no study: their manifests come from a script.
+    let made_by = if super::SLIDES.contains(&m.study.as_str()) {
+        super::SLIDES_SCRIPT.to_string()
+    } else {
+        format!("lt study {}", m.study)
+    };
     let _ = writeln!(
         h,
-        "<p class=\"meta\"><code>lt study {}</code> · folder <a href=\"{}\">{}/</a></p>",
-        esc(&m.study),
+        "<p class=\"meta\"><code>{}</code> · folder <a href=\"{}\">{}/</a></p>",
+        esc(&made_by),
         url(&s.folder, ""),
         esc(&s.folder)
     );
@@ -204,11 +233,27 @@ fn study(h: &mut String, s: &StudyDir) {
         }
         h.push_str("</div>\n");
     }
+    let compact = match &s.overview {
+        Some(Ok(o)) => Some(o),
+        Some(Err(e)) => {
+            let _ = writeln!(h, "<p class=\"warn\">{}</p>", esc(e));
+            None
+        }
+        None => None,
+    };
     for t in &m.tables {
-        table(h, &s.folder, t);
+        match compact {
+            // The compact table stands for the long one (its CSV is linked from it).
+            Some(o) if t.csv == crate::study::equal_time::GALLERIES_CSV => {
+                overview::write(h, &s.folder, &format!("g-{id}-scene"), m, o, &gallery);
+            }
+            _ => table(h, &s.folder, t),
+        }
     }
     for (i, g) in m.galleries.iter().enumerate() {
-        gallery(h, &s.folder, &format!("g-{id}-{i}"), g);
+        if compact.is_none() || !overview::on_demand(m, g) {
+            gallery(h, &s.folder, &format!("g-{id}-{i}"), g);
+        }
     }
     h.push_str("</section>\n");
 }

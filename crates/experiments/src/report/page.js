@@ -1,5 +1,6 @@
 // Galleries: wipe or flip between the reference and the selected estimate, and show the crop
-// (from the manifest, or the centre) enlarged for both. No network, no libraries.
+// (from the manifest, or the centre) enlarged for both; the compact table's rows open their
+// scene's galleries on demand. No network, no libraries.
 "use strict";
 (function () {
   function initGallery(g) {
@@ -222,10 +223,56 @@
   }
 
   var exercises = Array.prototype.map.call(document.querySelectorAll(".gallery"), initGallery);
-  window.ltExercise = function () {
-    exercises.forEach(function (f) {
-      f();
+
+  // The compact table's rows: a click shows the row's detail and, the first time, puts in its
+  // scene's full-size galleries if their reference loads (they are not committed); otherwise
+  // the detail's line says how to make them. Resolves once the row has settled.
+  function toggleRow(row) {
+    var detail = row.nextElementSibling;
+    var opening = detail.hidden;
+    detail.hidden = !opening;
+    row.setAttribute("aria-expanded", String(opening));
+    var tpl = detail.querySelector("template");
+    if (!opening || !tpl || detail.getAttribute("data-state")) return Promise.resolve();
+    detail.setAttribute("data-state", "probing");
+    return new Promise(function (resolve) {
+      var probe = new Image();
+      probe.onload = function () {
+        var box = detail.querySelector(".opened");
+        box.appendChild(tpl.content.cloneNode(true));
+        Array.prototype.forEach.call(box.querySelectorAll(".gallery"), function (g) {
+          exercises.push(initGallery(g));
+        });
+        detail.setAttribute("data-state", "shown");
+        resolve();
+      };
+      probe.onerror = function () {
+        detail.setAttribute("data-state", "absent");
+        resolve();
+      };
+      probe.src = tpl.getAttribute("data-probe");
     });
-    document.body.setAttribute("data-exercised", "1");
+  }
+  var rows = Array.prototype.slice.call(document.querySelectorAll("tr.scene"));
+  rows.forEach(function (row) {
+    row.addEventListener("click", function () {
+      toggleRow(row);
+    });
+    row.addEventListener("keydown", function (e) {
+      if (e.key === "Enter" || e.key === " ") {
+        e.preventDefault();
+        toggleRow(row);
+      }
+    });
+  });
+
+  // Every row opened, then every gallery's controls driven (index.html#exercise).
+  window.ltExercise = function () {
+    return Promise.all(rows.map(toggleRow)).then(function () {
+      exercises.forEach(function (f) {
+        f();
+      });
+      document.body.setAttribute("data-exercised", "1");
+    });
   };
 })();

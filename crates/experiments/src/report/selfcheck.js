@@ -65,8 +65,7 @@
       .then(function () {
         // index.html#exercise: drive the galleries' controls, then wait for what they load.
         if (location.hash === "#exercise" && window.ltExercise) {
-          window.ltExercise();
-          return allSettled();
+          return Promise.resolve(window.ltExercise()).then(allSettled);
         }
       })
       .catch(function (e) {

@@ -26,6 +26,8 @@ pub struct Slimmed {
     /// Charts re-encoded smaller (lossless), and the bytes that saved.
     pub charts: usize,
     pub chart_bytes_saved: u64,
+    /// Thumbnails of the equal-time study's compact table made from its full-size previews.
+    pub thumbs: usize,
 }
 
 /// Slims every study folder of `results` (see the module docs).
@@ -46,6 +48,7 @@ pub fn slim(results: &Path) -> Result<Slimmed, String> {
     for dir in dirs {
         if dir.join(MANIFEST_FILE).is_file() {
             slim_manifest(&dir, &mut done)?;
+            thumbs_from_previews(&dir, &mut done)?;
         }
         for md in markdown_files(&dir)? {
             slim_markdown(&dir, &md, &mut done)?;
@@ -113,6 +116,42 @@ fn slim_manifest(dir: &Path, done: &mut Slimmed) -> Result<(), String> {
     }
     if changed {
         m.write(dir)?;
+    }
+    Ok(())
+}
+
+/// The compact table's thumbnails (`equal_time::thumb`: every scene's reference and equal-time
+/// images), made from the full-size previews where they are missing: what moves a folder
+/// written before the table to it, so its previews need not be committed.
+fn thumbs_from_previews(dir: &Path, done: &mut Slimmed) -> Result<(), String> {
+    use crate::study::equal_time::{thumb, write_thumb};
+    let m = Manifest::read(dir)?;
+    for g in m
+        .galleries
+        .iter()
+        .filter(|g| super::overview::on_demand(&m, g))
+    {
+        for image in std::iter::once(&g.reference).chain(&g.items) {
+            let rel = Path::new(&image.image);
+            let (Some(scene), Some(what)) = (
+                rel.parent()
+                    .and_then(|p| p.file_name())
+                    .and_then(|s| s.to_str()),
+                rel.file_stem().and_then(|s| s.to_str()),
+            ) else {
+                continue;
+            };
+            let out = dir.join(thumb(scene, what));
+            let wanted = what == "reference" || what.starts_with("time-");
+            if !wanted || out.is_file() || !dir.join(rel).is_file() {
+                continue;
+            }
+            let rgb = image::open(dir.join(rel))
+                .map_err(|e| format!("cannot read {}: {e}", dir.join(rel).display()))?
+                .into_rgb8();
+            write_thumb(&out, &rgb)?;
+            done.thumbs += 1;
+        }
     }
     Ok(())
 }

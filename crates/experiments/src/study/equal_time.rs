@@ -8,16 +8,74 @@
 //! depend on those pass counts only, which the table records; the timings behind them vary from
 //! machine to machine, as any equal-time comparison does. Time is the CPU time of the render's
 //! threads (`cpu_clock`), so other work on a shared machine does not change the budgets.
+//!
+//! What is committed: the table (`GALLERIES_CSV`) and one small thumbnail per scene and
+//! integrator at equal time (`thumb`), which the report shows as one compact table. The
+//! full-size galleries (`gallery/<scene>/`) are git-ignored and made on demand, scene by scene,
+//! at the pass counts the table records (`regenerate`: `lt study equal-time --scene X`).
 
 use super::convergence::{self, integrators};
-use super::metrics::mse;
+use super::metrics::{mse, rel_mse};
 use super::output::{film, num, stem, StudyOutput};
+use super::reference::Reference;
 use super::{Scale, StudyContext};
-use crate::gallery::{write_gallery, Entry};
+use crate::gallery::{write_gallery, write_jpeg, Entry};
+use crate::manifest::{Gallery, Manifest};
 use crate::runs::RunSpec;
 use std::path::{Path, PathBuf};
 
 pub const NAME: &str = "equal-time";
+
+/// The study's table of every scene, comparison and integrator (what the report's compact
+/// table reads).
+pub const GALLERIES_CSV: &str = "galleries.csv";
+
+/// The comparisons of a scene's galleries: (file-name mode, the table's "comparison").
+pub const MODES: [(&str, &str); 2] = [("spp", "equal samples"), ("time", "equal time")];
+
+/// Width in pixels of the committed thumbnails (the height keeps the aspect ratio).
+pub const THUMB_WIDTH: u32 = 80;
+
+/// The committed thumbnail of `scene`'s image `what` ("reference", or "<mode>-<integrator>"),
+/// relative to the study folder.
+pub fn thumb(scene: &str, what: &str) -> String {
+    format!("thumbs/{scene}/{what}.jpg")
+}
+
+/// The full-size gallery folder of `scene` (relative to the study folder; git-ignored).
+pub fn gallery_dir(scene: &str) -> String {
+    format!("gallery/{scene}")
+}
+
+/// The command that makes `scene`'s full-size galleries at `scale` (`regenerate`); Bitterli's
+/// scenes need their integrator defined, as the study does.
+pub fn regenerate_command(scale: &str, scene: &str) -> String {
+    let define = if scale == "bitterli" {
+        "-D integrator=path "
+    } else {
+        ""
+    };
+    format!("lt {define}study equal-time --scale {scale} --scene {scene}")
+}
+
+/// Writes an 8-bit sRGB image shrunk to `THUMB_WIDTH` (area-averaged in sRGB values, which at
+/// this size no reader tells from averaging radiance) as a JPEG preview.
+pub fn write_thumb(path: &Path, rgb: &image::RgbImage) -> Result<(), String> {
+    let (w, h) = rgb.dimensions();
+    let tw = THUMB_WIDTH.min(w.max(1));
+    let th = ((h as f64 * tw as f64 / w.max(1) as f64).round() as u32).max(1);
+    write_jpeg(path, &image::imageops::thumbnail(rgb, tw, th))
+}
+
+fn srgb8(img: &lt_estimators::Image) -> image::RgbImage {
+    let bytes: Vec<u8> = img
+        .data
+        .iter()
+        .flat_map(|p| p.map(|v| (crate::image_io::srgb_encode(v) * 255.0).round() as u8))
+        .collect();
+    image::RgbImage::from_raw(img.width as u32, img.height as u32, bytes)
+        .expect("buffer matches size")
+}
 
 /// Veach's comparison: (label, pt parameters).
 pub const VEACH: [(&str, &[(&str, &str)]); 4] = [
@@ -148,63 +206,29 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
     let before = ctx.spent();
     let mut rows = Vec::new();
     for scene in &scale.scenes {
-        let name = stem(scene);
-        let reference = ctx.reference_at(scale, scene, None)?;
         let budget_passes = equal_time_passes(ctx, scene)?;
-        for (mode, title) in [("spp", "equal samples"), ("time", "equal time")] {
-            let mut images = Vec::new();
-            for &(i, n, budget) in &budget_passes {
-                let spec = match mode {
-                    "spp" => convergence::spec(scale, scene, i, 0),
-                    _ => RunSpec::new(scene, i, 1, n).resolution(film(scale, scene).ok()),
-                };
-                let e = ctx.run(&spec)?;
-                let img = e.image()?;
-                let m = mse(&img, &reference);
-                let passes = spec.passes;
-                rows.push(vec![
-                    name.clone(),
-                    title.to_string(),
-                    i.to_string(),
-                    passes.to_string(),
-                    format!("{:.3}", e.cpu_seconds_at(passes).unwrap_or(f64::NAN)),
-                    format!("{budget:.3}"),
-                    format!(
-                        "{:.3}",
-                        e.record.seconds.last().copied().unwrap_or(f64::NAN)
-                    ),
-                    num(m),
-                ]);
-                images.push((i, img, format!("{passes} spp, MSE {}", num(m))));
-            }
-            let entries: Vec<Entry> = images
-                .iter()
-                .map(|(i, img, note)| Entry {
-                    label: i,
-                    note: note.clone(),
-                    image: img,
-                    stem: format!("gallery/{name}/{mode}-{i}"),
+        let plan: Vec<(&str, &str, u32, f64)> = MODES
+            .iter()
+            .flat_map(|&(mode, _)| {
+                budget_passes.iter().map(move |&(i, n, budget)| {
+                    (
+                        mode,
+                        i,
+                        if mode == "spp" { scale.max_passes } else { n },
+                        budget,
+                    )
                 })
-                .collect();
-            let g = write_gallery(
-                &out.dir,
-                &format!("{name}, {title}"),
-                &format!(
-                    "Reference: {} × {} passes of {}.",
-                    reference.runs, reference.passes, reference.integrator
-                ),
-                &reference.gallery_entry(format!("gallery/{name}/reference")),
-                &entries,
-                Some((scale.width / 4).max(4)),
-            )?;
-            out.manifest.galleries.push(g);
-        }
+            })
+            .collect();
+        let (scene_rows, galleries) = scene_galleries(ctx, scale, &out.dir, scene, &plan, true)?;
+        rows.extend(scene_rows);
+        out.manifest.galleries.extend(galleries);
     }
     out.table(
         "galleries",
         "Equal samples and equal time",
         "Passes, CPU seconds actually taken, the CPU-time budget, wall seconds (which count \
-         other work on the machine), and MSE per scene and integrator.",
+         other work on the machine), MSE and relMSE per scene and integrator (one run, seed 1).",
         &[
             "scene",
             "comparison",
@@ -214,9 +238,11 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             "budget CPU s",
             "wall s",
             "MSE",
+            "relMSE",
         ],
         rows,
-        true,
+        // The report shows it as one compact table; the CSV holds every row.
+        false,
     )?;
     tungsten_table(ctx, scale, &mut out)?;
     if let Some(vs) = veach_scene(scale) {
@@ -241,7 +267,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
                 label: l,
                 note: note.clone(),
                 image: img,
-                stem: format!("gallery/veach-mis/{k}"),
+                stem: format!("mis/{k}"),
             })
             .collect();
         let g = write_gallery(
@@ -254,7 +280,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
                 label: "reference",
                 note: reference.integrator.clone(),
                 image: &reference.image,
-                stem: "gallery/veach-mis/reference".into(),
+                stem: "mis/reference".into(),
             },
             &entries,
             Some((scale.width / 4).max(4)),
@@ -271,6 +297,204 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
     }
     out.para(&ctx.compute_note(before));
     out.finish()
+}
+
+/// One scene's galleries (one per comparison of `plan`, in `MODES` order) and its table rows:
+/// `plan` holds (mode, integrator, passes, budget CPU s). Writes the full-size previews under
+/// `gallery_dir` and, when `thumbs`, the equal-time thumbnails (`thumb`).
+fn scene_galleries(
+    ctx: &StudyContext,
+    scale: &Scale,
+    dir: &Path,
+    scene: &Path,
+    plan: &[(&str, &str, u32, f64)],
+    thumbs: bool,
+) -> Result<(Vec<Vec<String>>, Vec<Gallery>), String> {
+    let name = stem(scene);
+    let reference = ctx.reference_at(scale, scene, None)?;
+    if thumbs {
+        write_thumb(
+            &dir.join(thumb(&name, "reference")),
+            &srgb8(&reference.image),
+        )?;
+    }
+    let mut rows = Vec::new();
+    let mut galleries = Vec::new();
+    for (mode, title) in MODES {
+        let mut images = Vec::new();
+        for &(_, i, passes, budget) in plan.iter().filter(|p| p.0 == mode) {
+            let spec = match mode {
+                "spp" => convergence::spec(scale, &scene.to_path_buf(), i, 0),
+                _ => RunSpec::new(scene, i, 1, passes).resolution(film(scale, scene).ok()),
+            };
+            let e = ctx.run(&spec)?;
+            let img = e.image()?;
+            let m = mse(&img, &reference);
+            if thumbs && mode == "time" {
+                write_thumb(
+                    &dir.join(thumb(&name, &format!("{mode}-{i}"))),
+                    &srgb8(&img),
+                )?;
+            }
+            rows.push(vec![
+                name.clone(),
+                title.to_string(),
+                i.to_string(),
+                spec.passes.to_string(),
+                format!("{:.3}", e.cpu_seconds_at(spec.passes).unwrap_or(f64::NAN)),
+                format!("{budget:.3}"),
+                format!(
+                    "{:.3}",
+                    e.record.seconds.last().copied().unwrap_or(f64::NAN)
+                ),
+                num(m),
+                num(rel_mse(&img, &reference)),
+            ]);
+            images.push((i, img, format!("{} spp, MSE {}", spec.passes, num(m))));
+        }
+        galleries.push(scene_gallery(
+            dir, scale, &name, mode, title, &reference, &images,
+        )?);
+    }
+    Ok((rows, galleries))
+}
+
+fn scene_gallery(
+    dir: &Path,
+    scale: &Scale,
+    name: &str,
+    mode: &str,
+    title: &str,
+    reference: &Reference,
+    images: &[(&str, lt_estimators::Image, String)],
+) -> Result<Gallery, String> {
+    let folder = gallery_dir(name);
+    let entries: Vec<Entry> = images
+        .iter()
+        .map(|(i, img, note)| Entry {
+            label: i,
+            note: note.clone(),
+            image: img,
+            stem: format!("{folder}/{mode}-{i}"),
+        })
+        .collect();
+    write_gallery(
+        dir,
+        &format!("{name}, {title}"),
+        &format!(
+            "Reference: {} × {} passes of {}.",
+            reference.runs, reference.passes, reference.integrator
+        ),
+        &reference.gallery_entry(format!("{folder}/reference")),
+        &entries,
+        Some((scale.width / 4).max(4)),
+    )
+}
+
+/// `lt study equal-time --scene X …`: the full-size galleries of the named scenes, rendered at
+/// the pass counts the study's table records, so the images are the ones its numbers describe
+/// whatever this machine's timings. The table, summary, manifest and committed thumbnails are
+/// left as they are; the renders go through the cache.
+pub fn regenerate(ctx: &StudyContext, scenes: &[String]) -> Result<(), String> {
+    let scale = &ctx.scale.gallery();
+    let dir = ctx.study_dir(NAME);
+    let manifest = Manifest::read(&dir)?;
+    let table = manifest
+        .tables
+        .iter()
+        .find(|t| t.csv == GALLERIES_CSV)
+        .ok_or_else(|| {
+            format!(
+                "{}: no table {GALLERIES_CSV}: run the whole study first",
+                dir.join(crate::manifest::MANIFEST_FILE).display()
+            )
+        })?;
+    let col = |c: &str| {
+        table.columns.iter().position(|x| x == c).ok_or_else(|| {
+            format!(
+                "{}: table {GALLERIES_CSV} has no column `{c}`",
+                dir.display()
+            )
+        })
+    };
+    let (cs, cc, ci, cp, cb) = (
+        col("scene")?,
+        col("comparison")?,
+        col("integrator")?,
+        col("passes")?,
+        // Tables written before budgets were CPU time call it "budget s".
+        col("budget CPU s").or_else(|_| col("budget s"))?,
+    );
+    for wanted in scenes {
+        let scene = scale
+            .scenes
+            .iter()
+            .find(|p| stem(p) == *wanted)
+            .ok_or_else(|| {
+                let known: Vec<String> = scale.scenes.iter().map(|p| stem(p)).collect();
+                format!(
+                    "--scene {wanted}: not a scene of the {} scale's galleries ({})",
+                    scale.name,
+                    known.join(", ")
+                )
+            })?;
+        let mut plan = Vec::new();
+        for (k, r) in table.rows.iter().enumerate() {
+            if r.get(cs) != Some(wanted) {
+                continue;
+            }
+            let cell = |c: usize| r.get(c).map(String::as_str).unwrap_or("");
+            let Some(&(mode, _)) = MODES.iter().find(|(_, t)| *t == cell(cc)) else {
+                continue;
+            };
+            let Some(&i) = integrators().iter().find(|i| **i == cell(ci)) else {
+                return Err(format!(
+                    "{}: {GALLERIES_CSV} row {}: unknown integrator `{}`",
+                    dir.display(),
+                    k + 2,
+                    cell(ci)
+                ));
+            };
+            let number = |c: usize| {
+                cell(c).parse::<f64>().map_err(|_| {
+                    format!(
+                        "{}: {GALLERIES_CSV} row {}: `{}` is no number",
+                        dir.display(),
+                        k + 2,
+                        cell(c)
+                    )
+                })
+            };
+            plan.push((mode, i, number(cp)? as u32, number(cb)?));
+        }
+        if plan.is_empty() {
+            return Err(format!(
+                "{}: {GALLERIES_CSV} has no rows for {wanted}: run the whole study first",
+                dir.display()
+            ));
+        }
+        let (rows, _) = scene_galleries(ctx, scale, &dir, scene, &plan, false)?;
+        // The images are the table's when their MSE is (the code that renders them may have
+        // changed since the table was written): say how many agree.
+        let mse = table.columns.iter().position(|c| c == "MSE");
+        let key = |r: &[String]| (r[0].clone(), r[1].clone(), r[2].clone());
+        let agree = rows
+            .iter()
+            .filter(|r| {
+                table
+                    .rows
+                    .iter()
+                    .any(|t| key(t) == key(r) && mse.is_some_and(|m| t.get(m) == r.get(7)))
+            })
+            .count();
+        eprintln!(
+            "{wanted}: full-size galleries written to {}; MSE as the table has it for {agree} \
+             of {} images (the others were rendered by different code)",
+            dir.join(gallery_dir(wanted)).display(),
+            rows.len()
+        );
+    }
+    Ok(())
 }
 
 /// Tungsten's render of one of Bitterli's scenes, when there is one: `TungstenRender.exr` beside
