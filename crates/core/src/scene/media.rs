@@ -37,6 +37,7 @@
 //! panes; the two techniques estimate the same and MIS pairs them from the last real vertex.
 //! Surface scenes (no media) walk a pane as a delta vertex, as Mitsuba's `path` does.
 
+use super::hit::BoundaryHit;
 use super::SurfaceHit;
 use super::{ConnectionEnd, Scene};
 use crate::bsdf::Material;
@@ -374,16 +375,20 @@ impl Scene {
             if !(t_max > 0.0) {
                 return Some(found);
             }
-            let Some(hit) = self.intersect(&Ray {
+            let ray = Ray {
                 o: origin,
                 d: dir,
                 t_max,
-            }) else {
+            };
+            super::ray_stats::count_closest();
+            let Some(prim_hit) = self.accel.intersect(&ray) else {
                 return Some(found);
             };
+            // The crossing's point and normal only; a pane's pass needs its shading normal too.
+            let hit = BoundaryHit::new(self, &ray, prim_hit);
             let pane = if panes && self.has_null_transmission(hit.material) {
                 // Seen along the walk's direction: |cos| is the same both ways.
-                self.pane_passed(&hit, dir)
+                self.pane_passed(&SurfaceHit::new(self, &ray, prim_hit), dir)
             } else {
                 PanesPassed::NONE
             };
