@@ -36,100 +36,171 @@ pub struct SurfaceHit {
     pub interface: u16,
 }
 
+/// Where a ray met primitive `h.prim`: the point, its error bound, the geometric normal (before
+/// `flip_normals`), and — when `SHADE` — the shading normal and uv (else `ng` and zero). The first
+/// stage of `SurfaceHit::new` (`SHADE`) and all of `BoundaryHit::new` (not): one computation, so a
+/// boundary crossing and a full hit of the same ray agree bit for bit.
+#[inline(always)]
+fn locate<const SHADE: bool>(scene: &Scene, ray: &Ray, h: PrimHit) -> Located {
+    let prim = scene.accel.primitive(h.prim);
+    let shape = &scene.shapes[prim.shape() as usize];
+    // `tri`: the mesh triangle holding the point (a parallelogram's source triangle).
+    // `analytic`: a disk's or cylinder's own ∂p/∂u, ∂p/∂v.
+    let mut analytic = None;
+    let (p, p_err, ng, ns, uv, tri, bary) = match *prim {
+        Primitive::Triangle {
+            p: [p0, p1, p2],
+            index,
+            ..
+        } => {
+            let sheared = ShearedRay::new(ray.o, ray.d);
+            let (_, [b0, b1, b2]) = intersect_triangle(&sheared, f32::INFINITY, &[p0, p1, p2]);
+            let p = b0 * p0 + b1 * p1 + b2 * p2;
+            let err = barycentric_error([b0, b1, b2], [p0, p1, p2]);
+            let ng = (p1 - p0).cross(p2 - p0).normalize();
+            let (ns, uv) = match &shape.geometry {
+                ShapeGeometry::Mesh(m) if SHADE => (
+                    m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng),
+                    if shape.reads_uv {
+                        m.uv(index as usize, b0, b1, b2)
+                    } else {
+                        Vec2::ZERO
+                    },
+                ),
+                _ => (ng, Vec2::ZERO),
+            };
+            (p, err, ng, ns, uv, index, [b0, b1, b2])
+        }
+        Primitive::Quad { q, index, .. } => {
+            let (p, err, u, v) = q.hit_point(ray.o, ray.d, h.t);
+            let ng = q.e1.cross(q.e2).normalize();
+            // Which of the two source triangles holds (u, v), with its barycentrics.
+            let (tri, b) = if u >= v {
+                (index, [1.0 - u, u - v, v])
+            } else {
+                (index + 1, [1.0 - v, u, v - u])
+            };
+            let (ns, uv) = match &shape.geometry {
+                ShapeGeometry::Mesh(m) if SHADE => (
+                    m.shading_normal(tri as usize, b[0], b[1], b[2])
+                        .unwrap_or(ng),
+                    if shape.reads_uv {
+                        m.uv(tri as usize, b[0], b[1], b[2])
+                    } else {
+                        Vec2::ZERO
+                    },
+                ),
+                _ => (ng, Vec2::ZERO),
+            };
+            (p, err, ng, ns, uv, tri, b)
+        }
+        Primitive::Sphere { center, radius, .. } => {
+            let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
+            let n = (p - center).normalize();
+            let uv = if SHADE && shape.reads_uv {
+                crate::shape::sphere_uv(shape.geometry.sphere_to_object() * n)
+            } else {
+                Vec2::ZERO
+            };
+            (p, err, n, n, uv, 0, [1.0, 0.0, 0.0])
+        }
+        Primitive::Disk { to_object, .. } | Primitive::Cylinder { to_object, .. } => {
+            let local = to_object.point(ray.at(h.t));
+            let q = match shape.geometry {
+                ShapeGeometry::Disk { to_world } => disk_at(local, &to_world, &to_object),
+                ShapeGeometry::Cylinder { to_world } => cylinder_at(local, &to_world),
+                _ => unreachable!("a disk or cylinder primitive of another shape"),
+            };
+            analytic = Some((q.dpdu, q.dpdv));
+            (q.p, q.p_err, q.n, q.n, q.uv, 0, [1.0, 0.0, 0.0])
+        }
+        Primitive::SdfVoxel { ref voxel, .. } => {
+            let ShapeGeometry::SdfGrid { grid, to_world } = &shape.geometry else {
+                unreachable!("an sdf voxel of another shape")
+            };
+            let (p, p_err) = sdf_hit_point(ray, h.t, voxel, to_world);
+            let to_object = to_world.inverse();
+            let local = to_object.point(p);
+            // Normals transform by the inverse transpose of to_world: to_object's transpose.
+            let normal = |g: Vec3| (to_object.m.transpose() * g).normalize_or_zero();
+            let ng = normal(grid.gradient(local));
+            let ng = if ng == Vec3::ZERO { -ray.d } else { ng };
+            let ns = if SHADE && grid.smooth {
+                normal(grid.smooth_normal(local))
+            } else {
+                ng
+            };
+            let ns = if ns == Vec3::ZERO { ng } else { ns };
+            (p, p_err, ng, ns, Vec2::ZERO, 0, [1.0, 0.0, 0.0])
+        }
+    };
+    Located {
+        p,
+        p_err,
+        ng,
+        ns,
+        uv,
+        tri,
+        bary,
+        analytic,
+    }
+}
+
+/// `locate`'s answer.
+struct Located {
+    p: Vec3,
+    p_err: Vec3,
+    ng: Vec3,
+    ns: Vec3,
+    uv: Vec2,
+    tri: u32,
+    bary: [f32; 3],
+    /// A disk's or cylinder's own ∂p/∂u, ∂p/∂v.
+    analytic: Option<(Vec3, Vec3)>,
+}
+
+/// What a walk along a segment needs of a surface it crosses (`Scene::crossings`): no shading
+/// normal, uv or tangent, which a full `SurfaceHit` spends most of its time on.
+#[derive(Clone, Copy, Debug)]
+pub struct BoundaryHit {
+    pub p: Vec3,
+    pub p_err: Vec3,
+    /// Geometric normal, unit, on the shape's outside (after `flip_normals`): `SurfaceHit::ng`.
+    pub ng: Vec3,
+    pub shape: u32,
+    pub material: u32,
+}
+
+impl BoundaryHit {
+    #[inline]
+    pub(crate) fn new(scene: &Scene, ray: &Ray, h: PrimHit) -> BoundaryHit {
+        let l = locate::<false>(scene, ray, h);
+        let shape_id = scene.accel.primitive(h.prim).shape();
+        let shape = &scene.shapes[shape_id as usize];
+        BoundaryHit {
+            p: l.p,
+            p_err: l.p_err,
+            ng: if shape.flip_normals { -l.ng } else { l.ng },
+            shape: shape_id,
+            material: shape.material,
+        }
+    }
+}
+
 impl SurfaceHit {
     pub(crate) fn new(scene: &Scene, ray: &Ray, h: PrimHit) -> SurfaceHit {
         let prim = scene.accel.primitive(h.prim);
         let shape = &scene.shapes[prim.shape() as usize];
-        // `tri`: the mesh triangle holding the point (a parallelogram's source triangle).
-        // `analytic`: a disk's or cylinder's own ∂p/∂u, ∂p/∂v.
-        let mut analytic = None;
-        let (p, p_err, mut ng, mut ns, uv, tri, bary) = match *prim {
-            Primitive::Triangle {
-                p: [p0, p1, p2],
-                index,
-                ..
-            } => {
-                let sheared = ShearedRay::new(ray.o, ray.d);
-                let (_, [b0, b1, b2]) = intersect_triangle(&sheared, f32::INFINITY, &[p0, p1, p2]);
-                let p = b0 * p0 + b1 * p1 + b2 * p2;
-                let err = barycentric_error([b0, b1, b2], [p0, p1, p2]);
-                let ng = (p1 - p0).cross(p2 - p0).normalize();
-                let (ns, uv) = match &shape.geometry {
-                    ShapeGeometry::Mesh(m) => (
-                        m.shading_normal(index as usize, b0, b1, b2).unwrap_or(ng),
-                        if shape.reads_uv {
-                            m.uv(index as usize, b0, b1, b2)
-                        } else {
-                            Vec2::ZERO
-                        },
-                    ),
-                    _ => (ng, Vec2::ZERO),
-                };
-                (p, err, ng, ns, uv, index, [b0, b1, b2])
-            }
-            Primitive::Quad { q, index, .. } => {
-                let (p, err, u, v) = q.hit_point(ray.o, ray.d, h.t);
-                let ng = q.e1.cross(q.e2).normalize();
-                // Which of the two source triangles holds (u, v), with its barycentrics.
-                let (tri, b) = if u >= v {
-                    (index, [1.0 - u, u - v, v])
-                } else {
-                    (index + 1, [1.0 - v, u, v - u])
-                };
-                let (ns, uv) = match &shape.geometry {
-                    ShapeGeometry::Mesh(m) => (
-                        m.shading_normal(tri as usize, b[0], b[1], b[2])
-                            .unwrap_or(ng),
-                        if shape.reads_uv {
-                            m.uv(tri as usize, b[0], b[1], b[2])
-                        } else {
-                            Vec2::ZERO
-                        },
-                    ),
-                    _ => (ng, Vec2::ZERO),
-                };
-                (p, err, ng, ns, uv, tri, b)
-            }
-            Primitive::Sphere { center, radius, .. } => {
-                let (p, err) = refine_sphere_hit(ray.at(h.t), center, radius);
-                let n = (p - center).normalize();
-                let uv = if shape.reads_uv {
-                    crate::shape::sphere_uv(shape.geometry.sphere_to_object() * n)
-                } else {
-                    Vec2::ZERO
-                };
-                (p, err, n, n, uv, 0, [1.0, 0.0, 0.0])
-            }
-            Primitive::Disk { to_object, .. } | Primitive::Cylinder { to_object, .. } => {
-                let local = to_object.point(ray.at(h.t));
-                let q = match shape.geometry {
-                    ShapeGeometry::Disk { to_world } => disk_at(local, &to_world, &to_object),
-                    ShapeGeometry::Cylinder { to_world } => cylinder_at(local, &to_world),
-                    _ => unreachable!("a disk or cylinder primitive of another shape"),
-                };
-                analytic = Some((q.dpdu, q.dpdv));
-                (q.p, q.p_err, q.n, q.n, q.uv, 0, [1.0, 0.0, 0.0])
-            }
-            Primitive::SdfVoxel { ref voxel, .. } => {
-                let ShapeGeometry::SdfGrid { grid, to_world } = &shape.geometry else {
-                    unreachable!("an sdf voxel of another shape")
-                };
-                let (p, p_err) = sdf_hit_point(ray, h.t, voxel, to_world);
-                let to_object = to_world.inverse();
-                let local = to_object.point(p);
-                // Normals transform by the inverse transpose of to_world: to_object's transpose.
-                let normal = |g: Vec3| (to_object.m.transpose() * g).normalize_or_zero();
-                let ng = normal(grid.gradient(local));
-                let ng = if ng == Vec3::ZERO { -ray.d } else { ng };
-                let ns = if grid.smooth {
-                    normal(grid.smooth_normal(local))
-                } else {
-                    ng
-                };
-                let ns = if ns == Vec3::ZERO { ng } else { ns };
-                (p, p_err, ng, ns, Vec2::ZERO, 0, [1.0, 0.0, 0.0])
-            }
-        };
+        let Located {
+            p,
+            p_err,
+            mut ng,
+            mut ns,
+            uv,
+            tri,
+            bary,
+            analytic,
+        } = locate::<true>(scene, ray, h);
         let uv = TexPoint {
             uv,
             attr: match (shape.attribute, &shape.geometry) {
