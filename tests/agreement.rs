@@ -730,8 +730,8 @@ const MEDIA_PASSES: [(&str, u32); 9] = [
     ("pb2d", 32),
     ("bb1d", 32),
     // pp3d's camera walk with bb1d's photon beams, each held at 32 passes above and by
-    // tests/points_beams.rs: 4 passes check its beams on every media scene for ≈ 1 CPU s.
-    ("bp2d", 4),
+    // tests/points_beams.rs: 8 passes check its beams on every media scene for ≈ 2 CPU s.
+    ("bp2d", 8),
     // Its merges query every photon of the pass: 4 passes keep it near 0.5 CPU s per scene
     // (results/points-beams.md, "upbp").
     ("upbp", 4),
