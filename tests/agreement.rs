@@ -720,7 +720,7 @@ const MEDIA_RESOLUTION: u32 = 24;
 
 /// Passes per media integrator (the reference `pt` first); one that joins `HANDLES_MEDIA`
 /// without a row here renders `MEDIA_DEFAULT_PASSES`.
-const MEDIA_PASSES: [(&str, u32); 8] = [
+const MEDIA_PASSES: [(&str, u32); 9] = [
     ("pt", 1024),
     ("pt-bsdf", 1024),
     ("light", 512),
@@ -729,6 +729,9 @@ const MEDIA_PASSES: [(&str, u32); 8] = [
     ("pp3d", 32),
     ("pb2d", 32),
     ("bb1d", 32),
+    // pp3d's camera walk with bb1d's photon beams, each held at 32 passes above and by
+    // tests/points_beams.rs: 8 passes check its beams on every media scene for ≈ 2 CPU s.
+    ("bp2d", 8),
     // Its merges query every photon of the pass: 4 passes keep it near 0.5 CPU s per scene
     // (results/points-beams.md, "upbp").
     ("upbp", 4),

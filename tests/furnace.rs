@@ -301,6 +301,11 @@ const MEDIUM_FURNACE_EXCLUDED: &[(&str, &str)] = &[
          (bias there); tests/points_beams.rs holds it to pt",
     ),
     (
+        "bp2d",
+        "as pp3d, with photon beams and the 2-D kernel: the kernel straddles the ball's boundary \
+         (bias there); tests/points_beams.rs holds it to pt",
+    ),
+    (
         "upbp",
         "its PP3D and PB2D kernels straddle the ball's boundary (bias there, as pp3d's and \
          pb2d's); agreement.rs holds it to pt on every media scene and tests/mis_check_upbp.rs \

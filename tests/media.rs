@@ -122,6 +122,7 @@ const FURNACE_EXCLUDED: &[(&str, &str)] = &[
         "bb1d",
         "as pp3d, with the 1-D kernel across photon and camera beams",
     ),
+    ("bp2d", "as pp3d, with the 2-D kernel across photon beams"),
     (
         "upbp",
         "as pp3d and pb2d, whose kernels it runs beside bdpt's connections",
@@ -276,7 +277,7 @@ fn agreement_passes(name: &str, glass: bool) -> Option<u32> {
         "bdpt" => Some(32),
         // Their kernels need ~10⁴ photon paths per pass to be judged by runs' spread: held to pt
         // on every shipped media scene by agreement.rs and tests/points_beams.rs instead.
-        "pp3d" | "pb2d" | "bb1d" => None,
+        "pp3d" | "pb2d" | "bb1d" | "bp2d" => None,
         // Consistent as they are: held to pt on every shipped media scene by agreement.rs
         // (runs' spread), its weights by tests/mis_check_upbp.rs.
         "upbp" => None,

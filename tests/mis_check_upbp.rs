@@ -1,8 +1,9 @@
-//! `lt mis-check --integrator upbp` as a test: on every shipped media scene, upbp's weights
-//! (connections, PP3D, PB2D and BB1D under one MIS; power and balance) agree with the
-//! from-scratch oracle (`lt_core::path::volume_merging`) and its own routine's weights over a
-//! path's techniques sum to one. Plus proof that the check fails on a merge density off by 1 %
-//! (PB2D's, BB1D's) and on a technique missing from the sum.
+//! `lt mis-check --integrator upbp` as a test: on every shipped media scene and on two surface
+//! scenes, upbp's weights (connections, surface merges, PP3D, PB2D and BB1D under one MIS; power
+//! and balance) agree with the from-scratch oracle (`lt_core::path::volume_merging`) and its own
+//! routine's weights over a path's techniques sum to one. Plus proof that the check fails on a
+//! merge density off by 1 % (PB2D's, BB1D's, the surface merges') and on a technique missing
+//! from the sum.
 
 use lt_core::path::Heuristic;
 use lt_experiments::verify::mis_check::upbp::{
@@ -91,6 +92,42 @@ fn a_planted_merge_density_error_fails() {
     }
     let (report, summary) = check_records(&scene, &missing, &opts, counts, "hg-spot");
     println!("PP3D missing:\n{summary}");
+    assert!(
+        report.failures() > report.checked() / 4,
+        "{report}{summary}"
+    );
+}
+
+/// Without media upbp is vcm's technique set (connections and surface merges): its weights on
+/// cornell-box (diffuse) and caustic-sds (specular chains) against the oracle, both heuristics,
+/// and the check failing on cornell-box with the surface merges' density ×1.01 in the oracle.
+#[test]
+fn upbp_surface_merges_match_the_oracle_and_a_planted_error_fails() {
+    let mut failed = Vec::new();
+    for h in [Heuristic::Power, Heuristic::Balance] {
+        for name in ["cornell-box", "caustic-sds"] {
+            let mut scene = shipped_scene(name, None);
+            let opts = options(&scene, h);
+            let (report, summary) = check_scene(&mut scene, &opts, name).unwrap();
+            println!("{name} {h:?}:\n{summary}");
+            assert!(report.merges() > 0, "{name}: no merged paths\n{report}");
+            if !report.passed() {
+                failed.push(format!("{report}{summary}"));
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+    let mut scene = shipped_scene("cornell-box", None);
+    let opts = options(&scene, Heuristic::Power);
+    prepare_scene(&mut scene, &opts);
+    let (c, passes) = collect(&scene, &opts).unwrap();
+    let counts = (passes, c.counts.too_long);
+    let mut planted = c.records;
+    for r in &mut planted {
+        r.set.as_mut().unwrap().surface_eta *= 1.01;
+    }
+    let (report, summary) = check_records(&scene, &planted, &opts, counts, "cornell-box");
+    println!("surface merges ×1.01:\n{summary}");
     assert!(
         report.failures() > report.checked() / 4,
         "{report}{summary}"

@@ -1,4 +1,4 @@
-//! The volumetric density estimators (`pp3d`, `pb2d`, `bb1d`: issue 45) agree with `pt` on shipped
+//! The volumetric density estimators (`pp3d`, `pb2d`, `bb1d`, `bp2d`: issue 45) agree with `pt` on shipped
 //! media scenes at their default radius (1 % of the scene's diameter, shrinking by the schedule),
 //! from 8,192 photon paths per pass (points) or BB1D_PHOTON_PATHS (beams).
 //!
@@ -18,10 +18,14 @@ use lt_tests::{render_blocks, shipped_scene};
 /// The scenes: their images are mostly medium-scattered light.
 const SCENES: [&str; 2] = ["media/hg-spot", "media/smallupbp-isosph"];
 /// (estimator, photon paths per pass).
-const ESTIMATORS: [(&str, u32); 3] = [
-    ("pp3d", PHOTON_PATHS),
-    ("pb2d", PHOTON_PATHS),
-    ("bb1d", BB1D_PHOTON_PATHS),
+/// (estimator, photon paths per pass, on `SCENES[0]` only).
+const ESTIMATORS: [(&str, u32, bool); 4] = [
+    ("pp3d", PHOTON_PATHS, false),
+    ("pb2d", PHOTON_PATHS, false),
+    ("bb1d", BB1D_PHOTON_PATHS, false),
+    // hg-spot only: its beams are the whole image there; smallupbp-isosph's image is mostly
+    // surface light that pt renders (a ×1.1 plant moves it by 2 %: see results/).
+    ("bp2d", BP2D_PHOTON_PATHS, true),
 ];
 const RESOLUTION: u32 = 16;
 const PT_PASSES: u32 = 2048;
@@ -32,12 +36,16 @@ const PHOTON_PATHS: u32 = 8192;
 /// A photon beam reaches every camera beam that crosses its flight, so far fewer light paths
 /// give bb1d a standard error below pb2d's (and its index grows with the beams' lengths).
 const BB1D_PHOTON_PATHS: u32 = 512;
+/// bp2d's photon beams reach every camera point within r of their flights, as bb1d's do: 256
+/// light paths give a 1.5–2 % standard error on hg-spot (a ×1.1 plant is 5σ) at ≈ 2.3 CPU s.
+const BP2D_PHOTON_PATHS: u32 = 256;
 /// The test's false-alarm rate, shared by all comparisons (Šidák).
 const ALPHA: f64 = 0.01;
 
 #[test]
 fn point_and_beam_estimates_agree_with_pt_on_media_scenes() {
-    let comparisons = (SCENES.len() * ESTIMATORS.len()) as f64;
+    let on_all = ESTIMATORS.iter().filter(|e| !e.2).count();
+    let comparisons = (SCENES.len() * on_all + ESTIMATORS.len() - on_all) as f64;
     let per_comparison = -((-ALPHA).ln_1p() / comparisons).exp_m1();
     let mut failures = Vec::new();
     for (k, name) in SCENES.iter().enumerate() {
@@ -52,7 +60,10 @@ fn point_and_beam_estimates_agree_with_pt_on_media_scenes() {
             seed,
             block,
         );
-        for (j, &(estimator, photon_paths)) in ESTIMATORS.iter().enumerate() {
+        for (j, &(estimator, photon_paths, first_only)) in ESTIMATORS.iter().enumerate() {
+            if first_only && k > 0 {
+                continue;
+            }
             let (rendered, blocks) = render_blocks(
                 &scene,
                 estimator,

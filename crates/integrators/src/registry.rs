@@ -16,6 +16,7 @@ use crate::vcm::bpm::Bpm;
 use crate::vcm::eamis::Eamis;
 use crate::vcm::Vcm;
 use crate::volume_density::bb1d::Bb1d;
+use crate::volume_density::bp2d::Bp2d;
 use crate::volume_density::pb2d::Pb2d;
 use crate::volume_density::pp3d::Pp3d;
 use crate::{Estimator, Kind};
@@ -255,9 +256,18 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
         make: |s, r| Ok(Estimator::Consistent(Box::new(Bb1d::read(s, r)?))),
     },
     IntegratorInfo {
+        name: "bp2d",
+        about: "photon beams gathered at the first medium vertex (2-D kernel), pt elsewhere",
+        kind: Kind::Consistent,
+        weights: Weights::None,
+        source: include_str!("volume_density/bp2d.rs"),
+        radius: Radius::Dimension(2),
+        make: |s, r| Ok(Estimator::Consistent(Box::new(Bp2d::read(s, r)?))),
+    },
+    IntegratorInfo {
         name: "upbp",
-        about: "unified points, beams and paths: bdpt's connections, volumetric photon points \
-                (PP3D) and camera beams (PB2D) under one MIS",
+        about: "unified points, beams and paths: bdpt's connections, PP3D, PB2D, BB1D and \
+                (opt-in, `techniques=all`) vcm's surface merges under one MIS",
         kind: Kind::Consistent,
         weights: Weights::Volumetric,
         source: include_str!("upbp/mod.rs"),
@@ -322,7 +332,7 @@ pub fn make_integrator(
 /// The integrators that walk participating media (`media/`); every other refuses a scene with
 /// media rather than render it silently wrong (issue 43, item 4).
 pub const HANDLES_MEDIA: &[&str] = &[
-    "pt", "pt-bsdf", "light", "bdpt", "pp3d", "pb2d", "bb1d", "upbp",
+    "pt", "pt-bsdf", "light", "bdpt", "pp3d", "pb2d", "bb1d", "bp2d", "upbp",
 ];
 
 /// One clear line for an integrator that cannot render the scene's media.

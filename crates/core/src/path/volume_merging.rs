@@ -28,6 +28,10 @@
 //!   2r sin θ turns their product into a volume density: the box across u times the Jacobian
 //!   of (s, t) → the plane of the two lines).
 //!
+//! - **surface merging** (vcm's vertex merging, `merging`) at a non-delta surface vertex x_i:
+//!   p_S,i = N · πr_S² · ∏_{j≤i} l_j · ∏_{j≥i} c_j (`Densities::merging`), so that a scene
+//!   without media has vcm's technique set.
+//!
 //! N is the number of light subpaths whose photons every camera subpath queries (a pass's), so
 //! against a connection (one per camera sample) the heuristics compare η_P = N (4/3)πr³ and
 //! η_B = N πr² times the products (as `merging`'s η = N π r² for surfaces). Every density is in
@@ -53,6 +57,8 @@ pub struct VolumeSet {
     pub beams_eta: f64,
     /// η_BB = N · 2r of BB1D; 0 turns it off.
     pub beam_beams_eta: f64,
+    /// η_S = N π r_S² of surface vertex merging (vcm's, `merging`); 0 turns it off.
+    pub surface_eta: f64,
 }
 
 /// One technique of UPBP's family on a path.
@@ -66,6 +72,8 @@ pub enum VolumeTechnique {
     Beam(usize),
     /// BB1D at the medium vertex x_i.
     BeamBeam(usize),
+    /// Surface vertex merging (vcm's) at the surface vertex x_i.
+    Surface(usize),
 }
 
 /// Per vertex x_j of a path: whether it lies in a medium, σ̂_j (module doc) of the camera
@@ -186,8 +194,8 @@ impl VolumeRates {
 }
 
 impl Densities {
-    /// The densities of a path completed by a volumetric merge at x_i (PP3D or PB2D), from
-    /// scratch: `Densities::merged`, whose two joining densities take their free flights here.
+    /// The densities of a path completed by a merge at x_i (PP3D, PB2D, BB1D, or a surface
+    /// merge in a scene with media), from scratch: `Densities::merged`, whose two joining densities take their free flights here.
     pub fn volume_merged(scene: &Scene, light: &[PathVertex], camera: &[PathVertex]) -> Densities {
         let mut d = Densities::merged(scene, light, camera);
         let i = light.len() - 1;
@@ -203,7 +211,8 @@ impl Densities {
     /// The effective densities the heuristics compare under `set`: n_s·p_s of the connection
     /// techniques s = 0 … k+1 (zero for s ≥ 1 without connections), then η_P·p_P,i for
     /// i = 0 … k, then η_B·p_B,i, then η_BB·p_BB,i for i = 0 … k (module doc; zero where x_i is
-    /// no medium vertex).
+    /// no medium vertex), then η_S·p_VM,i of surface merging (`Densities::merging`: zero where
+    /// x_i lies in a medium or is delta).
     pub fn effective_upbp(&self, set: VolumeSet, rates: &VolumeRates) -> Vec<f64> {
         let k = self.k();
         let mut all = self.effective_all();
@@ -240,6 +249,13 @@ impl Densities {
                 0.0
             });
         }
+        for i in 0..=k {
+            all.push(if rates.medium[i] {
+                0.0
+            } else {
+                set.surface_eta * self.merging(i)
+            });
+        }
         all
     }
 
@@ -251,6 +267,7 @@ impl Densities {
             VolumeTechnique::Point(i) => n + 1 + i,
             VolumeTechnique::Beam(i) => 2 * n + 1 + i,
             VolumeTechnique::BeamBeam(i) => 3 * n + 1 + i,
+            VolumeTechnique::Surface(i) => 4 * n + 1 + i,
         }
     }
 
@@ -281,8 +298,10 @@ impl Densities {
                     VolumeTechnique::Point(j - n - 1)
                 } else if j <= 3 * n {
                     VolumeTechnique::Beam(j - 2 * n - 1)
-                } else {
+                } else if j <= 4 * n {
                     VolumeTechnique::BeamBeam(j - 3 * n - 1)
+                } else {
+                    VolumeTechnique::Surface(j - 4 * n - 1)
                 }
             })
             .collect()

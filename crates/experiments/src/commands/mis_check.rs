@@ -52,7 +52,7 @@ pub struct MisCheckArgs {
     /// vcm, bpm: merging only in a checkerboard of pixels (eamis's per-pixel choice).
     #[arg(long)]
     pub checkerboard_merging: bool,
-    /// upbp: its `techniques` (all, or a comma-separated subset of bpt, pp3d, pb2d, bb1d).
+    /// upbp: its `techniques` (all, or a comma-separated subset of bpt, surf, pp3d, pb2d, bb1d).
     #[arg(long)]
     pub techniques: Option<String>,
 }

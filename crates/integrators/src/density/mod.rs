@@ -5,4 +5,5 @@
 pub mod photons;
 pub mod progressive;
 pub mod radius;
+pub mod surface_merge;
 pub mod visible;

@@ -13,11 +13,16 @@ use crate::subpath::media_walk::light_subpath_in;
 use crate::subpath::walk::{Subpath, WalkLimits};
 use crate::volume_density::beams::BeamGrid;
 use lt_core::math::Vec3;
-use lt_core::path::PathVertex;
+use lt_core::path::scatter::connectable;
+use lt_core::path::{PathVertex, VertexKind};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::spatial::PointGrid;
 use lt_core::Scene;
 use rayon::prelude::*;
+
+/// The radii a pass indexes its light subpaths for: r_P (PP3D), r_B (PB2D), (r_BB, M_BB)
+/// (BB1D), r_S (surface merges); None where the technique does not run.
+pub type Radii = (Option<f32>, Option<f32>, Option<(f32, u64)>, Option<f32>);
 
 /// Light subpaths traced per parallel chunk (fixed: the stored order, hence every sum, does not
 /// depend on the thread count).
@@ -54,6 +59,18 @@ pub struct PhotonRef {
     pub vertex: u32,
 }
 
+/// A surface light vertex for surface merges: light subpath `path`'s vertex `vertex` (≥ 1, on a
+/// non-delta surface), with what the merge kernel reads (`density::surface_merge`).
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceRef {
+    pub path: u32,
+    pub vertex: u32,
+    /// Unit direction towards y_{i−1}, geometric normal, |n_g · ω_y|.
+    pub wi: Vec3,
+    pub ng: Vec3,
+    pub cos_g: f32,
+}
+
 /// The pass's light subpaths and their photon indices.
 pub struct LightStore {
     chunks: Vec<Chunk>,
@@ -65,18 +82,23 @@ pub struct LightStore {
     pub beams: Option<BeamGrid>,
     /// For BB1D: the light subpaths' segments through media as short photon beams.
     pub light_beams: Option<LightBeams>,
+    /// For surface merges: the non-delta surface vertices (cells of 2 r_S).
+    pub surface_positions: Vec<Vec3>,
+    pub surface: Vec<SurfaceRef>,
+    pub surface_grid: Option<PointGrid>,
 }
 
 impl LightStore {
     /// Traces light subpaths 0 … m−1 of `pass` (streams `Domain::Light`, item = index, as bdpt's)
     /// and indexes their medium vertices for radii `r_points` (`None`: no PP3D) and `r_beams`
     /// (no PB2D), the segments through media of the first M_BB for `r_beam_beams` = (r_BB, M_BB)
-    /// (no BB1D); `needs`: the rates the weights read.
+    /// (no BB1D), their non-delta surface vertices for `r_surface` (no surface merges); `needs`:
+    /// the rates the weights read.
     pub fn trace(
         scene: &Scene,
         (seed, pass): (u64, u32),
         (m, limits, needs): (u64, WalkLimits, Needs),
-        (r_points, r_beams, r_beam_beams): (Option<f32>, Option<f32>, Option<(f32, u64)>),
+        (r_points, r_beams, r_beam_beams, r_surface): Radii,
     ) -> LightStore {
         let n_chunks = m.div_ceil(CHUNK) as usize;
         let chunks: Vec<Chunk> = (0..n_chunks)
@@ -129,8 +151,12 @@ impl LightStore {
             points: None,
             beams: None,
             light_beams,
+            surface_positions: Vec::new(),
+            surface: Vec::new(),
+            surface_grid: None,
         };
         let (mut positions, mut photons) = (Vec::new(), Vec::new());
+        let (mut s_positions, mut surface) = (Vec::new(), Vec::new());
         for path in 0..m as usize {
             let y = store.path(path).vertices;
             for (vertex, v) in y.iter().enumerate().skip(1) {
@@ -140,9 +166,26 @@ impl LightStore {
                         path: path as u32,
                         vertex: vertex as u32,
                     });
+                } else if r_surface.is_some()
+                    && matches!(v.kind, VertexKind::Surface { .. })
+                    && connectable(scene, v)
+                {
+                    s_positions.push(v.p);
+                    surface.push(SurfaceRef {
+                        path: path as u32,
+                        vertex: vertex as u32,
+                        wi: v.wo,
+                        ng: v.ng,
+                        cos_g: v.ng.dot(v.wo).abs(),
+                    });
                 }
             }
         }
+        if let Some(r) = r_surface.filter(|_| !surface.is_empty()) {
+            store.surface_grid = Some(PointGrid::build(&s_positions, 2.0 * r));
+        }
+        store.surface_positions = s_positions;
+        store.surface = surface;
         store.photon_positions = positions;
         store.photons = photons;
         if !store.photons.is_empty() {
@@ -176,8 +219,13 @@ impl LightStore {
 
     /// The photon's light subpath up to it (y_0 … y_i).
     pub fn photon(&self, p: PhotonRef) -> LightPath<'_> {
-        let full = self.path(p.path as usize);
-        let n = p.vertex as usize + 1;
+        self.up_to(p.path, p.vertex)
+    }
+
+    /// Light subpath `path` up to its vertex `vertex`.
+    pub fn up_to(&self, path: u32, vertex: u32) -> LightPath<'_> {
+        let full = self.path(path as usize);
+        let n = vertex as usize + 1;
         LightPath {
             vertices: &full.vertices[..n],
             back_flight: &full.back_flight[..n],

@@ -9,28 +9,31 @@
 //!   all M light subpaths) within r_P, 3-D kernel 1/((4/3)π r_P³);
 //! - `pb2d`: each segment of the camera walk, as a short beam (the flight the walk sampled),
 //!   gathers the photons within r_B of it, 2-D kernel 1/(π r_B²), T evaluated along it;
+//! - `surf`: vcm's vertex merging at every non-delta surface vertex of the camera walk with the
+//!   light subpaths' non-delta surface vertices within r_S = r_B (disk kernel 1/(π r_S²), the
+//!   side tests and BSDF evaluation of `density::surface_merge`, shared with vcm): on a scene
+//!   without media `bpt,surf` is vcm's technique set;
 //! - `bb1d`: the same short camera beams gather the light subpaths' segments through media as
 //!   short photon beams (`light_beams`) within r_BB, 1-D kernel 1/(2 r_BB) over sin θ, T
 //!   evaluated along both (`camera_beams`).
 //!
 //! Weights: `weights` (full-path densities, the measures and η's stated there and in
-//! `lt_core::path::volume_merging`, the oracle). Not here yet: surface merges (vcm's), BP2D,
-//! long beams, SmallUPBP's `previous`/`compatible` modes. Per pass, camera sample j pairs
+//! `lt_core::path::volume_merging`, the oracle). Not here yet: BP2D, long beams, SmallUPBP's `previous`/`compatible` modes. Per pass, camera sample j pairs
 //! with light subpath j mod M for its connections (bdpt's pairing) and queries all M for merges;
 //! radii shrink per kernel dimension (`volume_density::schedule`): r_P,i = r₁ i^((α_P−1)/3),
 //! r_B,i = r₁ i^((α−1)/2), r_BB,i = r₁ i^(α_BB−1). A scene without media has no photons: upbp
-//! is bdpt there.
+//! is bdpt there by default, vcm with `techniques=all` or `bpt,surf`.
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
 //! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `mis` | power/balance/none | power | heuristic over every technique |
-//! | `techniques` | all/bpt/pp3d/pb2d/bb1d | all | comma-separated subset of bpt, pp3d, pb2d, bb1d (SmallUPBP's names) |
+//! | `techniques` | all/bpt/surf/pp3d/pb2d/bb1d | bpt,pp3d,pb2d,bb1d | `all` (the five), or a comma- or plus-separated subset of bpt, surf, pp3d, pb2d, bb1d (SmallUPBP's names); surf is opt-in (`DEFAULT_TECHNIQUES`) |
 //! | `photons_per_pass` | u64 | the pixel count | light subpaths per pass (M) |
-//! | `radius` | f32 | — | initial radius r₁ in scene units (both kernels) |
+//! | `radius` | f32 | — | initial radius r₁ in scene units (every kernel) |
 //! | `radius_scene` | f32 | 0.01 | initial radius as a fraction of the scene's bounding-sphere diameter |
-//! | `alpha` | f64 | 2/3 | PB2D's radius reduction: r_B,i = r₁ i^((α−1)/2) |
+//! | `alpha` | f64 | 2/3 | PB2D's and surface merges' radius reduction: r_B,i = r_S,i = r₁ i^((α−1)/2) |
 //! | `alpha_points` | f64 | 4/7 | PP3D's radius reduction: r_P,i = r₁ i^((α_P−1)/3) |
 //! | `alpha_beam_beams` | f64 | 4/5 | BB1D's radius reduction: r_BB,i = r₁ i^(α_BB−1) |
 //! | `beam_paths` | u64 | ⌈M/8⌉ | light subpaths (the pass's first) whose segments are BB1D's photon beams |
@@ -68,10 +71,12 @@ pub struct Techniques {
     pub pp3d: bool,
     pub pb2d: bool,
     pub bb1d: bool,
+    /// Surface vertex merging (vcm's; SmallUPBP's `surf`).
+    pub surf: bool,
 }
 
 impl Techniques {
-    /// `all`, or a comma-separated subset of `bpt`, `pp3d`, `pb2d`, `bb1d`.
+    /// `all`, or a comma- or plus-separated subset of `bpt`, `surf`, `pp3d`, `pb2d`, `bb1d`.
     pub fn parse(text: &str) -> Result<Techniques, String> {
         if text.trim() == "all" {
             return Ok(Techniques {
@@ -79,6 +84,7 @@ impl Techniques {
                 pp3d: true,
                 pb2d: true,
                 bb1d: true,
+                surf: true,
             });
         }
         let mut t = Techniques {
@@ -86,6 +92,7 @@ impl Techniques {
             pp3d: false,
             pb2d: false,
             bb1d: false,
+            surf: false,
         };
         for name in text.split([',', '+']) {
             match name.trim() {
@@ -93,10 +100,11 @@ impl Techniques {
                 "pp3d" => t.pp3d = true,
                 "pb2d" => t.pb2d = true,
                 "bb1d" => t.bb1d = true,
+                "surf" => t.surf = true,
                 other => {
                     return Err(format!(
                         "unknown technique '{other}' (known: all, or a comma-separated subset of \
-                         bpt, pp3d, pb2d, bb1d)"
+                         bpt, surf, pp3d, pb2d, bb1d)"
                     ))
                 }
             }
@@ -104,6 +112,12 @@ impl Techniques {
         Ok(t)
     }
 }
+
+/// `techniques` by default: every technique but the surface merges. Surface merges are opt-in
+/// (`all`, or `+surf`): a merge's weight here is formed from the full path (O(k) per merge, not
+/// vcm's O(1) recursion), which made upbp 5–7× slower on cornell-box at its default radius, and
+/// the registry's loops hold upbp at bdpt's budget on surface scenes.
+pub const DEFAULT_TECHNIQUES: &str = "bpt,pp3d,pb2d,bb1d";
 
 #[derive(Clone, Copy, Debug)]
 pub struct UpbpParams {
@@ -147,7 +161,7 @@ impl UpbpParams {
                 .unwrap_or(Heuristic::Power),
             techniques: r
                 .get_with("techniques", Techniques::parse)?
-                .unwrap_or(Techniques::parse("all")?),
+                .unwrap_or(Techniques::parse(DEFAULT_TECHNIQUES)?),
         })
     }
 }
@@ -216,16 +230,24 @@ impl Upbp {
         } else {
             0.0
         };
+        // Surface merges share PB2D's 2-D schedule (the same kernel dimension): r_S = r_B.
+        let surface_eta = if t.surf {
+            mf * PI as f64 * rbf * rbf
+        } else {
+            0.0
+        };
         let set = VolumeSet {
             connections: t.bpt,
             points_eta,
             beams_eta,
             beam_beams_eta,
+            surface_eta,
         };
         let radii = (
             t.pp3d.then_some(rp),
             t.pb2d.then_some(rb),
             t.bb1d.then_some((rbb, m_bb)),
+            t.surf.then_some(rb),
         );
         let needs = Needs::of(&set);
         let store = LightStore::trace(scene, (seed, pass), (m, limits, needs), radii);
@@ -432,6 +454,7 @@ impl PassSetup {
             point_norm: norm(self.set.points_eta),
             beam_norm: norm(self.set.beams_eta),
             beam_beam_norm: norm(self.set.beam_beams_eta),
+            surface_norm: norm(self.set.surface_eta),
             needs: Needs::of(&self.set),
         }
     }

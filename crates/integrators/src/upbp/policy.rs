@@ -11,6 +11,7 @@
 use super::light_store::{LightPath, LightStore};
 use super::rates::{camera_vertex, junction, Needs};
 use super::weights::{weight, VertexRate};
+use crate::density::surface_merge::SurfaceGather;
 use crate::record::{Recorder, VolumeMerged};
 use crate::subpath::camera_loop::{CameraPolicy, Joins, SampleCtx, Weight};
 use crate::subpath::connect::JoinFlights;
@@ -18,7 +19,7 @@ use crate::subpath::strategy_weight::{with_chain_in, Split};
 use crate::subpath::walk::{Departure, Exit, Subpath};
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2, Vec3};
-use lt_core::path::scatter::connectable_inside;
+use lt_core::path::scatter::{connectable, connectable_inside};
 use lt_core::path::{Chain, Heuristic, PathVertex, VertexKind, VolumeSet, VolumeTechnique};
 use lt_core::sampling::Sampler;
 use lt_core::scene::ConnectionEnd;
@@ -35,10 +36,11 @@ pub struct PassData<'a> {
     pub r_points: f32,
     pub r_beams: f32,
     pub r_beam_beams: f32,
-    /// 1 / (M (4/3)π r_P³), 1 / (M π r_B²) and 1 / (M 2 r_BB).
+    /// 1 / (M (4/3)π r_P³), 1 / (M π r_B²), 1 / (M 2 r_BB) and 1 / (M π r_S²) (r_S = r_B).
     pub point_norm: f32,
     pub beam_norm: f32,
     pub beam_beam_norm: f32,
+    pub surface_norm: f32,
     /// The rates the weights read (`rates::Needs`).
     pub needs: Needs,
 }
@@ -178,6 +180,28 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
         cam: MergeSide,
         technique: VolumeTechnique,
     ) -> f64 {
+        let (y_i, zx) = (
+            &light.vertices[light.vertices.len() - 1],
+            &cam.vertices[cam.vertices.len() - 1],
+        );
+        let medium = medium_of(zx).expect("a volumetric merge's camera side is a medium vertex");
+        let phase = scene.media[medium as usize].phase();
+        let pdfs = (phase.pdf(zx.wo, y_i.wo), phase.pdf(y_i.wo, zx.wo));
+        self.merge_weight_with(scene, light, cam, technique, pdfs)
+    }
+
+    /// `merge_weight` with the camera side's x_i scattering densities given (solid angle): of
+    /// ω_y given ω_z (the camera walk continuing towards y_{i−1}) and of ω_z given ω_y (the
+    /// light walk continuing towards z_{t−2}) — the phase function's in a medium, the BSDF's
+    /// (`BsdfEval::pdf_w`, `pdf_rev_w`) at a surface merge.
+    pub fn merge_weight_with(
+        &self,
+        scene: &Scene,
+        light: MergeSide,
+        cam: MergeSide,
+        technique: VolumeTechnique,
+        (to_light, to_camera): (f32, f32),
+    ) -> f64 {
         let (yv, zv) = (light.vertices, cam.vertices);
         let i = yv.len() - 1;
         let t = zv.len();
@@ -230,6 +254,7 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
                     }
                     v
                 }
+                std::cmp::Ordering::Equal if !zv[t - 1].in_medium() => VertexRate::default(),
                 std::cmp::Ordering::Equal => {
                     let (u, w) = (yv[i].dir_to(&yv[i - 1]), zv[t - 1].dir_to(&zv[t - 2]));
                     let x = u.cross(w);
@@ -251,18 +276,14 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
             };
         }
         let (y_i, zx) = (&yv[i], &zv[t - 1]);
-        let medium = medium_of(zx).expect("a volumetric merge's camera side is a medium vertex");
-        let phase = scene.media[medium as usize].phase();
-        // c_{i−1}: the camera side's phase function sampling ω_y, in y_{i−1}'s measure from y_i.
+        // c_{i−1}: the camera side's x_i sampling ω_y, in y_{i−1}'s measure from y_i.
         c[i - 1] = if i == 1 && yv[0].is_delta_light() {
             0.0
         } else {
-            let pdf = phase.pdf(zx.wo, y_i.wo);
-            y_i.convert_density(pdf, &yv[i - 1]) as f64 * light.back
+            y_i.convert_density(to_light, &yv[i - 1]) as f64 * light.back
         };
         if i + 1 < k {
-            let pdf = phase.pdf(y_i.wo, zx.wo);
-            l[i + 1] = zx.convert_density(pdf, &zv[t - 2]) as f64 * cam.back;
+            l[i + 1] = zx.convert_density(to_camera, &zv[t - 2]) as f64 * cam.back;
         }
         c[k] = 1.0;
         l[k] = 0.0;
@@ -275,6 +296,75 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
         };
         let p = self.pass;
         weight(&chain, vol, &p.set, technique, p.h)
+    }
+}
+
+impl<const MEDIA: bool> Policy<'_, MEDIA> {
+    /// The camera side of a merge at the walk's last vertex z_{t−1} (`z`), its rates as walked.
+    fn camera_side<'b>(&'b self, z: &'b [PathVertex]) -> MergeSide<'b> {
+        let t = z.len();
+        MergeSide {
+            vertices: z,
+            back: self.back_flight[t - 1] as f64,
+            rates: &self.cam,
+            near_rate: self.cam[t - 2].light_rate,
+            end_rate: self.cam[t - 1].rate,
+            near_sin: self.cam[t - 2].sin,
+            nee: 0.0,
+        }
+    }
+
+    /// vcm's surface merges at the camera walk's non-delta surface vertex z_{t−1} with the light
+    /// subpaths' non-delta surface vertices y_i within r_S: β_z f(ω_z, ω_y)|cos| β_y / |n_y·ω_y|
+    /// / (M π r_S²) each (the kernel and side tests of `density::surface_merge`, vcm's own).
+    fn surface_merges<R: Recorder>(
+        &self,
+        scene: &Scene,
+        z: &[PathVertex],
+        ctx: &mut SampleCtx<'_, R>,
+        l: &mut Color,
+    ) {
+        let p = self.pass;
+        let t = z.len();
+        let zv = &z[t - 1];
+        let Some(grid) = p.store.surface_grid.as_ref() else {
+            return;
+        };
+        if t > p.max_k || t < 2 || !connectable(scene, zv) || zv.beta == Color::ZERO {
+            return;
+        }
+        let Some(gather) = SurfaceGather::at(scene, zv) else {
+            return;
+        };
+        let positions = &p.store.surface_positions;
+        grid.for_each_within(positions, zv.p, p.r_beams, |idx, _| {
+            let sr = p.store.surface[idx as usize];
+            let i = sr.vertex as usize;
+            if i + t - 1 > p.max_k {
+                return;
+            }
+            let Some(ev) = gather.eval(sr.wi, sr.ng, sr.cos_g) else {
+                return;
+            };
+            let y = p.store.up_to(sr.path, sr.vertex);
+            let value = zv.beta * ev.f_cos * y.vertices[i].beta / sr.cos_g * p.surface_norm;
+            let light = MergeSide::stored_photon(y, i);
+            let technique = VolumeTechnique::Surface(i);
+            let pdfs = (ev.pdf_w, ev.pdf_rev_w);
+            let w = self.merge_weight_with(scene, light, self.camera_side(z), technique, pdfs);
+            if R::ACTIVE {
+                ctx.rec.volume_merged(VolumeMerged {
+                    technique,
+                    light: y.vertices,
+                    camera: z,
+                    weight: w,
+                    value,
+                    raster: ctx.raster,
+                    radius: p.r_beams,
+                });
+            }
+            *l += value * w as f32;
+        });
     }
 }
 
@@ -381,6 +471,10 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         let p = self.pass;
         let t = z.len();
         let zv = &z[t - 1];
+        if !zv.in_medium() {
+            self.surface_merges(scene, z, ctx, l);
+            return;
+        }
         let (Some(grid), Some(m)) = (p.store.points.as_ref(), medium_of(zv)) else {
             return;
         };

@@ -9,7 +9,8 @@
 //! by σ̂_i (`VertexRate::rate`), the flight's scattering density over its pass probability at x_i:
 //! the beam covers x_i with the pass probability where the walk stopped there with the
 //! scattering density. BB1D counts η_BB = N·2r times sin θ_i and the product with both l_i and
-//! c_i divided by their σ̂'s (`light_rate`, `rate`): both walks' segments are beams.
+//! c_i divided by their σ̂'s (`light_rate`, `rate`): both walks' segments are beams. A surface
+//! merge (vcm's) at a non-delta surface vertex counts η_S = N·πr_S² times ∏_{j≤i} l_j ∏_{j≥i} c_j.
 
 use lt_core::path::{Chain, Heuristic, VolumeSet, VolumeTechnique};
 
@@ -54,6 +55,7 @@ pub fn weight(
         VolumeTechnique::Point(i) => p[k + 2 + i],
         VolumeTechnique::Beam(i) => p[2 * (k + 2) + i],
         VolumeTechnique::BeamBeam(i) => p[3 * (k + 2) + i],
+        VolumeTechnique::Surface(i) => p[4 * (k + 2) + i],
     };
     if !(own > 0.0) {
         return 0.0;
@@ -64,11 +66,11 @@ pub fn weight(
     h.weight_from_ratios(p)
 }
 
-/// Technique families: connections, PP3D, PB2D, BB1D.
-const BLOCKS: usize = 4;
+/// Technique families: connections, PP3D, PB2D, BB1D, surface merges.
+const BLOCKS: usize = 5;
 
-/// n·p of every technique into `out` (4 (k + 2) entries): connections s = 0 … k+1, PP3D, PB2D
-/// and BB1D at x_0 … x_{k+1} (the last of each never valid).
+/// n·p of every technique into `out` (5 (k + 2) entries): connections s = 0 … k+1, PP3D, PB2D,
+/// BB1D and surface merges at x_0 … x_{k+1} (the last of each never valid).
 fn effective(chain: &Chain, vol: &[VertexRate], set: &VolumeSet, out: &mut [f64]) {
     let k = chain.k();
     for s in 0..=k + 1 {
@@ -82,7 +84,7 @@ fn effective(chain: &Chain, vol: &[VertexRate], set: &VolumeSet, out: &mut [f64]
     let (l, c) = (chain.light, chain.camera);
     let mut light_to = 1.0;
     for i in 0..=k + 1 {
-        let (point, beam, beam_beam) = (&mut 0.0, &mut 0.0, &mut 0.0);
+        let (point, beam, beam_beam, surface) = (&mut 0.0, &mut 0.0, &mut 0.0, &mut 0.0);
         if i <= k {
             light_to *= l[i];
         }
@@ -99,9 +101,13 @@ fn effective(chain: &Chain, vol: &[VertexRate], set: &VolumeSet, out: &mut [f64]
                         * (camera_from / v.rate);
                 }
             }
+        } else if i >= 1 && i < k && chain.connectable[i] {
+            // vcm's vertex merging at a non-delta surface vertex (`Densities::merging`).
+            *surface = set.surface_eta * light_to * c[i..].iter().product::<f64>();
         }
         out[k + 2 + i] = *point;
         out[2 * (k + 2) + i] = *beam;
         out[3 * (k + 2) + i] = *beam_beam;
+        out[4 * (k + 2) + i] = *surface;
     }
 }

@@ -19,7 +19,9 @@
 //!   beam estimate and lets the walk go on only when the sampled flight passes (weight T/P), so
 //!   prefixes with a medium vertex are never continued; `bb1d` splits as `pb2d` (the camera
 //!   walk's flight is the query beam), and integrates the light side's last vertex along its
-//!   flight too (a photon beam carries what the points of its flight carry: `photon_beams.rs`).
+//!   flight too (a photon beam carries what the points of its flight carry: `photon_beams.rs`);
+//!   `bp2d` splits as `pp3d` (the camera's free-flight vertex is the query point) and gathers
+//!   the light side's flights as photon beams, as `bb1d`'s.
 //!
 //! A path of k segments is counted once: t segments from the camera to y, k − t from the light
 //! (the photon's `segments`), k ≤ max_depth. Surfaces are never density-estimated here: the
@@ -29,10 +31,12 @@
 pub mod bb1d;
 pub mod beam_beam;
 pub mod beams;
+pub mod bp2d;
 pub mod cell_frame;
 pub mod pb2d;
 pub mod photon_beams;
 pub mod photons;
+pub mod point_beam;
 pub mod points;
 pub mod pp3d;
 pub mod schedule;
@@ -49,7 +53,7 @@ use lt_estimators::Image;
 /// The default initial radius as a fraction of the scene's bounding-sphere diameter.
 pub const DEFAULT_RADIUS_SCENE: f32 = 0.01;
 
-/// The keys `pp3d`, `pb2d` and `bb1d` share (their files' tables document them).
+/// The keys `pp3d`, `pb2d`, `bb1d` and `bp2d` share (their files' tables document them).
 #[derive(Clone, Copy, Debug)]
 pub struct VolumeParams {
     pub max_depth: u32,
@@ -59,7 +63,8 @@ pub struct VolumeParams {
     /// r₁ in scene units.
     pub radius: f32,
     pub alpha: f64,
-    /// Kernel dimension: 3 for points, 2 for points × beams, 1 for beams × beams.
+    /// Kernel dimension: 3 for points, 2 for points × beams (either way round), 1 for beams ×
+    /// beams.
     pub dimension: u32,
 }
 
@@ -137,9 +142,11 @@ pub enum Query {
     Beams,
     /// Photon beams along the camera beam (`bb1d`).
     BeamBeams,
+    /// Photon beams at the first medium vertex (`bp2d`).
+    PointBeams,
 }
 
-/// One run of `pp3d`, `pb2d` or `bb1d`: the sum of the pass images so far.
+/// One run of `pp3d`, `pb2d`, `bb1d` or `bp2d`: the sum of the pass images so far.
 pub struct VolumeRun<'a> {
     pub params: &'a VolumeParams,
     pub query: Query,
@@ -197,6 +204,20 @@ impl ProgressiveRun for VolumeRun<'_> {
                 let n = photons.points.len();
                 (img, bad, n, photons::VolumePhotons::BYTES_PER_PHOTON, bytes)
             }
+            Query::PointBeams => {
+                let pb = photon_beams::PhotonBeams::trace(scene, depth, rr, paths, self.seed, pass);
+                let q = point_beam::PointBeamQuery::new(scene, &pb, r, depth);
+                let bytes = q.index.as_ref().map_or(0, |g| g.bytes());
+                let (img, bad) = self.render_with(&q, pass);
+                let n = pb.beams.len();
+                (
+                    img,
+                    bad,
+                    n,
+                    photon_beams::PhotonBeams::BYTES_PER_BEAM,
+                    bytes,
+                )
+            }
             Query::BeamBeams => {
                 let pb = photon_beams::PhotonBeams::trace(scene, depth, rr, paths, self.seed, pass);
                 let q = beam_beam::BeamBeamQuery::new(scene, &pb, r, depth);
@@ -221,7 +242,7 @@ impl ProgressiveRun for VolumeRun<'_> {
         self.log.photon_paths.push(paths);
         self.log.radius_scale.push(scale);
         self.log.mean_radius.push(r as f64);
-        let what = if self.query == Query::BeamBeams {
+        let what = if matches!(self.query, Query::BeamBeams | Query::PointBeams) {
             "photon beams"
         } else {
             "volume photons"

@@ -1,6 +1,6 @@
 //! `lt mis-check --integrator upbp`: the weights `upbp` applied to the paths it completed — by a
 //! connection, by a photon point at a camera medium vertex (PP3D), by a photon near a camera
-//! beam (PB2D) or by a photon beam near a camera beam (BB1D) — against the from-scratch oracle
+//! beam (PB2D), by a photon beam near a camera beam (BB1D) or by a surface merge (vcm's) — against the from-scratch oracle
 //! (`Densities::upbp_weight`, `lt_core::path::volume_merging`: every connection technique, PP3D,
 //! PB2D and BB1D at every medium vertex, each density and rate rebuilt from the path's
 //! positions), and the partition of unity of the
@@ -108,6 +108,7 @@ pub fn kind(t: &VolumeTechnique) -> &'static str {
         VolumeTechnique::Point(_) => "pp3d",
         VolumeTechnique::Beam(_) => "pb2d",
         VolumeTechnique::BeamBeam(_) => "bb1d",
+        VolumeTechnique::Surface(_) => "surf",
     }
 }
 
@@ -119,7 +120,7 @@ impl UpbpCollector {
     /// Every length has its quota of each kind of technique seen so far.
     fn full(&self) -> bool {
         let c = &self.counts;
-        let kinds = ["connections", "pp3d", "pb2d", "bb1d"];
+        let kinds = ["connections", "pp3d", "pb2d", "bb1d", "surf"];
         (1..=c.max_depth()).all(|k| {
             kinds.iter().all(|&name| {
                 let n = c.of_length(k, |t| kind(t) == name);
@@ -199,9 +200,10 @@ fn oracle(scene: &Scene, r: &UpbpRecord, ratio: f64) -> (Densities, VolumeRates)
 fn as_reported(t: VolumeTechnique) -> Technique {
     match t {
         VolumeTechnique::Connect(s) => Technique::Connect(s),
-        VolumeTechnique::Point(i) | VolumeTechnique::Beam(i) | VolumeTechnique::BeamBeam(i) => {
-            Technique::Merge(i)
-        }
+        VolumeTechnique::Point(i)
+        | VolumeTechnique::Beam(i)
+        | VolumeTechnique::BeamBeam(i)
+        | VolumeTechnique::Surface(i) => Technique::Merge(i),
     }
 }
 

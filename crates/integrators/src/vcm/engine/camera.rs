@@ -3,6 +3,7 @@
 
 use super::full_path::{merge_weight, MergeDensities};
 use super::{light_nee, Engine, LightPaths, PassInputs, PassSetup, Scratch};
+use crate::density::surface_merge::SurfaceGather;
 use crate::film::splat::Worker;
 use crate::record::{Merged, Recorder, Work};
 use crate::subpath::camera_loop::{
@@ -11,7 +12,7 @@ use crate::subpath::camera_loop::{
 use crate::subpath::connect::{emission_densities, nee_density, JoinFlights, Joined};
 use crate::subpath::strategy_weight::Split;
 use crate::subpath::walk::reverse_density;
-use lt_core::bsdf::{BsdfEval, TransportMode};
+use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
 use lt_core::path::scatter::{connectable, connectable_inside};
 use lt_core::path::subpath_mis::{ConnectionDensities, NextEventDensities, VertexTechniques};
@@ -242,39 +243,20 @@ impl VcmCamera<'_, '_> {
         let Some(grid) = &lights.grid else {
             return Color::ZERO;
         };
-        let VertexKind::Surface { material } = zv.kind else {
+        let Some(gather) = SurfaceGather::at(scene, zv) else {
             return Color::ZERO;
         };
         let max_k = self.engine.params.max_depth;
         let camera_segments = (t - 1) as u32;
-        let sf = zv.shading_frame();
-        let bsdf = scene.material(material);
-        let wo_side = zv.ng.dot(zv.wo);
-        let transmits = bsdf.transmits();
         let mut sum = Color::ZERO;
         grid.for_each_within(&lights.merge_positions, zv.p, setup.radius, |e, _| {
             let y = &lights.merge_vertex[e as usize];
             if y.segments + camera_segments > max_k {
                 return;
             }
-            // The light arrived on the side the camera looks from (a thin wall lit from behind
-            // stays dark in front), not along the light vertex's own surface, and on the same
-            // side of its own surface (front or back, by the shapes' normals) as the camera
-            // looks at z: light stored on the sunlit outside of a wall is never merged at the
-            // inner surface meeting that wall at an edge (the leak the SmallVCM sun twin showed),
-            // while merges across an inner corner stay.
-            // Through a surface that transmits, the light may arrive on the side facing away
-            // from the camera; it must still arrive on the same side of its own surface as of z's.
-            let y_front = y.ng.dot(y.wi) > 0.0;
-            let arrives_front = zv.ng.dot(y.wi) > 0.0;
-            let same_side = zv.ng.dot(y.wi) * wo_side > 0.0;
-            if !(same_side || transmits) || !(y.cos_g > 0.0) || y_front != arrives_front {
+            let Some(ev) = gather.eval(y.wi, y.ng, y.cos_g) else {
                 return;
-            }
-            let ev = bsdf.eval(&sf, zv.wo, y.wi, TransportMode::Radiance);
-            if ev.f_cos == Color::ZERO {
-                return;
-            }
+            };
             let value = zv.beta * ev.f_cos * y.beta / y.cos_g;
             let c_y_prev = (ev.pdf_w * y.to_prev) as f64;
             let l_z_prev = if t >= 3 {
