@@ -19,7 +19,7 @@ use lt_integrators::upbp::Upbp;
 use serde_json::json;
 
 /// The technique families, in the tables' order.
-pub const FAMILIES: [&str; 7] = [
+pub const FAMILIES: [&str; 8] = [
     "emission (s = 0)",
     "next event (s = 1)",
     "light tracing (t = 1)",
@@ -27,12 +27,13 @@ pub const FAMILIES: [&str; 7] = [
     "PP3D",
     "PB2D",
     "BB1D",
+    "surface merges",
 ];
 
 /// Σ weight × value (channel mean) per family over one pass.
 struct Sums {
     film_weight: f64,
-    by: [f64; 7],
+    by: [f64; FAMILIES.len()],
 }
 
 fn mean(c: lt_core::Color) -> f64 {
@@ -64,6 +65,7 @@ impl Recorder for Sums {
             VolumeTechnique::Beam(_) => 5,
             VolumeTechnique::BeamBeam(_) => 6,
             VolumeTechnique::Connect(_) => 3,
+            VolumeTechnique::Surface(_) => 7,
         };
         self.by[family] += mean(p.value) * p.weight * self.film_weight;
     }
@@ -71,7 +73,7 @@ impl Recorder for Sums {
 
 /// One run's per-family means (image units, the pixel mean's part) and their sum.
 pub struct Shares {
-    pub by: [f64; 7],
+    pub by: [f64; FAMILIES.len()],
     pub sum: f64,
 }
 
@@ -87,11 +89,11 @@ pub fn shares(ctx: &StudyContext, spec: &RunSpec) -> Result<Shares, String> {
         let upbp = Upbp::read(&scene, &r)?;
         r.finish()?;
         let pixels = scene.camera.pixel_count() as f64;
-        let mut by = [0.0; 7];
+        let mut by = [0.0; FAMILIES.len()];
         for pass in 0..spec.passes {
             let mut s = Sums {
                 film_weight: 1.0,
-                by: [0.0; 7],
+                by: [0.0; FAMILIES.len()],
             };
             upbp.record_pass(&scene, spec.seed, pass, &mut s);
             for (a, v) in by.iter_mut().zip(s.by) {
@@ -107,7 +109,7 @@ pub fn shares(ctx: &StudyContext, spec: &RunSpec) -> Result<Shares, String> {
         .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .map_err(|e| format!("{}: not a shares record: {e}", path.display()))?;
-    let mut by = [0.0; 7];
+    let mut by = [0.0; FAMILIES.len()];
     for (i, b) in by.iter_mut().enumerate() {
         *b = v["means"][i]
             .as_f64()
