@@ -65,6 +65,33 @@ pub fn spec(scale: &Scale, scene: &Path, max_depth: Option<u32>) -> Result<RunSp
     Ok(s)
 }
 
+/// Whether `s` is a reference as `spec` makes them, at whatever film and passes (a study may
+/// make its references at its own, as the figures do): the scene's reference integrator, the
+/// reference seed, and the runs and parameters `spec` gives it. `lt plan study` sends these to
+/// the reference cache.
+pub fn is_reference(s: &RunSpec) -> bool {
+    let stem = s
+        .scene
+        .file_stem()
+        .map(|x| x.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let (integrator, _) = integrator_for(&stem);
+    let consistent = crate::runs::is_consistent(integrator);
+    let params_fit = s
+        .params
+        .iter()
+        .all(|(k, v)| k == "max_depth" || (consistent && k == "radius_px" && v == "1"));
+    s.integrator == integrator
+        && s.seed == REFERENCE_SEED
+        && s.runs
+            == if consistent {
+                CONSISTENT_REFERENCE_RUNS
+            } else {
+                1
+            }
+        && params_fit
+}
+
 /// A reference as the studies use it.
 pub struct Reference {
     pub image: Image,
