@@ -18,8 +18,8 @@ use crate::study::{Scale, StudyContext};
 use std::path::PathBuf;
 
 /// The caustic as seen in the mirror, as fractions of the film (x0, y0, x1, y1): where the
-/// reference's SDS light is (the bright patch below the ball's mirror image).
-pub(super) const SDS_CROP: [f64; 4] = [0.3, 0.35, 0.75, 0.65];
+/// reference's caustic is (the bright ellipse beside the ball, in the ball's shadow).
+pub(super) const SDS_CROP: [f64; 4] = [0.33, 0.4, 0.7, 0.6];
 
 /// The unbiased estimators first, then the consistent ones; `sppm` fixes the time.
 const UNBIASED: [Contender; 2] = [

@@ -243,12 +243,12 @@ fn techniques_table(ctx: &StudyContext, out: &mut StudyOutput) -> Result<(), Str
         "vcm-techniques",
         "Figure 4b: what each family of techniques contributes (from the techniques study)",
         &format!(
-            "Read from `{}` (the techniques study: 4 runs of 8 passes at 128 px, one thread, \
+            "Read from `{}/families.csv` (the techniques study: 4 runs of 8 passes at 128 px, one thread, \
              techniques timed by the time-stamp counter): each family's share of the pass's CPU \
              time (Student-t interval over runs) and its share of the image's mean (the \
              family's mean over the sum of all). Families that contribute nothing (the walks, \
              `other`) are left out.",
-            path.display()
+            crate::study::techniques::NAME
         ),
         &[
             "scene",
