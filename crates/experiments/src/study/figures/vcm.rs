@@ -69,12 +69,15 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
     let scale = &ctx.scale;
     let mut rows = Vec::new();
     let mut verdicts = Vec::new();
+    let mut normalised = Vec::new();
     for k in 0..SCENES.len() {
         let name = SCENES[k];
         let cmp = comparison(scale, b, k)?;
         let reference = ctx.reference_at(&reference_at(scale, b, &cmp.scene), &cmp.scene, None)?;
         let (budget_s, arms) = cmp.run(ctx)?;
         let mut measured: Vec<(&str, Errors)> = Vec::new();
+        // relMSE × CPU s of bdpt, ppm, vcm: the check on equal time as achieved.
+        let mut inefficiency = Vec::new();
         let mut shown = Vec::new();
         // Table order: bdpt, ppm, vcm (the setter, first in `arms`).
         for &i in &[1, 2, 0] {
@@ -99,9 +102,11 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
                     num(e.flip.estimate)
                 ),
             ));
+            inefficiency.push(e.rel.estimate * super::mean_cpu(&arm.entries));
             measured.push((arm.contender.label, e));
         }
         verdicts.push(scene_verdict(name, &measured));
+        normalised.push(time_normalised(name, &inefficiency));
         let entries: Vec<Entry> = shown
             .iter()
             .map(|(l, img, note)| Entry {
@@ -168,6 +173,12 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
         SCENES.len(),
         verdicts.join("; ")
     ));
+    out.para(&format!(
+        "Equal time is what the probes predicted; the CPU s column is what each arm took. \
+         Normalised by it (relMSE × CPU s, an unbiased estimator's time-invariant \
+         inefficiency), vcm against the better of bdpt and ppm: {}.",
+        normalised.join("; ")
+    ));
     techniques_table(ctx, out)
 }
 
@@ -197,6 +208,19 @@ fn scene_verdict(name: &str, m: &[(&str, Errors)]) -> String {
         better.0,
         num(v.estimate / worse.1.rel.estimate),
         worse.0
+    )
+}
+
+/// vcm's inefficiency (relMSE × CPU s; `ineff` in bdpt, ppm, vcm order) against the better and
+/// the geometric mean of bdpt's and ppm's.
+fn time_normalised(name: &str, ineff: &[f64]) -> String {
+    let (better, worse) = (ineff[0].min(ineff[1]), ineff[0].max(ineff[1]));
+    let mid = (better * worse).sqrt();
+    format!(
+        "{name} {}× the better's ({} their geometric mean, {}×)",
+        num(ineff[2] / better),
+        if ineff[2] <= mid { "below" } else { "above" },
+        num(mid / better)
     )
 }
 
