@@ -77,10 +77,12 @@ pub fn is_reference(s: &RunSpec) -> bool {
         .unwrap_or_default();
     let (integrator, _) = integrator_for(&stem);
     let consistent = crate::runs::is_consistent(integrator);
-    let params_fit = s
-        .params
-        .iter()
-        .all(|(k, v)| k == "max_depth" || (consistent && k == "radius_px" && v == "1"));
+    // A consistent reference is made at radius 1 px, an unbiased one has no radius.
+    let radius_given = s.params.iter().any(|(k, v)| k == "radius_px" && v == "1");
+    let params_fit = radius_given == consistent
+        && s.params
+            .iter()
+            .all(|(k, v)| k == "max_depth" || (consistent && k == "radius_px" && v == "1"));
     s.integrator == integrator
         && s.seed == REFERENCE_SEED
         && s.runs
@@ -144,5 +146,31 @@ impl Reference {
             consistent: e.record.consistent(),
             seconds: e.record.seconds.last().copied().unwrap_or(0.0),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{is_reference, CONSISTENT_REFERENCE_RUNS, REFERENCE_SEED};
+    use crate::runs::RunSpec;
+
+    /// A reference is told by what it is, at any film and passes; a study run is not one.
+    #[test]
+    fn references_are_told_at_any_film_and_passes() {
+        let bdpt = |seed| RunSpec::new("scenes/cornell-box.toml", "bdpt", seed, 512);
+        assert!(is_reference(
+            &bdpt(REFERENCE_SEED).resolution(Some((128, 128)))
+        ));
+        assert!(is_reference(&bdpt(REFERENCE_SEED).param("max_depth", 4)));
+        assert!(!is_reference(&bdpt(1)));
+        assert!(!is_reference(&bdpt(REFERENCE_SEED).param("mis", "balance")));
+        let vcm = RunSpec::new("scenes/caustic-sds.toml", "vcm", REFERENCE_SEED, 64);
+        assert!(is_reference(
+            &vcm.clone()
+                .runs(CONSISTENT_REFERENCE_RUNS)
+                .param("radius_px", 1)
+        ));
+        assert!(!is_reference(&vcm.clone().param("radius_px", 1)));
+        assert!(!is_reference(&vcm.runs(CONSISTENT_REFERENCE_RUNS)));
     }
 }
