@@ -529,12 +529,112 @@ fn committed_figures_verdicts_follow_their_intervals() {
             robust += 1;
         }
     }
-    assert_eq!(scenes.len(), 1, "figure 2's scene");
+    assert_eq!(
+        scenes.len(),
+        2,
+        "figure 2's scenes: Bitterli's veach-mis and ours"
+    );
     assert_eq!(
         summary
             .matches(", within the better one's interval or below it")
             .count(),
         robust,
         "figure 2's verdicts"
+    );
+    figure_3_verdict_follows_its_intervals(&dir, &summary);
+    figure_4_verdicts_follow_their_intervals(&dir, &summary);
+}
+
+fn cell(r: &HashMap<String, String>, c: &str) -> f64 {
+    r[c].parse().unwrap_or_else(|e| panic!("{c}: {e}: {r:?}"))
+}
+
+/// Every (m, m lo, m hi) of `rows` holds its mean inside its interval.
+fn means_inside(rows: &[HashMap<String, String>], measures: &[&str]) {
+    for r in rows {
+        for m in measures {
+            let (v, lo, hi) = (
+                cell(r, m),
+                cell(r, &format!("{m} lo")),
+                cell(r, &format!("{m} hi")),
+            );
+            assert!(lo <= v && v <= hi, "{m} outside its interval: {r:?}");
+        }
+    }
+}
+
+/// Figure 3 (ppm.csv): the summary says "holds" exactly when, on the caustic crop, the better
+/// consistent estimator's relMSE and FLIP intervals both lie below the better unbiased one's,
+/// "holds to the eye" when only FLIP's do, "is not shown" otherwise.
+fn figure_3_verdict_follows_its_intervals(dir: &std::path::Path, summary: &str) {
+    let rows = csv(&dir.join("ppm.csv"));
+    means_inside(&rows, &["relMSE", "FLIP", "caustic relMSE", "caustic FLIP"]);
+    let best = |kind: &str| {
+        rows.iter()
+            .filter(|r| r["kind"] == kind)
+            .min_by(|a, b| cell(a, "caustic relMSE").total_cmp(&cell(b, "caustic relMSE")))
+            .unwrap_or_else(|| panic!("figure 3 has no {kind} estimator"))
+    };
+    let (c, u) = (best("consistent"), best("unbiased"));
+    let below = |m: &str| cell(c, &format!("{m} hi")) < cell(u, &format!("{m} lo"));
+    let (rel, flip) = (below("caustic relMSE"), below("caustic FLIP"));
+    let said = |v: &str| summary.contains(&format!("converge — {v}"));
+    assert_eq!(
+        said("holds: on the caustic"),
+        rel && flip,
+        "figure 3's verdict"
+    );
+    assert_eq!(said("holds to the eye"), flip && !rel, "figure 3's verdict");
+    assert_eq!(
+        said("is not shown at this budget"),
+        !flip,
+        "figure 3's verdict"
+    );
+}
+
+/// Figure 4 (vcm.csv): per scene, vcm is "as good as the better" of bdpt and ppm when its
+/// relMSE interval reaches the better one's, "near the better" when it reaches below the
+/// geometric mean of the two, "not near" otherwise; the summary's phrases and count follow.
+fn figure_4_verdicts_follow_their_intervals(dir: &std::path::Path, summary: &str) {
+    let rows = csv(&dir.join("vcm.csv"));
+    means_inside(&rows, &["relMSE", "FLIP"]);
+    let mut scenes: Vec<&str> = rows.iter().map(|r| r["scene"].as_str()).collect();
+    scenes.dedup();
+    assert_eq!(scenes.len(), 3, "figure 4's scenes");
+    let mut counts = [0usize; 3];
+    for s in &scenes {
+        let rel = |i: &str| {
+            let r = rows
+                .iter()
+                .find(|r| r["scene"] == *s && r["integrator"] == i)
+                .unwrap_or_else(|| panic!("{s}: no {i}"));
+            (
+                cell(r, "relMSE"),
+                cell(r, "relMSE lo"),
+                cell(r, "relMSE hi"),
+            )
+        };
+        let (b, p, v) = (rel("bdpt"), rel("ppm"), rel("vcm"));
+        let (better, worse) = if b.0 <= p.0 { (b, p) } else { (p, b) };
+        let k = if v.1 <= better.2 {
+            0
+        } else if v.1 <= (better.0 * worse.0).sqrt() {
+            1
+        } else {
+            2
+        };
+        counts[k] += 1;
+    }
+    let phrases = [
+        ", as good as the better",
+        ", near the better (below the geometric mean)",
+        ", not near the better",
+    ];
+    for (p, n) in phrases.iter().zip(counts) {
+        assert_eq!(summary.matches(p).count(), n, "figure 4's verdicts: {p}");
+    }
+    assert!(
+        summary.contains(&format!("holds on {} of 3 scenes", counts[0] + counts[1])),
+        "figure 4's count"
     );
 }

@@ -39,7 +39,8 @@ pub fn key_of(material: &Value) -> Key {
 
 /// The content hash of a scene: every file it was read from (`Scene::source_files`), names
 /// excluded, so a moved or copied scene keeps its hash and an edited mesh changes it; and the
-/// load options that change what is read (`-D` definitions, `--approximate`), when given.
+/// load options that changed what was read (`-D` definitions of an XML scene, `--approximate`),
+/// when given.
 pub fn scene_hash(files: &[PathBuf]) -> Result<String, String> {
     if files.is_empty() {
         return Err("the scene names no source files, so it has no content hash".into());
@@ -51,7 +52,8 @@ pub fn scene_hash(files: &[PathBuf]) -> Result<String, String> {
         h.update(&(bytes.len() as u64).to_le_bytes());
         h.update(&bytes);
     }
-    let opts = lt_scene_io::default_load_options();
+    // The options the scene was read with (`scene_load`: the first file is the scene's own).
+    let opts = crate::scene_load::options_for(&files[0]);
     if opts.approximate || !opts.defines.is_empty() {
         h.update(format!("load {} {:?}", opts.approximate, opts.defines).as_bytes());
     }

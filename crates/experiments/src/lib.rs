@@ -14,5 +14,6 @@ pub mod manifest;
 pub mod plot;
 pub mod report;
 pub mod runs;
+pub mod scene_load;
 pub mod study;
 pub mod verify;

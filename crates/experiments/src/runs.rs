@@ -12,7 +12,6 @@ use crate::image_io::{read_exr, write_exr};
 use lt_core::Scene;
 use lt_estimators::Image;
 use lt_integrators::{make_integrator, render_runs, IntegratorParams, Kind, RenderOptions};
-use lt_scene_io::load_scene;
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -90,7 +89,7 @@ impl RunSpec {
 
     /// The scene as this run renders it (resolution applied).
     pub fn load_scene(&self) -> Result<Scene, String> {
-        let mut scene = load_scene(&self.scene).map_err(|e| e.to_string())?;
+        let mut scene = crate::scene_load::load(&self.scene).map_err(|e| e.to_string())?;
         if let Some((w, h)) = self.resolution {
             if w == 0 || h == 0 {
                 return Err(format!("resolution {w}×{h} has no pixels"));

@@ -222,7 +222,7 @@ pub struct PartialJob {
 
 impl PartialJob {
     pub fn load_scene(&self) -> Result<Scene, String> {
-        let mut scene = lt_scene_io::load_scene(&self.scene).map_err(|e| e.to_string())?;
+        let mut scene = crate::scene_load::load(&self.scene).map_err(|e| e.to_string())?;
         if let Some((w, h)) = self.resolution {
             if w == 0 || h == 0 {
                 return Err(format!("resolution {w}x{h} has no pixels"));

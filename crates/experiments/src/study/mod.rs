@@ -71,14 +71,9 @@ pub fn plan(
     Ok(specs
         .into_iter()
         .map(|s| {
-            // A reference is exactly what `reference::spec` makes for its scene and depth.
-            let depth = s
-                .params
-                .iter()
-                .find(|(k, _)| k == "max_depth")
-                .and_then(|(_, v)| v.parse().ok());
-            let is_reference = reference::spec(scale, &s.scene, depth).is_ok_and(|r| r == s);
-            let role = if is_reference {
+            // A reference is what `reference::spec` makes for its scene, at the scale's film
+            // and passes or at a study's own (the figures').
+            let role = if reference::is_reference(&s) {
                 Role::References
             } else {
                 Role::Runs

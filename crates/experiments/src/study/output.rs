@@ -18,7 +18,7 @@ pub fn film(scale: &Scale, scene: &Path) -> Result<(u32, u32), String> {
     let size = match map.get(scene) {
         Some(s) => *s,
         None => {
-            let s = lt_scene_io::load_scene(scene).map_err(|e| e.to_string())?;
+            let s = crate::scene_load::load(scene).map_err(|e| e.to_string())?;
             let size = (s.camera.width, s.camera.height);
             map.insert(scene.to_path_buf(), size);
             size

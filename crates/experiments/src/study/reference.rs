@@ -65,6 +65,35 @@ pub fn spec(scale: &Scale, scene: &Path, max_depth: Option<u32>) -> Result<RunSp
     Ok(s)
 }
 
+/// Whether `s` is a reference as `spec` makes them, at whatever film and passes (a study may
+/// make its references at its own, as the figures do): the scene's reference integrator, the
+/// reference seed, and the runs and parameters `spec` gives it. `lt plan study` sends these to
+/// the reference cache.
+pub fn is_reference(s: &RunSpec) -> bool {
+    let stem = s
+        .scene
+        .file_stem()
+        .map(|x| x.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let (integrator, _) = integrator_for(&stem);
+    let consistent = crate::runs::is_consistent(integrator);
+    // A consistent reference is made at radius 1 px, an unbiased one has no radius.
+    let radius_given = s.params.iter().any(|(k, v)| k == "radius_px" && v == "1");
+    let params_fit = radius_given == consistent
+        && s.params
+            .iter()
+            .all(|(k, v)| k == "max_depth" || (consistent && k == "radius_px" && v == "1"));
+    s.integrator == integrator
+        && s.seed == REFERENCE_SEED
+        && s.runs
+            == if consistent {
+                CONSISTENT_REFERENCE_RUNS
+            } else {
+                1
+            }
+        && params_fit
+}
+
 /// A reference as the studies use it.
 pub struct Reference {
     pub image: Image,
@@ -117,5 +146,31 @@ impl Reference {
             consistent: e.record.consistent(),
             seconds: e.record.seconds.last().copied().unwrap_or(0.0),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{is_reference, CONSISTENT_REFERENCE_RUNS, REFERENCE_SEED};
+    use crate::runs::RunSpec;
+
+    /// A reference is told by what it is, at any film and passes; a study run is not one.
+    #[test]
+    fn references_are_told_at_any_film_and_passes() {
+        let bdpt = |seed| RunSpec::new("scenes/cornell-box.toml", "bdpt", seed, 512);
+        assert!(is_reference(
+            &bdpt(REFERENCE_SEED).resolution(Some((128, 128)))
+        ));
+        assert!(is_reference(&bdpt(REFERENCE_SEED).param("max_depth", 4)));
+        assert!(!is_reference(&bdpt(1)));
+        assert!(!is_reference(&bdpt(REFERENCE_SEED).param("mis", "balance")));
+        let vcm = RunSpec::new("scenes/caustic-sds.toml", "vcm", REFERENCE_SEED, 64);
+        assert!(is_reference(
+            &vcm.clone()
+                .runs(CONSISTENT_REFERENCE_RUNS)
+                .param("radius_px", 1)
+        ));
+        assert!(!is_reference(&vcm.clone().param("radius_px", 1)));
+        assert!(!is_reference(&vcm.runs(CONSISTENT_REFERENCE_RUNS)));
     }
 }

@@ -1,0 +1,287 @@
+//! Figure 4: Georgiev et al. 2012 (vertex connection and merging). `bdpt` (connections), `ppm`
+//! (merging: Hachisuka et al.'s photon mapping) and `vcm` (both under one MIS) at equal CPU time
+//! on three scenes where a different technique wins — `cornell-box` (diffuse: connections),
+//! `veach-door` (light through a door ajar: long connections), `caustic-sds` (a caustic seen in
+//! a mirror: only merging) — with the per-technique contributions the techniques study measured
+//! on the same scenes (results/techniques/families.csv; read, never recomputed).
+
+use super::{
+    at, cell, errors, film, num, reference_scale, toml_scene, Budget, Contender, EqualTime, Errors,
+};
+use crate::gallery::{write_gallery, Entry};
+use crate::runs::RunSpec;
+use crate::study::output::StudyOutput;
+use crate::study::{Scale, StudyContext};
+use std::path::PathBuf;
+
+/// The scenes, in `Budget::vcm_passes`' order; the techniques study's committed scenes.
+pub(super) const SCENES: [&str; 3] = ["cornell-box", "veach-door", "caustic-sds"];
+
+const VCM: Contender = Contender {
+    label: "vcm",
+    integrator: "vcm",
+};
+const BDPT: Contender = Contender {
+    label: "bdpt",
+    integrator: "bdpt",
+};
+const PPM: Contender = Contender {
+    label: "ppm",
+    integrator: "ppm",
+};
+
+fn reference_at(scale: &Scale, b: &Budget, scene: &std::path::Path) -> Scale {
+    reference_scale(scale, b, scene, b.vcm_reference_passes)
+}
+
+fn comparison(scale: &Scale, b: &Budget, k: usize) -> Result<EqualTime, String> {
+    let scene = toml_scene(scale, SCENES[k]);
+    let res = film(&at(scale, b, b.vcm_reference_passes), &scene)?;
+    Ok(EqualTime {
+        scene,
+        res,
+        runs: b.comparison_runs,
+        setter: VCM,
+        setter_passes: b.vcm_passes[k],
+        others: vec![BDPT, PPM],
+    })
+}
+
+pub(super) fn specs(
+    scale: &Scale,
+    b: &Budget,
+    ctx: Option<&StudyContext>,
+) -> Result<Vec<RunSpec>, String> {
+    let mut v = Vec::new();
+    for k in 0..SCENES.len() {
+        let scene: PathBuf = toml_scene(scale, SCENES[k]);
+        v.extend(crate::study::reference::spec(
+            &reference_at(scale, b, &scene),
+            &scene,
+            None,
+        ));
+        v.extend(comparison(scale, b, k)?.planned(ctx)?);
+    }
+    Ok(v)
+}
+
+pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> Result<(), String> {
+    let scale = &ctx.scale;
+    let mut rows = Vec::new();
+    let mut verdicts = Vec::new();
+    let mut normalised = Vec::new();
+    for k in 0..SCENES.len() {
+        let name = SCENES[k];
+        let cmp = comparison(scale, b, k)?;
+        let reference = ctx.reference_at(&reference_at(scale, b, &cmp.scene), &cmp.scene, None)?;
+        let (budget_s, arms) = cmp.run(ctx)?;
+        let mut measured: Vec<(&str, Errors)> = Vec::new();
+        // relMSE × CPU s of bdpt, ppm, vcm: the check on equal time as achieved.
+        let mut inefficiency = Vec::new();
+        let mut shown = Vec::new();
+        // Table order: bdpt, ppm, vcm (the setter, first in `arms`).
+        for &i in &[1, 2, 0] {
+            let arm = &arms[i];
+            let (e, images) = errors(&arm.entries, &reference, scale.confidence)?;
+            let mut row = vec![
+                name.to_string(),
+                arm.contender.label.to_string(),
+                arm.passes.to_string(),
+                num(super::mean_cpu(&arm.entries)),
+            ];
+            row.extend(cell(&e.rel));
+            row.extend(cell(&e.flip));
+            rows.push(row);
+            shown.push((
+                arm.contender.label,
+                images.into_iter().next().ok_or("no runs")?,
+                format!(
+                    "{} spp, relMSE {}, FLIP {}",
+                    arm.passes,
+                    num(e.rel.estimate),
+                    num(e.flip.estimate)
+                ),
+            ));
+            inefficiency.push(e.rel.estimate * super::mean_cpu(&arm.entries));
+            measured.push((arm.contender.label, e));
+        }
+        verdicts.push(scene_verdict(name, &measured));
+        normalised.push(time_normalised(name, &inefficiency));
+        let entries: Vec<Entry> = shown
+            .iter()
+            .map(|(l, img, note)| Entry {
+                label: l,
+                note: note.clone(),
+                image: img,
+                stem: format!("gallery/vcm-{name}/{l}"),
+            })
+            .collect();
+        let g = write_gallery(
+            &out.dir,
+            &format!("Figure 4: {name}, bdpt, ppm and vcm at equal CPU time"),
+            &format!(
+                "Equal CPU time ({} s per run, vcm's mean at {} passes). Reference: {} {} at {} \
+                 passes{}.",
+                num(budget_s),
+                cmp.setter_passes,
+                if reference.consistent {
+                    format!("{} independent runs of", reference.runs)
+                } else {
+                    String::new()
+                },
+                reference.integrator,
+                reference.passes,
+                if reference.consistent { " each" } else { "" }
+            ),
+            &reference.gallery_entry(format!("gallery/vcm-{name}/reference")),
+            &entries,
+            Some((b.width / 4).max(4)),
+        )?;
+        out.manifest.galleries.push(g);
+    }
+    out.table(
+        "vcm",
+        "Figure 4: bdpt, ppm and vcm at equal time (Georgiev et al. 2012)",
+        &format!(
+            "{} independent runs per estimator on each scene; vcm's runs fix the CPU time, \
+             bdpt's and ppm's pass counts come from their CPU time per pass at vcm's count. \
+             References: bdpt at {} passes (cornell-box, veach-door), independent vcm runs at \
+             radius 1 px (caustic-sds).",
+            b.comparison_runs, b.vcm_reference_passes
+        ),
+        &[
+            "scene",
+            "integrator",
+            "passes",
+            "CPU s",
+            "relMSE",
+            "relMSE lo",
+            "relMSE hi",
+            "FLIP",
+            "FLIP lo",
+            "FLIP hi",
+        ],
+        rows,
+        true,
+    )?;
+    let near = verdicts.iter().filter(|v| !v.contains(NOT_NEAR)).count();
+    out.para(&format!(
+        "**Verdict (figure 4).** Georgiev et al.'s claim — vcm is robust: near the better of \
+         bdpt and photon mapping on every scene — holds on {near} of {} scenes ({}). Near means \
+         vcm's relMSE interval reaches below the geometric mean of the two others' relMSE: \
+         nearer the better than the worse on the log scale the errors span.",
+        SCENES.len(),
+        verdicts.join("; ")
+    ));
+    out.para(&format!(
+        "Equal time is what the probes predicted; the CPU s column is what each arm took. \
+         Normalised by it (relMSE × CPU s, an unbiased estimator's time-invariant \
+         inefficiency), vcm against the better of bdpt and ppm: {}.",
+        normalised.join("; ")
+    ));
+    techniques_table(ctx, out)
+}
+
+/// The phrase of a scene where vcm is not near the better technique.
+const NOT_NEAR: &str = "not near the better";
+
+/// One scene's verdict: vcm against the better and the worse of bdpt and ppm by relMSE.
+fn scene_verdict(name: &str, m: &[(&str, Errors)]) -> String {
+    let (bdpt, ppm, vcm) = (&m[0], &m[1], &m[2]);
+    let (better, worse) = if bdpt.1.rel.estimate <= ppm.1.rel.estimate {
+        (bdpt, ppm)
+    } else {
+        (ppm, bdpt)
+    };
+    let v = &vcm.1.rel;
+    let midpoint = (better.1.rel.estimate * worse.1.rel.estimate).sqrt();
+    let how = if v.lo <= better.1.rel.hi {
+        "as good as the better (the intervals meet, or vcm's lies below)"
+    } else if v.lo <= midpoint {
+        "near the better (below the geometric mean)"
+    } else {
+        NOT_NEAR
+    };
+    format!(
+        "{name}: vcm's relMSE is {}× {}'s (the better) and {}× {}'s, {how}",
+        num(v.estimate / better.1.rel.estimate),
+        better.0,
+        num(v.estimate / worse.1.rel.estimate),
+        worse.0
+    )
+}
+
+/// vcm's inefficiency (relMSE × CPU s; `ineff` in bdpt, ppm, vcm order) against the better and
+/// the geometric mean of bdpt's and ppm's.
+fn time_normalised(name: &str, ineff: &[f64]) -> String {
+    let (better, worse) = (ineff[0].min(ineff[1]), ineff[0].max(ineff[1]));
+    let mid = (better * worse).sqrt();
+    format!(
+        "{name} {}× the better's ({} their geometric mean, {}×)",
+        num(ineff[2] / better),
+        if ineff[2] <= mid { "below" } else { "above" },
+        num(mid / better)
+    )
+}
+
+/// The techniques study's per-family shares on the figure's scenes, for bdpt and vcm: the part
+/// of the time and of the image each family of techniques has (the mean's share of their sum).
+fn techniques_table(ctx: &StudyContext, out: &mut StudyOutput) -> Result<(), String> {
+    let path = ctx
+        .study_dir(crate::study::techniques::NAME)
+        .join("families.csv");
+    let Ok(rows) = crate::report::findings::csv(&path) else {
+        out.para(&format!(
+            "The per-technique contributions are not shown: `{}` is missing; `lt study \
+             techniques --scale committed` writes it.",
+            path.display()
+        ));
+        return Ok(());
+    };
+    let lead = |s: &str| {
+        s.split_whitespace()
+            .next()
+            .and_then(|x| x.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    let mut table = Vec::new();
+    for scene in SCENES {
+        for integrator in ["bdpt", "vcm"] {
+            let of: Vec<_> = rows
+                .iter()
+                .filter(|r| r["scene"] == scene && r["integrator"] == integrator)
+                .collect();
+            let total: f64 = of.iter().map(|r| lead(&r["mean"])).sum();
+            for r in of.iter().filter(|r| lead(&r["mean"]) > 0.0) {
+                table.push(vec![
+                    scene.to_string(),
+                    integrator.to_string(),
+                    r["family"].clone(),
+                    r["share of time"].clone(),
+                    num(lead(&r["mean"]) / total),
+                ]);
+            }
+        }
+    }
+    out.table(
+        "vcm-techniques",
+        "Figure 4b: what each family of techniques contributes (from the techniques study)",
+        &format!(
+            "Read from `{}/families.csv` (the techniques study: 4 runs of 8 passes at 128 px, one thread, \
+             techniques timed by the time-stamp counter): each family's share of the pass's CPU \
+             time (Student-t interval over runs) and its share of the image's mean (the \
+             family's mean over the sum of all). Families that contribute nothing (the walks, \
+             `other`) are left out.",
+            crate::study::techniques::NAME
+        ),
+        &[
+            "scene",
+            "integrator",
+            "family",
+            "share of time",
+            "share of image",
+        ],
+        table,
+        true,
+    )
+}
