@@ -153,9 +153,9 @@ pub fn size(scale: &Scale) -> StudySize {
     };
     let (width, runs, passes, scenes) = match scale.name {
         "test" => (16, 4, 4, named(&["cornell-box"])),
-        // Bitterli's veach-bidir loads only with `-D integrator=path`, which TOML scenes refuse:
-        // it is the `bitterli` scale's (`lt study techniques --scale bitterli -D
-        // integrator=path`, into results/techniques-bitterli/).
+        // Bitterli's veach-bidir loads only with `-D integrator=path`: it is the `bitterli`
+        // scale's (`lt study techniques --scale bitterli -D integrator=path`, into
+        // results/techniques-bitterli/; study renders apply `-D` to XML scenes only).
         "bitterli" => (
             128,
             4,
