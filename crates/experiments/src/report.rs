@@ -10,6 +10,7 @@
 //! images, and writes a JSON line into `<pre id="lt-selfcheck" hidden>` — what
 //! `crates/experiments/tests/report_browser.rs` reads from Chromium's dumped DOM.
 
+mod escape;
 pub mod findings;
 mod html;
 mod markdown;

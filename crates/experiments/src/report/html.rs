@@ -1,6 +1,7 @@
 //! The page itself: study sections from manifests, with the inline CSS and scripts beside this
 //! file (`page.css`, `page.js`, `selfcheck.js`).
 
+use super::escape::{esc, url};
 use super::markdown;
 use super::overview;
 use super::StudyDir;
@@ -61,35 +62,6 @@ pub fn files_named(m: &Manifest) -> Vec<&str> {
     for g in m.galleries.iter().filter(|g| !overview::on_demand(m, g)) {
         out.push(&g.reference.image);
         out.extend(g.items.iter().map(|i| i.image.as_str()));
-    }
-    out
-}
-
-/// Escapes text for HTML content and double-quoted attributes.
-pub fn esc(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            _ => out.push(c),
-        }
-    }
-    out
-}
-
-/// `folder/rel` as a relative URL: every byte outside the unreserved set (and '/') escaped.
-pub fn url(folder: &str, rel: &str) -> String {
-    let mut out = String::new();
-    for b in format!("{folder}/{rel}").bytes() {
-        if b.is_ascii_alphanumeric() || b"-._~/".contains(&b) {
-            out.push(b as char);
-        } else {
-            let _ = write!(out, "%{b:02X}");
-        }
     }
     out
 }
@@ -411,10 +383,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn escapes_and_urls() {
-        assert_eq!(esc("a<b>&\"'"), "a&lt;b&gt;&amp;&quot;&#39;");
-        assert_eq!(url("equal-time", "g/pt 1.png"), "equal-time/g/pt%201.png");
-        assert_eq!(url("x", "ä\"#.svg"), "x/%C3%A4%22%23.svg");
+    fn slugs_and_titles() {
         assert_eq!(slug("Per length (k ≤ 5)"), "per-length-k-5");
         assert_eq!(
             without_title("# Convergence\n\nText\n", "Convergence"),

@@ -5,7 +5,7 @@
 //! committed: each row holds its scene's galleries in a `<template>` that the page opens when
 //! the images exist locally, and the command that makes them (`equal_time::regenerate`).
 
-use super::html::{esc, url};
+use super::escape::{esc, url};
 use crate::manifest::{Gallery, Manifest};
 use crate::study::equal_time::{self, thumb, GALLERIES_CSV};
 use std::collections::HashMap;
