@@ -2,7 +2,7 @@
 //! `veach-bidir`: `pt` against `bdpt` at equal CPU time, and bdpt's per-strategy (s, t) images
 //! of the path pyramid, read from `lt render --strategies` output (see `PYRAMID_DIR`).
 
-use super::{at, cell, errors, film, num, Budget, Contender, EqualTime};
+use super::{at, cell, errors, film, labelled_entries, num, Budget, Contender, EqualTime};
 use crate::gallery::{write_gallery, Entry};
 use crate::runs::RunSpec;
 use crate::study::output::{stem, StudyOutput};
@@ -164,15 +164,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
             ),
         ),
     ];
-    let entries: Vec<Entry> = notes
-        .iter()
-        .map(|(i, img, note)| Entry {
-            label: i,
-            note: note.clone(),
-            image: img,
-            stem: format!("gallery/{name}/{i}"),
-        })
-        .collect();
+    let entries = labelled_entries(&notes, &name);
     let g = write_gallery(
         &out.dir,
         "Figure 1: veach-bidir, pt against bdpt at equal CPU time",

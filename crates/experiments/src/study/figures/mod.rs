@@ -29,6 +29,7 @@ use super::output::StudyOutput;
 use super::output::{film, num, pct};
 use super::reference::Reference;
 use super::{Scale, StudyContext};
+use crate::gallery::Entry;
 use crate::manifest::Crop;
 use crate::runs::{RunEntry, RunSpec};
 use lt_estimators::{Image, Interval};
@@ -293,6 +294,21 @@ fn crop_reference(r: &Reference, c: Crop) -> Reference {
         consistent: r.consistent,
         seconds: r.seconds,
     }
+}
+/// Gallery entries for (label, image, note) triples, each stored as `gallery/{dir}/{label}`.
+pub(super) fn labelled_entries<'a, I: std::borrow::Borrow<Image>>(
+    shown: &'a [(&'a str, I, String)],
+    dir: &str,
+) -> Vec<Entry<'a>> {
+    shown
+        .iter()
+        .map(|(label, image, note)| Entry {
+            label,
+            note: note.clone(),
+            image: image.borrow(),
+            stem: format!("gallery/{dir}/{label}"),
+        })
+        .collect()
 }
 
 fn cell(i: &Interval) -> [String; 3] {

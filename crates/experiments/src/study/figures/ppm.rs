@@ -7,10 +7,10 @@
 //! independent vcm runs at radius 1 px (`reference::integrator_for`).
 
 use super::{
-    cell, crop_image, crop_reference, errors, errors_of_images, film, num, reference_scale,
-    toml_scene, Budget, Contender, EqualTime, Errors,
+    cell, crop_image, crop_reference, errors, errors_of_images, film, labelled_entries, num,
+    reference_scale, toml_scene, Budget, Contender, EqualTime, Errors,
 };
-use crate::gallery::{write_gallery, Entry};
+use crate::gallery::write_gallery;
 use crate::manifest::Crop;
 use crate::runs::RunSpec;
 use crate::study::output::{stem, StudyOutput};
@@ -183,15 +183,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
     )?;
     out.para(&verdict(&measured));
     let name = stem(&scene);
-    let entries: Vec<Entry> = shown
-        .iter()
-        .map(|(l, img, note)| Entry {
-            label: l,
-            note: note.clone(),
-            image: img,
-            stem: format!("gallery/sds-{name}/{l}"),
-        })
-        .collect();
+    let entries = labelled_entries(&shown, &format!("sds-{name}"));
     let g = write_gallery(
         &out.dir,
         "Figure 3: caustic-sds, the caustic seen in the mirror at equal CPU time",

@@ -6,9 +6,10 @@
 //! on the same scenes (results/techniques/families.csv; read, never recomputed).
 
 use super::{
-    at, cell, errors, film, num, reference_scale, toml_scene, Budget, Contender, EqualTime, Errors,
+    at, cell, errors, film, labelled_entries, num, reference_scale, toml_scene, Budget, Contender,
+    EqualTime, Errors,
 };
-use crate::gallery::{write_gallery, Entry};
+use crate::gallery::write_gallery;
 use crate::runs::RunSpec;
 use crate::study::output::StudyOutput;
 use crate::study::{Scale, StudyContext};
@@ -107,15 +108,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
         }
         verdicts.push(scene_verdict(name, &measured));
         normalised.push(time_normalised(name, &inefficiency));
-        let entries: Vec<Entry> = shown
-            .iter()
-            .map(|(l, img, note)| Entry {
-                label: l,
-                note: note.clone(),
-                image: img,
-                stem: format!("gallery/vcm-{name}/{l}"),
-            })
-            .collect();
+        let entries = labelled_entries(&shown, &format!("vcm-{name}"));
         let g = write_gallery(
             &out.dir,
             &format!("Figure 4: {name}, bdpt, ppm and vcm at equal CPU time"),
