@@ -2,7 +2,7 @@
 //! `veach-bidir`: `pt` against `bdpt` at equal CPU time, and bdpt's per-strategy (s, t) images
 //! of the path pyramid, read from `lt render --strategies` output (see `PYRAMID_DIR`).
 
-use super::{at, cell, errors, film, labelled_entries, num, Budget, Contender, EqualTime};
+use super::{at, cell, columns, errors, film, labelled_entries, num, Budget, Contender, EqualTime};
 use crate::gallery::{write_gallery, Entry};
 use crate::runs::RunSpec;
 use crate::study::output::{stem, StudyOutput};
@@ -31,15 +31,9 @@ fn comparison(scale: &Scale, b: &Budget) -> Result<EqualTime, String> {
         scene,
         res,
         runs: b.runs,
-        setter: Contender {
-            label: "bdpt",
-            integrator: "bdpt",
-        },
+        setter: Contender("bdpt"),
         setter_passes: b.bdpt_passes,
-        others: vec![Contender {
-            label: "pt",
-            integrator: "pt",
-        }],
+        others: vec![Contender("pt")],
     })
 }
 
@@ -72,7 +66,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
     let mut rows = Vec::new();
     for (arm, e) in [(pt, &ep), (bdpt, &eb)] {
         let mut row = vec![
-            arm.contender.label.to_string(),
+            arm.contender.0.to_string(),
             arm.passes.to_string(),
             num(super::mean_cpu(&arm.entries)),
         ];
@@ -93,20 +87,10 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
             reference.passes,
             reference.integrator
         ),
-        &[
-            "integrator",
-            "passes",
-            "CPU s",
-            "relMSE",
-            "relMSE lo",
-            "relMSE hi",
-            "FLIP",
-            "FLIP lo",
-            "FLIP hi",
-            "MSE",
-            "MSE lo",
-            "MSE hi",
-        ],
+        &columns(
+            &["integrator", "passes", "CPU s"],
+            &["MSE", "MSE lo", "MSE hi"],
+        ),
         rows,
         true,
     )?;

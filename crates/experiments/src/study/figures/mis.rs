@@ -3,7 +3,7 @@
 //! (`scenes/veach-mis.toml`, which takes none of the study's `-D` definitions: they apply to
 //! Mitsuba XML scenes only, see `crate::scene_load`).
 
-use super::{at, cell, errors, film, num, run_spec, Budget};
+use super::{at, cell, columns, errors, film, num, run_spec, Budget};
 use crate::gallery::{write_gallery, Entry};
 use crate::runs::RunSpec;
 use crate::study::equal_time::VEACH;
@@ -140,18 +140,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
         "mis",
         "Figure 2: Veach's MIS comparison at equal samples",
         "pt by technique and heuristic, the same passes for each; CPU s is the mean per run.",
-        &[
-            "scene",
-            "technique",
-            "passes",
-            "CPU s",
-            "relMSE",
-            "relMSE lo",
-            "relMSE hi",
-            "FLIP",
-            "FLIP lo",
-            "FLIP hi",
-        ],
+        &columns(&["scene", "technique", "passes", "CPU s"], &[]),
         rows,
         true,
     )?;

@@ -147,12 +147,10 @@ fn mean_cpu(v: &[RunEntry]) -> f64 {
     v.iter().map(cpu).sum::<f64>() / v.len().max(1) as f64
 }
 
-/// One estimator of an equal-time figure: its label and integrator.
+/// One estimator of an equal-time figure: its registry name, which is also its label in the
+/// tables and galleries.
 #[derive(Clone, Copy)]
-struct Contender {
-    label: &'static str,
-    integrator: &'static str,
-}
+struct Contender(&'static str);
 
 /// An equal-time comparison on one scene: `setter`'s K runs at `setter_passes` fix the budget
 /// (their mean CPU seconds); each of `others` is probed at `setter_passes` (seed 1) for its CPU
@@ -176,12 +174,12 @@ struct Arm {
 impl EqualTime {
     fn specs_of(&self, c: Contender, passes: u32) -> Vec<RunSpec> {
         (0..self.runs)
-            .map(|r| run_spec(&self.scene, self.res, c.integrator, 1 + r as u64, passes))
+            .map(|r| run_spec(&self.scene, self.res, c.0, 1 + r as u64, passes))
             .collect()
     }
 
     fn probe(&self, c: Contender) -> RunSpec {
-        run_spec(&self.scene, self.res, c.integrator, 1, self.setter_passes)
+        run_spec(&self.scene, self.res, c.0, 1, self.setter_passes)
     }
 
     /// (budget CPU s, passes) of `c` from the setter's runs and `c`'s probe.
@@ -295,6 +293,21 @@ fn crop_reference(r: &Reference, c: Crop) -> Reference {
         seconds: r.seconds,
     }
 }
+/// The columns `cell` fills for relMSE, then FLIP: each estimate and its interval's ends.
+const ERROR_COLUMNS: [&str; 6] = [
+    "relMSE",
+    "relMSE lo",
+    "relMSE hi",
+    "FLIP",
+    "FLIP lo",
+    "FLIP hi",
+];
+
+/// A figure table's columns: `lead`, the error columns, `tail`.
+fn columns(lead: &[&'static str], tail: &[&'static str]) -> Vec<&'static str> {
+    [lead, &ERROR_COLUMNS[..], tail].concat()
+}
+
 /// Gallery entries for (label, image, note) triples, each stored as `gallery/{dir}/{label}`.
 pub(super) fn labelled_entries<'a, I: std::borrow::Borrow<Image>>(
     shown: &'a [(&'a str, I, String)],

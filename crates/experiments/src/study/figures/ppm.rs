@@ -7,8 +7,8 @@
 //! independent vcm runs at radius 1 px (`reference::integrator_for`).
 
 use super::{
-    cell, crop_image, crop_reference, errors, errors_of_images, film, labelled_entries, num,
-    reference_scale, toml_scene, Budget, Contender, EqualTime, Errors,
+    cell, columns, crop_image, crop_reference, errors, errors_of_images, film, labelled_entries,
+    num, reference_scale, toml_scene, Budget, Contender, EqualTime, Errors,
 };
 use crate::gallery::write_gallery;
 use crate::manifest::Crop;
@@ -22,24 +22,9 @@ use std::path::PathBuf;
 pub(super) const SDS_CROP: [f64; 4] = [0.33, 0.4, 0.7, 0.6];
 
 /// The unbiased estimators first, then the consistent ones; `sppm` fixes the time.
-const UNBIASED: [Contender; 2] = [
-    Contender {
-        label: "pt",
-        integrator: "pt",
-    },
-    Contender {
-        label: "bdpt",
-        integrator: "bdpt",
-    },
-];
-const PPM: Contender = Contender {
-    label: "ppm",
-    integrator: "ppm",
-};
-const SPPM: Contender = Contender {
-    label: "sppm",
-    integrator: "sppm",
-};
+const UNBIASED: [Contender; 2] = [Contender("pt"), Contender("bdpt")];
+const PPM: Contender = Contender("ppm");
+const SPPM: Contender = Contender("sppm");
 
 fn scene(scale: &Scale) -> PathBuf {
     toml_scene(scale, "caustic-sds")
@@ -114,9 +99,9 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
         let (full, images) = errors(&arm.entries, &reference, scale.confidence)?;
         let crops: Vec<_> = images.iter().map(|img| crop_image(img, crop)).collect();
         let sds = errors_of_images(&crops, &cropped, scale.confidence)?;
-        let consistent = crate::runs::is_consistent(arm.contender.integrator);
+        let consistent = crate::runs::is_consistent(arm.contender.0);
         let mut row = vec![
-            arm.contender.label.to_string(),
+            arm.contender.0.to_string(),
             if consistent { "consistent" } else { "unbiased" }.to_string(),
             arm.passes.to_string(),
             num(super::mean_cpu(&arm.entries)),
@@ -127,7 +112,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
         row.extend(cell(&sds.flip));
         rows.push(row);
         shown.push((
-            arm.contender.label,
+            arm.contender.0,
             images.into_iter().next().ok_or("no runs")?,
             format!(
                 "{} spp, relMSE {} (caustic {}), FLIP {}",
@@ -137,7 +122,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
                 num(full.flip.estimate)
             ),
         ));
-        measured.push((arm.contender.label, full, sds));
+        measured.push((arm.contender.0, full, sds));
     }
     out.table(
         "ppm",
@@ -160,24 +145,17 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
             reference.integrator,
             reference.passes * reference.runs,
         ),
-        &[
-            "integrator",
-            "kind",
-            "passes",
-            "CPU s",
-            "relMSE",
-            "relMSE lo",
-            "relMSE hi",
-            "FLIP",
-            "FLIP lo",
-            "FLIP hi",
-            "caustic relMSE",
-            "caustic relMSE lo",
-            "caustic relMSE hi",
-            "caustic FLIP",
-            "caustic FLIP lo",
-            "caustic FLIP hi",
-        ],
+        &columns(
+            &["integrator", "kind", "passes", "CPU s"],
+            &[
+                "caustic relMSE",
+                "caustic relMSE lo",
+                "caustic relMSE hi",
+                "caustic FLIP",
+                "caustic FLIP lo",
+                "caustic FLIP hi",
+            ],
+        ),
         rows,
         true,
     )?;

@@ -6,8 +6,8 @@
 //! on the same scenes (results/techniques/families.csv; read, never recomputed).
 
 use super::{
-    at, cell, errors, film, labelled_entries, num, reference_scale, toml_scene, Budget, Contender,
-    EqualTime, Errors,
+    at, cell, columns, errors, film, labelled_entries, num, reference_scale, toml_scene, Budget,
+    Contender, EqualTime, Errors,
 };
 use crate::gallery::write_gallery;
 use crate::runs::RunSpec;
@@ -18,18 +18,9 @@ use std::path::PathBuf;
 /// The scenes, in `Budget::vcm_passes`' order; the techniques study's committed scenes.
 pub(super) const SCENES: [&str; 3] = ["cornell-box", "veach-door", "caustic-sds"];
 
-const VCM: Contender = Contender {
-    label: "vcm",
-    integrator: "vcm",
-};
-const BDPT: Contender = Contender {
-    label: "bdpt",
-    integrator: "bdpt",
-};
-const PPM: Contender = Contender {
-    label: "ppm",
-    integrator: "ppm",
-};
+const VCM: Contender = Contender("vcm");
+const BDPT: Contender = Contender("bdpt");
+const PPM: Contender = Contender("ppm");
 
 fn reference_at(scale: &Scale, b: &Budget, scene: &std::path::Path) -> Scale {
     reference_scale(scale, b, scene, b.vcm_reference_passes)
@@ -86,7 +77,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
             let (e, images) = errors(&arm.entries, &reference, scale.confidence)?;
             let mut row = vec![
                 name.to_string(),
-                arm.contender.label.to_string(),
+                arm.contender.0.to_string(),
                 arm.passes.to_string(),
                 num(super::mean_cpu(&arm.entries)),
             ];
@@ -94,7 +85,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
             row.extend(cell(&e.flip));
             rows.push(row);
             shown.push((
-                arm.contender.label,
+                arm.contender.0,
                 images.into_iter().next().ok_or("no runs")?,
                 format!(
                     "{} spp, relMSE {}, FLIP {}",
@@ -104,7 +95,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
                 ),
             ));
             inefficiency.push(e.rel.estimate * super::mean_cpu(&arm.entries));
-            measured.push((arm.contender.label, e));
+            measured.push((arm.contender.0, e));
         }
         verdicts.push(scene_verdict(name, &measured));
         normalised.push(time_normalised(name, &inefficiency));
@@ -142,18 +133,7 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
              radius 1 px (caustic-sds).",
             b.comparison_runs, b.vcm_reference_passes
         ),
-        &[
-            "scene",
-            "integrator",
-            "passes",
-            "CPU s",
-            "relMSE",
-            "relMSE lo",
-            "relMSE hi",
-            "FLIP",
-            "FLIP lo",
-            "FLIP hi",
-        ],
+        &columns(&["scene", "integrator", "passes", "CPU s"], &[]),
         rows,
         true,
     )?;
