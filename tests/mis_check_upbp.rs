@@ -32,20 +32,7 @@ fn upbp_weights_match_the_oracle_on_every_media_scene() {
         names.len() >= 5,
         "expected the media scenes, found {names:?}"
     );
-    let mut failed = Vec::new();
-    for h in [Heuristic::Power, Heuristic::Balance] {
-        for name in &names {
-            let mut scene = shipped_scene(name, None);
-            let opts = options(&scene, h);
-            let (report, summary) = check_scene(&mut scene, &opts, name).unwrap();
-            println!("{name} {h:?}:\n{summary}");
-            assert!(report.merges() > 0, "{name}: no merged paths\n{report}");
-            if !report.passed() {
-                failed.push(format!("{report}{summary}"));
-            }
-        }
-    }
-    assert!(failed.is_empty(), "{}", failed.join("\n"));
+    weights_match_the_oracle(names.iter().map(String::as_str));
 }
 
 /// Records of hg-spot (a spot light in a medium ball: every kind of technique is common).
@@ -103,20 +90,7 @@ fn a_planted_merge_density_error_fails() {
 /// and the check failing on cornell-box with the surface merges' density ×1.01 in the oracle.
 #[test]
 fn upbp_surface_merges_match_the_oracle_and_a_planted_error_fails() {
-    let mut failed = Vec::new();
-    for h in [Heuristic::Power, Heuristic::Balance] {
-        for name in ["cornell-box", "caustic-sds"] {
-            let mut scene = shipped_scene(name, None);
-            let opts = options(&scene, h);
-            let (report, summary) = check_scene(&mut scene, &opts, name).unwrap();
-            println!("{name} {h:?}:\n{summary}");
-            assert!(report.merges() > 0, "{name}: no merged paths\n{report}");
-            if !report.passed() {
-                failed.push(format!("{report}{summary}"));
-            }
-        }
-    }
-    assert!(failed.is_empty(), "{}", failed.join("\n"));
+    weights_match_the_oracle(["cornell-box", "caustic-sds"]);
     let mut scene = shipped_scene("cornell-box", None);
     let opts = options(&scene, Heuristic::Power);
     prepare_scene(&mut scene, &opts);
@@ -132,4 +106,23 @@ fn upbp_surface_merges_match_the_oracle_and_a_planted_error_fails() {
         report.failures() > report.checked() / 4,
         "{report}{summary}"
     );
+}
+
+/// Every applied weight of upbp on each named shipped scene against the oracle, both
+/// heuristics; each scene must have merged paths among those checked.
+fn weights_match_the_oracle<'a>(names: impl IntoIterator<Item = &'a str> + Clone) {
+    let mut failed = Vec::new();
+    for h in [Heuristic::Power, Heuristic::Balance] {
+        for name in names.clone() {
+            let mut scene = shipped_scene(name, None);
+            let opts = options(&scene, h);
+            let (report, summary) = check_scene(&mut scene, &opts, name).unwrap();
+            println!("{name} {h:?}:\n{summary}");
+            assert!(report.merges() > 0, "{name}: no merged paths\n{report}");
+            if !report.passed() {
+                failed.push(format!("{report}{summary}"));
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
