@@ -17,7 +17,7 @@ use lt_core::scene::{LightDesc, RenderSettings, SceneBuilder, ShapeGeometry, Tri
 use lt_core::{Color, Scene, Vec2, Vec3};
 use lt_estimators::agreement::agreement_with_reference_t;
 use lt_integrators::{IntegratorParams, Kind, INTEGRATORS};
-use lt_tests::render_blocks;
+use lt_tests::{assert_same_image_as_pt, is_pt_without_media, render_blocks};
 
 /// Family-wise false-alarm rate of one configuration's block tests.
 const ALPHA: f64 = 1e-3;
@@ -173,6 +173,10 @@ fn run(
 ) -> Result<String, String> {
     let scene = plane(lights);
     let who = format!("{case}: {name}{label}");
+    if is_pt_without_media(name) {
+        assert_same_image_as_pt(&scene, &who, name);
+        return Ok(format!("{who}: pt's image bit for bit (PT_WITHOUT_MEDIA)"));
+    }
     let (rendered, blocks) = render_blocks(&scene, name, p, passes, 11, BLOCK);
     if rendered.invalid_samples != 0 {
         return Err(format!(

@@ -21,7 +21,9 @@ use lt_core::scene::{MediumInterface, RenderSettings, SceneBuilder, ShapeGeometr
 use lt_core::{Color, Scene, Vec3};
 use lt_estimators::agreement::agreement_with_reference_t;
 use lt_integrators::{IntegratorParams, INTEGRATORS};
-use lt_tests::{handles_media, media_refusal, render_blocks};
+use lt_tests::{
+    assert_same_image_as_pt, handles_media, is_pt_without_media, media_refusal, render_blocks,
+};
 
 const RHO: f32 = 0.6;
 const LE: f32 = 0.5;
@@ -191,6 +193,12 @@ fn check(integrator: &str, sphere: bool, scale: f32) {
 
 fn check_with(integrator: &str, sphere: bool, scale: f32, passes: u32) {
     let case = if sphere { "sphere" } else { "cube" };
+    if is_pt_without_media(integrator) {
+        let who = format!("{integrator} {case} scale={scale:e}");
+        assert_same_image_as_pt(&furnace(sphere, scale), &who, integrator);
+        println!("{who}: pt's image bit for bit (PT_WITHOUT_MEDIA)");
+        return;
+    }
     if let Some(why) = excluded(integrator, case) {
         println!("{integrator} {case} furnace: excluded ({why})");
         return;

@@ -7,7 +7,8 @@
 use lt_core::Scene;
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions, INTEGRATORS};
 use lt_tests::{
-    handles_media, media_refusal, shipped_media_scene_names, shipped_scene, shipped_scene_names,
+    assert_same_image_as_pt, handles_media, is_pt_without_media, media_refusal,
+    shipped_media_scene_names, shipped_scene, shipped_scene_names,
 };
 use std::ops::ControlFlow;
 
@@ -127,6 +128,10 @@ fn every_integrator_gives_finite_non_negative_pixels_on_every_shipped_scene() {
                     "{} on {name}: {refusal}",
                     info.name
                 );
+                continue;
+            }
+            if is_pt_without_media(info.name) {
+                assert_same_image_as_pt(&scene, name, info.name);
                 continue;
             }
             // upbp has no photons without media (bdpt's connections under its weights): 4

@@ -94,6 +94,48 @@ pub fn shipped_media_scene_names() -> Vec<String> {
     names
 }
 
+/// Whether `integrator` is `pt` on scenes without media (`registry::PT_WITHOUT_MEDIA`): the
+/// surface loops then hold it to pt's image ([`assert_same_image_as_pt`]) rather than to their
+/// own checks, which pt's entry already passes.
+pub fn is_pt_without_media(integrator: &str) -> bool {
+    lt_integrators::registry::PT_WITHOUT_MEDIA.contains(&integrator)
+}
+
+/// Renders `integrator` and `pt` with default keys for one pass (seed 5) on `scene`, a scene
+/// without media, and asserts the same image bit for bit and the same invalid-sample count;
+/// `who` names the case in the message.
+pub fn assert_same_image_as_pt(scene: &Scene, who: &str, integrator: &str) {
+    assert!(!scene.has_media, "{who}: the scene has media");
+    let image = |name: &str| {
+        let integ = make_integrator(name, scene, &IntegratorParams::default())
+            .unwrap_or_else(|e| panic!("{who}: {name}: {e}"));
+        let opts = RenderOptions {
+            passes: 1,
+            time_limit: None,
+            seed: 5,
+            threads: 0,
+        };
+        let result = render(scene, &integ, &opts, |_| ControlFlow::Continue(())).unwrap();
+        let bits: Vec<u64> = (result.estimate.data.iter().flatten())
+            .map(|v| v.to_bits())
+            .collect();
+        (bits, result.invalid_samples)
+    };
+    let (ours, pts) = (image(integrator), image("pt"));
+    assert_eq!(
+        ours.1, pts.1,
+        "{who}: {integrator}'s invalid samples differ from pt's"
+    );
+    let first = ours.0.iter().zip(&pts.0).position(|(a, b)| a != b);
+    assert!(
+        ours.0.len() == pts.0.len() && first.is_none(),
+        "{who}: {integrator} is listed in PT_WITHOUT_MEDIA but its image differs from pt's \
+         (first at value {first:?}: {:?} against {:?})",
+        first.map(|i| f64::from_bits(ours.0[i])),
+        first.map(|i| f64::from_bits(pts.0[i]))
+    );
+}
+
 /// Whether `integrator` renders scenes with media (`registry::HANDLES_MEDIA`).
 pub fn handles_media(integrator: &str) -> bool {
     lt_integrators::registry::HANDLES_MEDIA.contains(&integrator)

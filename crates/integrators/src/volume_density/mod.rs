@@ -173,6 +173,14 @@ impl<'a> VolumeRun<'a> {
 
     fn render_with(&self, events: &(impl MediumEvents + Sync), pass: u32) -> (Image, u64) {
         let pt = self.params.pt();
+        if !self.scene.has_media {
+            // Nothing was stored and nothing is queried: the walk is pt's surface walk, so a pass
+            // is pt's pass bit for bit (`registry::PT_WITHOUT_MEDIA`). The media walk would give
+            // the same distribution from other random numbers (cornell-rough-glass).
+            return pixel_pass(self.scene, self.seed, pass, |s, raster| {
+                pt.radiance(self.scene, raster, s)
+            });
+        }
         pixel_pass(self.scene, self.seed, pass, |s, raster| {
             radiance_with(&pt, self.scene, raster, s, events)
         })
