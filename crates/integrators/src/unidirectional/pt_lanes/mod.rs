@@ -28,7 +28,6 @@ mod state;
 use crate::params::ParamReader;
 use crate::pt::{Pt, PtParams};
 use crate::{Estimator, Integrator};
-use lt_core::math::is_valid_color;
 use lt_core::Scene;
 use lt_estimators::Image;
 use rayon::prelude::*;
@@ -75,27 +74,15 @@ impl Integrator for PtLanes {
         "pt"
     }
 
-    /// `film::pixel::pixel_pass`, with each row's pixels walked in batches of `LANES`.
+    /// `film::pixel::pixel_pass`, with each row's pixels walked `LANES` at a time.
     fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
         let w = scene.camera.width as usize;
         let h = scene.camera.height as usize;
         let mut img = Image::new(w, h);
         let invalid = AtomicU64::new(0);
         img.data.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            let mut bad = 0;
-            for (c, batch) in row.chunks_mut(LANES).enumerate() {
-                let first = (y * w + c * LANES) as u64;
-                let estimates =
-                    driver::run_batch(&self.pt, scene, (seed, pass), first, batch.len());
-                for (px, c) in batch.iter_mut().zip(estimates) {
-                    let Some(c) = c else { continue };
-                    if is_valid_color(c) {
-                        *px = [c.x as f64, c.y as f64, c.z as f64];
-                    } else {
-                        bad += 1;
-                    }
-                }
-            }
+            let first = (y * w) as u64;
+            let bad = driver::run_row(&self.pt, scene, (seed, pass), first, row);
             if bad > 0 {
                 invalid.fetch_add(bad, Ordering::Relaxed);
             }
