@@ -1,6 +1,5 @@
 //! `pt` with `lanes=8`: the same estimator as `pt` (`unidirectional::pt`), run eight pixel
-//! samples at a time, bounce by bounce, over a structure-of-arrays path state (issue 47, item 3;
-//! first cut).
+//! samples at a time, bounce by bounce, over a structure-of-arrays path state (issue 47, item 3).
 //!
 //! Each lane is one pixel's camera sample drawing from exactly the stream the scalar `pt` uses
 //! for it (`Sampler::for_item(Domain::Camera, seed, pixel, pass)`), and every lane kernel does the
@@ -8,15 +7,19 @@
 //! approximations of transcendental functions), so the image is the scalar `pt`'s bit for bit —
 //! which is the whole test (`tests/pt_lanes.rs`). The scalar `pt` stays the reference.
 //!
-//! What runs lane-wide and what per lane (first cut):
+//! What runs lane-wide and what per lane:
+//! - the closest hits of a bounce's rays: the ray core's packet query (`Scene::intersect_packet`,
+//!   `geometry/packet.rs`: the flat core tests the 8 rays together, other cores one by one);
 //! - lane kernels (`kernels.rs`): the MIS weights of emitter hits and of next-event estimation
 //!   (power heuristic), and the radiance and throughput arithmetic that adds them to the estimate;
-//! - per lane, through the scalar functions (`driver.rs`): camera rays, `Scene::intersect` and
-//!   shadow rays, light and BSDF sampling and evaluation, Russian roulette, lights at infinity.
+//! - per lane, through the scalar functions (`driver.rs`): camera rays, shadow rays, light and
+//!   BSDF sampling and evaluation, Russian roulette, lights at infinity.
 //!
-//! Next steps (results/bench.md): a packet query through the wide BVH for the 8 rays of a bounce,
-//! and lane kernels for the diffuse BSDF and the area light's `sample_li`, with the scalar step
-//! kept as the per-lane fallback for other materials and lights.
+//! A lane whose path ends takes the row's next pixel before the next bounce (`driver::run_row`),
+//! so the packet stays full until the row runs out. Measured (results/bench.md, "Lane-parallel
+//! `pt`, second cut"): the packet query pays on the flat core; a lane kernel for the
+//! parallelogram light's `sample_li` did not (the transposition into lanes cost more than the
+//! arithmetic it shared) and was dropped.
 //!
 //! Participating media are not handled: `lanes=8` on a scene with media is refused in one line
 //! (`registry`).
