@@ -11,7 +11,7 @@ use super::state::{ColorLanes, Mask, PathLanes, LANES};
 use crate::film::pixel::{pixel_sample, weighted};
 use crate::pt::{Pt, Techniques};
 use crate::subpath::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
-use lt_core::bsdf::TransportMode;
+use lt_core::bsdf::{ShadingFrame, TransportMode};
 use lt_core::geometry::Ray;
 use lt_core::math::{is_valid_color, Color, Vec3};
 use lt_core::sampling::{Domain, Sampler};
@@ -75,10 +75,16 @@ fn bounce(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, nee: bool, rules: &Walk
             lanes.alive[i] = false;
         }
     }
+    // Each surviving lane's shading frame, built once for both steps below (as `Pt::radiance`
+    // builds it once per bounce).
+    let frames: [Option<ShadingFrame>; LANES] = std::array::from_fn(|i| {
+        let hit = hits[i].as_ref().filter(|_| lanes.alive[i]);
+        hit.map(SurfaceHit::shading_frame)
+    });
     if nee {
-        next_event(pt, scene, lanes, &hits);
+        next_event(pt, scene, lanes, &hits, &frames);
     }
-    scatter(scene, lanes, &hits, rules);
+    scatter(scene, lanes, &hits, &frames, rules);
     for i in live(&lanes.alive) {
         lanes.depth[i] += 1;
     }
@@ -189,11 +195,19 @@ fn emitters(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<Surfac
 
 /// Next-event estimation at every live non-delta vertex: `Pt::direct_light`'s draws and queries
 /// per lane, its weight and sum through `kernels::add_next_event`.
-fn next_event(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<SurfaceHit>; LANES]) {
+fn next_event(
+    pt: &Pt,
+    scene: &Scene,
+    lanes: &mut PathLanes,
+    hits: &[Option<SurfaceHit>; LANES],
+    frames: &[Option<ShadingFrame>; LANES],
+) {
     let mut ran = [false; LANES];
     let mut ne = NextEventLanes::default();
     for i in live(&lanes.alive) {
-        let Some(hit) = &hits[i] else { continue };
+        let (Some(hit), Some(sf)) = (&hits[i], &frames[i]) else {
+            continue;
+        };
         if scene.material_is_delta(hit.material) {
             continue;
         }
@@ -211,11 +225,10 @@ fn next_event(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<Surf
         if ls.radiance == Color::ZERO || ls.pdf_w == 0.0 {
             continue;
         }
-        let sf = hit.shading_frame();
         let wo = -lanes.ray[i].d;
         let ev = scene
             .material(hit.material)
-            .eval(&sf, wo, ls.wi, TransportMode::Radiance);
+            .eval(sf, wo, ls.wi, TransportMode::Radiance);
         if ev.f_cos == Color::ZERO || !scene.visible_light(hit, &ls) {
             continue;
         }
@@ -235,14 +248,16 @@ fn scatter(
     scene: &Scene,
     lanes: &mut PathLanes,
     hits: &[Option<SurfaceHit>; LANES],
+    frames: &[Option<ShadingFrame>; LANES],
     rules: &WalkRules,
 ) {
     for i in live(&lanes.alive.clone()) {
-        let Some(hit) = &hits[i] else { continue };
-        let sf = hit.shading_frame();
+        let (Some(hit), Some(sf)) = (&hits[i], &frames[i]) else {
+            continue;
+        };
         let at = WalkPoint {
             hit,
-            sf: &sf,
+            sf,
             wo: -lanes.ray[i].d,
         };
         let sampler = lanes.samplers[i]
