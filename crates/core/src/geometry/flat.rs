@@ -76,15 +76,15 @@ impl Isa {
 }
 
 pub struct Flat {
-    quads: QuadSoa,
+    pub(super) quads: QuadSoa,
     /// Index in the scene's primitive list of each parallelogram (`u32::MAX` for padding, to a
     /// multiple of `CHUNK`).
-    quad_ids: Vec<u32>,
-    spheres: SphereSoa,
-    sphere_ids: Vec<u32>,
+    pub(super) quad_ids: Vec<u32>,
+    pub(super) spheres: SphereSoa,
+    pub(super) sphere_ids: Vec<u32>,
     /// Indices of the triangles, disks and cylinders, tested one by one.
-    triangles: Vec<u32>,
-    isa: Isa,
+    pub(super) triangles: Vec<u32>,
+    pub(super) isa: Isa,
 }
 
 /// The smaller of two candidate hits by (distance, primitive index).

@@ -4,6 +4,7 @@ pub mod accel;
 #[cfg(lt_embree)]
 pub mod embree;
 pub mod flat;
+pub mod packet;
 pub mod primitive;
 pub mod quad;
 pub mod quadric;

@@ -139,7 +139,7 @@ impl Parallelogram {
 pub struct QuadSoa {
     /// Per chunk, p0, |p0|, n, |n|, a1, |a1|, a2, |a2| component by component: `[k][i]` is
     /// component k % 3 of vector k / 3 of the chunk's parallelogram i.
-    chunks: Vec<[[f32; CHUNK]; 24]>,
+    pub(super) chunks: Vec<[[f32; CHUNK]; 24]>,
 }
 
 impl QuadSoa {
@@ -204,7 +204,7 @@ impl QuadSoa {
 /// |a2|]: every comparison is evaluated and combined with `&`/`|`, so a loop over many
 /// parallelograms vectorises. NaN compares false here exactly as in the branching version.
 #[inline(always)]
-fn distance(q: [Vec3; 8], o: Vec3, o_abs: Vec3, d: Vec3, t_max: f32) -> f32 {
+pub(super) fn distance(q: [Vec3; 8], o: Vec3, o_abs: Vec3, d: Vec3, t_max: f32) -> f32 {
     let [p0, p0_abs, n, n_abs, a1, a1_abs, a2, a2_abs] = q;
     let denom = d.dot(n);
     let to = p0 - o;

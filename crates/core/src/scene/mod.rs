@@ -18,6 +18,7 @@ pub use visibility::ConnectionEnd;
 
 use crate::bsdf::Material;
 use crate::camera::Camera;
+use crate::geometry::packet::PACKET;
 use crate::geometry::{Accel, Ray};
 use crate::light::{Light, LightSampler};
 use crate::math::Vec3;
@@ -121,6 +122,20 @@ impl Scene {
         ray_stats::count_closest();
         let h = self.accel.intersect(ray)?;
         Some(SurfaceHit::new(self, ray, h))
+    }
+
+    /// `intersect` of each ray of a packet whose `active` flag is set (`None` on the others),
+    /// through the ray core's packet query (`geometry::packet`).
+    pub fn intersect_packet(
+        &self,
+        rays: &[Ray; PACKET],
+        active: &[bool; PACKET],
+    ) -> [Option<SurfaceHit>; PACKET] {
+        for _ in active.iter().filter(|&&a| a) {
+            ray_stats::count_closest();
+        }
+        let hits = self.accel.intersect_packet(rays, active);
+        std::array::from_fn(|i| hits[i].map(|h| SurfaceHit::new(self, &rays[i], h)))
     }
 
     pub fn material(&self, id: u32) -> &Material {

@@ -1,58 +1,93 @@
-//! One batch of up to `LANES` pixels walked bounce by bounce, following `Pt::radiance` (without a
-//! recorder) step for step: each step runs over the live lanes, the scene queries per lane
-//! through the scalar functions, the arithmetic of the estimate through the lane kernels.
+//! One image row walked `LANES` paths at a time, bounce by bounce, following `Pt::radiance`
+//! (without a recorder) step for step: each step runs over the live lanes, the closest hits
+//! through the ray core's packet query, the other scene queries per lane through the scalar
+//! functions, the arithmetic of the estimate through the lane kernels. A lane whose path ends
+//! is refilled with the row's next pixel before the next bounce, so the packet stays full until
+//! the row runs out (each pixel draws from its own stream, so the order pixels are taken in
+//! changes no bits).
 
 use super::kernels::{self, NextEventLanes};
 use super::state::{ColorLanes, Mask, PathLanes, LANES};
 use crate::film::pixel::{pixel_sample, weighted};
 use crate::pt::{Pt, Techniques};
 use crate::subpath::walk::{continue_path, escaped_radiance, WalkPoint, WalkRules};
-use lt_core::bsdf::TransportMode;
+use lt_core::bsdf::{ShadingFrame, TransportMode};
 use lt_core::geometry::Ray;
-use lt_core::math::Color;
-use lt_core::math::Vec3;
+use lt_core::math::{is_valid_color, Color, Vec3};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::scene::SurfaceHit;
 use lt_core::Scene;
 
-/// The estimates of pixels `first .. first + n` (n ≤ `LANES`) of pass `pass` of the run seeded
-/// by `seed`, weighted by the film filter as `film::pixel::pixel_pass` weighs them; `None` where
-/// the filter's offset left the film (`pixel_pass` then leaves the pixel at zero).
-pub fn run_batch(
+/// Renders pixels `first .. first + row.len()` of pass `pass` of the run seeded by `seed` into
+/// `row`, as `film::pixel::pixel_pass` does (filter weight, invalid estimates left at zero);
+/// returns how many were invalid.
+pub fn run_row(
     pt: &Pt,
     scene: &Scene,
     (seed, pass): (u64, u32),
     first: u64,
-    n: usize,
-) -> Vec<Option<Color>> {
-    let mut lanes = start(scene, (seed, pass), first, n);
+    row: &mut [[f64; 3]],
+) -> u64 {
     let nee = pt.params.techniques != Techniques::Bsdf;
     let rules = WalkRules::camera(pt.params.rr_depth);
-    let mut hits: [Option<SurfaceHit>; LANES] = [None; LANES];
-    for depth in 1..=pt.params.max_depth {
-        if !lanes.alive.iter().any(|&a| a) {
+    let mut lanes = idle_lanes();
+    let mut next = 0;
+    let mut bad = 0;
+    loop {
+        for i in 0..LANES {
+            while !lanes.alive[i] && next < row.len() {
+                start(scene, (seed, pass), first, &mut lanes, i, next);
+                next += 1;
+            }
+        }
+        let was_alive = lanes.alive;
+        if !was_alive.iter().any(|&a| a) {
             break;
         }
-        for i in live(&lanes.alive) {
-            hits[i] = scene.intersect(&lanes.ray[i]);
+        // `Pt::radiance`'s loop runs no bounce when max_depth is 0.
+        if pt.params.max_depth == 0 {
+            lanes.alive = [false; LANES];
+        } else {
+            bounce(pt, scene, &mut lanes, nee, &rules);
         }
-        escape(pt, scene, &mut lanes, &hits);
-        emitters(pt, scene, &mut lanes, &hits);
-        if depth == pt.params.max_depth {
-            break;
+        for i in 0..LANES {
+            if was_alive[i] && !lanes.alive[i] {
+                let c = weighted(lanes.l.get(i), lanes.film_weight[i]);
+                if is_valid_color(c) {
+                    row[lanes.pixel[i]] = [c.x as f64, c.y as f64, c.z as f64];
+                } else {
+                    bad += 1;
+                }
+            }
         }
-        if nee {
-            next_event(pt, scene, &mut lanes, &hits);
-        }
-        scatter(scene, &mut lanes, &hits, &rules, depth);
     }
-    (0..n)
-        .map(|i| {
-            lanes.samplers[i]
-                .as_ref()
-                .map(|_| weighted(lanes.l.get(i), lanes.film_weight[i]))
-        })
-        .collect()
+    bad
+}
+
+/// One turn of `Pt::radiance`'s loop on every live lane, each at its own depth; lanes whose path
+/// ends retire (`alive` cleared).
+fn bounce(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, nee: bool, rules: &WalkRules) {
+    let hits = scene.intersect_packet(&lanes.ray, &lanes.alive);
+    escape(pt, scene, lanes, &hits);
+    emitters(pt, scene, lanes, &hits);
+    for i in live(&lanes.alive.clone()) {
+        if lanes.depth[i] == pt.params.max_depth {
+            lanes.alive[i] = false;
+        }
+    }
+    // Each surviving lane's shading frame, built once for both steps below (as `Pt::radiance`
+    // builds it once per bounce).
+    let frames: [Option<ShadingFrame>; LANES] = std::array::from_fn(|i| {
+        let hit = hits[i].as_ref().filter(|_| lanes.alive[i]);
+        hit.map(SurfaceHit::shading_frame)
+    });
+    if nee {
+        next_event(pt, scene, lanes, &hits, &frames);
+    }
+    scatter(scene, lanes, &hits, &frames, rules);
+    for i in live(&lanes.alive) {
+        lanes.depth[i] += 1;
+    }
 }
 
 /// The live lanes' indices.
@@ -60,38 +95,51 @@ fn live(alive: &Mask) -> impl Iterator<Item = usize> + '_ {
     (0..LANES).filter(move |&i| alive[i])
 }
 
-/// Each lane's pixel stream, film position and camera ray (`pixel_pass`, then the first lines of
-/// `Pt::radiance`).
-fn start(scene: &Scene, (seed, pass): (u64, u32), first: u64, n: usize) -> PathLanes {
-    let mut samplers: [Option<Sampler>; LANES] = std::array::from_fn(|_| None);
-    let mut film_weight = [0.0f32; LANES];
-    let mut alive = [false; LANES];
-    let ray = std::array::from_fn(|i| {
-        if i >= n {
-            return idle_ray();
-        }
-        let pixel = first + i as u64;
-        let mut s = Sampler::for_item(Domain::Camera, seed, pixel, pass as u64);
-        let Some(film) = pixel_sample(scene, pixel, &mut s) else {
-            return idle_ray();
-        };
-        let ray = scene.camera.sample_ray(film.raster, &mut s);
-        film_weight[i] = film.weight;
-        alive[i] = true;
-        samplers[i] = Some(s);
-        ray
-    });
+/// Lanes with no pixel yet.
+fn idle_lanes() -> PathLanes {
     PathLanes {
-        prev_p: ray.map(|r: Ray| r.o),
-        alive,
-        samplers,
-        film_weight,
-        ray,
+        alive: [false; LANES],
+        pixel: [0; LANES],
+        depth: [1; LANES],
+        samplers: std::array::from_fn(|_| None),
+        film_weight: [0.0; LANES],
+        ray: [idle_ray(); LANES],
         beta: ColorLanes::splat(Color::ONE),
         l: ColorLanes::splat(Color::ZERO),
         prev_pdf_w: [0.0; LANES],
         prev_delta: [true; LANES],
+        prev_p: [Vec3::ZERO; LANES],
     }
+}
+
+/// Lane `i` takes the row's pixel `x`: its stream, film position and camera ray (`pixel_pass`,
+/// then the first lines of `Pt::radiance`). A sample the filter moved off the film leaves the
+/// pixel at zero and the lane idle.
+fn start(
+    scene: &Scene,
+    (seed, pass): (u64, u32),
+    first: u64,
+    lanes: &mut PathLanes,
+    i: usize,
+    x: usize,
+) {
+    let pixel = first + x as u64;
+    let mut s = Sampler::for_item(Domain::Camera, seed, pixel, pass as u64);
+    let Some(film) = pixel_sample(scene, pixel, &mut s) else {
+        return;
+    };
+    let ray = scene.camera.sample_ray(film.raster, &mut s);
+    lanes.alive[i] = true;
+    lanes.pixel[i] = x;
+    lanes.depth[i] = 1;
+    lanes.samplers[i] = Some(s);
+    lanes.film_weight[i] = film.weight;
+    lanes.ray[i] = ray;
+    lanes.beta.set(i, Color::ONE);
+    lanes.l.set(i, Color::ZERO);
+    lanes.prev_pdf_w[i] = 0.0;
+    lanes.prev_delta[i] = true;
+    lanes.prev_p[i] = ray.o;
 }
 
 /// The ray slot of a lane without a sample (never traced).
@@ -147,11 +195,19 @@ fn emitters(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<Surfac
 
 /// Next-event estimation at every live non-delta vertex: `Pt::direct_light`'s draws and queries
 /// per lane, its weight and sum through `kernels::add_next_event`.
-fn next_event(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<SurfaceHit>; LANES]) {
+fn next_event(
+    pt: &Pt,
+    scene: &Scene,
+    lanes: &mut PathLanes,
+    hits: &[Option<SurfaceHit>; LANES],
+    frames: &[Option<ShadingFrame>; LANES],
+) {
     let mut ran = [false; LANES];
     let mut ne = NextEventLanes::default();
     for i in live(&lanes.alive) {
-        let Some(hit) = &hits[i] else { continue };
+        let (Some(hit), Some(sf)) = (&hits[i], &frames[i]) else {
+            continue;
+        };
         if scene.material_is_delta(hit.material) {
             continue;
         }
@@ -169,11 +225,10 @@ fn next_event(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<Surf
         if ls.radiance == Color::ZERO || ls.pdf_w == 0.0 {
             continue;
         }
-        let sf = hit.shading_frame();
         let wo = -lanes.ray[i].d;
         let ev = scene
             .material(hit.material)
-            .eval(&sf, wo, ls.wi, TransportMode::Radiance);
+            .eval(sf, wo, ls.wi, TransportMode::Radiance);
         if ev.f_cos == Color::ZERO || !scene.visible_light(hit, &ls) {
             continue;
         }
@@ -188,27 +243,28 @@ fn next_event(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<Surf
 }
 
 /// Each live lane samples its BSDF, updates its throughput and plays Russian roulette
-/// (`continue_path`, per lane); lanes that stop retire.
+/// (`continue_path`, per lane, at the lane's own depth); lanes that stop retire.
 fn scatter(
     scene: &Scene,
     lanes: &mut PathLanes,
     hits: &[Option<SurfaceHit>; LANES],
+    frames: &[Option<ShadingFrame>; LANES],
     rules: &WalkRules,
-    depth: u32,
 ) {
     for i in live(&lanes.alive.clone()) {
-        let Some(hit) = &hits[i] else { continue };
-        let sf = hit.shading_frame();
+        let (Some(hit), Some(sf)) = (&hits[i], &frames[i]) else {
+            continue;
+        };
         let at = WalkPoint {
             hit,
-            sf: &sf,
+            sf,
             wo: -lanes.ray[i].d,
         };
         let sampler = lanes.samplers[i]
             .as_mut()
             .expect("a live lane has a stream");
         let mut beta = lanes.beta.get(i);
-        let next = continue_path(scene, &at, rules, &mut beta, depth, sampler);
+        let next = continue_path(scene, &at, rules, &mut beta, lanes.depth[i], sampler);
         lanes.beta.set(i, beta);
         let Some(bs) = next else {
             lanes.alive[i] = false;

@@ -1,6 +1,5 @@
 //! `pt` with `lanes=8`: the same estimator as `pt` (`unidirectional::pt`), run eight pixel
-//! samples at a time, bounce by bounce, over a structure-of-arrays path state (issue 47, item 3;
-//! first cut).
+//! samples at a time, bounce by bounce, over a structure-of-arrays path state (issue 47, item 3).
 //!
 //! Each lane is one pixel's camera sample drawing from exactly the stream the scalar `pt` uses
 //! for it (`Sampler::for_item(Domain::Camera, seed, pixel, pass)`), and every lane kernel does the
@@ -8,15 +7,19 @@
 //! approximations of transcendental functions), so the image is the scalar `pt`'s bit for bit —
 //! which is the whole test (`tests/pt_lanes.rs`). The scalar `pt` stays the reference.
 //!
-//! What runs lane-wide and what per lane (first cut):
+//! What runs lane-wide and what per lane:
+//! - the closest hits of a bounce's rays: the ray core's packet query (`Scene::intersect_packet`,
+//!   `geometry/packet.rs`: the flat core tests the 8 rays together, other cores one by one);
 //! - lane kernels (`kernels.rs`): the MIS weights of emitter hits and of next-event estimation
 //!   (power heuristic), and the radiance and throughput arithmetic that adds them to the estimate;
-//! - per lane, through the scalar functions (`driver.rs`): camera rays, `Scene::intersect` and
-//!   shadow rays, light and BSDF sampling and evaluation, Russian roulette, lights at infinity.
+//! - per lane, through the scalar functions (`driver.rs`): camera rays, shadow rays, light and
+//!   BSDF sampling and evaluation, Russian roulette, lights at infinity.
 //!
-//! Next steps (results/bench.md): a packet query through the wide BVH for the 8 rays of a bounce,
-//! and lane kernels for the diffuse BSDF and the area light's `sample_li`, with the scalar step
-//! kept as the per-lane fallback for other materials and lights.
+//! A lane whose path ends takes the row's next pixel before the next bounce (`driver::run_row`),
+//! so the packet stays full until the row runs out. Measured (results/bench.md, "Lane-parallel
+//! `pt`, second cut"): the packet query pays on the flat core; a lane kernel for the
+//! parallelogram light's `sample_li` did not (the transposition into lanes cost more than the
+//! arithmetic it shared) and was dropped.
 //!
 //! Participating media are not handled: `lanes=8` on a scene with media is refused in one line
 //! (`registry`).
@@ -28,7 +31,6 @@ mod state;
 use crate::params::ParamReader;
 use crate::pt::{Pt, PtParams};
 use crate::{Estimator, Integrator};
-use lt_core::math::is_valid_color;
 use lt_core::Scene;
 use lt_estimators::Image;
 use rayon::prelude::*;
@@ -75,27 +77,15 @@ impl Integrator for PtLanes {
         "pt"
     }
 
-    /// `film::pixel::pixel_pass`, with each row's pixels walked in batches of `LANES`.
+    /// `film::pixel::pixel_pass`, with each row's pixels walked `LANES` at a time.
     fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
         let w = scene.camera.width as usize;
         let h = scene.camera.height as usize;
         let mut img = Image::new(w, h);
         let invalid = AtomicU64::new(0);
         img.data.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            let mut bad = 0;
-            for (c, batch) in row.chunks_mut(LANES).enumerate() {
-                let first = (y * w + c * LANES) as u64;
-                let estimates =
-                    driver::run_batch(&self.pt, scene, (seed, pass), first, batch.len());
-                for (px, c) in batch.iter_mut().zip(estimates) {
-                    let Some(c) = c else { continue };
-                    if is_valid_color(c) {
-                        *px = [c.x as f64, c.y as f64, c.z as f64];
-                    } else {
-                        bad += 1;
-                    }
-                }
-            }
+            let first = (y * w) as u64;
+            let bad = driver::run_row(&self.pt, scene, (seed, pass), first, row);
             if bad > 0 {
                 invalid.fetch_add(bad, Ordering::Relaxed);
             }

@@ -45,7 +45,12 @@ pub type Mask = [bool; LANES];
 pub struct PathLanes {
     /// Lanes whose path is still being walked.
     pub alive: Mask,
-    /// Each lane's pixel stream (`None`: no sample, the batch is shorter or the filter left the film).
+    /// Each lane's pixel, as an index into the row being rendered.
+    pub pixel: [usize; LANES],
+    /// Each lane's bounce: `Pt::radiance`'s loop counter (lanes refilled at different times walk
+    /// different bounces).
+    pub depth: [u32; LANES],
+    /// Each lane's pixel stream (`None`: the lane has not been given a pixel yet).
     pub samplers: [Option<Sampler>; LANES],
     /// The film filter's weight of each lane's sample.
     pub film_weight: [f32; LANES],
