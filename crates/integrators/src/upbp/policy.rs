@@ -7,7 +7,13 @@
 //! **PP3D** at the medium vertex z (β_z holding σs(z)), per photon y_i within r_P:
 //! β_z f_p(ω_z, ω_y) (β_y / σs(y_i)) / (N (4/3)π r_P³). PB2D's and BB1D's estimates are
 //! `camera_beams`'s.
+//!
+//! **BP2D** at the medium vertex z, per photon beam b within r_B of it (`beam_points`), x' the
+//! projection of z on the beam: β_z f_p(ω_z, −ω_b) Φ_b(x') / (M_B π r_B²), Φ_b(x') the beam's
+//! value there (`camera_beams::BeamEnd`) — Jarosz et al. 2011's beam × point 2-D estimate, as
+//! `volume_density::point_beam`.
 
+use super::camera_beams::BeamEnd;
 use super::light_store::{LightPath, LightStore};
 use super::rates::{camera_vertex, junction, Needs};
 use super::weights::{weight, VertexRate};
@@ -41,6 +47,8 @@ pub struct PassData<'a> {
     pub beam_norm: f32,
     pub beam_beam_norm: f32,
     pub surface_norm: f32,
+    /// 1 / (M_B π r_B²): BP2D's kernel and beam count.
+    pub beam_point_norm: f32,
     /// The rates the weights read (`rates::Needs`).
     pub needs: Needs,
 }
@@ -368,6 +376,73 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
     }
 }
 
+impl<const MEDIA: bool> Policy<'_, MEDIA> {
+    /// BP2D at the camera walk's medium vertex z_{t−1}: the photon beams within r_B of it.
+    fn beam_points<R: Recorder>(
+        &mut self,
+        scene: &Scene,
+        z: &[PathVertex],
+        ctx: &mut SampleCtx<'_, R>,
+        l: &mut Color,
+    ) {
+        let p = self.pass;
+        let t = z.len();
+        let zv = &z[t - 1];
+        let Some(lb) = p.store.light_beams.as_ref() else {
+            return;
+        };
+        let (Some(index), Some(m)) = (lb.index.as_ref(), medium_of(zv)) else {
+            return;
+        };
+        if t > p.max_k || zv.beta == Color::ZERO {
+            return;
+        }
+        let phase = scene.media[m as usize].phase();
+        let frame = &index.lists.frame;
+        // Every beam within the index's radius (≥ r_B) of z is listed in z's cell.
+        let cell = frame.index(frame.cell_of(zv.p));
+        let r2 = p.r_beams * p.r_beams;
+        let mut light_buf = std::mem::take(&mut self.light_buf);
+        for &bi in index.lists.items(cell) {
+            let b = &lb.beams[bi as usize];
+            let i = lb.refs[bi as usize].vertex as usize;
+            if b.medium != m || i + t - 1 > p.max_k {
+                continue;
+            }
+            let tb = (zv.p - b.origin).dot(b.dir);
+            if !(tb >= 0.0 && tb < b.length) {
+                continue;
+            }
+            if (zv.p - (b.origin + b.dir * tb)).length_squared() > r2 {
+                continue;
+            }
+            let Some(end) = BeamEnd::at(scene, lb, p.store, (bi, tb), &mut light_buf) else {
+                continue;
+            };
+            let value = zv.beta * phase.eval(zv.wo, -b.dir) * end.value * p.beam_point_norm;
+            if value == Color::ZERO {
+                continue;
+            }
+            let light = end.side(&light_buf, p);
+            let technique = VolumeTechnique::BeamPoint(i);
+            let w = self.merge_weight(scene, light, self.camera_side(z), technique);
+            if R::ACTIVE {
+                ctx.rec.volume_merged(VolumeMerged {
+                    technique,
+                    light: &light_buf,
+                    camera: z,
+                    weight: w,
+                    value,
+                    raster: ctx.raster,
+                    radius: p.r_beams,
+                });
+            }
+            *l += value * w as f32;
+        }
+        self.light_buf = light_buf;
+    }
+}
+
 impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     const MEDIA: bool = MEDIA;
 
@@ -474,6 +549,9 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         if !zv.in_medium() {
             self.surface_merges(scene, z, ctx, l);
             return;
+        }
+        if p.set.beam_points_eta > 0.0 {
+            self.beam_points(scene, z, ctx, l);
         }
         let (Some(grid), Some(m)) = (p.store.points.as_ref(), medium_of(zv)) else {
             return;
