@@ -77,6 +77,98 @@ pub struct VolumeSet {
     pub beam_points_eta: f64,
     /// The photon beams (BB1D's and BP2D's) are long: σ̂ᴸ_i → the flight's scattering density.
     pub long_beams: bool,
+    /// Which paths are estimated and which techniques the heuristics count (`UpbpMode`).
+    pub mode: UpbpMode,
+}
+
+/// SmallUPBP's `-compatible` and `-previous` (Křivánek et al. 2014's comparisons with "previous
+/// work"). Both estimate only the paths of class ES*M(S|D|M)*L: from the camera, delta surface
+/// vertices up to a first medium vertex x_m (`first_medium_from_camera`); every other path gets
+/// weight 0 from every technique.
+///
+/// - `Full`: every path, every technique of the set counted: Σw = 1 over the set.
+/// - `Compatible`: class-C paths only, with `Full`'s weights: every technique that can make a
+///   class-C path runs for it, so Σw = 1 over the whole set on class C (0 outside) — the image is
+///   `Full`'s restricted to class C, term for term.
+/// - `Previous`: class-C paths, and only the techniques that meet at x_m count and run: the
+///   merges at x_m (PP3D, PB2D, BB1D, BP2D), the connections whose camera subpath ends at x_m
+///   (s = m) or whose light subpath does (s = m + 1: light tracing when x_m is the camera's
+///   first vertex): Σw = 1 over those on class C (0 outside). The camera walks "stop" at x_m:
+///   nothing runs past it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UpbpMode {
+    #[default]
+    Full,
+    Compatible,
+    Previous,
+}
+
+impl UpbpMode {
+    pub fn parse(text: &str) -> Result<UpbpMode, String> {
+        match text.trim() {
+            "full" => Ok(UpbpMode::Full),
+            "compatible" => Ok(UpbpMode::Compatible),
+            "previous" => Ok(UpbpMode::Previous),
+            other => Err(format!(
+                "unknown mode '{other}' (known: full, compatible, previous)"
+            )),
+        }
+    }
+
+    /// Whether the heuristics count `technique` on a path whose class vertex is `m`
+    /// (`first_medium_from_camera`).
+    pub fn counts(self, m: Option<usize>, technique: VolumeTechnique) -> bool {
+        match (self, m) {
+            (UpbpMode::Full, _) => true,
+            (_, None) => false,
+            (UpbpMode::Compatible, Some(_)) => true,
+            (UpbpMode::Previous, Some(m)) => match technique {
+                VolumeTechnique::Connect(s) => s == m || s == m + 1,
+                VolumeTechnique::Point(i)
+                | VolumeTechnique::Beam(i)
+                | VolumeTechnique::BeamBeam(i)
+                | VolumeTechnique::Surface(i)
+                | VolumeTechnique::BeamPoint(i) => i == m,
+            },
+        }
+    }
+}
+
+/// The class vertex of a path x_0 … x_k: scanning from the camera (x_{k−1} down to x_1) past
+/// delta surface vertices (neither in a medium nor `connectable`), the first other vertex when it
+/// lies in a medium; None when it is a surface or there is none (the path is not of class
+/// ES*M(S|D|M)*L).
+pub fn first_medium_from_camera(
+    k: usize,
+    medium: impl Fn(usize) -> bool,
+    connectable: &[bool],
+) -> Option<usize> {
+    for j in (1..k).rev() {
+        if medium(j) {
+            return Some(j);
+        }
+        if connectable[j] {
+            return None;
+        }
+    }
+    None
+}
+
+/// Technique `j` of `Densities::effective_upbp`'s list for a path of k = n − 1 segments.
+fn technique_at(n: usize, j: usize) -> VolumeTechnique {
+    if j <= n {
+        VolumeTechnique::Connect(j)
+    } else if j <= 2 * n {
+        VolumeTechnique::Point(j - n - 1)
+    } else if j <= 3 * n {
+        VolumeTechnique::Beam(j - 2 * n - 1)
+    } else if j <= 4 * n {
+        VolumeTechnique::BeamBeam(j - 3 * n - 1)
+    } else if j <= 5 * n {
+        VolumeTechnique::Surface(j - 4 * n - 1)
+    } else {
+        VolumeTechnique::BeamPoint(j - 5 * n - 1)
+    }
 }
 
 /// One technique of UPBP's family on a path.
@@ -272,7 +364,8 @@ impl Densities {
     /// techniques s = 0 … k+1 (zero for s ≥ 1 without connections), then η_P·p_P,i for
     /// i = 0 … k, then η_B·p_B,i, then η_BB·p_BB,i for i = 0 … k (module doc; zero where x_i is
     /// no medium vertex), then η_S·p_VM,i of surface merging (`Densities::merging`: zero where
-    /// x_i lies in a medium or is delta), then η_BP·p_BP,i.
+    /// x_i lies in a medium or is delta), then η_BP·p_BP,i; under `set.mode` (`UpbpMode`) the
+    /// techniques it does not count are zero.
     pub fn effective_upbp(&self, set: VolumeSet, rates: &VolumeRates) -> Vec<f64> {
         let k = self.k();
         let mut all = self.effective_all();
@@ -324,6 +417,14 @@ impl Densities {
                 0.0
             });
         }
+        if set.mode != UpbpMode::Full {
+            let m = first_medium_from_camera(k, |j| rates.medium[j], &self.connectable);
+            for (j, p) in all.iter_mut().enumerate() {
+                if !set.mode.counts(m, technique_at(k + 1, j)) {
+                    *p = 0.0;
+                }
+            }
+        }
         all
     }
 
@@ -360,21 +461,7 @@ impl Densities {
         all.iter()
             .enumerate()
             .filter(|(_, &p)| p > 0.0)
-            .map(|(j, _)| {
-                if j <= n {
-                    VolumeTechnique::Connect(j)
-                } else if j <= 2 * n {
-                    VolumeTechnique::Point(j - n - 1)
-                } else if j <= 3 * n {
-                    VolumeTechnique::Beam(j - 2 * n - 1)
-                } else if j <= 4 * n {
-                    VolumeTechnique::BeamBeam(j - 3 * n - 1)
-                } else if j <= 5 * n {
-                    VolumeTechnique::Surface(j - 4 * n - 1)
-                } else {
-                    VolumeTechnique::BeamPoint(j - 5 * n - 1)
-                }
-            })
+            .map(|(j, _)| technique_at(n, j))
             .collect()
     }
 }

@@ -59,6 +59,9 @@ pub struct MisCheckArgs {
     /// upbp: its `beams` (short or long photon beams for BB1D and BP2D).
     #[arg(long)]
     pub beams: Option<String>,
+    /// upbp: its `mode` (full, compatible or previous: SmallUPBP's).
+    #[arg(long)]
+    pub mode: Option<String>,
 }
 
 /// `lt mis-check`: the report, or an error carrying it when any check fails.
@@ -151,6 +154,9 @@ fn run_upbp(args: &MisCheckArgs) -> Result<String, String> {
     }
     if let Some(b) = &args.beams {
         opts.beams = b.clone();
+    }
+    if let Some(m) = &args.mode {
+        opts.mode = m.clone();
     }
     opts.paths = args.paths;
     opts.seed = args.seed;

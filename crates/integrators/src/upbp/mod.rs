@@ -32,6 +32,7 @@
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `mis` | power/balance/none | power | heuristic over every technique |
 //! | `techniques` | all/bpt/surf/pp3d/pb2d/bb1d/bp2d | bpt,pp3d,pb2d,bb1d | `all` (the six), or a comma- or plus-separated subset of bpt, surf, pp3d, pb2d, bb1d, bp2d (SmallUPBP's names); surf and bp2d are opt-in (`DEFAULT_TECHNIQUES`) |
+//! | `mode` | full/compatible/previous | full | SmallUPBP's modes (`lt_core::path::UpbpMode`): every path; only paths ES*M(S|D|M)*L with full weights; those paths with only the techniques meeting at their first medium vertex from the camera |
 //! | `beams` | short/long | short | the photon beams of BB1D and BP2D: the flight the light walk sampled, or on to the next surface (`light_beams`) |
 //! | `photons_per_pass` | u64 | the pixel count | light subpaths per pass (M) |
 //! | `radius` | f32 | — | initial radius r₁ in scene units (every kernel) |
@@ -60,7 +61,7 @@ use crate::volume_density::VolumeParams;
 use crate::{ProgressLog, Progressive, ProgressiveRun};
 use light_store::{BeamSetup, LightStore};
 use lt_core::math::PI;
-use lt_core::path::{Heuristic, VolumeSet};
+use lt_core::path::{Heuristic, UpbpMode, VolumeSet};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
 use lt_estimators::Image;
@@ -140,6 +141,8 @@ pub struct UpbpParams {
     pub techniques: Techniques,
     /// `beams=long`: BB1D's and BP2D's photon beams run to the next surface (`light_beams`).
     pub long_beams: bool,
+    /// `mode`: SmallUPBP's compatible/previous (`UpbpMode`).
+    pub mode: UpbpMode,
 }
 
 impl UpbpParams {
@@ -175,6 +178,7 @@ impl UpbpParams {
                 .get_with("techniques", Techniques::parse)?
                 .unwrap_or(Techniques::parse(DEFAULT_TECHNIQUES)?),
             long_beams: r.get_with("beams", parse_beams)?.unwrap_or(false),
+            mode: r.get_with("mode", UpbpMode::parse)?.unwrap_or_default(),
         })
     }
 }
@@ -272,6 +276,7 @@ impl Upbp {
             surface_eta,
             beam_points_eta,
             long_beams: self.params.long_beams,
+            mode: self.params.mode,
         };
         // One beam index serves both beam techniques: listed within the larger radius.
         let r_index = match (t.bb1d, t.bp2d) {

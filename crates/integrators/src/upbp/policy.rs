@@ -26,7 +26,9 @@ use crate::subpath::walk::{Departure, Exit, Subpath};
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::path::scatter::{connectable, connectable_inside};
-use lt_core::path::{Chain, Heuristic, PathVertex, VertexKind, VolumeSet, VolumeTechnique};
+use lt_core::path::{
+    Chain, Heuristic, PathVertex, UpbpMode, VertexKind, VolumeSet, VolumeTechnique,
+};
 use lt_core::sampling::Sampler;
 use lt_core::scene::ConnectionEnd;
 use lt_core::Scene;
@@ -68,6 +70,9 @@ pub struct Policy<'a, const MEDIA: bool> {
     pub buf: Vec<PathVertex>,
     /// A light side with a photon beam's point last.
     pub light_buf: Vec<PathVertex>,
+    /// The camera walk's first vertex past the camera that is no delta surface, and whether it
+    /// lies in a medium (`UpbpMode`'s class vertex x_m when it does).
+    pub first: Option<(usize, bool)>,
 }
 
 /// `v / σs` per channel, zero where σs is (β is zero there too): a photon's power as
@@ -175,6 +180,30 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
             exit: None,
             buf: Vec::new(),
             light_buf: Vec::new(),
+            first: None,
+        }
+    }
+
+    /// Whether the techniques at camera vertex z_{t−1} run under the pass's mode: always
+    /// (`Full`); once the walk passed its class vertex (`Compatible`); at it only (`Previous`).
+    /// The weights give the others 0 anyway (`UpbpMode::counts`): this only spares their work.
+    fn runs_at(&self, t: usize) -> bool {
+        match (self.pass.set.mode, self.first) {
+            (UpbpMode::Full, _) => true,
+            (_, None | Some((_, false))) => false,
+            (UpbpMode::Compatible, Some((m, true))) => m <= t - 1,
+            (UpbpMode::Previous, Some((m, true))) => m == t - 1,
+        }
+    }
+
+    /// Whether the camera beams along the segment leaving `prefix`'s last vertex run: their
+    /// query points lie in a medium, so they are the class vertex when `prefix` is all delta.
+    fn runs_along(&self, prefix: usize) -> bool {
+        let all_delta = self.first.is_none_or(|(m, _)| m >= prefix);
+        match self.pass.set.mode {
+            UpbpMode::Full => true,
+            UpbpMode::Compatible => all_delta || self.runs_at(prefix),
+            UpbpMode::Previous => all_delta,
         }
     }
 
@@ -459,6 +488,9 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         self.departure
             .extend((0..z.len()).map(|j| camera.departure(j)));
         self.exit = camera.exit;
+        self.first = (1..z.len())
+            .find(|&j| z[j].in_medium() || connectable_inside(scene, &z[j]))
+            .map(|j| (j, z[j].in_medium()));
     }
 
     fn emitter_weight(
@@ -518,6 +550,9 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     }
 
     fn connect<R: Recorder>(&mut self, scene: &Scene, joins: &mut Joins<'_, R>, _: &mut Sampler) {
+        if !self.runs_at(joins.t()) {
+            return;
+        }
         let this = &*self;
         joins.join_subpath_in::<MEDIA>(scene, this.y, |c| {
             let (s, t) = (c.light.len(), c.camera.len());
@@ -546,6 +581,9 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         let p = self.pass;
         let t = z.len();
         let zv = &z[t - 1];
+        if !self.runs_at(t) {
+            return;
+        }
         if !zv.in_medium() {
             self.surface_merges(scene, z, ctx, l);
             return;
@@ -611,7 +649,7 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         ctx: &mut SampleCtx<'_, R>,
         l: &mut Color,
     ) {
-        if !MEDIA {
+        if !MEDIA || !self.runs_along(z.len() - 1) {
             return;
         }
         let t = z.len();
@@ -627,7 +665,7 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         ctx: &mut SampleCtx<'_, R>,
         l: &mut Color,
     ) {
-        let Some(exit) = self.exit.filter(|_| MEDIA) else {
+        let Some(exit) = self.exit.filter(|_| MEDIA && self.runs_along(z.len())) else {
             return;
         };
         let far = ConnectionEnd {

@@ -11,11 +11,13 @@
 //! scattering density. BB1D counts η_BB = N·2r times sin θ_i and the product with both l_i and
 //! c_i divided by their σ̂'s (`light_rate`, `rate`): both walks' segments are beams. A surface
 //! merge (vcm's) at a non-delta surface vertex counts η_S = N·πr_S² times ∏_{j≤i} l_j ∏_{j≥i} c_j.
-//! BP2D counts η_BP = N_B·πr² times the product with l_i divided by σ̂ᴸ_i (the light's segment
+//! Under SmallUPBP's compatible/previous modes (`lt_core::path::UpbpMode`) the techniques the
+//! mode does not count are zero, as in the oracle. BP2D counts η_BP = N_B·πr² times the product with l_i divided by σ̂ᴸ_i (the light's segment
 //! is the beam, the camera's x_i a sampled point). With long photon beams (`VolumeSet::long_beams`)
 //! BB1D's and BP2D's σ̂ᴸ_i is the light flight's whole scattering density (`light_flight`).
 
-use lt_core::path::{Chain, Heuristic, VolumeSet, VolumeTechnique};
+use lt_core::path::volume_merging::first_medium_from_camera;
+use lt_core::path::{Chain, Heuristic, UpbpMode, VolumeSet, VolumeTechnique};
 
 /// Per path vertex x_j: in a medium, σ̂_j of the camera direction's flight into it, σ̂ᴸ_j of the
 /// light direction's, and sin θ_j between the two flights (`lt_core::path::VolumeRates`).
@@ -121,5 +123,21 @@ fn effective(chain: &Chain, vol: &[VertexRate], set: &VolumeSet, out: &mut [f64]
         out[3 * (k + 2) + i] = *beam_beam;
         out[4 * (k + 2) + i] = *surface;
         out[5 * (k + 2) + i] = *beam_point;
+    }
+    // SmallUPBP's compatible/previous modes: the techniques the mode does not count are zero.
+    if set.mode != UpbpMode::Full {
+        let m = first_medium_from_camera(k, |j| vol[j].medium, chain.connectable);
+        for s in 0..=k + 1 {
+            if !set.mode.counts(m, VolumeTechnique::Connect(s)) {
+                out[s] = 0.0;
+            }
+        }
+        for i in 0..=k + 1 {
+            if !set.mode.counts(m, VolumeTechnique::Point(i)) {
+                for b in 1..BLOCKS {
+                    out[b * (k + 2) + i] = 0.0;
+                }
+            }
+        }
     }
 }
