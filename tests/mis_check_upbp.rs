@@ -6,7 +6,7 @@
 //! 1 % (PB2D's, BB1D's, BP2D's, the surface merges'), on a technique missing from the sum, and on
 //! long beams weighed as short ones.
 
-use lt_core::path::Heuristic;
+use lt_core::path::{Heuristic, UpbpMode};
 use lt_experiments::verify::mis_check::upbp::{
     check_records, check_scene, collect, prepare_scene, UpbpOptions, UpbpRecord,
 };
@@ -133,6 +133,43 @@ fn upbp_long_beams_match_the_oracle_and_short_weights_fail() {
         }
     }
     assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+/// SmallUPBP's modes on hg-spot (power): `compatible` (class ES*M(S|D|M)*L, full weights) and
+/// `previous` (that class, only the techniques meeting at its first medium vertex) against the
+/// oracle, which holds what each mode claims (Σw = 1 over the techniques it counts on the class,
+/// 0 outside); and the check failing when each mode's records are weighed as the other's.
+#[test]
+fn upbp_compatible_and_previous_modes_match_the_oracle_and_swapped_fail() {
+    let swapped = |mode: UpbpMode| match mode {
+        UpbpMode::Previous => UpbpMode::Compatible,
+        _ => UpbpMode::Previous,
+    };
+    for (name, mode) in [
+        ("compatible", UpbpMode::Compatible),
+        ("previous", UpbpMode::Previous),
+    ] {
+        let mut scene = shipped_scene("media/hg-spot", None);
+        let mut opts = options(&scene, Heuristic::Power);
+        opts.mode = name.into();
+        prepare_scene(&mut scene, &opts);
+        let (c, passes) = collect(&scene, &opts).unwrap();
+        let counts = (passes, c.counts.too_long);
+        assert!(c.records.iter().all(|r| r.set.unwrap().mode == mode));
+        let (report, summary) = check_records(&scene, &c.records, &opts, counts, "hg-spot");
+        println!("mode {name}:\n{summary}");
+        assert!(report.merges() > 0 && report.passed(), "{report}{summary}");
+        let mut planted = c.records;
+        for r in &mut planted {
+            r.set.as_mut().unwrap().mode = swapped(mode);
+        }
+        let (report, summary) = check_records(&scene, &planted, &opts, counts, "hg-spot");
+        println!("mode {name} weighed as {:?}:\n{summary}", swapped(mode));
+        assert!(
+            report.failures() > report.checked() / 4,
+            "{report}{summary}"
+        );
+    }
 }
 
 /// Without media upbp is vcm's technique set (connections and surface merges): its weights on
