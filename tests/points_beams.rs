@@ -26,7 +26,9 @@ const ESTIMATORS: [(&str, u32, bool, Option<&str>); 5] = [
     // surface light that pt renders (a ×1.1 plant moves it by 2 %: see results/).
     ("bp2d", BP2D_PHOTON_PATHS, true, None),
     // BP2D inside upbp, beside bdpt's connections under one MIS (every light path's segments
-    // are beams: `beam_paths` = M).
+    // are beams: `beam_paths` = M): holds the combination's sum. BP2D carries ≈ 3 % of this
+    // image, so a ×1.1 on its kernel moves it 0.3 % and passes here (results/points-beams.md):
+    // its value is held by the `bp2d` row, its weights by tests/mis_check_upbp.rs.
     ("upbp", BP2D_PHOTON_PATHS, true, Some("bpt,bp2d")),
 ];
 const RESOLUTION: u32 = 16;
