@@ -191,7 +191,7 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
         match (self.pass.set.mode, self.first) {
             (UpbpMode::Full, _) => true,
             (_, None | Some((_, false))) => false,
-            (UpbpMode::Compatible, Some((m, true))) => m <= t - 1,
+            (UpbpMode::Compatible, Some((m, true))) => m < t,
             (UpbpMode::Previous, Some((m, true))) => m == t - 1,
         }
     }

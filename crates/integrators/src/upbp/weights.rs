@@ -127,9 +127,9 @@ fn effective(chain: &Chain, vol: &[VertexRate], set: &VolumeSet, out: &mut [f64]
     // SmallUPBP's compatible/previous modes: the techniques the mode does not count are zero.
     if set.mode != UpbpMode::Full {
         let m = first_medium_from_camera(k, |j| vol[j].medium, chain.connectable);
-        for s in 0..=k + 1 {
+        for (s, p) in out[..=k + 1].iter_mut().enumerate() {
             if !set.mode.counts(m, VolumeTechnique::Connect(s)) {
-                out[s] = 0.0;
+                *p = 0.0;
             }
         }
         for i in 0..=k + 1 {
