@@ -1,11 +1,12 @@
 //! `lt mis-check --integrator upbp` as a test: on every shipped media scene and on two surface
-//! scenes, upbp's weights (connections, surface merges, PP3D, PB2D and BB1D under one MIS; power
-//! and balance) agree with the from-scratch oracle (`lt_core::path::volume_merging`) and its own
-//! routine's weights over a path's techniques sum to one. Plus proof that the check fails on a
-//! merge density off by 1 % (PB2D's, BB1D's, the surface merges') and on a technique missing
-//! from the sum.
+//! scenes, upbp's weights (connections, surface merges, PP3D, PB2D, BB1D and BP2D under one MIS;
+//! power and balance) agree with the from-scratch oracle (`lt_core::path::volume_merging`) and
+//! its own routine's weights over a path's techniques sum to one; with long photon beams
+//! (`beams=long`) on two media scenes. Plus proof that the check fails on a merge density off by
+//! 1 % (PB2D's, BB1D's, BP2D's, the surface merges'), on a technique missing from the sum, and on
+//! long beams weighed as short ones.
 
-use lt_core::path::Heuristic;
+use lt_core::path::{Heuristic, UpbpMode};
 use lt_experiments::verify::mis_check::upbp::{
     check_records, check_scene, collect, prepare_scene, UpbpOptions, UpbpRecord,
 };
@@ -72,6 +73,17 @@ fn a_planted_merge_density_error_fails() {
         report.failures() > report.checked() / 4,
         "{report}{summary}"
     );
+    // BP2D's density ×1.01 likewise.
+    let mut beam_point = records.clone();
+    for r in &mut beam_point {
+        r.set.as_mut().unwrap().beam_points_eta *= 1.01;
+    }
+    let (report, summary) = check_records(&scene, &beam_point, &opts, counts, "hg-spot");
+    println!("BP2D ×1.01:\n{summary}");
+    assert!(
+        report.failures() > report.checked() / 4,
+        "{report}{summary}"
+    );
     // PP3D missing from the oracle's sum: the integrator's weights counted it.
     let mut missing = records;
     for r in &mut missing {
@@ -83,6 +95,81 @@ fn a_planted_merge_density_error_fails() {
         report.failures() > report.checked() / 4,
         "{report}{summary}"
     );
+}
+
+/// Long photon beams (`beams=long`: BB1D's and BP2D's σ̂ᴸ the light flight's whole scattering
+/// density) on hg-spot (one homogeneous medium) and grid-smoke (a heterogeneous one, where the
+/// pieces' densities differ), both heuristics; and the check failing when the oracle weighs the
+/// long beams' paths as short beams' (σ̂ᴸ the pass-probability ratio).
+#[test]
+fn upbp_long_beams_match_the_oracle_and_short_weights_fail() {
+    let mut failed = Vec::new();
+    for h in [Heuristic::Power, Heuristic::Balance] {
+        for name in ["media/hg-spot", "media/grid-smoke"] {
+            let mut scene = shipped_scene(name, None);
+            let mut opts = options(&scene, h);
+            opts.beams = "long".into();
+            prepare_scene(&mut scene, &opts);
+            let (c, passes) = collect(&scene, &opts).unwrap();
+            let counts = (passes, c.counts.too_long);
+            let (report, summary) = check_records(&scene, &c.records, &opts, counts, name);
+            println!("{name} {h:?} long beams:\n{summary}");
+            assert!(report.merges() > 0, "{name}: no merged paths\n{report}");
+            if !report.passed() {
+                failed.push(format!("{report}{summary}"));
+            }
+            if h == Heuristic::Power && name == "media/hg-spot" {
+                let mut short = c.records;
+                for r in &mut short {
+                    r.set.as_mut().unwrap().long_beams = false;
+                }
+                let (report, summary) = check_records(&scene, &short, &opts, counts, name);
+                println!("long beams weighed as short:\n{summary}");
+                assert!(
+                    report.failures() > report.checked() / 4,
+                    "{report}{summary}"
+                );
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+/// SmallUPBP's modes on hg-spot (power): `compatible` (class ES*M(S|D|M)*L, full weights) and
+/// `previous` (that class, only the techniques meeting at its first medium vertex) against the
+/// oracle, which holds what each mode claims (Σw = 1 over the techniques it counts on the class,
+/// 0 outside); and the check failing when each mode's records are weighed as the other's.
+#[test]
+fn upbp_compatible_and_previous_modes_match_the_oracle_and_swapped_fail() {
+    let swapped = |mode: UpbpMode| match mode {
+        UpbpMode::Previous => UpbpMode::Compatible,
+        _ => UpbpMode::Previous,
+    };
+    for (name, mode) in [
+        ("compatible", UpbpMode::Compatible),
+        ("previous", UpbpMode::Previous),
+    ] {
+        let mut scene = shipped_scene("media/hg-spot", None);
+        let mut opts = options(&scene, Heuristic::Power);
+        opts.mode = name.into();
+        prepare_scene(&mut scene, &opts);
+        let (c, passes) = collect(&scene, &opts).unwrap();
+        let counts = (passes, c.counts.too_long);
+        assert!(c.records.iter().all(|r| r.set.unwrap().mode == mode));
+        let (report, summary) = check_records(&scene, &c.records, &opts, counts, "hg-spot");
+        println!("mode {name}:\n{summary}");
+        assert!(report.merges() > 0 && report.passed(), "{report}{summary}");
+        let mut planted = c.records;
+        for r in &mut planted {
+            r.set.as_mut().unwrap().mode = swapped(mode);
+        }
+        let (report, summary) = check_records(&scene, &planted, &opts, counts, "hg-spot");
+        println!("mode {name} weighed as {:?}:\n{summary}", swapped(mode));
+        assert!(
+            report.failures() > report.checked() / 4,
+            "{report}{summary}"
+        );
+    }
 }
 
 /// Without media upbp is vcm's technique set (connections and surface merges): its weights on

@@ -17,15 +17,19 @@ use lt_tests::{render_blocks, shipped_scene};
 
 /// The scenes: their images are mostly medium-scattered light.
 const SCENES: [&str; 2] = ["media/hg-spot", "media/smallupbp-isosph"];
-/// (estimator, photon paths per pass).
-/// (estimator, photon paths per pass, on `SCENES[0]` only).
-const ESTIMATORS: [(&str, u32, bool); 4] = [
-    ("pp3d", PHOTON_PATHS, false),
-    ("pb2d", PHOTON_PATHS, false),
-    ("bb1d", BB1D_PHOTON_PATHS, false),
+/// (estimator, photon paths per pass, on `SCENES[0]` only, `techniques` for upbp).
+const ESTIMATORS: [(&str, u32, bool, Option<&str>); 5] = [
+    ("pp3d", PHOTON_PATHS, false, None),
+    ("pb2d", PHOTON_PATHS, false, None),
+    ("bb1d", BB1D_PHOTON_PATHS, false, None),
     // hg-spot only: its beams are the whole image there; smallupbp-isosph's image is mostly
     // surface light that pt renders (a ×1.1 plant moves it by 2 %: see results/).
-    ("bp2d", BP2D_PHOTON_PATHS, true),
+    ("bp2d", BP2D_PHOTON_PATHS, true, None),
+    // BP2D inside upbp, beside bdpt's connections under one MIS (every light path's segments
+    // are beams: `beam_paths` = M): holds the combination's sum. BP2D carries ≈ 3 % of this
+    // image, so a ×1.1 on its kernel moves it 0.3 % and passes here (results/points-beams.md):
+    // its value is held by the `bp2d` row, its weights by tests/mis_check_upbp.rs.
+    ("upbp", BP2D_PHOTON_PATHS, true, Some("bpt,bp2d")),
 ];
 const RESOLUTION: u32 = 16;
 const PT_PASSES: u32 = 2048;
@@ -60,14 +64,21 @@ fn point_and_beam_estimates_agree_with_pt_on_media_scenes() {
             seed,
             block,
         );
-        for (j, &(estimator, photon_paths, first_only)) in ESTIMATORS.iter().enumerate() {
+        for (j, &(estimator, photon_paths, first_only, techniques)) in ESTIMATORS.iter().enumerate()
+        {
             if first_only && k > 0 {
                 continue;
+            }
+            let mut params = IntegratorParams::new().with("photons_per_pass", photon_paths);
+            if let Some(t) = techniques {
+                params = params
+                    .with("techniques", t)
+                    .with("beam_paths", photon_paths);
             }
             let (rendered, blocks) = render_blocks(
                 &scene,
                 estimator,
-                IntegratorParams::new().with("photons_per_pass", photon_paths),
+                params,
                 PASSES,
                 seed + 1 + 10 * j as u64,
                 block,

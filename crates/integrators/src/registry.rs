@@ -97,8 +97,8 @@ pub enum Weights {
     ConnectMerge { connections: bool },
     /// lvc-bdpt's: bdpt's techniques, connections counted N / L̄ times (`lvc_bdpt`).
     VertexCache,
-    /// upbp's: bdpt's connections, PP3D and PB2D under one MIS from the full path's densities
-    /// (`upbp::weights`; the oracle `lt_core::path::volume_merging`).
+    /// upbp's: bdpt's connections and the volumetric and surface merges under one MIS from the
+    /// full path's densities (`upbp::weights`; the oracle `lt_core::path::volume_merging`).
     Volumetric,
     /// eamis's: vcm's full-path weights with the counts its pilot chose (`eamis`); `lt mis-check`
     /// holds those weights through vcm with the same counts (`vertex_connections`).
@@ -267,7 +267,8 @@ pub const INTEGRATORS: &[IntegratorInfo] = &[
     IntegratorInfo {
         name: "upbp",
         about: "unified points, beams and paths: bdpt's connections, PP3D, PB2D, BB1D and \
-                (opt-in, `techniques=all`) vcm's surface merges under one MIS",
+                (opt-in, `techniques=all`) vcm's surface merges and BP2D under one MIS; short \
+                or long photon beams, SmallUPBP's compatible/previous modes",
         kind: Kind::Consistent,
         weights: Weights::Volumetric,
         source: include_str!("upbp/mod.rs"),

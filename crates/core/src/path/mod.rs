@@ -81,4 +81,4 @@ pub use path::Path;
 pub use scatter::{scatter, Scatter};
 pub use subpath_mis::{CameraMis, LightMis, SubpathMis};
 pub use vertex::{geometry, PathVertex, VertexKind};
-pub use volume_merging::{VolumeRates, VolumeSet, VolumeTechnique};
+pub use volume_merging::{UpbpMode, VolumeRates, VolumeSet, VolumeTechnique};

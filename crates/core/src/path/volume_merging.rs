@@ -28,6 +28,20 @@
 //!   2r sin θ turns their product into a volume density: the box across u times the Jacobian
 //!   of (s, t) → the plane of the two lines).
 //!
+//! - **beam–point 2-D** (BP2D): the light walk's segment x_{i−1} → x_i as a photon beam within
+//!   r of the camera walk's medium vertex x_i (sampled by free flight, as PP3D's), a disk of
+//!   area πr² across the beam, T evaluated along it (Jarosz et al. 2011's beam × point 2-D
+//!   estimate, `volume_density::point_beam`). PB2D mirrored: the light side no longer samples
+//!   the distance to x_i, so l_i becomes l_i / σ̂ᴸ_i and the camera's c_i stays a sampled
+//!   point's: p_BP,i = N_B · πr² · ∏_{j<i} l_j · (l_i / σ̂ᴸ_i) · ∏_{j≥i} c_j, N_B the light
+//!   subpaths whose segments are beams (BB1D's); no sin θ (one side is a point).
+//! - **long photon beams** (`VolumeSet::long_beams`, BB1D and BP2D): a light segment's beam runs
+//!   to the next surface whatever the free flight sampled, so it covers x_i with probability 1:
+//!   σ̂ᴸ_i is replaced by the flight's whole scattering density at x_i (`flight_rate`, the pass
+//!   probabilities of every piece before x_i included), so l_i / σ̂ᴸ_i = p_ω,L / d_L², the
+//!   direction's density alone (SmallUPBP's `mRaySamplePdfInv` for long beams against
+//!   `mRaySamplePdfsRatio` for short ones).
+//!
 //! - **surface merging** (vcm's vertex merging, `merging`) at a non-delta surface vertex x_i:
 //!   p_S,i = N · πr_S² · ∏_{j≤i} l_j · ∏_{j≥i} c_j (`Densities::merging`), so that a scene
 //!   without media has vcm's technique set.
@@ -59,6 +73,102 @@ pub struct VolumeSet {
     pub beam_beams_eta: f64,
     /// η_S = N π r_S² of surface vertex merging (vcm's, `merging`); 0 turns it off.
     pub surface_eta: f64,
+    /// η_BP = N_B πr² of BP2D; 0 turns it off.
+    pub beam_points_eta: f64,
+    /// The photon beams (BB1D's and BP2D's) are long: σ̂ᴸ_i → the flight's scattering density.
+    pub long_beams: bool,
+    /// Which paths are estimated and which techniques the heuristics count (`UpbpMode`).
+    pub mode: UpbpMode,
+}
+
+/// SmallUPBP's `-compatible` and `-previous` (Křivánek et al. 2014's comparisons with "previous
+/// work"). Both estimate only the paths of class ES*M(S|D|M)*L: from the camera, delta surface
+/// vertices up to a first medium vertex x_m (`first_medium_from_camera`); every other path gets
+/// weight 0 from every technique.
+///
+/// - `Full`: every path, every technique of the set counted: Σw = 1 over the set.
+/// - `Compatible`: class-C paths only, with `Full`'s weights: every technique that can make a
+///   class-C path runs for it, so Σw = 1 over the whole set on class C (0 outside) — the image is
+///   `Full`'s restricted to class C, term for term.
+/// - `Previous`: class-C paths, and only the techniques that meet at x_m count and run: the
+///   merges at x_m (PP3D, PB2D, BB1D, BP2D), the connections whose camera subpath ends at x_m
+///   (s = m) or whose light subpath does (s = m + 1: light tracing when x_m is the camera's
+///   first vertex): Σw = 1 over those on class C (0 outside). The camera walks "stop" at x_m:
+///   nothing runs past it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UpbpMode {
+    #[default]
+    Full,
+    Compatible,
+    Previous,
+}
+
+impl UpbpMode {
+    pub fn parse(text: &str) -> Result<UpbpMode, String> {
+        match text.trim() {
+            "full" => Ok(UpbpMode::Full),
+            "compatible" => Ok(UpbpMode::Compatible),
+            "previous" => Ok(UpbpMode::Previous),
+            other => Err(format!(
+                "unknown mode '{other}' (known: full, compatible, previous)"
+            )),
+        }
+    }
+
+    /// Whether the heuristics count `technique` on a path whose class vertex is `m`
+    /// (`first_medium_from_camera`).
+    pub fn counts(self, m: Option<usize>, technique: VolumeTechnique) -> bool {
+        match (self, m) {
+            (UpbpMode::Full, _) => true,
+            (_, None) => false,
+            (UpbpMode::Compatible, Some(_)) => true,
+            (UpbpMode::Previous, Some(m)) => match technique {
+                VolumeTechnique::Connect(s) => s == m || s == m + 1,
+                VolumeTechnique::Point(i)
+                | VolumeTechnique::Beam(i)
+                | VolumeTechnique::BeamBeam(i)
+                | VolumeTechnique::Surface(i)
+                | VolumeTechnique::BeamPoint(i) => i == m,
+            },
+        }
+    }
+}
+
+/// The class vertex of a path x_0 … x_k: scanning from the camera (x_{k−1} down to x_1) past
+/// delta surface vertices (neither in a medium nor `connectable`), the first other vertex when it
+/// lies in a medium; None when it is a surface or there is none (the path is not of class
+/// ES*M(S|D|M)*L).
+pub fn first_medium_from_camera(
+    k: usize,
+    medium: impl Fn(usize) -> bool,
+    connectable: &[bool],
+) -> Option<usize> {
+    for j in (1..k).rev() {
+        if medium(j) {
+            return Some(j);
+        }
+        if connectable[j] {
+            return None;
+        }
+    }
+    None
+}
+
+/// Technique `j` of `Densities::effective_upbp`'s list for a path of k = n − 1 segments.
+fn technique_at(n: usize, j: usize) -> VolumeTechnique {
+    if j <= n {
+        VolumeTechnique::Connect(j)
+    } else if j <= 2 * n {
+        VolumeTechnique::Point(j - n - 1)
+    } else if j <= 3 * n {
+        VolumeTechnique::Beam(j - 2 * n - 1)
+    } else if j <= 4 * n {
+        VolumeTechnique::BeamBeam(j - 3 * n - 1)
+    } else if j <= 5 * n {
+        VolumeTechnique::Surface(j - 4 * n - 1)
+    } else {
+        VolumeTechnique::BeamPoint(j - 5 * n - 1)
+    }
 }
 
 /// One technique of UPBP's family on a path.
@@ -74,17 +184,43 @@ pub enum VolumeTechnique {
     BeamBeam(usize),
     /// Surface vertex merging (vcm's) at the surface vertex x_i.
     Surface(usize),
+    /// BP2D at the medium vertex x_i: a photon beam gathered at the camera walk's x_i.
+    BeamPoint(usize),
 }
 
 /// Per vertex x_j of a path: whether it lies in a medium, σ̂_j (module doc) of the camera
 /// direction's flight x_{j+1} → x_j (0 where no flight scatters: surfaces, endpoints), σ̂ᴸ_j of
-/// the light direction's flight x_{j−1} → x_j, and sin θ_j between those two flights.
+/// the light direction's flight x_{j−1} → x_j, sin θ_j between those two flights, and the light
+/// direction's whole scattering density at x_j (`flight_rate`: a long beam's σ̂ᴸ).
 #[derive(Clone, Debug, PartialEq)]
 pub struct VolumeRates {
     pub medium: Vec<bool>,
     pub rate: Vec<f64>,
     pub light_rate: Vec<f64>,
     pub sin: Vec<f64>,
+    pub light_flight: Vec<f64>,
+}
+
+impl VolumeRates {
+    /// σ̂ᴸ_j as `set`'s photon beams read it: the short beam's ratio, or a long beam's whole
+    /// scattering density.
+    pub fn light_side(&self, set: &VolumeSet, j: usize) -> f64 {
+        if set.long_beams {
+            self.light_flight[j]
+        } else {
+            self.light_rate[j]
+        }
+    }
+}
+
+/// A long beam's σ̂ᴸ at `to` of the flight `from` → `to`: its scattering density per unit length
+/// over all its pieces (a long beam covers every point of the flight: its cover probability is
+/// 1), from scratch; 0 when `to` is no medium vertex.
+pub fn flight_rate(scene: &Scene, from: &PathVertex, to: &PathVertex) -> f64 {
+    if !to.in_medium() {
+        return 0.0;
+    }
+    free_flight(scene, from, to)
 }
 
 /// sin θ between the flights from `a` into `x` and from `b` into `x` (the lines' angle: the
@@ -151,11 +287,21 @@ impl VolumeRates {
                 }
             })
             .collect();
+        let light_flight = (0..=k)
+            .map(|j| {
+                if j > 0 && medium[j] {
+                    flight_rate(scene, &v[j - 1], &v[j])
+                } else {
+                    0.0
+                }
+            })
+            .collect();
         VolumeRates {
             medium,
             rate,
             light_rate,
             sin,
+            light_flight,
         }
     }
 
@@ -188,6 +334,12 @@ impl VolumeRates {
                     side.light_rate[j]
                 })
                 .collect(),
+            light_flight: (0..=k)
+                .map(|j| {
+                    let side = if j <= i { &at_light } else { &at_camera };
+                    side.light_flight[j]
+                })
+                .collect(),
             sin,
         }
     }
@@ -212,7 +364,8 @@ impl Densities {
     /// techniques s = 0 … k+1 (zero for s ≥ 1 without connections), then η_P·p_P,i for
     /// i = 0 … k, then η_B·p_B,i, then η_BB·p_BB,i for i = 0 … k (module doc; zero where x_i is
     /// no medium vertex), then η_S·p_VM,i of surface merging (`Densities::merging`: zero where
-    /// x_i lies in a medium or is delta).
+    /// x_i lies in a medium or is delta), then η_BP·p_BP,i; under `set.mode` (`UpbpMode`) the
+    /// techniques it does not count are zero.
     pub fn effective_upbp(&self, set: VolumeSet, rates: &VolumeRates) -> Vec<f64> {
         let k = self.k();
         let mut all = self.effective_all();
@@ -238,7 +391,7 @@ impl Densities {
             });
         }
         for i in 0..=k {
-            let (r, rl, sin) = (rates.rate[i], rates.light_rate[i], rates.sin[i]);
+            let (r, rl, sin) = (rates.rate[i], rates.light_side(&set, i), rates.sin[i]);
             all.push(if mergeable(i) && r > 0.0 && rl > 0.0 {
                 set.beam_beams_eta
                     * sin
@@ -256,6 +409,22 @@ impl Densities {
                 set.surface_eta * self.merging(i)
             });
         }
+        for i in 0..=k {
+            let rl = rates.light_side(&set, i);
+            all.push(if mergeable(i) && rl > 0.0 {
+                set.beam_points_eta * (light_to(i) / rl) * camera_from(i)
+            } else {
+                0.0
+            });
+        }
+        if set.mode != UpbpMode::Full {
+            let m = first_medium_from_camera(k, |j| rates.medium[j], &self.connectable);
+            for (j, p) in all.iter_mut().enumerate() {
+                if !set.mode.counts(m, technique_at(k + 1, j)) {
+                    *p = 0.0;
+                }
+            }
+        }
         all
     }
 
@@ -268,6 +437,7 @@ impl Densities {
             VolumeTechnique::Beam(i) => 2 * n + 1 + i,
             VolumeTechnique::BeamBeam(i) => 3 * n + 1 + i,
             VolumeTechnique::Surface(i) => 4 * n + 1 + i,
+            VolumeTechnique::BeamPoint(i) => 5 * n + 1 + i,
         }
     }
 
@@ -291,19 +461,7 @@ impl Densities {
         all.iter()
             .enumerate()
             .filter(|(_, &p)| p > 0.0)
-            .map(|(j, _)| {
-                if j <= n {
-                    VolumeTechnique::Connect(j)
-                } else if j <= 2 * n {
-                    VolumeTechnique::Point(j - n - 1)
-                } else if j <= 3 * n {
-                    VolumeTechnique::Beam(j - 2 * n - 1)
-                } else if j <= 4 * n {
-                    VolumeTechnique::BeamBeam(j - 3 * n - 1)
-                } else {
-                    VolumeTechnique::Surface(j - 4 * n - 1)
-                }
-            })
+            .map(|(j, _)| technique_at(n, j))
             .collect()
     }
 }

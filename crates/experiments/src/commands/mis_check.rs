@@ -52,9 +52,16 @@ pub struct MisCheckArgs {
     /// vcm, bpm: merging only in a checkerboard of pixels (eamis's per-pixel choice).
     #[arg(long)]
     pub checkerboard_merging: bool,
-    /// upbp: its `techniques` (all, or a comma-separated subset of bpt, surf, pp3d, pb2d, bb1d).
+    /// upbp: its `techniques` (all, or a comma-separated subset of bpt, surf, pp3d, pb2d, bb1d,
+    /// bp2d).
     #[arg(long)]
     pub techniques: Option<String>,
+    /// upbp: its `beams` (short or long photon beams for BB1D and BP2D).
+    #[arg(long)]
+    pub beams: Option<String>,
+    /// upbp: its `mode` (full, compatible or previous: SmallUPBP's).
+    #[arg(long)]
+    pub mode: Option<String>,
 }
 
 /// `lt mis-check`: the report, or an error carrying it when any check fails.
@@ -144,6 +151,12 @@ fn run_upbp(args: &MisCheckArgs) -> Result<String, String> {
     }
     if let Some(t) = &args.techniques {
         opts.techniques = t.clone();
+    }
+    if let Some(b) = &args.beams {
+        opts.beams = b.clone();
+    }
+    if let Some(m) = &args.mode {
+        opts.mode = m.clone();
     }
     opts.paths = args.paths;
     opts.seed = args.seed;

@@ -7,9 +7,17 @@
 //! (`Scene::for_each_medium_piece`), carrying T and P_pass of the pieces before it.
 //! (As PB2D's camera beams, a thin dielectric pane passed inside a segment is left out of
 //! P_pass: no shipped media scene has one.)
+//!
+//! **Long** beams (`beams=long`, SmallUPBP's long photon beams): the segment's beam runs on past
+//! a medium vertex y_i to the next surface that is not a null boundary (or out of the scene),
+//! whatever the free flight sampled, so it covers every point of the flight with probability 1
+//! and its value there is β_leave T(t) (no 1/P_pass). The light walk still goes on from the
+//! y_i it sampled; the merges' weights read the flight's whole scattering density as σ̂ᴸ
+//! (`lt_core::path::volume_merging::flight_rate`).
 
 use crate::subpath::walk::Subpath;
 use crate::volume_density::photon_beams::{sphere_exit, BeamIndex, PhotonBeam};
+use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec3};
 use lt_core::path::PathVertex;
 use lt_core::scene::{ConnectionEnd, Crossing, MediumPiece};
@@ -44,12 +52,16 @@ pub struct Back {
 
 impl Back {
     /// The reverse flight from `x` (in this piece of medium `mm`, starting at `a`) to the
-    /// segment's start, and σ̂ there (0 at a surface or the camera).
-    pub fn at(&self, mm: &lt_core::medium::Medium, x: Vec3, a: Vec3) -> (f64, f64) {
+    /// segment's start, and its rate there (0 at a surface or the camera): σ̂, or with `long` (a
+    /// long photon beam's σ̂ᴸ, `flight_rate`) the reverse flight's whole scattering density —
+    /// the first value itself.
+    pub fn at(&self, mm: &lt_core::medium::Medium, x: Vec3, a: Vec3, long: bool) -> (f64, f64) {
         let scatter = self.first && self.start_in_medium;
         let d = mm.free_flight_density(x, a, scatter);
         let rate = if !self.start_in_medium {
             0.0
+        } else if long {
+            (self.before * d) as f64
         } else if self.first {
             let pass = mm.free_flight_density(x, a, false);
             if pass > 0.0 {
@@ -94,13 +106,45 @@ impl Back {
     }
 }
 
-/// The beams (`PhotonBeam::power` = β_leave T_before / P_before at the piece's start) and their
-/// sources, in path order.
+/// The beams (`PhotonBeam::power` = β_leave T_before / P_before at the piece's start, or
+/// β_leave T_before when `long`) and their sources, in path order.
 #[derive(Default)]
 pub struct LightBeams {
     pub beams: Vec<PhotonBeam>,
     pub refs: Vec<BeamRef>,
     pub index: Option<BeamIndex>,
+    /// Long beams (module doc): no 1/P_pass in their values.
+    pub long: bool,
+}
+
+/// Shapes a long beam passes before it meets a surface at most (null boundaries: a medium's
+/// shell and its nesting).
+const MAX_NULL_CROSSINGS: usize = 64;
+
+/// The end of a long beam leaving medium vertex `x` along `dir`: the first surface that is not a
+/// null boundary, or the far end at infinity.
+fn next_surface(scene: &Scene, x: Vec3, dir: Vec3) -> ConnectionEnd {
+    let mut ray = Ray::new(x, dir);
+    for _ in 0..MAX_NULL_CROSSINGS {
+        let Some(hit) = scene.intersect(&ray) else {
+            break;
+        };
+        if !scene.shapes[hit.shape as usize].null {
+            return ConnectionEnd {
+                p: hit.p,
+                p_err: hit.p_err,
+                ng: hit.ng,
+                infinite: false,
+            };
+        }
+        ray = hit.spawn_ray(dir);
+    }
+    ConnectionEnd {
+        p: dir,
+        p_err: Vec3::ZERO,
+        ng: Vec3::ZERO,
+        infinite: true,
+    }
 }
 
 impl LightBeams {
@@ -109,8 +153,13 @@ impl LightBeams {
         let y = &sub.vertices;
         for i in 1..=y.len() {
             let (end, dir, leave) = if i < y.len() {
-                let e: ConnectionEnd = (&y[i]).into();
-                (e, y[i - 1].dir_to(&y[i]), sub.departure(i))
+                let dir = y[i - 1].dir_to(&y[i]);
+                let e: ConnectionEnd = if self.long && y[i].in_medium() {
+                    next_surface(scene, y[i].p, dir)
+                } else {
+                    (&y[i]).into()
+                };
+                (e, dir, sub.departure(i))
             } else if let Some(exit) = sub.exit {
                 let far = ConnectionEnd {
                     p: exit.dir,
@@ -156,11 +205,12 @@ impl LightBeams {
                 length = length.min(sphere_exit(piece.a, dir, c, r.max(1e-3)));
             }
             if length > 0.0 && p_before > 0.0 {
+                let cover = if self.long { 1.0 } else { p_before };
                 self.beams.push(PhotonBeam {
                     origin: piece.a,
                     dir,
                     length,
-                    power: leave.beta * t_before / p_before,
+                    power: leave.beta * t_before / cover,
                     medium: m,
                     segments: vertex,
                 });

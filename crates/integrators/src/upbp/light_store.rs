@@ -20,9 +20,18 @@ use lt_core::spatial::PointGrid;
 use lt_core::Scene;
 use rayon::prelude::*;
 
-/// The radii a pass indexes its light subpaths for: r_P (PP3D), r_B (PB2D), (r_BB, M_BB)
-/// (BB1D), r_S (surface merges); None where the technique does not run.
-pub type Radii = (Option<f32>, Option<f32>, Option<(f32, u64)>, Option<f32>);
+/// The radii a pass indexes its light subpaths for: r_P (PP3D), r_B (PB2D), the photon beams
+/// (BB1D, BP2D), r_S (surface merges); None where no technique reads them.
+pub type Radii = (Option<f32>, Option<f32>, Option<BeamSetup>, Option<f32>);
+
+/// A pass's photon beams: the radius their index serves (the largest of BB1D's and BP2D's), the
+/// light subpaths whose segments are beams (the pass's first M_B), and whether they are long.
+#[derive(Clone, Copy, Debug)]
+pub struct BeamSetup {
+    pub r_index: f32,
+    pub paths: u64,
+    pub long: bool,
+}
 
 /// Light subpaths traced per parallel chunk (fixed: the stored order, hence every sum, does not
 /// depend on the thread count).
@@ -80,7 +89,7 @@ pub struct LightStore {
     pub points: Option<PointGrid>,
     /// For PB2D (photon spheres of r_B).
     pub beams: Option<BeamGrid>,
-    /// For BB1D: the light subpaths' segments through media as short photon beams.
+    /// For BB1D and BP2D: the light subpaths' segments through media as photon beams.
     pub light_beams: Option<LightBeams>,
     /// For surface merges: the non-delta surface vertices (cells of 2 r_S).
     pub surface_positions: Vec<Vec3>,
@@ -91,8 +100,8 @@ pub struct LightStore {
 impl LightStore {
     /// Traces light subpaths 0 … m−1 of `pass` (streams `Domain::Light`, item = index, as bdpt's)
     /// and indexes their medium vertices for radii `r_points` (`None`: no PP3D) and `r_beams`
-    /// (no PB2D), the segments through media of the first M_BB for `r_beam_beams` = (r_BB, M_BB)
-    /// (no BB1D), their non-delta surface vertices for `r_surface` (no surface merges); `needs`:
+    /// (no PB2D), the segments through media of the first M_B as photon beams (`BeamSetup`; no
+    /// BB1D or BP2D), their non-delta surface vertices for `r_surface` (no surface merges); `needs`:
     /// the rates the weights read.
     pub fn trace(
         scene: &Scene,
@@ -106,6 +115,7 @@ impl LightStore {
             .map(|c| {
                 let mut chunk = Chunk::default();
                 chunk.starts.push(0);
+                chunk.beams.long = r_beam_beams.is_some_and(|b| b.long);
                 let mut sub = Subpath::with_capacity(limits.max_vertices);
                 for j in c as u64 * CHUNK..((c as u64 + 1) * CHUNK).min(m) {
                     let mut ls = Sampler::for_item(Domain::Light, seed, j, pass as u64);
@@ -122,7 +132,7 @@ impl LightStore {
                     chunk
                         .rates
                         .extend((0..y.len()).map(|i| light_vertex(scene, y, i, needs)));
-                    if r_beam_beams.is_some_and(|(_, m_bb)| j < m_bb) && scene.has_media {
+                    if r_beam_beams.is_some_and(|b| j < b.paths) && scene.has_media {
                         chunk.beams.add_path(scene, j as u32, &sub);
                     }
                     chunk.nee.push(if y.len() >= 2 {
@@ -136,12 +146,15 @@ impl LightStore {
             })
             .collect();
         let mut chunks = chunks;
-        let light_beams = r_beam_beams.map(|(r, _)| {
-            let mut all = LightBeams::default();
+        let light_beams = r_beam_beams.map(|b| {
+            let mut all = LightBeams {
+                long: b.long,
+                ..LightBeams::default()
+            };
             for c in &mut chunks {
                 all.append(std::mem::take(&mut c.beams));
             }
-            all.build_index(r);
+            all.build_index(b.r_index);
             all
         });
         let mut store = LightStore {

@@ -14,14 +14,16 @@
 //!   side tests and BSDF evaluation of `density::surface_merge`, shared with vcm): on a scene
 //!   without media `bpt,surf` is vcm's technique set;
 //! - `bb1d`: the same short camera beams gather the light subpaths' segments through media as
-//!   short photon beams (`light_beams`) within r_BB, 1-D kernel 1/(2 r_BB) over sin θ, T
-//!   evaluated along both (`camera_beams`).
+//!   photon beams (`light_beams`, short by default, long with `beams=long`) within r_BB, 1-D
+//!   kernel 1/(2 r_BB) over sin θ, T evaluated along both (`camera_beams`);
+//! - `bp2d`: each medium vertex of the camera walk gathers the same photon beams within r_B of
+//!   it, 2-D kernel 1/(π r_B²) across each beam, T evaluated along it (`policy::beam_points`).
 //!
 //! Weights: `weights` (full-path densities, the measures and η's stated there and in
-//! `lt_core::path::volume_merging`, the oracle). Not here yet: BP2D, long beams, SmallUPBP's `previous`/`compatible` modes. Per pass, camera sample j pairs
+//! `lt_core::path::volume_merging`, the oracle). Per pass, camera sample j pairs
 //! with light subpath j mod M for its connections (bdpt's pairing) and queries all M for merges;
 //! radii shrink per kernel dimension (`volume_density::schedule`): r_P,i = r₁ i^((α_P−1)/3),
-//! r_B,i = r₁ i^((α−1)/2), r_BB,i = r₁ i^(α_BB−1). A scene without media has no photons: upbp
+//! r_B,i = r₁ i^((α−1)/2) (PB2D, BP2D, surface merges), r_BB,i = r₁ i^(α_BB−1). A scene without media has no photons: upbp
 //! is bdpt there by default, vcm with `techniques=all` or `bpt,surf`.
 //!
 //! | key | type | default | meaning |
@@ -29,14 +31,16 @@
 //! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `mis` | power/balance/none | power | heuristic over every technique |
-//! | `techniques` | all/bpt/surf/pp3d/pb2d/bb1d | bpt,pp3d,pb2d,bb1d | `all` (the five), or a comma- or plus-separated subset of bpt, surf, pp3d, pb2d, bb1d (SmallUPBP's names); surf is opt-in (`DEFAULT_TECHNIQUES`) |
+//! | `techniques` | all/bpt/surf/pp3d/pb2d/bb1d/bp2d | bpt,pp3d,pb2d,bb1d | `all` (the six), or a comma- or plus-separated subset of bpt, surf, pp3d, pb2d, bb1d, bp2d (SmallUPBP's names); surf and bp2d are opt-in (`DEFAULT_TECHNIQUES`) |
+//! | `mode` | full/compatible/previous | full | SmallUPBP's modes (`lt_core::path::UpbpMode`): every path; only paths ES*M(S|D|M)*L with full weights; those paths with only the techniques meeting at their first medium vertex from the camera |
+//! | `beams` | short/long | short | the photon beams of BB1D and BP2D: the flight the light walk sampled, or on to the next surface (`light_beams`) |
 //! | `photons_per_pass` | u64 | the pixel count | light subpaths per pass (M) |
 //! | `radius` | f32 | — | initial radius r₁ in scene units (every kernel) |
 //! | `radius_scene` | f32 | 0.01 | initial radius as a fraction of the scene's bounding-sphere diameter |
 //! | `alpha` | f64 | 2/3 | PB2D's and surface merges' radius reduction: r_B,i = r_S,i = r₁ i^((α−1)/2) |
 //! | `alpha_points` | f64 | 4/7 | PP3D's radius reduction: r_P,i = r₁ i^((α_P−1)/3) |
 //! | `alpha_beam_beams` | f64 | 4/5 | BB1D's radius reduction: r_BB,i = r₁ i^(α_BB−1) |
-//! | `beam_paths` | u64 | ⌈M/8⌉ | light subpaths (the pass's first) whose segments are BB1D's photon beams |
+//! | `beam_paths` | u64 | ⌈M/8⌉ | light subpaths (the pass's first) whose segments are BB1D's and BP2D's photon beams |
 
 pub mod camera_beams;
 pub mod light_beams;
@@ -55,9 +59,9 @@ use crate::subpath::walk::{Subpath, WalkLimits};
 use crate::volume_density::schedule::{balanced_alpha, radius_scale};
 use crate::volume_density::VolumeParams;
 use crate::{ProgressLog, Progressive, ProgressiveRun};
-use light_store::LightStore;
+use light_store::{BeamSetup, LightStore};
 use lt_core::math::PI;
-use lt_core::path::{Heuristic, VolumeSet};
+use lt_core::path::{Heuristic, UpbpMode, VolumeSet};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
 use lt_estimators::Image;
@@ -73,10 +77,13 @@ pub struct Techniques {
     pub bb1d: bool,
     /// Surface vertex merging (vcm's; SmallUPBP's `surf`).
     pub surf: bool,
+    /// Photon beams at camera points (SmallUPBP's `bp2d`).
+    pub bp2d: bool,
 }
 
 impl Techniques {
-    /// `all`, or a comma- or plus-separated subset of `bpt`, `surf`, `pp3d`, `pb2d`, `bb1d`.
+    /// `all`, or a comma- or plus-separated subset of `bpt`, `surf`, `pp3d`, `pb2d`, `bb1d`,
+    /// `bp2d`.
     pub fn parse(text: &str) -> Result<Techniques, String> {
         if text.trim() == "all" {
             return Ok(Techniques {
@@ -85,6 +92,7 @@ impl Techniques {
                 pb2d: true,
                 bb1d: true,
                 surf: true,
+                bp2d: true,
             });
         }
         let mut t = Techniques {
@@ -93,6 +101,7 @@ impl Techniques {
             pb2d: false,
             bb1d: false,
             surf: false,
+            bp2d: false,
         };
         for name in text.split([',', '+']) {
             match name.trim() {
@@ -101,10 +110,11 @@ impl Techniques {
                 "pb2d" => t.pb2d = true,
                 "bb1d" => t.bb1d = true,
                 "surf" => t.surf = true,
+                "bp2d" => t.bp2d = true,
                 other => {
                     return Err(format!(
                         "unknown technique '{other}' (known: all, or a comma-separated subset of \
-                         bpt, surf, pp3d, pb2d, bb1d)"
+                         bpt, surf, pp3d, pb2d, bb1d, bp2d)"
                     ))
                 }
             }
@@ -113,10 +123,11 @@ impl Techniques {
     }
 }
 
-/// `techniques` by default: every technique but the surface merges. Surface merges are opt-in
-/// (`all`, or `+surf`): a merge's weight here is formed from the full path (O(k) per merge, not
-/// vcm's O(1) recursion), which made upbp 5–7× slower on cornell-box at its default radius, and
-/// the registry's loops hold upbp at bdpt's budget on surface scenes.
+/// `techniques` by default: every technique but the surface merges and BP2D. Surface merges are
+/// opt-in (`all`, or `+surf`): a merge's weight here is formed from the full path (O(k) per
+/// merge, not vcm's O(1) recursion), which made upbp 5–7× slower on cornell-box at its default
+/// radius, and the registry's loops hold upbp at bdpt's budget on surface scenes. BP2D (`+bp2d`)
+/// is opt-in so that the default's images stay those the registry's studies were run with.
 pub const DEFAULT_TECHNIQUES: &str = "bpt,pp3d,pb2d,bb1d";
 
 #[derive(Clone, Copy, Debug)]
@@ -128,6 +139,10 @@ pub struct UpbpParams {
     pub beam_paths: Option<u64>,
     pub mis: Heuristic,
     pub techniques: Techniques,
+    /// `beams=long`: BB1D's and BP2D's photon beams run to the next surface (`light_beams`).
+    pub long_beams: bool,
+    /// `mode`: SmallUPBP's compatible/previous (`UpbpMode`).
+    pub mode: UpbpMode,
 }
 
 impl UpbpParams {
@@ -162,7 +177,18 @@ impl UpbpParams {
             techniques: r
                 .get_with("techniques", Techniques::parse)?
                 .unwrap_or(Techniques::parse(DEFAULT_TECHNIQUES)?),
+            long_beams: r.get_with("beams", parse_beams)?.unwrap_or(false),
+            mode: r.get_with("mode", UpbpMode::parse)?.unwrap_or_default(),
         })
+    }
+}
+
+/// `beams`: `long` (true) or `short`.
+fn parse_beams(text: &str) -> Result<bool, String> {
+    match text.trim() {
+        "long" => Ok(true),
+        "short" => Ok(false),
+        other => Err(format!("unknown beams '{other}' (known: short, long)")),
     }
 }
 
@@ -230,6 +256,12 @@ impl Upbp {
         } else {
             0.0
         };
+        // BP2D shares PB2D's 2-D schedule (r_B) and BB1D's beams (M_B of them).
+        let beam_points_eta = if t.bp2d {
+            m_bb as f64 * PI as f64 * rbf * rbf
+        } else {
+            0.0
+        };
         // Surface merges share PB2D's 2-D schedule (the same kernel dimension): r_S = r_B.
         let surface_eta = if t.surf {
             mf * PI as f64 * rbf * rbf
@@ -242,11 +274,25 @@ impl Upbp {
             beams_eta,
             beam_beams_eta,
             surface_eta,
+            beam_points_eta,
+            long_beams: self.params.long_beams,
+            mode: self.params.mode,
         };
+        // One beam index serves both beam techniques: listed within the larger radius.
+        let r_index = match (t.bb1d, t.bp2d) {
+            (true, true) => rbb.max(rb),
+            (true, false) => rbb,
+            _ => rb,
+        };
+        let beams = (t.bb1d || t.bp2d).then_some(BeamSetup {
+            r_index,
+            paths: m_bb,
+            long: self.params.long_beams,
+        });
         let radii = (
             t.pp3d.then_some(rp),
             t.pb2d.then_some(rb),
-            t.bb1d.then_some((rbb, m_bb)),
+            beams,
             t.surf.then_some(rb),
         );
         let needs = Needs::of(&set);
@@ -455,6 +501,7 @@ impl PassSetup {
             beam_norm: norm(self.set.beams_eta),
             beam_beam_norm: norm(self.set.beam_beams_eta),
             surface_norm: norm(self.set.surface_eta),
+            beam_point_norm: norm(self.set.beam_points_eta),
             needs: Needs::of(&self.set),
         }
     }

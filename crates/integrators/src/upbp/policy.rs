@@ -7,7 +7,13 @@
 //! **PP3D** at the medium vertex z (β_z holding σs(z)), per photon y_i within r_P:
 //! β_z f_p(ω_z, ω_y) (β_y / σs(y_i)) / (N (4/3)π r_P³). PB2D's and BB1D's estimates are
 //! `camera_beams`'s.
+//!
+//! **BP2D** at the medium vertex z, per photon beam b within r_B of it (`beam_points`), x' the
+//! projection of z on the beam: β_z f_p(ω_z, −ω_b) Φ_b(x') / (M_B π r_B²), Φ_b(x') the beam's
+//! value there (`camera_beams::BeamEnd`) — Jarosz et al. 2011's beam × point 2-D estimate, as
+//! `volume_density::point_beam`.
 
+use super::camera_beams::BeamEnd;
 use super::light_store::{LightPath, LightStore};
 use super::rates::{camera_vertex, junction, Needs};
 use super::weights::{weight, VertexRate};
@@ -20,7 +26,9 @@ use crate::subpath::walk::{Departure, Exit, Subpath};
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2, Vec3};
 use lt_core::path::scatter::{connectable, connectable_inside};
-use lt_core::path::{Chain, Heuristic, PathVertex, VertexKind, VolumeSet, VolumeTechnique};
+use lt_core::path::{
+    Chain, Heuristic, PathVertex, UpbpMode, VertexKind, VolumeSet, VolumeTechnique,
+};
 use lt_core::sampling::Sampler;
 use lt_core::scene::ConnectionEnd;
 use lt_core::Scene;
@@ -41,6 +49,8 @@ pub struct PassData<'a> {
     pub beam_norm: f32,
     pub beam_beam_norm: f32,
     pub surface_norm: f32,
+    /// 1 / (M_B π r_B²): BP2D's kernel and beam count.
+    pub beam_point_norm: f32,
     /// The rates the weights read (`rates::Needs`).
     pub needs: Needs,
 }
@@ -60,6 +70,9 @@ pub struct Policy<'a, const MEDIA: bool> {
     pub buf: Vec<PathVertex>,
     /// A light side with a photon beam's point last.
     pub light_buf: Vec<PathVertex>,
+    /// The camera walk's first vertex past the camera that is no delta surface, and whether it
+    /// lies in a medium (`UpbpMode`'s class vertex x_m when it does).
+    pub first: Option<(usize, bool)>,
 }
 
 /// `v / σs` per channel, zero where σs is (β is zero there too): a photon's power as
@@ -167,6 +180,30 @@ impl<'a, const MEDIA: bool> Policy<'a, MEDIA> {
             exit: None,
             buf: Vec::new(),
             light_buf: Vec::new(),
+            first: None,
+        }
+    }
+
+    /// Whether the techniques at camera vertex z_{t−1} run under the pass's mode: always
+    /// (`Full`); once the walk passed its class vertex (`Compatible`); at it only (`Previous`).
+    /// The weights give the others 0 anyway (`UpbpMode::counts`): this only spares their work.
+    fn runs_at(&self, t: usize) -> bool {
+        match (self.pass.set.mode, self.first) {
+            (UpbpMode::Full, _) => true,
+            (_, None | Some((_, false))) => false,
+            (UpbpMode::Compatible, Some((m, true))) => m < t,
+            (UpbpMode::Previous, Some((m, true))) => m == t - 1,
+        }
+    }
+
+    /// Whether the camera beams along the segment leaving `prefix`'s last vertex run: their
+    /// query points lie in a medium, so they are the class vertex when `prefix` is all delta.
+    fn runs_along(&self, prefix: usize) -> bool {
+        let all_delta = self.first.is_none_or(|(m, _)| m >= prefix);
+        match self.pass.set.mode {
+            UpbpMode::Full => true,
+            UpbpMode::Compatible => all_delta || self.runs_at(prefix),
+            UpbpMode::Previous => all_delta,
         }
     }
 
@@ -368,6 +405,73 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
     }
 }
 
+impl<const MEDIA: bool> Policy<'_, MEDIA> {
+    /// BP2D at the camera walk's medium vertex z_{t−1}: the photon beams within r_B of it.
+    fn beam_points<R: Recorder>(
+        &mut self,
+        scene: &Scene,
+        z: &[PathVertex],
+        ctx: &mut SampleCtx<'_, R>,
+        l: &mut Color,
+    ) {
+        let p = self.pass;
+        let t = z.len();
+        let zv = &z[t - 1];
+        let Some(lb) = p.store.light_beams.as_ref() else {
+            return;
+        };
+        let (Some(index), Some(m)) = (lb.index.as_ref(), medium_of(zv)) else {
+            return;
+        };
+        if t > p.max_k || zv.beta == Color::ZERO {
+            return;
+        }
+        let phase = scene.media[m as usize].phase();
+        let frame = &index.lists.frame;
+        // Every beam within the index's radius (≥ r_B) of z is listed in z's cell.
+        let cell = frame.index(frame.cell_of(zv.p));
+        let r2 = p.r_beams * p.r_beams;
+        let mut light_buf = std::mem::take(&mut self.light_buf);
+        for &bi in index.lists.items(cell) {
+            let b = &lb.beams[bi as usize];
+            let i = lb.refs[bi as usize].vertex as usize;
+            if b.medium != m || i + t - 1 > p.max_k {
+                continue;
+            }
+            let tb = (zv.p - b.origin).dot(b.dir);
+            if !(tb >= 0.0 && tb < b.length) {
+                continue;
+            }
+            if (zv.p - (b.origin + b.dir * tb)).length_squared() > r2 {
+                continue;
+            }
+            let Some(end) = BeamEnd::at(scene, lb, p.store, (bi, tb), &mut light_buf) else {
+                continue;
+            };
+            let value = zv.beta * phase.eval(zv.wo, -b.dir) * end.value * p.beam_point_norm;
+            if value == Color::ZERO {
+                continue;
+            }
+            let light = end.side(&light_buf, p);
+            let technique = VolumeTechnique::BeamPoint(i);
+            let w = self.merge_weight(scene, light, self.camera_side(z), technique);
+            if R::ACTIVE {
+                ctx.rec.volume_merged(VolumeMerged {
+                    technique,
+                    light: &light_buf,
+                    camera: z,
+                    weight: w,
+                    value,
+                    raster: ctx.raster,
+                    radius: p.r_beams,
+                });
+            }
+            *l += value * w as f32;
+        }
+        self.light_buf = light_buf;
+    }
+}
+
 impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     const MEDIA: bool = MEDIA;
 
@@ -384,6 +488,9 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         self.departure
             .extend((0..z.len()).map(|j| camera.departure(j)));
         self.exit = camera.exit;
+        self.first = (1..z.len())
+            .find(|&j| z[j].in_medium() || connectable_inside(scene, &z[j]))
+            .map(|j| (j, z[j].in_medium()));
     }
 
     fn emitter_weight(
@@ -443,6 +550,9 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     }
 
     fn connect<R: Recorder>(&mut self, scene: &Scene, joins: &mut Joins<'_, R>, _: &mut Sampler) {
+        if !self.runs_at(joins.t()) {
+            return;
+        }
         let this = &*self;
         joins.join_subpath_in::<MEDIA>(scene, this.y, |c| {
             let (s, t) = (c.light.len(), c.camera.len());
@@ -471,9 +581,15 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         let p = self.pass;
         let t = z.len();
         let zv = &z[t - 1];
+        if !self.runs_at(t) {
+            return;
+        }
         if !zv.in_medium() {
             self.surface_merges(scene, z, ctx, l);
             return;
+        }
+        if p.set.beam_points_eta > 0.0 {
+            self.beam_points(scene, z, ctx, l);
         }
         let (Some(grid), Some(m)) = (p.store.points.as_ref(), medium_of(zv)) else {
             return;
@@ -533,7 +649,7 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         ctx: &mut SampleCtx<'_, R>,
         l: &mut Color,
     ) {
-        if !MEDIA {
+        if !MEDIA || !self.runs_along(z.len() - 1) {
             return;
         }
         let t = z.len();
@@ -549,7 +665,7 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         ctx: &mut SampleCtx<'_, R>,
         l: &mut Color,
     ) {
-        let Some(exit) = self.exit.filter(|_| MEDIA) else {
+        let Some(exit) = self.exit.filter(|_| MEDIA && self.runs_along(z.len())) else {
             return;
         };
         let far = ConnectionEnd {

@@ -19,46 +19,15 @@
 //! 1/sin θ is integrable: near-parallel beams meet within their lengths with probability
 //! ∝ sin θ.
 
-use super::photon_beams::{BeamIndex, PhotonBeams};
-use crate::media::pt::MediumEvents;
+use super::photon_beams::BeamQuery;
 use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec3};
 use lt_core::medium::MediumId;
-use lt_core::Scene;
 
 /// Beams closer to parallel than this (sin θ) are not counted: their closest points are
 /// ill-conditioned, and they meet within finite lengths with probability ∝ sin θ (a bias of
 /// that order, ~1e-4 of the beams that pass the distance test).
 const MIN_SIN: f32 = 1e-4;
-
-/// One pass's photon beams indexed for camera-beam queries at radius `r`.
-pub struct BeamBeamQuery<'a> {
-    pub scene: &'a Scene,
-    pub beams: &'a PhotonBeams,
-    pub index: Option<BeamIndex>,
-    pub r: f32,
-    /// 1 / (2r): the 1-D kernel's normalisation.
-    pub norm: f32,
-    pub max_depth: u32,
-}
-
-impl<'a> BeamBeamQuery<'a> {
-    pub fn new(
-        scene: &'a Scene,
-        beams: &'a PhotonBeams,
-        r: f32,
-        max_depth: u32,
-    ) -> BeamBeamQuery<'a> {
-        BeamBeamQuery {
-            scene,
-            beams,
-            index: BeamIndex::build(&beams.beams, r),
-            r,
-            norm: 1.0 / (2.0 * r),
-            max_depth,
-        }
-    }
-}
 
 /// The closest points of two lines o_c + s ω_c and o_b + t ω_b (unit directions): (s, t, the
 /// distance between them, sin θ); `None` when (nearly) parallel.
@@ -76,51 +45,51 @@ pub fn closest_points(oc: Vec3, wc: Vec3, ob: Vec3, wb: Vec3) -> Option<(f32, f3
     Some((s, t, u, sin2.sqrt()))
 }
 
-impl MediumEvents for BeamBeamQuery<'_> {
-    fn along_flight(&self, ray: &Ray, t_max: f32, m: MediumId, depth: u32) -> Option<Color> {
-        let index = self.index.as_ref()?;
-        let longest = self.max_depth.saturating_sub(depth);
-        if longest == 0 {
-            return None;
-        }
-        let medium = &self.scene.media[m as usize];
-        let phase = medium.phase();
-        let wo = -ray.d;
-        let mut sum = Color::ZERO;
-        index
-            .lists
-            .frame
-            .for_cells_along(ray, t_max, |cell, _, t_lo, t_hi| {
-                for &i in index.lists.items(cell) {
-                    let b = &self.beams.beams[i as usize];
-                    if b.medium != m || b.segments > longest {
-                        continue;
-                    }
-                    let Some((s, t, u, sin)) = closest_points(ray.o, ray.d, b.origin, b.dir) else {
-                        continue;
-                    };
-                    // Counted in the one cell whose interval holds s (each beam once).
-                    if !(s >= t_lo && s < t_hi && s < t_max && t >= 0.0 && t < b.length) {
-                        continue;
-                    }
-                    if u > self.r {
-                        continue;
-                    }
-                    let y = ray.o + ray.d * s;
-                    let x = b.origin + b.dir * t;
-                    let tc = medium.transmittance(ray.o, y);
-                    let tb = medium.transmittance(b.origin, x);
-                    sum += tc * tb * medium.sigma_s(y) * b.power * (phase.eval(wo, -b.dir) / sin);
+/// The estimate along the camera flight `ray` up to `t_max` (`BeamQuery` with
+/// `BeamKernel::Line1d`).
+pub fn along_camera_beam(
+    q: &BeamQuery,
+    ray: &Ray,
+    t_max: f32,
+    m: MediumId,
+    depth: u32,
+) -> Option<Color> {
+    let index = q.index.as_ref()?;
+    let longest = q.max_depth.saturating_sub(depth);
+    if longest == 0 {
+        return None;
+    }
+    let medium = &q.scene.media[m as usize];
+    let phase = medium.phase();
+    let wo = -ray.d;
+    let mut sum = Color::ZERO;
+    index
+        .lists
+        .frame
+        .for_cells_along(ray, t_max, |cell, _, t_lo, t_hi| {
+            for &i in index.lists.items(cell) {
+                let b = &q.beams.beams[i as usize];
+                if b.medium != m || b.segments > longest {
+                    continue;
                 }
-            });
-        Some(sum * self.norm)
-    }
-
-    /// The beam counted every medium vertex of the flight: a sampled scattering ends the walk
-    /// (only flights that pass go on, weighted T/P), as in `pb2d`.
-    fn at_scatter(&self, _x: Vec3, _wo: Vec3, _m: MediumId, _depth: u32) -> Option<Color> {
-        Some(Color::ZERO)
-    }
+                let Some((s, t, u, sin)) = closest_points(ray.o, ray.d, b.origin, b.dir) else {
+                    continue;
+                };
+                // Counted in the one cell whose interval holds s (each beam once).
+                if !(s >= t_lo && s < t_hi && s < t_max && t >= 0.0 && t < b.length) {
+                    continue;
+                }
+                if u > q.r {
+                    continue;
+                }
+                let y = ray.o + ray.d * s;
+                let x = b.origin + b.dir * t;
+                let tc = medium.transmittance(ray.o, y);
+                let tb = medium.transmittance(b.origin, x);
+                sum += tc * tb * medium.sigma_s(y) * b.power * (phase.eval(wo, -b.dir) / sin);
+            }
+        });
+    Some(sum * q.norm)
 }
 
 #[cfg(test)]

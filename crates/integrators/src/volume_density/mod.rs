@@ -212,23 +212,14 @@ impl ProgressiveRun for VolumeRun<'_> {
                 let n = photons.points.len();
                 (img, bad, n, photons::VolumePhotons::BYTES_PER_PHOTON, bytes)
             }
-            Query::PointBeams => {
+            Query::PointBeams | Query::BeamBeams => {
+                let kernel = if self.query == Query::PointBeams {
+                    photon_beams::BeamKernel::Point2d
+                } else {
+                    photon_beams::BeamKernel::Line1d
+                };
                 let pb = photon_beams::PhotonBeams::trace(scene, depth, rr, paths, self.seed, pass);
-                let q = point_beam::PointBeamQuery::new(scene, &pb, r, depth);
-                let bytes = q.index.as_ref().map_or(0, |g| g.bytes());
-                let (img, bad) = self.render_with(&q, pass);
-                let n = pb.beams.len();
-                (
-                    img,
-                    bad,
-                    n,
-                    photon_beams::PhotonBeams::BYTES_PER_BEAM,
-                    bytes,
-                )
-            }
-            Query::BeamBeams => {
-                let pb = photon_beams::PhotonBeams::trace(scene, depth, rr, paths, self.seed, pass);
-                let q = beam_beam::BeamBeamQuery::new(scene, &pb, r, depth);
+                let q = photon_beams::BeamQuery::new(scene, &pb, (r, kernel), depth);
                 let bytes = q.index.as_ref().map_or(0, |g| g.bytes());
                 let (img, bad) = self.render_with(&q, pass);
                 let n = pb.beams.len();

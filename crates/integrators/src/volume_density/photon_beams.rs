@@ -19,6 +19,7 @@
 
 use super::cell_frame::{CellFrame, CellLists};
 use super::photons::{LightRecord, PhotonData};
+use crate::media::pt::MediumEvents;
 use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec3};
 use lt_core::medium::MediumId;
@@ -158,5 +159,69 @@ impl BeamIndex {
     /// Bytes held by the index (not the beams): 4 per entry and per cell.
     pub fn bytes(&self) -> usize {
         self.lists.bytes()
+    }
+}
+
+/// Which kernel a photon-beam query gathers with: at the camera walk's first medium vertex, 2-D
+/// across each beam (`bp2d`: `point_beam.rs`), or along the camera's flight, 1-D across the two
+/// lines (`bb1d`: `beam_beam.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BeamKernel {
+    /// 1/(π r²) over the disk across a beam.
+    Point2d,
+    /// 1/(2r) over the lines' separation.
+    Line1d,
+}
+
+/// One pass's photon beams indexed for queries at radius `r` with `kernel` (`bp2d`, `bb1d`).
+pub struct BeamQuery<'a> {
+    pub scene: &'a Scene,
+    pub beams: &'a PhotonBeams,
+    pub index: Option<BeamIndex>,
+    pub r: f32,
+    pub kernel: BeamKernel,
+    /// The kernel's normalisation: 1/(π r²) or 1/(2r).
+    pub norm: f32,
+    pub max_depth: u32,
+}
+
+impl<'a> BeamQuery<'a> {
+    pub fn new(
+        scene: &'a Scene,
+        beams: &'a PhotonBeams,
+        (r, kernel): (f32, BeamKernel),
+        max_depth: u32,
+    ) -> BeamQuery<'a> {
+        let norm = match kernel {
+            BeamKernel::Point2d => 1.0 / (std::f32::consts::PI * r * r),
+            BeamKernel::Line1d => 1.0 / (2.0 * r),
+        };
+        BeamQuery {
+            scene,
+            beams,
+            index: BeamIndex::build(&beams.beams, r),
+            r,
+            kernel,
+            norm,
+            max_depth,
+        }
+    }
+}
+
+impl MediumEvents for BeamQuery<'_> {
+    fn along_flight(&self, ray: &Ray, t_max: f32, m: MediumId, depth: u32) -> Option<Color> {
+        match self.kernel {
+            BeamKernel::Line1d => super::beam_beam::along_camera_beam(self, ray, t_max, m, depth),
+            BeamKernel::Point2d => None,
+        }
+    }
+
+    fn at_scatter(&self, x: Vec3, wo: Vec3, m: MediumId, depth: u32) -> Option<Color> {
+        match self.kernel {
+            BeamKernel::Point2d => super::point_beam::at_camera_point(self, x, wo, m, depth),
+            // The beam counted every medium vertex of the flight: a sampled scattering ends the
+            // walk (only flights that pass go on, weighted T/P), as in `pb2d`.
+            BeamKernel::Line1d => Some(Color::ZERO),
+        }
     }
 }

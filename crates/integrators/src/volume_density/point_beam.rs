@@ -15,70 +15,38 @@
 //! line (the 2-D kernel 1/(πr²) normalised over the disk across the beam). T_b is
 //! `Medium::transmittance` (deterministic). `power` carries 1/N (`photons.rs`).
 
-use super::photon_beams::{BeamIndex, PhotonBeams};
-use crate::media::pt::MediumEvents;
+use super::photon_beams::BeamQuery;
 use lt_core::math::{Color, Vec3};
 use lt_core::medium::MediumId;
-use lt_core::Scene;
 
-/// One pass's photon beams indexed for point queries at radius `r`.
-pub struct PointBeamQuery<'a> {
-    pub scene: &'a Scene,
-    pub beams: &'a PhotonBeams,
-    pub index: Option<BeamIndex>,
-    pub r: f32,
-    /// 1 / (π r²): the 2-D kernel's normalisation.
-    pub norm: f32,
-    pub max_depth: u32,
-}
-
-impl<'a> PointBeamQuery<'a> {
-    pub fn new(
-        scene: &'a Scene,
-        beams: &'a PhotonBeams,
-        r: f32,
-        max_depth: u32,
-    ) -> PointBeamQuery<'a> {
-        PointBeamQuery {
-            scene,
-            beams,
-            index: BeamIndex::build(&beams.beams, r),
-            r,
-            norm: 1.0 / (std::f32::consts::PI * r * r),
-            max_depth,
+/// The estimate at the camera point `x` (`BeamQuery` with `BeamKernel::Point2d`).
+pub fn at_camera_point(q: &BeamQuery, x: Vec3, wo: Vec3, m: MediumId, depth: u32) -> Option<Color> {
+    let Some(index) = &q.index else {
+        return Some(Color::ZERO);
+    };
+    let medium = &q.scene.media[m as usize];
+    let phase = medium.phase();
+    let longest = q.max_depth.saturating_sub(depth);
+    let frame = &index.lists.frame;
+    // Every beam within r of x is listed in x's cell (`BeamIndex::build`).
+    let cell = frame.index(frame.cell_of(x));
+    let r2 = q.r * q.r;
+    let mut sum = Color::ZERO;
+    for &i in index.lists.items(cell) {
+        let b = &q.beams.beams[i as usize];
+        if b.medium != m || b.segments > longest {
+            continue;
         }
-    }
-}
-
-impl MediumEvents for PointBeamQuery<'_> {
-    fn at_scatter(&self, x: Vec3, wo: Vec3, m: MediumId, depth: u32) -> Option<Color> {
-        let Some(index) = &self.index else {
-            return Some(Color::ZERO);
-        };
-        let medium = &self.scene.media[m as usize];
-        let phase = medium.phase();
-        let longest = self.max_depth.saturating_sub(depth);
-        let frame = &index.lists.frame;
-        // Every beam within r of x is listed in x's cell (`BeamIndex::build`).
-        let cell = frame.index(frame.cell_of(x));
-        let r2 = self.r * self.r;
-        let mut sum = Color::ZERO;
-        for &i in index.lists.items(cell) {
-            let b = &self.beams.beams[i as usize];
-            if b.medium != m || b.segments > longest {
-                continue;
-            }
-            let t = (x - b.origin).dot(b.dir);
-            if !(t >= 0.0 && t < b.length) {
-                continue;
-            }
-            let on_beam = b.origin + b.dir * t;
-            if (x - on_beam).length_squared() > r2 {
-                continue;
-            }
-            let tb = medium.transmittance(b.origin, on_beam);
-            sum += tb * b.power * phase.eval(wo, -b.dir);
+        let t = (x - b.origin).dot(b.dir);
+        if !(t >= 0.0 && t < b.length) {
+            continue;
         }
-        Some(sum * self.norm)
+        let on_beam = b.origin + b.dir * t;
+        if (x - on_beam).length_squared() > r2 {
+            continue;
+        }
+        let tb = medium.transmittance(b.origin, on_beam);
+        sum += tb * b.power * phase.eval(wo, -b.dir);
     }
+    Some(sum * q.norm)
 }

@@ -66,6 +66,8 @@ impl Recorder for Sums {
             VolumeTechnique::BeamBeam(_) => 6,
             VolumeTechnique::Connect(_) => 3,
             VolumeTechnique::Surface(_) => 7,
+            // BP2D is in none of the studies' technique sets; counted with the 2-D kernel.
+            VolumeTechnique::BeamPoint(_) => 5,
         };
         self.by[family] += mean(p.value) * p.weight * self.film_weight;
     }
