@@ -10,6 +10,7 @@
 
 mod agreement;
 mod consistency;
+mod crossings;
 mod directional;
 mod furnace;
 mod light_paths;

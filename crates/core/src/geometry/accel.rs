@@ -9,6 +9,7 @@ use super::flat::{self, Flat, Isa};
 use super::packet::PACKET;
 use super::primitive::{PrimHit, Primitive};
 use super::ray::Ray;
+use super::segment_hits;
 use super::triangle::ShearedRay;
 use super::wide::WideBvh;
 use crate::math::Vec3;
@@ -409,6 +410,23 @@ impl Accel {
             #[cfg(lt_embree)]
             Structure::Embree(e) => e.occluded(ray, &self.sheared(ray.o, ray.d)),
         }
+    }
+
+    /// Every hit within (0, t_max) in one query, sorted along the ray (`segment_hits.rs`) into
+    /// `out` (cleared first); false, with `out` empty, where this core has no such query.
+    pub fn all_hits(&self, ray: &Ray, out: &mut Vec<PrimHit>) -> bool {
+        out.clear();
+        let sheared = self.sheared(ray.o, ray.d);
+        match &self.structure {
+            Structure::Flat(_) | Structure::FlatScalar => {
+                segment_hits::all_hits_scalar(&self.prims, ray, &sheared, out)
+            }
+            Structure::Wide(w) => w.all_hits(&self.prims, ray, &sheared, out),
+            _ if self.prims.is_empty() => {}
+            _ => return false,
+        }
+        segment_hits::sort_along_ray(out);
+        true
     }
 
     /// `occluded` with a traversal stack of `N` entries: obvhs's `ray_traverse_miss`, negated.

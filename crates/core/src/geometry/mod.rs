@@ -10,6 +10,7 @@ pub mod quad;
 pub mod quadric;
 pub mod ray;
 pub mod sdf;
+pub mod segment_hits;
 pub mod soa;
 pub mod sphere;
 pub mod triangle;

@@ -28,6 +28,9 @@ use obvhs::bvh2::Bvh2;
 use obvhs::BvhBuildParams;
 use std::mem::MaybeUninit;
 
+/// Every hit along a ray in one walk (`segment_hits.rs`).
+mod all_hits;
+
 /// Children per node: one AVX2 vector of boxes.
 const WIDTH: usize = 8;
 /// Ize's factor on a slab's exit distance, which three relative roundings may have lowered.

@@ -130,31 +130,51 @@ impl Medium {
         sampler: &mut Sampler,
     ) -> FreeFlight {
         match self {
+            Medium::Homogeneous(_) => {
+                let t = self.sample_flight_distance(sampler).expect("homogeneous");
+                self.end_free_flight(o, d, t, t_max)
+            }
+            Medium::Grid(g) => g.sample_free_flight(o, d, t_max, sampler),
+        }
+    }
+
+    /// A homogeneous medium's free-flight distance, drawn before the surface ahead is known (its
+    /// draws do not depend on `t_max`); `end_free_flight` then compares it with the surface's
+    /// distance. The two are `sample_free_flight` split in two, bit for bit, so a walk may look
+    /// for a surface only up to the sampled distance (as Mitsuba's `volpath` does in homogeneous
+    /// media). `None` (nothing drawn) for a grid, whose tracking steps stop at `t_max`.
+    pub fn sample_flight_distance(&self, sampler: &mut Sampler) -> Option<f32> {
+        match self {
             Medium::Homogeneous(h) => {
                 let channel = ((sampler.next_f32() * 3.0) as usize).min(2);
                 let sigma = h.sigma_t[channel];
                 let u = sampler.next_f32();
-                let t = if sigma > 0.0 {
+                Some(if sigma > 0.0 {
                     -(1.0 - u).ln() / sigma
                 } else {
                     f32::INFINITY
-                };
-                if t < t_max {
-                    let x = o + d * t;
-                    let p = self.free_flight_density(o, x, true);
-                    FreeFlight::Scattered {
-                        t,
-                        weight: weigh(self.sigma_s(x) * self.transmittance(o, x), p),
-                    }
-                } else {
-                    let x = o + d * t_max;
-                    let p = self.free_flight_density(o, x, false);
-                    FreeFlight::Passed {
-                        weight: weigh(self.transmittance(o, x), p),
-                    }
-                }
+                })
             }
-            Medium::Grid(g) => g.sample_free_flight(o, d, t_max, sampler),
+            Medium::Grid(_) => None,
+        }
+    }
+
+    /// The outcome of a homogeneous free flight of sampled length `t` (`sample_flight_distance`)
+    /// towards a surface at `t_max`: scattered at `t` before it, or passed to it.
+    pub fn end_free_flight(&self, o: Vec3, d: Vec3, t: f32, t_max: f32) -> FreeFlight {
+        if t < t_max {
+            let x = o + d * t;
+            let p = self.free_flight_density(o, x, true);
+            FreeFlight::Scattered {
+                t,
+                weight: weigh(self.sigma_s(x) * self.transmittance(o, x), p),
+            }
+        } else {
+            let x = o + d * t_max;
+            let p = self.free_flight_density(o, x, false);
+            FreeFlight::Passed {
+                weight: weigh(self.transmittance(o, x), p),
+            }
         }
     }
 

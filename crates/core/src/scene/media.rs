@@ -41,7 +41,7 @@ use super::hit::BoundaryHit;
 use super::SurfaceHit;
 use super::{ConnectionEnd, Scene};
 use crate::bsdf::Material;
-use crate::geometry::{offset_ray_origin, Ray};
+use crate::geometry::{offset_ray_origin, segment_hits, PrimHit, Ray};
 use crate::math::{gamma, Color, Vec3};
 use crate::medium::MediumId;
 use crate::sampling::Sampler;
@@ -115,6 +115,80 @@ impl PanesPassed {
         probability: 1.0,
         reversible: true,
     };
+}
+
+/// A surface a segment crosses (`Scene::boundary_crossings`).
+#[derive(Clone, Copy, Debug)]
+pub struct SegmentCrossing {
+    pub p: Vec3,
+    pub p_err: Vec3,
+    pub shape: u32,
+    /// The outward geometric normal.
+    pub ng: Vec3,
+    /// What passing it does, at a pane crossed with `panes`; else nothing.
+    pub pane: PanesPassed,
+}
+
+/// Where the rays of a segment's crossings query start and stop (`Scene::boundary_crossings`).
+struct SegmentWalk {
+    /// The first ray's origin: `from` itself, or moved out of its error box when on a surface.
+    start: Vec3,
+    /// The direction from `from` towards `to`, not unit.
+    dir0: Vec3,
+    /// The point every ray aims at and its error box's depth along a unit direction (`to` moved
+    /// out of its own box when on a surface); none towards a light at infinity.
+    target: Option<(Vec3, Vec3)>,
+}
+
+impl SegmentWalk {
+    fn new(scene: &Scene, from: ConnectionEnd, to: ConnectionEnd) -> SegmentWalk {
+        let a = scene.end(from.p, from.p_err, from.ng);
+        let b = (!to.infinite).then(|| scene.end(to.p, to.p_err, to.ng));
+        let dir0 = match &b {
+            Some(b) => b.p - a.p,
+            None => to.p,
+        };
+        let on_surface = |e: &ConnectionEnd| e.ng != Vec3::ZERO;
+        let start = if on_surface(&from) {
+            a.towards(dir0)
+        } else {
+            a.p
+        };
+        let target = b.map(|b| {
+            if on_surface(&to) {
+                (b.towards(-dir0), b.err)
+            } else {
+                (b.p, Vec3::ZERO)
+            }
+        });
+        SegmentWalk {
+            start,
+            dir0,
+            target,
+        }
+    }
+
+    /// The ray from `origin` to the target, stopping short of its error box (of a bare point, by
+    /// the rounding of the length); None once `origin` is at or past it.
+    fn ray_from(&self, origin: Vec3) -> Option<Ray> {
+        let (d, t_max) = match self.target {
+            Some((stop, err)) => {
+                let d = stop - origin;
+                if !(d.dot(self.dir0) > 0.0) {
+                    return None;
+                }
+                let len = d.length();
+                let dir = d / len;
+                (dir, (len - dir.abs().dot(err)) * (1.0 - gamma(2)))
+            }
+            None => (self.dir0.normalize(), f32::INFINITY),
+        };
+        (t_max > 0.0).then_some(Ray {
+            o: origin,
+            d,
+            t_max,
+        })
+    }
 }
 
 /// Where a segment towards a light at infinity is cut off: far enough that any positive σt
@@ -270,7 +344,7 @@ impl Scene {
             (a, b, false)
         };
         let panes = crossing != Crossing::NullOnly;
-        let crossings = self.crossings(from, to, panes)?;
+        let crossings = self.boundary_crossings(from, to, panes, false)?;
         let dir = if to.infinite {
             to.p
         } else {
@@ -284,14 +358,15 @@ impl Scene {
         } else {
             (from.p, to.p, dir)
         };
-        let order: Box<dyn Iterator<Item = &(Vec3, u32, Vec3, PanesPassed)>> = if reversed {
+        let order: Box<dyn Iterator<Item = &SegmentCrossing>> = if reversed {
             Box::new(crossings.iter().rev())
         } else {
             Box::new(crossings.iter())
         };
         let (mut current, mut here, mut through) = (medium, start, PanesPassed::NONE);
-        for &(p, shape, ng, pane) in order {
-            let s = &self.shapes[shape as usize];
+        for c in order {
+            let (p, ng, pane) = (c.p, c.ng, c.pane);
+            let s = &self.shapes[c.shape as usize];
             match crossing {
                 _ if s.null => {}
                 _ if panes && self.has_null_transmission(s.material) => {
@@ -319,10 +394,9 @@ impl Scene {
         Some(through)
     }
 
-    /// The surfaces strictly between `from` (finite) and `to`, in order from `from`: each hit
-    /// point with its shape, its outward geometric normal and (with `panes`, at a thin dielectric)
-    /// what passing the pane along the walk does, else nothing. `None` when the walk does not end
-    /// (a degenerate spot).
+    /// The surfaces strictly between `from` (finite) and `to`, in order from `from`, each with
+    /// (with `panes`, at a thin dielectric) what passing the pane along the walk does, else
+    /// nothing. `None` when the walk does not end (a degenerate spot).
     ///
     /// An end on a surface is left (and approached) from outside its error box, so that surface is
     /// not taken for a crossing. An end on no surface (no normal: a medium vertex, a point or spot
@@ -331,71 +405,102 @@ impl Scene {
     /// crossed here as the walk crossed it. (With an error box there, a medium vertex 3.6e-6 inside
     /// a null face — within the box its bound accumulates along a walk — lost the face from the
     /// oracle's walk towards it: hg-spot's mis-check, results/media-mis-check.md.)
-    fn crossings(
+    ///
+    /// One query of every hit on the segment (`Accel::all_hits`) where the ray core has it, else
+    /// (`restart`, or obvhs's BVH and Embree) a closest-hit query restarted past each crossing
+    /// (ARCHITECTURE.md, "Crossings in one query").
+    pub fn boundary_crossings(
         &self,
         from: ConnectionEnd,
         to: ConnectionEnd,
         panes: bool,
-    ) -> Option<Vec<(Vec3, u32, Vec3, PanesPassed)>> {
-        let a = self.end(from.p, from.p_err, from.ng);
-        let target = (!to.infinite).then(|| self.end(to.p, to.p_err, to.ng));
-        let dir0 = match &target {
-            Some(b) => b.p - a.p,
-            None => to.p,
-        };
-        let on_surface = |e: &ConnectionEnd| e.ng != Vec3::ZERO;
-        let mut origin = if on_surface(&from) {
-            a.towards(dir0)
-        } else {
-            a.p
-        };
-        let to_on_surface = on_surface(&to);
+        restart: bool,
+    ) -> Option<Vec<SegmentCrossing>> {
+        let walk = SegmentWalk::new(self, from, to);
         let mut found = Vec::new();
-        for _ in 0..MAX_CROSSINGS {
-            let (dir, t_max) = match &target {
-                Some(b) => {
-                    let stop = if to_on_surface { b.towards(-dir0) } else { b.p };
-                    let d = stop - origin;
-                    if !(d.dot(dir0) > 0.0) {
-                        return Some(found);
-                    }
-                    let len = d.length();
-                    let dir = d / len;
-                    // Short of the target's error box, or of the bare point by the rounding of
-                    // `len`.
-                    let box_depth = if to_on_surface {
-                        dir.abs().dot(b.err)
-                    } else {
-                        0.0
-                    };
-                    (dir, (len - box_depth) * (1.0 - gamma(2)))
+        let Some(ray) = walk.ray_from(walk.start) else {
+            return Some(found);
+        };
+        let mut hits = Vec::new();
+        super::ray_stats::count_closest();
+        if restart || !self.accel.all_hits(&ray, &mut hits) {
+            return self.crossings_restarting(&walk, ray, panes, found);
+        }
+        // The restart walk's next ray starts past the last crossing's error box
+        // (`offset_ray_origin`) and finds what lies beyond that point. A hit of this ray near
+        // it — the same crossing again (the neighbours at a shared edge or vertex) or another
+        // surface within rounding — cannot be told apart by t, whose rounding is as large as
+        // the offset (a few ulps of the coordinates). So from such a hit on, as from a curved
+        // primitive's (whose test gives its nearest hit only), the restart walk goes on from the
+        // last crossing: it is rare, and what happens there is then the restart walk's.
+        let origin_scale = ray.o.abs().max_element();
+        let (mut skip_to, mut next) = (0.0f32, walk.start);
+        for h in hits {
+            let near = !found.is_empty() && h.t <= skip_to + gamma(16) * (origin_scale + h.t);
+            if !near {
+                let crossing = self.crossing_at(&ray, h, panes);
+                next = offset_ray_origin(crossing.p, crossing.p_err, crossing.ng, ray.d);
+                skip_to = (next - ray.o).dot(ray.d);
+                found.push(crossing);
+                if found.len() == MAX_CROSSINGS {
+                    return None;
                 }
-                None => (dir0.normalize(), f32::INFINITY),
-            };
-            if !(t_max > 0.0) {
-                return Some(found);
             }
-            let ray = Ray {
-                o: origin,
-                d: dir,
-                t_max,
-            };
-            super::ray_stats::count_closest();
+            if near || segment_hits::may_hit_again(self.accel.primitive(h.prim)) {
+                let Some(ray) = walk.ray_from(next) else {
+                    return Some(found);
+                };
+                super::ray_stats::count_closest();
+                return self.crossings_restarting(&walk, ray, panes, found);
+            }
+        }
+        Some(found)
+    }
+
+    /// `boundary_crossings` by a closest-hit query per crossing, each restarted past the last
+    /// crossing's error box and re-aimed at the end; `ray` is the first query's, already counted.
+    fn crossings_restarting(
+        &self,
+        walk: &SegmentWalk,
+        mut ray: Ray,
+        panes: bool,
+        mut found: Vec<SegmentCrossing>,
+    ) -> Option<Vec<SegmentCrossing>> {
+        loop {
             let Some(prim_hit) = self.accel.intersect(&ray) else {
                 return Some(found);
             };
-            // The crossing's point and normal only; a pane's pass needs its shading normal too.
-            let hit = BoundaryHit::new(self, &ray, prim_hit);
-            let pane = if panes && self.has_null_transmission(hit.material) {
-                // Seen along the walk's direction: |cos| is the same both ways.
-                self.pane_passed(&SurfaceHit::new(self, &ray, prim_hit), dir)
-            } else {
-                PanesPassed::NONE
-            };
-            found.push((hit.p, hit.shape, hit.ng, pane));
-            origin = offset_ray_origin(hit.p, hit.p_err, hit.ng, dir);
+            let crossing = self.crossing_at(&ray, prim_hit, panes);
+            let origin = offset_ray_origin(crossing.p, crossing.p_err, crossing.ng, ray.d);
+            found.push(crossing);
+            if found.len() == MAX_CROSSINGS {
+                return None;
+            }
+            match walk.ray_from(origin) {
+                Some(next) => ray = next,
+                None => return Some(found),
+            }
+            super::ray_stats::count_closest();
         }
-        None
+    }
+
+    /// The crossing where `ray` hits `h`: its point and normal only (`BoundaryHit`); a pane's
+    /// pass needs its shading normal too.
+    fn crossing_at(&self, ray: &Ray, h: PrimHit, panes: bool) -> SegmentCrossing {
+        let hit = BoundaryHit::new(self, ray, h);
+        let pane = if panes && self.has_null_transmission(hit.material) {
+            // Seen along the walk's direction: |cos| is the same both ways.
+            self.pane_passed(&SurfaceHit::new(self, ray, h), ray.d)
+        } else {
+            PanesPassed::NONE
+        };
+        SegmentCrossing {
+            p: hit.p,
+            p_err: hit.p_err,
+            shape: hit.shape,
+            ng: hit.ng,
+            pane,
+        }
     }
 
     /// T(a, b) through null boundaries, deterministic (each medium's exact `transmittance`), or

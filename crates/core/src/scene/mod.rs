@@ -13,7 +13,10 @@ pub use crate::light::LightDesc;
 pub use crate::shape::{MeshAttribute, ShapeGeometry, TriangleMesh};
 pub use builder::SceneBuilder;
 pub use hit::SurfaceHit;
-pub use media::{ConnectionFlight, Crossing, MediumInterface, MediumPiece, MAX_MEDIUM_INTERFACES};
+pub use media::{
+    ConnectionFlight, Crossing, MediumInterface, MediumPiece, SegmentCrossing,
+    MAX_MEDIUM_INTERFACES,
+};
 pub use visibility::ConnectionEnd;
 
 use crate::bsdf::Material;

@@ -44,6 +44,11 @@ struct Scatter {
 /// own walk is [`Volpath`], whose defaults do nothing; the walk is monomorphised per kind, so
 /// `pt` runs the code it ran before.
 pub trait MediumEvents {
+    /// Whether `along_flight` reads the surface ahead (`t_max`): then every free flight waits
+    /// for the full closest-hit query. `Volpath` does not, and in a homogeneous medium looks for
+    /// a surface only up to the sampled flight distance (`radiance_with`).
+    const READS_FLIGHT_END: bool = true;
+
     /// At the start of a free flight in medium `m` along `ray` up to `t_max`, whose scattering
     /// vertex would be the walk's `depth`-th: an estimate to add (times β) of every path whose
     /// first medium vertex from the camera lies on this flight.
@@ -65,7 +70,15 @@ pub trait MediumEvents {
 /// continued by phase sampling.
 pub struct Volpath;
 
-impl MediumEvents for Volpath {}
+impl MediumEvents for Volpath {
+    const READS_FLIGHT_END: bool = false;
+}
+
+/// The bound of the closest-hit query of a free flight of sampled length `t`: above `t` by far
+/// more than the rounding of the primitive tests' `t < t_max` (a few ulps), so every surface
+/// nearer than `t` is found and one not found lies beyond `t` — the walk then takes the same
+/// branch as with the unbounded query.
+const FLIGHT_BOUND: f32 = 1.0 + 1.0 / 1_048_576.0;
 
 /// The radiance estimate of one camera sample at `raster` through media.
 pub fn radiance(pt: &Pt, scene: &Scene, raster: Vec2, sampler: &mut Sampler) -> Color {
@@ -95,14 +108,34 @@ pub fn radiance_with<E: MediumEvents>(
     let mut depth = 1;
     let mut crossings = NullCrossings::default();
     loop {
-        let hit = scene.intersect(&ray);
+        // In a homogeneous medium the flight's length is drawn first and the surface looked for
+        // only up to it: a short flight's query is cut off early, and the SurfaceHit of a
+        // surface beyond a scattering is never built. The same draws and the same comparison as
+        // `sample_free_flight` (`Medium::sample_flight_distance`): the same path, bit for bit.
+        let flight = match medium {
+            Some(m) if !E::READS_FLIGHT_END => {
+                scene.media[m as usize].sample_flight_distance(sampler)
+            }
+            _ => None,
+        };
+        let hit = match flight {
+            Some(t) => scene.intersect(&Ray {
+                t_max: ray.t_max.min(t * FLIGHT_BOUND),
+                ..ray
+            }),
+            None => scene.intersect(&ray),
+        };
         if let Some(m) = medium {
             let t_max = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
             let mm = &scene.media[m as usize];
             if let Some(along) = events.along_flight(&ray, t_max, m, depth) {
                 l += beta * along;
             }
-            match mm.sample_free_flight(ray.o, ray.d, t_max, sampler) {
+            let outcome = match flight {
+                Some(t) => mm.end_free_flight(ray.o, ray.d, t, t_max),
+                None => mm.sample_free_flight(ray.o, ray.d, t_max, sampler),
+            };
+            match outcome {
                 FreeFlight::Scattered { t, weight } => {
                     beta *= weight;
                     if beta == Color::ZERO || depth == params.max_depth {
