@@ -35,6 +35,14 @@ pub const STUDIES: &[StudyInfo] = &[
         specs: figures::specs,
         run: figures::run,
     },
+    // The lecture's slides with independent runs (issue 48, item 5), beside the figures. Not in
+    // `all`: about 10 core-minutes of renders (results/slides/summary.md). Run it by name.
+    StudyInfo {
+        name: figures::slides::NAME,
+        listed: false,
+        specs: figures::slides::specs,
+        run: figures::slides::run,
+    },
     StudyInfo {
         name: "convergence",
         listed: true,
