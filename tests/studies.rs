@@ -638,3 +638,86 @@ fn figure_4_verdicts_follow_their_intervals(dir: &std::path::Path, summary: &str
         "figure 4's count"
     );
 }
+
+/// The committed slides (results/slides/, `lt study slides`): every mean lies in its interval,
+/// and each verdict says "holds" exactly when its relMSE intervals lie apart in the claim's
+/// direction (`figures::slides::verdicts`), "is not shown" otherwise.
+#[test]
+fn committed_slides_verdicts_follow_their_intervals() {
+    let root = lt_tests::scenes_dir().parent().unwrap().to_path_buf();
+    let dir = root.join("results/slides");
+    let summary = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    let rows = csv(&dir.join("slides.csv"));
+    means_inside(&rows, &["relMSE", "FLIP"]);
+    let rel = |set: &str, scene: &str, i: &str, n: &str| {
+        let r = rows
+            .iter()
+            .find(|r| {
+                r["set"] == set && r["scene"] == scene && r["integrator"] == i && r["passes"] == n
+            })
+            .unwrap_or_else(|| panic!("no slide {set} {scene} {i} {n}"));
+        (cell(r, "relMSE lo"), cell(r, "relMSE hi"))
+    };
+    // (a below b): a's interval lies below b's.
+    let below = |a: (f64, f64), b: (f64, f64)| a.1 < b.0;
+    let counts = |set: &str, scene: &str| -> Vec<String> {
+        let mut v: Vec<String> = rows
+            .iter()
+            .filter(|r| r["set"] == set && r["scene"] == scene)
+            .map(|r| r["passes"].clone())
+            .collect();
+        v.dedup();
+        v.sort_by_key(|n| n.parse::<u32>().unwrap());
+        v.dedup();
+        v
+    };
+    let seed = counts("seed", "cornell-box");
+    let top = counts("sppm", "caustic-sds").pop().unwrap();
+    let pt: Vec<_> = ["cornell-box", "cornell-small-light", "cornell-glass-light"]
+        .iter()
+        .map(|s| rel("seed", s, "pt", &seed[0]))
+        .collect();
+    let bdpt_wins = |scene: &str| {
+        seed.iter()
+            .all(|n| below(rel("seed", scene, "bdpt", n), rel("seed", scene, "pt", n)))
+    };
+    let expected = [
+        (
+            "pt's difficulty",
+            below(pt[0], pt[1]) && below(pt[1], pt[2]),
+        ),
+        ("cornell-glass-light", bdpt_wins("cornell-glass-light")),
+        ("veach-door", bdpt_wins("veach-door")),
+        (
+            "caustic-sds",
+            below(
+                rel("sppm", "caustic-sds", "sppm", &top),
+                rel("sppm", "caustic-sds", "bdpt", &top),
+            ),
+        ),
+        (
+            "cornell-box",
+            below(
+                rel("sppm", "cornell-box", "bdpt", &top),
+                rel("sppm", "cornell-box", "sppm", &top),
+            ),
+        ),
+    ];
+    for (title, holds) in expected {
+        let head = format!("**Verdict (slides, {title}).**");
+        let text = summary
+            .split("\n\n")
+            .find(|p| p.starts_with(&head))
+            .unwrap_or_else(|| panic!("the slides' verdict on {title} is missing"));
+        assert_eq!(
+            text.contains("— holds:"),
+            holds,
+            "slides' verdict on {title}"
+        );
+        assert_eq!(
+            text.contains("— is not shown:"),
+            !holds,
+            "slides' verdict on {title}"
+        );
+    }
+}
