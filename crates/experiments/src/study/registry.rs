@@ -28,7 +28,7 @@ pub struct StudyInfo {
 /// The studies in the order `lt study all` runs them and the report shows them.
 pub const STUDIES: &[StudyInfo] = &[
     // First, so the report opens with the figures after its findings. Not in `all`: its
-    // renders take about a core-quarter-hour (results/figures/summary.md). Run it by name.
+    // renders take about half a core-hour (results/figures/summary.md). Run it by name.
     StudyInfo {
         name: figures::NAME,
         listed: false,
