@@ -36,7 +36,7 @@ pub const STUDIES: &[StudyInfo] = &[
         run: figures::run,
     },
     // The lecture's slides with independent runs (issue 48, item 5), beside the figures. Not in
-    // `all`: about 10 core-minutes of renders (results/slides/summary.md). Run it by name.
+    // `all`: about 17 core-minutes of renders (results/slides/summary.md). Run it by name.
     StudyInfo {
         name: figures::slides::NAME,
         listed: false,
