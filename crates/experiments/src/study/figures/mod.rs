@@ -5,13 +5,16 @@
 //!    against `bdpt` at equal CPU time, and bdpt's per-strategy images of the path pyramid.
 //! 2. `mis`: Veach & Guibas 1995's MIS figure on `veach-mis` (Bitterli's and ours).
 //! 3. `ppm`: Hachisuka, Ogaki & Jensen 2008 — caustics seen in a mirror (L S D S E), where
-//!    only the consistent estimators (`sppm`, `ppm`) converge; `pt`, `bdpt` beside them.
+//!    only the consistent estimators (`sppm`, `ppm`) converge; `pt`, `bdpt` beside them; and a
+//!    point light's caustic seen directly (`cornell-point-caustic`), which bdpt reaches too.
 //! 4. `vcm`: Georgiev et al. 2012 — `bdpt`, `ppm` and `vcm` at equal time on three scenes,
 //!    with the per-technique contributions the techniques study measured.
+//! 5. `slides` (its own study, `lt study slides`): the lecture's slides with independent runs.
 //!
-//! Equal time is made reproducible as in `equal_time` (see `EqualTime`): one estimator's runs
-//! fix the budget (the mean CPU seconds of its K runs), a probe of every other estimator at the
-//! same pass count measures its CPU seconds per pass, and it gets round(budget / that) passes.
+//! Equal time is made reproducible and robust to a drifting load (see `EqualTime`): one
+//! estimator's pass count fixes the budget, interleaved probes of every estimator at that count
+//! give each its mean CPU seconds per pass, and each gets round(budget / that) passes; the runs
+//! are interleaved too, and relMSE × CPU s compares arms whose achieved times still differ.
 //! The images then depend on those counts only, which the tables record. Errors are per run
 //! against a long reference; means carry Student-t intervals over the K independent runs
 //! (`metrics::mean_of_runs`) — for the progressive estimators too: each run is one progressive
