@@ -28,12 +28,20 @@ pub struct StudyInfo {
 /// The studies in the order `lt study all` runs them and the report shows them.
 pub const STUDIES: &[StudyInfo] = &[
     // First, so the report opens with the figures after its findings. Not in `all`: its
-    // renders take about a core-quarter-hour (results/figures/summary.md). Run it by name.
+    // renders take about half a core-hour (results/figures/summary.md). Run it by name.
     StudyInfo {
         name: figures::NAME,
         listed: false,
         specs: figures::specs,
         run: figures::run,
+    },
+    // The lecture's slides with independent runs (issue 48, item 5), beside the figures. Not in
+    // `all`: about 17 core-minutes of renders (results/slides/summary.md). Run it by name.
+    StudyInfo {
+        name: figures::slides::NAME,
+        listed: false,
+        specs: figures::slides::specs,
+        run: figures::slides::run,
     },
     StudyInfo {
         name: "convergence",

@@ -23,7 +23,7 @@ fn scene(scale: &Scale) -> PathBuf {
     scale.scene_beside_focus("bitterli/veach-bidir/scene.xml")
 }
 
-/// bdpt's runs fix the budget; pt is probed at bdpt's pass count.
+/// bdpt's pass count fixes the budget; both are probed at it (`EqualTime`).
 fn comparison(scale: &Scale, b: &Budget) -> Result<EqualTime, String> {
     let scene = scene(scale);
     let res = film(&at(scale, b, b.bidir_reference_passes), &scene)?;
@@ -31,13 +31,14 @@ fn comparison(scale: &Scale, b: &Budget) -> Result<EqualTime, String> {
         scene,
         res,
         runs: b.runs,
+        probes: b.probes,
         setter: Contender("bdpt"),
         setter_passes: b.bdpt_passes,
         others: vec![Contender("pt")],
     })
 }
 
-/// The reference, bdpt's runs and pt's probe; pt's runs once those are in the context's cache.
+/// The reference and the probes; the runs once the probes are in the context's cache.
 pub(super) fn specs(
     scale: &Scale,
     b: &Budget,
@@ -79,11 +80,12 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
         "bidir",
         "Figure 1: Veach's bidirectional room at equal time",
         &format!(
-            "veach-bidir (Bitterli's), pt against bdpt at {} CPU s per run (bdpt's mean over its \
-             runs; pt's pass count from its CPU time per pass at {} passes). Reference: {} \
-             passes of {}.",
+            "veach-bidir (Bitterli's), pt against bdpt at {} CPU s per run (bdpt's cost at {} \
+             passes; pt's pass count from {} interleaved probes of each at that count, the runs \
+             interleaved too; CPU s is what each arm took). Reference: {} passes of {}.",
             num(budget_s),
             b.bdpt_passes,
+            b.probes,
             reference.passes,
             reference.integrator
         ),

@@ -5,13 +5,16 @@
 //!    against `bdpt` at equal CPU time, and bdpt's per-strategy images of the path pyramid.
 //! 2. `mis`: Veach & Guibas 1995's MIS figure on `veach-mis` (Bitterli's and ours).
 //! 3. `ppm`: Hachisuka, Ogaki & Jensen 2008 — caustics seen in a mirror (L S D S E), where
-//!    only the consistent estimators (`sppm`, `ppm`) converge; `pt`, `bdpt` beside them.
+//!    only the consistent estimators (`sppm`, `ppm`) converge; `pt`, `bdpt` beside them; and a
+//!    point light's caustic seen directly (`cornell-point-caustic`), which bdpt reaches too.
 //! 4. `vcm`: Georgiev et al. 2012 — `bdpt`, `ppm` and `vcm` at equal time on three scenes,
 //!    with the per-technique contributions the techniques study measured.
+//! 5. `slides` (its own study, `lt study slides`): the lecture's slides with independent runs.
 //!
-//! Equal time is made reproducible as in `equal_time` (see `EqualTime`): one estimator's runs
-//! fix the budget (the mean CPU seconds of its K runs), a probe of every other estimator at the
-//! same pass count measures its CPU seconds per pass, and it gets round(budget / that) passes.
+//! Equal time is made reproducible and robust to a drifting load (see `EqualTime`): one
+//! estimator's pass count fixes the budget, interleaved probes of every estimator at that count
+//! give each its mean CPU seconds per pass, and each gets round(budget / that) passes; the runs
+//! are interleaved too, and relMSE × CPU s compares arms whose achieved times still differ.
 //! The images then depend on those counts only, which the tables record. Errors are per run
 //! against a long reference; means carry Student-t intervals over the K independent runs
 //! (`metrics::mean_of_runs`) — for the progressive estimators too: each run is one progressive
@@ -20,6 +23,7 @@
 mod bidir;
 mod mis;
 mod ppm;
+pub mod slides;
 mod vcm;
 
 pub use bidir::{pyramid_command, PYRAMID_DIR};
@@ -48,11 +52,13 @@ struct Budget {
     mis_passes: u32,
     /// Independent runs per estimator of figures 3 and 4.
     comparison_runs: usize,
+    /// Probes per estimator that set figures 3 and 4's pass counts (`EqualTime`).
+    probes: usize,
     /// Passes of a consistent reference (over its runs, `reference::spec`): caustic-sds's, in
     /// figures 3 and 4.
     consistent_reference_passes: u32,
-    /// Figure 3: sppm's passes per run, which fix the equal CPU time.
-    sppm_passes: u32,
+    /// Figure 3: sppm's passes per run on each of `ppm::SCENES`, which fix the equal CPU time.
+    sppm_passes: [u32; 2],
     /// Figure 4: passes of an unbiased (bdpt) reference, and vcm's passes per run on each of
     /// `vcm::SCENES`, which fix the equal CPU time there.
     vcm_reference_passes: u32,
@@ -69,8 +75,9 @@ fn budget(scale: &Scale) -> Budget {
             mis_reference_passes: 64,
             mis_passes: 4,
             comparison_runs: 3,
+            probes: 1,
             consistent_reference_passes: 64,
-            sppm_passes: 4,
+            sppm_passes: [4, 4],
             vcm_reference_passes: 32,
             vcm_passes: [2, 2, 2],
         }
@@ -81,16 +88,20 @@ fn budget(scale: &Scale) -> Budget {
             // (t₃ = 3.18) left its interval reaching below zero (1.44 [−0.44, 3.32]).
             runs: 12,
             bidir_reference_passes: 512,
-            bdpt_passes: 32,
+            // 16, not 32 (≈ 6.6 CPU s per run, not 13): the compute a machine shared by five
+            // agents afforded for the rerun of 2026-12-06 evening; pt is still far behind.
+            bdpt_passes: 16,
             mis_reference_passes: 1024,
             mis_passes: 16,
             // 8, not 12: figures 3 and 4 have 16 arms between them (t₇ = 2.36 against t₁₁ =
             // 2.20 is the price).
             comparison_runs: 8,
+            // 3 rounds of interleaved probes: their mean cost per pass, not one render's.
+            probes: 3,
             // 8 vcm runs of 512 passes at radius 1 px: ≈ 2 CPU-min at 128 px.
             consistent_reference_passes: 4096,
-            // ≈ 10 CPU s per run at 128 px.
-            sppm_passes: 480,
+            // ≈ 7 CPU s per run at 128 px (caustic-sds, cornell-point-caustic).
+            sppm_passes: [480, 240],
             vcm_reference_passes: 512,
             // ≈ 2.5 CPU s per run at 128 px (cornell-box, veach-door, caustic-sds): what a
             // shared 2-core machine (load 12) afforded within the hour the figures had.
@@ -152,13 +163,21 @@ fn mean_cpu(v: &[RunEntry]) -> f64 {
 #[derive(Clone, Copy)]
 struct Contender(&'static str);
 
-/// An equal-time comparison on one scene: `setter`'s K runs at `setter_passes` fix the budget
-/// (their mean CPU seconds); each of `others` is probed at `setter_passes` (seed 1) for its CPU
-/// seconds per pass and gets `equal_time_passes` of the budget.
+/// First seed of the probes: apart from the runs' seeds 1 … K, so a probe is never a run.
+const PROBE_SEED: u64 = 1001;
+
+/// An equal-time comparison on one scene, made robust to a machine whose load drifts (a shared
+/// machine's CPU s per pass moved by ±40 % within the hour): every contender, the setter too,
+/// is probed `probes` times at `setter_passes`, the probes interleaved (setter, a, b, setter,
+/// a, b, …) so a load change hits all alike; each gets its mean CPU s per pass, and `c` gets
+/// round(setter_passes × cost(setter) / cost(c)) passes. The K runs are interleaved the same
+/// way (run 1 of every contender, then run 2, …), and the tables state the CPU s each arm
+/// achieved and relMSE × CPU s, which an unbiased estimator keeps at any budget.
 struct EqualTime {
     scene: PathBuf,
     res: (u32, u32),
     runs: usize,
+    probes: usize,
     setter: Contender,
     setter_passes: u32,
     others: Vec<Contender>,
@@ -172,72 +191,113 @@ struct Arm {
 }
 
 impl EqualTime {
-    fn specs_of(&self, c: Contender, passes: u32) -> Vec<RunSpec> {
-        (0..self.runs)
-            .map(|r| run_spec(&self.scene, self.res, c.0, 1 + r as u64, passes))
+    /// The setter, then `others` in order: the order of the arms and of each interleaved round.
+    fn contenders(&self) -> Vec<Contender> {
+        std::iter::once(self.setter)
+            .chain(self.others.iter().copied())
             .collect()
     }
 
-    fn probe(&self, c: Contender) -> RunSpec {
-        run_spec(&self.scene, self.res, c.0, 1, self.setter_passes)
+    /// Every contender's probes, round by round.
+    fn probe_specs(&self) -> Vec<RunSpec> {
+        let cs = self.contenders();
+        (0..self.probes as u64)
+            .flat_map(|j| {
+                cs.iter().map(move |c| {
+                    run_spec(
+                        &self.scene,
+                        self.res,
+                        c.0,
+                        PROBE_SEED + j,
+                        self.setter_passes,
+                    )
+                })
+            })
+            .collect()
     }
 
-    /// (budget CPU s, passes) of `c` from the setter's runs and `c`'s probe.
-    fn passes_for(setter: &[RunEntry], probe: &RunEntry) -> Result<(f64, u32), String> {
-        let budget = mean_cpu(setter);
-        let per_pass = cpu(probe) / probe.record.spec.passes as f64;
-        Ok((budget, equal_time_passes(budget, per_pass)?))
+    /// (budget CPU s per run, passes of each contender) from the probes (`probe_specs`' order):
+    /// the setter's mean cost at its passes, and each contender's passes at that budget.
+    fn passes_for(&self, probes: &[RunEntry]) -> Result<(f64, Vec<u32>), String> {
+        let n = self.contenders().len();
+        let per_pass: Vec<f64> = (0..n)
+            .map(|k| {
+                let mine: Vec<&RunEntry> = probes.iter().skip(k).step_by(n).collect();
+                mine.iter().map(|e| cpu(e)).sum::<f64>()
+                    / (mine.len().max(1) as f64 * self.setter_passes as f64)
+            })
+            .collect();
+        let budget = per_pass[0] * self.setter_passes as f64;
+        let mut passes = vec![self.setter_passes];
+        for &c in &per_pass[1..] {
+            passes.push(equal_time_passes(budget, c)?);
+        }
+        Ok((budget, passes))
     }
 
-    /// The renders to plan: the setter's runs and the probes; the others' runs only when the
-    /// context's cache holds what fixes their pass counts (as `equal_time::specs`).
+    /// The runs, round by round (run r of every contender, then run r + 1), at `passes`.
+    fn run_specs(&self, passes: &[u32]) -> Vec<RunSpec> {
+        let cs = self.contenders();
+        (0..self.runs)
+            .flat_map(|r| {
+                cs.iter()
+                    .zip(passes)
+                    .map(move |(c, &n)| run_spec(&self.scene, self.res, c.0, 1 + r as u64, n))
+            })
+            .collect()
+    }
+
+    /// The renders to plan: the probes; the runs only when the context's cache holds every
+    /// probe, which fixes their pass counts (as `equal_time::specs`).
     fn planned(&self, ctx: Option<&StudyContext>) -> Result<Vec<RunSpec>, String> {
-        let setter = self.specs_of(self.setter, self.setter_passes);
-        let mut v = setter.clone();
-        v.extend(self.others.iter().map(|&c| self.probe(c)));
+        let mut v = self.probe_specs();
         let Some(ctx) = ctx else { return Ok(v) };
-        let found: Option<Vec<RunEntry>> = setter
+        let found: Option<Vec<RunEntry>> = v
             .iter()
             .map(|s| ctx.runs.lookup(s))
             .collect::<Result<Vec<_>, _>>()?
             .into_iter()
             .collect();
-        let Some(found) = found else { return Ok(v) };
-        for &c in &self.others {
-            if let Some(p) = ctx.runs.lookup(&self.probe(c))? {
-                let (_, n) = Self::passes_for(&found, &p)?;
-                v.extend(self.specs_of(c, n));
-            }
+        if let Some(found) = found {
+            let (_, passes) = self.passes_for(&found)?;
+            v.extend(self.run_specs(&passes));
         }
         Ok(v)
     }
 
     /// Every arm, setter first then `others` in order, rendered now where the cache lacks
-    /// them; and the budget in CPU seconds per run.
+    /// them; and the budget in CPU seconds per run the probes predicted.
     fn run(&self, ctx: &StudyContext) -> Result<(f64, Vec<Arm>), String> {
-        let setter = ctx.run_all(&self.specs_of(self.setter, self.setter_passes))?;
-        let mut budget = mean_cpu(&setter);
-        let mut arms = vec![Arm {
-            contender: self.setter,
-            passes: self.setter_passes,
-            entries: setter,
-        }];
-        for &c in &self.others {
-            let probe = ctx.run(&self.probe(c))?;
-            let (b, n) = Self::passes_for(&arms[0].entries, &probe)?;
-            budget = b;
-            arms.push(Arm {
-                contender: c,
-                passes: n,
-                entries: ctx.run_all(&self.specs_of(c, n))?,
-            });
-        }
+        let probes = ctx.run_all(&self.probe_specs())?;
+        let (budget, passes) = self.passes_for(&probes)?;
+        let runs = ctx.run_all(&self.run_specs(&passes))?;
+        let n = passes.len();
+        let arms = self
+            .contenders()
+            .into_iter()
+            .zip(passes)
+            .enumerate()
+            .map(|(k, (contender, passes))| Arm {
+                contender,
+                passes,
+                entries: runs.iter().skip(k).step_by(n).cloned().collect(),
+            })
+            .collect();
         Ok((budget, arms))
     }
 }
 
+/// Per run relMSE × CPU s (the inefficiency: an unbiased estimator's is the same at any
+/// budget, so it compares arms whose achieved times differ), and its mean with an interval.
+fn inefficiency(rel: &[f64], entries: &[RunEntry], confidence: f64) -> Interval {
+    let v: Vec<f64> = rel.iter().zip(entries).map(|(r, e)| r * cpu(e)).collect();
+    mean_of_runs(&v, confidence)
+}
+
 /// relMSE, FLIP and MSE of each run, and their means with intervals.
 struct Errors {
+    /// Each run's relMSE, in the runs' order.
+    rel_runs: Vec<f64>,
     rel: Interval,
     flip: Interval,
     mse: Interval,
@@ -252,6 +312,7 @@ fn errors_of_images(images: &[Image], r: &Reference, confidence: f64) -> Result<
         .collect::<Result<_, _>>()?;
     Ok(Errors {
         rel: mean_of_runs(&rel, confidence),
+        rel_runs: rel,
         flip: mean_of_runs(&flip, confidence),
         mse: mean_of_runs(&m, confidence),
     })
