@@ -42,6 +42,7 @@
 //! | `alpha_beam_beams` | f64 | 4/5 | BB1D's radius reduction: r_BB,i = r₁ i^(α_BB−1) |
 //! | `beam_paths` | u64 | ⌈M/8⌉ | light subpaths (the pass's first) whose segments are BB1D's and BP2D's photon beams |
 
+mod beam_end;
 pub mod camera_beams;
 pub mod light_beams;
 pub mod light_store;

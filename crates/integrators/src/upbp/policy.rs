@@ -10,10 +10,10 @@
 //!
 //! **BP2D** at the medium vertex z, per photon beam b within r_B of it (`beam_points`), x' the
 //! projection of z on the beam: β_z f_p(ω_z, −ω_b) Φ_b(x') / (M_B π r_B²), Φ_b(x') the beam's
-//! value there (`camera_beams::BeamEnd`) — Jarosz et al. 2011's beam × point 2-D estimate, as
+//! value there (`beam_end::BeamEnd`) — Jarosz et al. 2011's beam × point 2-D estimate, as
 //! `volume_density::point_beam`.
 
-use super::camera_beams::BeamEnd;
+use super::beam_end::BeamEnd;
 use super::light_store::{LightPath, LightStore};
 use super::rates::{camera_vertex, junction, Needs};
 use super::weights::{weight, VertexRate};
@@ -153,6 +153,23 @@ impl<'a> MergeSide<'a> {
             end_rate: y.rates[i].light_rate,
             near_sin: y.rates[i - 1].sin,
             nee: y.nee,
+        }
+    }
+
+    /// A photon beam's side at the merge point (`BeamEnd::at` filled `light_buf`).
+    pub(super) fn at_beam_end<'s: 'a>(
+        end: &BeamEnd<'s>,
+        light_buf: &'a [PathVertex],
+        p: &PassData,
+    ) -> MergeSide<'a> {
+        MergeSide {
+            vertices: light_buf,
+            back: end.back,
+            rates: end.rates,
+            near_rate: end.near_rate,
+            end_rate: end.end_rate,
+            near_sin: near_sin(light_buf, p.needs),
+            nee: end.nee,
         }
     }
 }
@@ -452,7 +469,7 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
             if value == Color::ZERO {
                 continue;
             }
-            let light = end.side(&light_buf, p);
+            let light = MergeSide::at_beam_end(&end, &light_buf, p);
             let technique = VolumeTechnique::BeamPoint(i);
             let w = self.merge_weight(scene, light, self.camera_side(z), technique);
             if R::ACTIVE {

@@ -30,6 +30,7 @@
 
 pub mod bb1d;
 pub mod beam_beam;
+mod beam_events;
 pub mod beams;
 pub mod bp2d;
 pub mod cell_frame;

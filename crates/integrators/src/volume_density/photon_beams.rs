@@ -19,7 +19,6 @@
 
 use super::cell_frame::{CellFrame, CellLists};
 use super::photons::{LightRecord, PhotonData};
-use crate::media::pt::MediumEvents;
 use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec3};
 use lt_core::medium::MediumId;
@@ -204,24 +203,6 @@ impl<'a> BeamQuery<'a> {
             kernel,
             norm,
             max_depth,
-        }
-    }
-}
-
-impl MediumEvents for BeamQuery<'_> {
-    fn along_flight(&self, ray: &Ray, t_max: f32, m: MediumId, depth: u32) -> Option<Color> {
-        match self.kernel {
-            BeamKernel::Line1d => super::beam_beam::along_camera_beam(self, ray, t_max, m, depth),
-            BeamKernel::Point2d => None,
-        }
-    }
-
-    fn at_scatter(&self, x: Vec3, wo: Vec3, m: MediumId, depth: u32) -> Option<Color> {
-        match self.kernel {
-            BeamKernel::Point2d => super::point_beam::at_camera_point(self, x, wo, m, depth),
-            // The beam counted every medium vertex of the flight: a sampled scattering ends the
-            // walk (only flights that pass go on, weighted T/P), as in `pb2d`.
-            BeamKernel::Line1d => Some(Color::ZERO),
         }
     }
 }
