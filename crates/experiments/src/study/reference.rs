@@ -119,6 +119,19 @@ impl Reference {
         }
     }
 
+    /// How the reference was made, for a gallery's caption: "bdpt at 512 passes", or
+    /// "8 independent runs of vcm at 512 passes each".
+    pub fn described(&self) -> String {
+        if self.consistent {
+            format!(
+                "{} independent runs of {} at {} passes each",
+                self.runs, self.integrator, self.passes
+            )
+        } else {
+            format!("{} at {} passes", self.integrator, self.passes)
+        }
+    }
+
     pub fn from_entry(e: &RunEntry) -> Result<Reference, String> {
         let image = e.image()?;
         let se = e.std_error()?.ok_or_else(|| {

@@ -214,20 +214,13 @@ fn scene_figure(
         &format!("Figure 3: {}, {} at equal CPU time", sc.name, sc.paths),
         &format!(
             "Equal CPU time ({} s per run); the caustic is the crop {}×{} at ({}, {}). \
-             Reference: {}{} at {} passes{}.",
+             Reference: {}.",
             num(budget_s),
             crop.w,
             crop.h,
             crop.x,
             crop.y,
-            if reference.consistent {
-                format!("{} independent runs of ", reference.runs)
-            } else {
-                String::new()
-            },
-            reference.integrator,
-            reference.passes,
-            if reference.consistent { " each" } else { "" }
+            reference.described()
         ),
         &reference.gallery_entry(format!("gallery/{dir}/reference")),
         &entries,

@@ -206,16 +206,9 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             &out.dir,
             &format!("The {set} slides: {scene}"),
             &format!(
-                "Run 1 of {} of each slide (seed 1). Reference: {}{} at {} passes{}.",
+                "Run 1 of {} of each slide (seed 1). Reference: {}.",
                 b.runs,
-                if reference.consistent {
-                    format!("{} independent runs of ", reference.runs)
-                } else {
-                    String::new()
-                },
-                reference.integrator,
-                reference.passes,
-                if reference.consistent { " each" } else { "" }
+                reference.described()
             ),
             &reference.gallery_entry(format!("gallery/{dir}/reference")),
             &entries,

@@ -117,18 +117,10 @@ pub(super) fn figure(ctx: &StudyContext, b: &Budget, out: &mut StudyOutput) -> R
             &out.dir,
             &format!("Figure 4: {name}, bdpt, ppm and vcm at equal CPU time"),
             &format!(
-                "Equal CPU time ({} s per run, vcm's mean at {} passes). Reference: {} {} at {} \
-                 passes{}.",
+                "Equal CPU time ({} s per run, vcm's mean at {} passes). Reference: {}.",
                 num(budget_s),
                 cmp.setter_passes,
-                if reference.consistent {
-                    format!("{} independent runs of", reference.runs)
-                } else {
-                    String::new()
-                },
-                reference.integrator,
-                reference.passes,
-                if reference.consistent { " each" } else { "" }
+                reference.described()
             ),
             &reference.gallery_entry(format!("gallery/vcm-{name}/reference")),
             &entries,
