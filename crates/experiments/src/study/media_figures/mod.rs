@@ -45,8 +45,10 @@ pub struct Budget {
     pub reference_passes: u32,
 }
 
-/// The study's own budget at every scale but `test`: it is sized for about ten core-minutes
-/// of renders (results/media-figures/summary.md states what it took).
+/// The study's own budget: `committed` (and every scale but `test` and `full`) is sized for
+/// about ten core-minutes of renders (results/media-figures/summary.md states what it took);
+/// `full` gives each run 4× that time, to see which verdicts depend on the budget (≈ 40
+/// core-minutes).
 pub fn budget(scale: &Scale) -> Budget {
     if scale.name == "test" {
         Budget {
@@ -54,6 +56,13 @@ pub fn budget(scale: &Scale) -> Budget {
             runs: 3,
             cpu_seconds: 0.05,
             reference_passes: 16,
+        }
+    } else if scale.name == "full" {
+        Budget {
+            width: 64,
+            runs: 8,
+            cpu_seconds: 6.0,
+            reference_passes: 512,
         }
     } else {
         Budget {
