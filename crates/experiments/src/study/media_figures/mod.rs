@@ -264,7 +264,7 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
     )?;
     out.para(&format!(
         "Points, beams and paths compared as their papers did, on our scenes: {} independent runs \
-         (seeds 1 … {}) per cell at {} px wide, each run {} CPU s on one thread (the pass count \
+         (seeds 1 … {}) per cell at {} px wide, each run {} CPU s on {} (the pass count \
          from two cached probes, `media_figures` says how; each table gives the cells' measured \
          mean). Errors against a {}-pass bdpt reference of each scene at the same film (seed \
          1 000 000): relMSE (ε = 0.01) less the reference's own noise, and FLIP, as means over \
@@ -275,6 +275,11 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
         b.runs,
         b.width,
         super::output::num(b.cpu_seconds),
+        match ctx.runs.threads {
+            1 => "one thread".to_string(),
+            0 => "one thread per core (CPU s summed over them)".to_string(),
+            n => format!("{n} threads (CPU s summed over them)"),
+        },
         b.reference_passes,
         super::output::pct(scale.confidence)
     ));
