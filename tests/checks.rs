@@ -9,6 +9,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod agreement;
+mod bdpt_weights;
 mod consistency;
 mod crossings;
 mod directional;

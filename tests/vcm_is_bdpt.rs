@@ -4,7 +4,7 @@
 //! renders the same image — on every shipped scene, with M = N and M ≠ N light paths.
 
 use lt_core::path::Heuristic;
-use lt_integrators::bdpt::{Bdpt, BdptParams};
+use lt_integrators::bdpt::{Bdpt, BdptParams, BdptWeights};
 use lt_integrators::connect_merge::{initial_radius, Engine, PassInputs, VcmParams};
 use lt_integrators::radius::InitialRadius;
 use lt_integrators::record::{Completed, Recorder};
@@ -34,6 +34,8 @@ fn params(
         rr_depth: scene.settings.rr_depth,
         mis,
         light_paths,
+        // bdpt's chain: vcm's recursion is held to the other computation.
+        weights: BdptWeights::Chain,
     };
     let v = VcmParams {
         max_depth: b.max_depth,

@@ -8,8 +8,13 @@
 //! - s, t ≥ 2: a shadow ray between the two subpath ends.
 //!
 //! Weights come from the subpaths' stored densities (`pdf_fwd`, `pdf_rev`, filled by
-//! `walk::random_walk`) with the ≤ 4 entries the connection changes patched, through
-//! `lt_core::path::Chain` — the same arithmetic the from-scratch oracle runs, never a `Path`.
+//! `walk::random_walk`) with the ≤ 4 entries the connection changes patched, never a `Path`.
+//! By default (`weights = recursive`) they run the O(1) per-vertex recursion of
+//! `lt_core::path::SubpathMis` (Georgiev et al. 2012), each subpath's records formed once per
+//! walk (`subpath::recursive_weight`); `weights = chain` builds the O(k) `lt_core::path::Chain`
+//! of every strategy — the same arithmetic the from-scratch oracle runs, and the oracle the
+//! recursion is held to per path (tests/bdpt_weights.rs). The two give each path the same
+//! weight up to f64 rounding. `mis = none` (uniform weights) always takes the chain.
 //! With `light_paths` = M ≠ N, camera sample j pairs with light subpath j mod M, every light
 //! subpath is splatted once, and light tracing's weight carries n_k/n_s = M/N.
 //!
@@ -17,7 +22,8 @@
 //! both subpaths are walked by `subpath::media_walk` (medium vertices where free flights scatter,
 //! null boundaries crossed), every join of (s, t) carries the edge's transmittance estimate, and
 //! the weights read the walks' volume-measure densities with the join's patched densities taking
-//! their free flights (`strategy_weight::with_chain_in::<true>`); never the estimate.
+//! their free flights (`strategy_weight::with_chain_in::<true>`, `recursive_weight`'s
+//! `with_flight`); never the estimate.
 //!
 //! | key | type | default | meaning |
 //! |---|---|---|---|
@@ -25,6 +31,7 @@
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `mis` | power/balance/none | power | heuristic over the strategies (none: uniform weights) |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
+//! | `weights` | recursive/chain | recursive | O(1) per-vertex recursion or the O(k) chain per strategy (`mis = none`: the chain) |
 
 use crate::film::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::params::ParamReader;
@@ -35,13 +42,14 @@ use crate::subpath::camera_loop::{
 };
 use crate::subpath::connect::{nee_density, splat_light_subpath_in, JoinFlights};
 use crate::subpath::media_walk::light_subpath_in;
+use crate::subpath::recursive_weight::{self as recursive, camera_records, light_records};
 pub use crate::subpath::strategy_weight::{mis_weight, mis_weight_in, with_chain, with_chain_in};
 pub use crate::subpath::strategy_weight::{EndEvals, Split};
 use crate::subpath::walk::{Subpath, WalkLimits};
 use crate::Integrator;
 use lt_core::bsdf::BsdfEval;
 use lt_core::math::{Color, Vec2};
-use lt_core::path::{Heuristic, PathVertex};
+use lt_core::path::{CameraMis, Heuristic, LightMis, PathVertex, SubpathMis, TechniqueSet};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
 use lt_estimators::Image;
@@ -53,6 +61,27 @@ pub struct BdptParams {
     pub mis: Heuristic,
     /// `None`: one light subpath per pixel.
     pub light_paths: Option<u64>,
+    pub weights: BdptWeights,
+}
+
+/// How bdpt computes a strategy's MIS weight (the same number up to f64 rounding).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BdptWeights {
+    /// O(1) per strategy from per-vertex records (`subpath::recursive_weight`); power and
+    /// balance heuristics (uniform weights take the chain).
+    Recursive,
+    /// O(k) per strategy: the path's density chain (`subpath::strategy_weight`), the oracle.
+    Chain,
+}
+
+impl BdptWeights {
+    pub fn parse(v: &str) -> Result<BdptWeights, String> {
+        match v {
+            "recursive" => Ok(BdptWeights::Recursive),
+            "chain" => Ok(BdptWeights::Chain),
+            _ => Err(format!("'{v}' is not recursive or chain")),
+        }
+    }
 }
 
 impl BdptParams {
@@ -64,6 +93,9 @@ impl BdptParams {
                 .get_with("mis", Heuristic::parse)?
                 .unwrap_or(Heuristic::Power),
             light_paths: r.light_paths()?,
+            weights: r
+                .get_with("weights", BdptWeights::parse)?
+                .unwrap_or(BdptWeights::Recursive),
         })
     }
 }
@@ -76,6 +108,9 @@ pub struct Bdpt {
 pub struct Scratch {
     camera: CameraScratch,
     light: Subpath,
+    /// The recursion's records of the light and the camera subpath (`recursive_weight`).
+    light_mis: Vec<LightMis>,
+    camera_mis: Vec<CameraMis>,
 }
 
 /// What one camera sample pairs: the pixel it samples (none for items past the pixel count), the
@@ -99,10 +134,26 @@ struct Policy<'a, const MEDIA: bool> {
     h: Heuristic,
     /// M/N.
     ratio: f64,
+    /// With recursive weights: the recursion and the records of `y` and of the camera walk
+    /// (formed in `walked`); `None` weighs by the chain.
+    recursion: Option<Records<'a>>,
+}
+
+/// What recursive weights read: the pass's recursion and both subpaths' records.
+struct Records<'a> {
+    mis: SubpathMis,
+    light: &'a [LightMis],
+    camera: &'a mut Vec<CameraMis>,
 }
 
 impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     const MEDIA: bool = MEDIA;
+
+    fn walked(&mut self, scene: &Scene, z: &[PathVertex], _: Vec2) {
+        if let Some(r) = &mut self.recursion {
+            camera_records(scene, &r.mis, z, r.camera);
+        }
+    }
 
     fn emitter_weight(
         &self,
@@ -111,6 +162,16 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         flights: JoinFlights,
         _: Vec2,
     ) -> Weight {
+        if let Some(r) = &self.recursion {
+            let w = recursive::emitter_weight::<MEDIA>(
+                scene,
+                &r.mis,
+                path,
+                r.camera,
+                flights.camera_back,
+            );
+            return (w, None);
+        }
         let (split, mut evals) = Split::reached(path);
         evals.flights = Some(flights);
         let w = mis_weight_in::<MEDIA>(scene, split, evals, self.h, self.ratio);
@@ -125,6 +186,16 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
         flights: JoinFlights,
         _: Vec2,
     ) -> Weight {
+        if let Some(r) = &self.recursion {
+            let w = recursive::next_event_weight::<MEDIA>(
+                scene,
+                &r.mis,
+                (z, r.camera),
+                (x0, camera_end),
+                flights,
+            );
+            return (w, None);
+        }
         let (split, mut evals) = Split::next_event(z, x0, camera_end);
         evals.flights = Some(flights);
         let w = mis_weight_in::<MEDIA>(scene, split, evals, self.h, self.ratio);
@@ -132,6 +203,13 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
     }
 
     fn connect<R: Recorder>(&mut self, scene: &Scene, joins: &mut Joins<'_, R>, _: &mut Sampler) {
+        if let Some(r) = &self.recursion {
+            let (mis, ly, zr) = (&r.mis, r.light, &r.camera[..]);
+            joins.join_subpath_in::<MEDIA>(scene, self.y, |c| {
+                (recursive::connection_weight::<MEDIA>(mis, c, ly, zr), None)
+            });
+            return;
+        }
         joins.join_subpath_in::<MEDIA>(scene, self.y, |c| {
             let (split, evals) = Split::connection(c, self.light_nee);
             let w = mis_weight_in::<MEDIA>(scene, split, evals, self.h, self.ratio);
@@ -149,6 +227,15 @@ impl Bdpt {
 
     fn ratio(&self, scene: &Scene) -> f64 {
         self.light_paths(scene) as f64 / scene.camera.pixel_count() as f64
+    }
+
+    /// The per-vertex recursion when the weights take it (`weights = recursive` with the power or
+    /// balance heuristic: Veach's counts, light tracing's M/N), else `None` (the chain).
+    fn recursion(&self, scene: &Scene) -> Option<SubpathMis> {
+        let h = self.params.mis;
+        let exact = matches!(h, Heuristic::Power | Heuristic::Balance);
+        (self.params.weights == BdptWeights::Recursive && exact)
+            .then(|| SubpathMis::new(h, TechniqueSet::new(true, 0.0), self.ratio(scene)))
     }
 
     /// One camera sample as `pair` says; returns the pixel's own estimate (strategies t ≥ 2).
@@ -187,6 +274,11 @@ impl Bdpt {
         } else {
             0.0
         };
+        let mis = self.recursion(scene);
+        if let Some(mis) = &mis {
+            light_records(scene, mis, y, light_nee, &mut scratch.light_mis);
+        }
+        let ly = &scratch.light_mis[..];
         rec.lap(Work::LightWalk);
 
         // t = 1: every connectable light vertex joined to the pinhole.
@@ -205,6 +297,17 @@ impl Bdpt {
                 splats,
                 rec,
                 |s, c| {
+                    if let Some(mis) = &mis {
+                        let back = light.back_flight(s - 1);
+                        let w = recursive::light_tracing_weight::<MEDIA>(
+                            scene,
+                            mis,
+                            (&y[..s], ly),
+                            c,
+                            back,
+                        );
+                        return (w, None);
+                    }
                     let camera_only = [c.camera];
                     let split = Split {
                         light: &y[..s],
@@ -233,6 +336,11 @@ impl Bdpt {
             light_nee,
             h,
             ratio,
+            recursion: mis.map(|mis| Records {
+                mis,
+                light: ly,
+                camera: &mut scratch.camera_mis,
+            }),
         };
         let depths = Depths {
             max_depth: self.params.max_depth,
@@ -269,6 +377,8 @@ impl Bdpt {
         Scratch {
             camera: CameraScratch::new(self.params.max_depth),
             light: Subpath::with_capacity(self.params.max_depth as usize),
+            light_mis: Vec::with_capacity(self.params.max_depth as usize + 1),
+            camera_mis: Vec::with_capacity(self.params.max_depth as usize + 2),
         }
     }
 

@@ -21,7 +21,7 @@
 use super::chain::ChainSet;
 use super::target::Base;
 use super::{bootstrap_size, ChainParams, MetropolisRun};
-use crate::bidirectional::bdpt::{Bdpt, BdptParams};
+use crate::bidirectional::bdpt::{Bdpt, BdptParams, BdptWeights};
 use crate::params::ParamReader;
 use crate::{Progressive, ProgressiveRun};
 use lt_core::path::Heuristic;
@@ -50,6 +50,7 @@ impl Mmlt {
                 rr_depth,
                 mis,
                 light_paths: None,
+                weights: BdptWeights::Recursive,
             },
         });
         Ok(Mmlt {

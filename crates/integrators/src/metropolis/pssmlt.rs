@@ -18,7 +18,7 @@
 use super::chain::{ChainSet, Keys};
 use super::target::{Base, Restrict};
 use super::{bootstrap_size, ChainParams, MetropolisRun};
-use crate::bidirectional::bdpt::{Bdpt, BdptParams};
+use crate::bidirectional::bdpt::{Bdpt, BdptParams, BdptWeights};
 use crate::params::ParamReader;
 use crate::unidirectional::pt::{Pt, PtParams, Techniques};
 use crate::{Progressive, ProgressiveRun};
@@ -49,6 +49,7 @@ impl Pssmlt {
                     rr_depth,
                     mis,
                     light_paths: None,
+                    weights: BdptWeights::Recursive,
                 },
             }),
             "pt" => Base::Pt(Pt {

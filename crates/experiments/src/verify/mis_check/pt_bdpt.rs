@@ -39,7 +39,9 @@ use lt_core::math::{Color, Vec2};
 use lt_core::path::{oracle_weight, Heuristic, Path, PathVertex, Technique, VertexKind};
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
-use lt_integrators::bdpt::{mis_weight_in, with_chain_in, Bdpt, BdptParams, EndEvals, Split};
+use lt_integrators::bdpt::{
+    mis_weight_in, with_chain_in, Bdpt, BdptParams, BdptWeights, EndEvals, Split,
+};
 use lt_integrators::connect::eval_towards;
 use lt_integrators::lvc_bdpt::{lvc_weight, LvcBdpt, LvcParams};
 use lt_integrators::pt::{Pt, PtParams, Techniques};
@@ -249,6 +251,8 @@ pub fn collect(scene: &Scene, opts: &Options) -> (Collector, u32) {
                     rr_depth: opts.rr_depth,
                     mis: opts.heuristic,
                     light_paths: opts.light_paths,
+                    // The weights bdpt applies by default: the recursion, held to the oracle.
+                    weights: BdptWeights::Recursive,
                 },
             };
             while passes < opts.max_passes && !c.full() {
