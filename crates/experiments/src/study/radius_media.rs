@@ -67,12 +67,13 @@ pub fn scene(scale: &Scale) -> PathBuf {
     scale.scene_beside_focus("studies/medium-point.toml")
 }
 
-/// (runs, passes, photon-path divisor) at a scale. The committed scale (16 runs of 256 passes,
-/// half of `photon_paths`) is the one results/radius-shrinkage-media/ holds (its cost:
+/// (runs, passes, photon-path divisor) at a scale. The committed scale (16 runs of 128 passes,
+/// a quarter of `photon_paths`: 256 passes at half of them did not fit the round's time on the
+/// shared machine) is the one results/radius-shrinkage-media/ holds (its cost:
 /// results/points-beams.md); quick is for trying changes.
 pub fn media_scale(scale: &Scale) -> (usize, u32, u64) {
     match scale.name {
-        "full" | "committed" => (16, 256, 2),
+        "full" | "committed" => (16, 128, 4),
         "test" => (4, 8, 100),
         _ => (8, 64, 10),
     }
@@ -650,7 +651,14 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
             (1, pv, Some(kz_v)),
             (2, pv.max(pb), None),
         ] {
-            let (meas, ci, diff, inside) = slope_cells(&m.rates.slopes[q], exact_rates[q]);
+            let (meas, ci, diff, mut inside) = slope_cells(&m.rates.slopes[q], exact_rates[q]);
+            // A bias² below the variance of the K runs' mean at the last N is not resolved by
+            // them: the tail's slope then measures their noise (decided from the exact curves).
+            let (runs, _, _) = media_scale(scale);
+            let floor = m.exact_variance.last().map_or(0.0, |v| v / runs as f64);
+            if q == 0 && m.exact_bias2.last().is_some_and(|&b| b < floor) {
+                inside = "unresolved".into();
+            }
             let (_, _, _, inside_asymptotic) = slope_cells(&m.rates.slopes[q], pred);
             let inside_kz = kz.map_or("—".into(), |k| slope_cells(&m.rates.slopes[q], k).3);
             let last = m.rates.at_n.last().map(|j| &j[q]);
@@ -685,7 +693,10 @@ pub fn run(ctx: &StudyContext) -> Result<(), String> {
          at these N (pass biases ∝ rᵢ², variances ∝ rᵢ^(−d), summed exactly and fitted over the \
          same tail: `predicted_at_these_n`) and whether the interval holds it; whether it holds \
          the asymptotic rate; the quantity and its standard error at the last N, and its exact \
-         value there. A `—` slope: the quantity is not resolved from zero in the tail.",
+         value there. A `—` slope: the quantity is not resolved from zero in the tail; \
+         `unresolved`: the exact bias² at the last N lies below the exact variance of the K \
+         runs' mean (Var_N/K), so the runs cannot resolve the tail's slope (per-n.csv holds its \
+         values N by N).",
         &[
             "integrator",
             "d",
@@ -888,11 +899,20 @@ mod tests {
                 let exact: Vec<Moments> =
                     rays.iter().map(|c| beam_moments(e, *c, r, &rule)).collect();
                 let mut diffs = Vec::new();
+                let mut weighted = Vec::new();
+                let values = beam_values();
                 let (mut s1, mut s2) = (vec![0.0; rays.len()], vec![0.0; rays.len()]);
                 for pass in 0..passes {
                     let v = frozen_beam_pass(&scene, e, (11, pass, paths), r as f32, &rays);
                     let d = v.iter().zip(&exact).map(|(x, m)| x - m.mean).sum::<f64>();
                     diffs.push(d / rays.len() as f64);
+                    // Σ (x − E)(E − L) / Σ (E − L)²: the first-order change in bias² (relative).
+                    let (mut num, mut den) = (0.0, 0.0);
+                    for ((x, m), l) in v.iter().zip(&exact).zip(&values) {
+                        num += (x - m.mean) * (m.mean - l);
+                        den += (m.mean - l).powi(2);
+                    }
+                    weighted.push(num / den);
                     for k in 0..rays.len() {
                         s1[k] += v[k];
                         s2[k] += v[k] * v[k];
@@ -902,6 +922,11 @@ mod tests {
                 let m = diffs.iter().sum::<f64>() / p;
                 let sd = (diffs.iter().map(|d| (d - m).powi(2)).sum::<f64>() / (p - 1.0)).sqrt();
                 let z = m / (sd / p.sqrt());
+                let wm = weighted.iter().sum::<f64>() / p;
+                let wsd = (weighted.iter().map(|d| (d - wm).powi(2)).sum::<f64>() / (p - 1.0))
+                    .sqrt()
+                    / p.sqrt();
+                eprintln!("{e} r {r}: bias-weighted (pass − E_r)/bias {wm:.4} ± {wsd:.4}");
                 let measured: f64 = (0..rays.len())
                     .map(|k| (s2[k] / p - (s1[k] / p).powi(2)) * p / (p - 1.0))
                     .sum();
