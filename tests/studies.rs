@@ -226,6 +226,7 @@ fn committed_radius_shrinkage_claims_hold_within_their_intervals() {
         let checked = check_claims(&path);
         assert!(checked > 0, "{}: no claims found", path.display());
     }
+    media_study_holds_its_exact_predictions(&root.join("results/radius-shrinkage-media"));
     // The plane study's exact check, as committed: every measured bias² and variance holds the
     // exact model's value, and bias² at N = 1 is told from 0 (a bias is measured, not noise).
     // (At the test scale, 16 runs, bias² at N = 1 is only ~4 standard errors: that part is
@@ -248,6 +249,55 @@ fn committed_radius_shrinkage_claims_hold_within_their_intervals() {
                 lo > 0.0,
                 "{}: bias² at N = 1 includes 0: {r:?}",
                 path.display()
+            );
+        }
+    }
+}
+
+/// The committed radius-shrinkage-media study (issue 45 item 3): pp3d's, pb2d's and bb1d's
+/// bias², variance and MSE slopes inside their exact predictions at these N at four α each
+/// (`rates.csv`; a bias² the runs cannot resolve is marked so), and at every N the measured bias² and variance hold their exact values within
+/// t · s.e. (`per-n.csv`; the jackknife over the committed 16 runs: Student t with 15 dof, Šidák
+/// over every comparison at a 1 % false-alarm rate), so each kernel's level is held, not only its
+/// slope. A pb2d kernel normalisation × 1.05 fails both (results/points-beams.md).
+fn media_study_holds_its_exact_predictions(dir: &Path) {
+    let rates = csv(&dir.join("rates.csv"));
+    for e in ["pp3d", "pb2d", "bb1d"] {
+        let mine: Vec<_> = rates.iter().filter(|r| r["integrator"] == e).collect();
+        let alphas: std::collections::BTreeSet<&str> =
+            mine.iter().map(|r| r["α"].as_str()).collect();
+        assert!(alphas.len() >= 4, "{e}: only {} values of α", alphas.len());
+        for r in mine {
+            // `unresolved`: a bias² below the runs' noise at the last N (the study decides it
+            // from its exact curves); its values are held N by N below.
+            let unresolved = r["quantity"] == "bias²" && r["inside"] == "unresolved";
+            assert!(
+                r["inside"] == "yes" || unresolved,
+                "{}: {r:?}",
+                dir.display()
+            );
+        }
+    }
+    let per_n = csv(&dir.join("per-n.csv"));
+    let comparisons = 2 * per_n.len();
+    let per_test = lt_core::testing::sidak(0.01, comparisons);
+    let t = lt_estimators::bias_variance::t_quantile(1.0 - per_test, 15.0);
+    let num = |r: &HashMap<String, String>, k: &str| -> f64 {
+        r[k].parse().unwrap_or_else(|e| panic!("{k}: {e}: {r:?}"))
+    };
+    for r in &per_n {
+        for (q, se, exact) in [
+            ("bias²", "± bias²", "exact bias²"),
+            ("variance", "± variance", "exact variance"),
+        ] {
+            let (m, s, x) = (num(r, q), num(r, se), num(r, exact));
+            assert!(
+                (m - x).abs() <= t * s,
+                "{}: {} α {} N {}: {q} {m} ± {s}, exact {x} (t {t})",
+                dir.display(),
+                r["integrator"],
+                r["α"],
+                r["N"]
             );
         }
     }
@@ -424,6 +474,10 @@ fn check_claims(path: &Path) -> usize {
         let mut claims = vec![("inside", at_n.clone().or(asymptotic.clone()))];
         if r.contains_key("inside asymptotic") {
             claims.push(("inside asymptotic", asymptotic));
+        }
+        // The media study keeps K&Z's model at these N beside its exact prediction.
+        if r.contains_key("inside K&Z at these N") {
+            claims.push(("inside K&Z at these N", r["K&Z at these N"].parse::<f64>()));
         }
         for (column, predicted) in claims {
             let claim = r[column].as_str();

@@ -7,6 +7,7 @@
 //! stopped, and a study whose renders ran elsewhere (`lt plan study`, a cluster) is finished by
 //! running it again: every render is then found.
 
+pub mod beam_moments;
 pub mod context;
 pub mod convergence;
 pub mod equal_time;
