@@ -173,7 +173,13 @@ impl EnvironmentMap {
         if self.rows.is_empty() {
             return None;
         }
-        let (j, _, uy) = self.rows.sample(u.y);
+        let (j, p_row, uy) = self.rows.sample(u.y);
+        // A row of zero weight is drawn only where rounding leaves a sliver of the CDF to it
+        // (u.y just below 1 before a trailing black row): no direction of density there, and
+        // its column distribution is empty.
+        if !(p_row > 0.0) {
+            return None;
+        }
         let (i, _, ux) = self.columns[j].sample(u.x);
         let uv = Vec2::new(
             (i as f32 + ux) / self.width as f32,

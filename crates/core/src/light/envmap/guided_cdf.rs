@@ -89,9 +89,11 @@ impl GuidedCdf {
         i
     }
 
-    /// Returns (bin, pmf, u remapped to [0, 1) within the bin), as `Distribution1D::sample`.
+    /// Returns (bin, pmf, u remapped to [0, 1) within the bin), as `Distribution1D::sample`;
+    /// for a non-empty distribution (`is_empty`).
     #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32, f32) {
+        debug_assert!(!self.is_empty(), "sampling an empty distribution");
         let i = self.bin(u);
         let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
         let p = self.pmf[i];
