@@ -198,6 +198,19 @@ const FAR: f32 = 1e30;
 /// More boundary crossings than this on one segment is a ray caught in a degenerate spot.
 const MAX_CROSSINGS: usize = 1024;
 
+/// A thread's buffers for the crossings of its segments, reused from one shadow ray to the next
+/// (each was two or three allocations per shadow ray). Taken out while in use, so a nested use
+/// would only allocate afresh.
+#[derive(Default)]
+struct Scratch {
+    hits: Vec<PrimHit>,
+    crossings: Vec<SegmentCrossing>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::default();
+}
+
 /// Which surfaces a segment walk passes: every one (the oracle, whose f excludes visibility:
 /// an opaque surface is then a boundary like a null one, and V zeroes the edge anyway; a pane
 /// passes as the null event it is), or null ones only (an opaque surface or a pane blocks), or
@@ -334,7 +347,7 @@ impl Scene {
         b: ConnectionEnd,
         medium: Option<MediumId>,
         crossing: Crossing,
-        mut visit: impl FnMut(MediumPiece),
+        visit: impl FnMut(MediumPiece),
     ) -> Option<PanesPassed> {
         // Crossings are found from a finite end; from a light at infinity they are found from the
         // other end and walked backwards.
@@ -344,7 +357,27 @@ impl Scene {
             (a, b, false)
         };
         let panes = crossing != Crossing::NullOnly;
-        let crossings = self.boundary_crossings(from, to, panes, false)?;
+        let mut crossings = SCRATCH.with(|s| std::mem::take(&mut s.borrow_mut().crossings));
+        let walked = self.crossings_into(from, to, panes, false, &mut crossings);
+        let through = walked
+            .then(|| self.walk_pieces(&crossings, from, to, reversed, medium, crossing, visit));
+        SCRATCH.with(|s| s.borrow_mut().crossings = crossings);
+        through.flatten()
+    }
+
+    /// `for_each_medium_piece` over the segment's `crossings` (found from `from`).
+    #[allow(clippy::too_many_arguments)]
+    fn walk_pieces(
+        &self,
+        crossings: &[SegmentCrossing],
+        from: ConnectionEnd,
+        to: ConnectionEnd,
+        reversed: bool,
+        medium: Option<MediumId>,
+        crossing: Crossing,
+        mut visit: impl FnMut(MediumPiece),
+    ) -> Option<PanesPassed> {
+        let panes = crossing != Crossing::NullOnly;
         let dir = if to.infinite {
             to.p
         } else {
@@ -358,13 +391,10 @@ impl Scene {
         } else {
             (from.p, to.p, dir)
         };
-        let order: Box<dyn Iterator<Item = &SegmentCrossing>> = if reversed {
-            Box::new(crossings.iter().rev())
-        } else {
-            Box::new(crossings.iter())
-        };
+        let n = crossings.len();
         let (mut current, mut here, mut through) = (medium, start, PanesPassed::NONE);
-        for c in order {
+        for k in 0..n {
+            let c = &crossings[if reversed { n - 1 - k } else { k }];
             let (p, ng, pane) = (c.p, c.ng, c.pane);
             let s = &self.shapes[c.shape as usize];
             match crossing {
@@ -416,15 +446,47 @@ impl Scene {
         panes: bool,
         restart: bool,
     ) -> Option<Vec<SegmentCrossing>> {
-        let walk = SegmentWalk::new(self, from, to);
         let mut found = Vec::new();
+        self.crossings_into(from, to, panes, restart, &mut found)
+            .then_some(found)
+    }
+
+    /// `boundary_crossings` into `found` (cleared first); false where that gives `None`. Its
+    /// buffers are the thread's (`SCRATCH`), not allocated per shadow ray.
+    fn crossings_into(
+        &self,
+        from: ConnectionEnd,
+        to: ConnectionEnd,
+        panes: bool,
+        restart: bool,
+        found: &mut Vec<SegmentCrossing>,
+    ) -> bool {
+        found.clear();
+        let walk = SegmentWalk::new(self, from, to);
         let Some(ray) = walk.ray_from(walk.start) else {
-            return Some(found);
+            return true;
         };
-        let mut hits = Vec::new();
         super::ray_stats::count_closest();
-        if restart || !self.accel.all_hits(&ray, &mut hits) {
+        if restart {
             return self.crossings_restarting(&walk, ray, panes, found);
+        }
+        let mut hits = SCRATCH.with(|s| std::mem::take(&mut s.borrow_mut().hits));
+        let walked = self.crossings_from_hits(&walk, ray, panes, found, &mut hits);
+        SCRATCH.with(|s| s.borrow_mut().hits = hits);
+        walked
+    }
+
+    /// `crossings_into` from one every-hit query (into `hits`), where the ray core has it.
+    fn crossings_from_hits(
+        &self,
+        walk: &SegmentWalk,
+        ray: Ray,
+        panes: bool,
+        found: &mut Vec<SegmentCrossing>,
+        hits: &mut Vec<PrimHit>,
+    ) -> bool {
+        if !self.accel.all_hits(&ray, hits) {
+            return self.crossings_restarting(walk, ray, panes, found);
         }
         // The restart walk's next ray starts past the last crossing's error box
         // (`offset_ray_origin`) and finds what lies beyond that point. A hit of this ray near
@@ -435,7 +497,7 @@ impl Scene {
         // last crossing: it is rare, and what happens there is then the restart walk's.
         let origin_scale = ray.o.abs().max_element();
         let (mut skip_to, mut next) = (0.0f32, walk.start);
-        for h in hits {
+        for &h in hits.iter() {
             let near = !found.is_empty() && h.t <= skip_to + gamma(16) * (origin_scale + h.t);
             if !near {
                 let crossing = self.crossing_at(&ray, h, panes);
@@ -443,18 +505,18 @@ impl Scene {
                 skip_to = (next - ray.o).dot(ray.d);
                 found.push(crossing);
                 if found.len() == MAX_CROSSINGS {
-                    return None;
+                    return false;
                 }
             }
             if near || segment_hits::may_hit_again(self.accel.primitive(h.prim)) {
                 let Some(ray) = walk.ray_from(next) else {
-                    return Some(found);
+                    return true;
                 };
                 super::ray_stats::count_closest();
-                return self.crossings_restarting(&walk, ray, panes, found);
+                return self.crossings_restarting(walk, ray, panes, found);
             }
         }
-        Some(found)
+        true
     }
 
     /// `boundary_crossings` by a closest-hit query per crossing, each restarted past the last
@@ -464,21 +526,21 @@ impl Scene {
         walk: &SegmentWalk,
         mut ray: Ray,
         panes: bool,
-        mut found: Vec<SegmentCrossing>,
-    ) -> Option<Vec<SegmentCrossing>> {
+        found: &mut Vec<SegmentCrossing>,
+    ) -> bool {
         loop {
             let Some(prim_hit) = self.accel.intersect(&ray) else {
-                return Some(found);
+                return true;
             };
             let crossing = self.crossing_at(&ray, prim_hit, panes);
             let origin = offset_ray_origin(crossing.p, crossing.p_err, crossing.ng, ray.d);
             found.push(crossing);
             if found.len() == MAX_CROSSINGS {
-                return None;
+                return false;
             }
             match walk.ray_from(origin) {
                 Some(next) => ray = next,
-                None => return Some(found),
+                None => return true,
             }
             super::ray_stats::count_closest();
         }
