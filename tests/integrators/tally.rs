@@ -4,7 +4,7 @@
 use lt_core::Scene;
 use lt_integrators::record::tally::RunTally;
 use lt_integrators::record::tally_run::{tally_run, Tallied};
-use lt_integrators::record::Work;
+use lt_integrators::record::{VolumeFamily, Work};
 use lt_integrators::{make_integrator, render, IntegratorParams, RenderOptions};
 use lt_scene_io::load_scene;
 use std::ops::ControlFlow;
@@ -93,4 +93,62 @@ fn a_tallied_render_is_the_plain_render_bit_for_bit() {
 fn t_keys(scene: &Scene, t: &Tallied) -> Vec<Work> {
     let (_, tally) = pool(1).install(|| tally_run(scene, t, 1, 1, 1));
     tally.techniques.keys().copied().collect()
+}
+
+/// upbp with every technique on a media scene: the tallied image is the plain one bit for bit at
+/// 1 and 2 threads, every volumetric family is heard (in contributions and in time) at the
+/// camera vertex counts its geometry allows, and the techniques' means add up to the image's.
+#[test]
+fn upbp_tallies_its_volumetric_families() {
+    let scene = lt_tests::shipped_scene("media/hg-spot", Some((12, 12)));
+    let params = IntegratorParams::new()
+        .with("techniques", "all")
+        .with("photons_per_pass", 64);
+    let est = make_integrator("upbp", &scene, &params).unwrap();
+    let opts = RenderOptions {
+        passes: 2,
+        time_limit: None,
+        seed: 11,
+        threads: 2,
+    };
+    let plain = render(&scene, &est, &opts, |_| ControlFlow::Continue(())).unwrap();
+    let t = Tallied::make("upbp", &scene, &params).unwrap();
+    for threads in [1, 2] {
+        let (img, tally) = pool(threads).install(|| tally_run(&scene, &t, 11, 2, 1));
+        assert!(
+            img.data
+                .iter()
+                .zip(&plain.estimate.data)
+                .all(|(a, b)| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())),
+            "upbp: the tallied image differs ({threads} threads)"
+        );
+        assert!(
+            sum_error(&tally) < 1e-4,
+            "upbp: techniques sum to {} of the image mean {}",
+            1.0 + sum_error(&tally),
+            tally.image_mean
+        );
+        for family in VolumeFamily::ALL {
+            let heard: Vec<_> = tally
+                .techniques
+                .iter()
+                .filter(|(w, _)| matches!(w, Work::VolumeMerge { family: f, .. } if *f == family))
+                .collect();
+            assert!(
+                heard.iter().any(|(_, f)| f.mean > 0.0)
+                    && heard.iter().any(|(_, f)| f.seconds > 0.0),
+                "upbp: {} adds nothing to the image or is never timed ({threads} threads)",
+                family.name()
+            );
+            // PP3D and BP2D gather at a camera medium vertex (t ≥ 2), PB2D and BB1D on the
+            // segment into it (its query point is the camera side's t-th vertex, t ≥ 2).
+            assert!(
+                heard
+                    .iter()
+                    .all(|(w, _)| matches!(w, Work::VolumeMerge { t, .. } if *t >= 2)),
+                "upbp: {} at t < 2",
+                family.name()
+            );
+        }
+    }
 }

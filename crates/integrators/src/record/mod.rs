@@ -85,6 +85,60 @@ pub enum Work {
     Merge {
         t: u16,
     },
+    /// A volumetric merge (`upbp`) whose camera side has t vertices, the query point or medium
+    /// vertex x_i last: PP3D and BP2D at the camera walk's medium vertex z_{t−1}, PB2D and BB1D
+    /// along the camera segment ending at z_{t−1}. Surface merges inside upbp are `Merge`.
+    VolumeMerge {
+        family: VolumeFamily,
+        t: u16,
+    },
+}
+
+/// upbp's volumetric technique families, by their SmallUPBP names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum VolumeFamily {
+    /// Photon points × camera points (3-D kernel).
+    Pp3d,
+    /// Photon points × camera beams (2-D kernel).
+    Pb2d,
+    /// Photon beams × camera points (2-D kernel).
+    Bp2d,
+    /// Photon beams × camera beams (1-D kernel).
+    Bb1d,
+}
+
+impl VolumeFamily {
+    pub const ALL: [VolumeFamily; 4] = [
+        VolumeFamily::Pp3d,
+        VolumeFamily::Pb2d,
+        VolumeFamily::Bp2d,
+        VolumeFamily::Bb1d,
+    ];
+
+    /// The lower-case name the tables and `--set techniques=` use.
+    pub fn name(self) -> &'static str {
+        match self {
+            VolumeFamily::Pp3d => "pp3d",
+            VolumeFamily::Pb2d => "pb2d",
+            VolumeFamily::Bp2d => "bp2d",
+            VolumeFamily::Bb1d => "bb1d",
+        }
+    }
+
+    /// The work a volumetric merge of `technique` with a camera side of `t` vertices is:
+    /// `None` for a connection (not a merge).
+    pub fn work_of(technique: lt_core::path::VolumeTechnique, t: u16) -> Option<Work> {
+        use lt_core::path::VolumeTechnique as V;
+        let family = match technique {
+            V::Point(_) => VolumeFamily::Pp3d,
+            V::Beam(_) => VolumeFamily::Pb2d,
+            V::BeamPoint(_) => VolumeFamily::Bp2d,
+            V::BeamBeam(_) => VolumeFamily::Bb1d,
+            V::Surface(_) => return Some(Work::Merge { t }),
+            V::Connect(_) => return None,
+        };
+        Some(Work::VolumeMerge { family, t })
+    }
 }
 
 pub trait Recorder {

@@ -1,5 +1,5 @@
 //! Per-technique cost and second moment (issue 25, item 1): what each technique of `bdpt`,
-//! `lvc-bdpt`, `vcm` and `bpm` costs in time and what it adds to the image and to its noise.
+//! `lvc-bdpt`, `vcm`, `bpm` and `upbp` costs in time and what it adds to the image and to its noise.
 //! A `Tally` is a `Recorder`: the integrator renders its pass exactly as always (same random
 //! numbers, same sums in the same order, same image bits — `tally_run` returns the image, and
 //! the tests compare it bit for bit with `render`'s), and hears of every weighted contribution
@@ -7,7 +7,8 @@
 //!
 //! **Techniques.** A connection (s, t): s light vertices, t camera vertices, k = s + t − 1
 //! segments — s = 0 emission hits (t = k + 1), s = 1 next-event estimation, t = 1 light-tracing
-//! splats; a merge at camera vertex count t (all light lengths of one range query together).
+//! splats; a merge at camera vertex count t (all light lengths of one range query together);
+//! upbp's volumetric merges by family (PP3D, PB2D, BP2D, BB1D) and camera vertex count t.
 //! Beside them two shared costs: the light walk (`bdpt`: per item; `lvc-bdpt`: the cache;
 //! `vcm`/`bpm`: light subpaths, their MIS records and the merge grid) and the camera walk.
 //!
@@ -35,7 +36,7 @@
 //! dropped with its item (`VOID_LAP`).
 
 use crate::film::splat::{splat_pass_with, Splats};
-use crate::record::{Completed, Merged, Recorder, Work};
+use crate::record::{Completed, Merged, Recorder, VolumeFamily, VolumeMerged, Work};
 use lt_core::camera::FilmFilter;
 use lt_core::math::is_valid_color;
 use lt_core::{Color, Scene};
@@ -188,6 +189,17 @@ impl Recorder for Tally<'_> {
         }
         let work = Work::Merge {
             t: p.camera.len() as u16,
+        };
+        let v = grey(p.value) * p.weight * self.film_weight as f64;
+        self.entries.push((work, self.pixel, v));
+    }
+
+    fn volume_merged(&mut self, p: VolumeMerged) {
+        if p.weight == 0.0 || !is_valid_color(p.value * p.weight as f32) {
+            return;
+        }
+        let Some(work) = VolumeFamily::work_of(p.technique, p.camera.len() as u16) else {
+            return;
         };
         let v = grey(p.value) * p.weight * self.film_weight as f64;
         self.entries.push((work, self.pixel, v));
@@ -451,5 +463,6 @@ pub fn label(w: Work) -> String {
         Work::CameraWalk => "camera walk".into(),
         Work::Connection { s, t } => format!("s={s},t={t}"),
         Work::Merge { t } => format!("merge t={t}"),
+        Work::VolumeMerge { family, t } => format!("{} t={t}", family.name()),
     }
 }

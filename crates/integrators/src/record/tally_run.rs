@@ -5,6 +5,7 @@ use crate::bidirectional::bdpt::{Bdpt, BdptParams};
 use crate::bidirectional::lvc_bdpt::{LvcBdpt, LvcParams};
 use crate::params::{IntegratorParams, ParamReader};
 use crate::record::tally::RunTally;
+use crate::upbp::{add_pass, Upbp};
 use crate::vcm::bpm::Bpm;
 use crate::vcm::engine::{Run, VcmParams};
 use crate::vcm::Vcm;
@@ -19,10 +20,11 @@ pub enum Tallied {
     LvcBdpt(LvcBdpt),
     /// `vcm` or `bpm`.
     Vcm(VcmParams),
+    Upbp(Upbp),
 }
 
 /// The integrators `Tallied` covers.
-pub const TALLIED: [&str; 4] = ["bdpt", "lvc-bdpt", "vcm", "bpm"];
+pub const TALLIED: [&str; 5] = ["bdpt", "lvc-bdpt", "vcm", "bpm", "upbp"];
 
 impl Tallied {
     pub fn make(name: &str, scene: &Scene, params: &IntegratorParams) -> Result<Tallied, String> {
@@ -35,6 +37,7 @@ impl Tallied {
             "lvc-bdpt" => Tallied::LvcBdpt(LvcBdpt::new(scene, LvcParams::read(scene, &r)?)),
             "vcm" => Tallied::Vcm(Vcm::read(scene, &r)?.params),
             "bpm" => Tallied::Vcm(Bpm::read(scene, &r)?.params),
+            "upbp" => Tallied::Upbp(Upbp::read(scene, &r)?),
             other => {
                 return Err(format!(
                     "per-technique tallies cover {}, not {other}",
@@ -85,6 +88,15 @@ pub fn tally_run(
                 run.add(&tally);
             }
             r.estimate()
+        }
+        Tallied::Upbp(u) => {
+            let mut sum = Image::new(w, h);
+            for pass in 0..passes {
+                let (img, _, tally) = u.tally_pass(scene, seed, pass, every);
+                add_pass(&mut sum, &img);
+                run.add(&tally);
+            }
+            sum.mean_of_passes(passes)
         }
     };
     run.close();

@@ -24,7 +24,7 @@ use super::light_beams::Back;
 use super::policy::{medium_of, near_sin, without_sigma_s, MergeSide, Policy};
 use super::rates::Needs;
 use super::weights::VertexRate;
-use crate::record::{Recorder, VolumeMerged};
+use crate::record::{Recorder, VolumeFamily, VolumeMerged, Work};
 use crate::subpath::camera_loop::SampleCtx;
 use crate::subpath::walk::Departure;
 use crate::volume_density::beam_beam::closest_points;
@@ -127,11 +127,17 @@ impl<const MEDIA: bool> Policy<'_, MEDIA> {
                     p_before,
                     back,
                 };
+                // The camera side of a merge on this segment: the prefix and the query point.
+                let t = prefix.len() as u16 + 1;
                 if points {
                     self.photons_near(scene, prefix, (&pc, dir), leave, ctx, l);
+                    let family = VolumeFamily::Pb2d;
+                    ctx.rec.lap(Work::VolumeMerge { family, t });
                 }
                 if beams {
                     self.beams_near(scene, prefix, (&pc, dir), leave, ctx, l);
+                    let family = VolumeFamily::Bb1d;
+                    ctx.rec.lap(Work::VolumeMerge { family, t });
                 }
             }
             back = back.after(Some(mm), piece.a, piece.b);

@@ -52,6 +52,9 @@ pub mod weights;
 
 use crate::film::splat::{splat_pass_with, Pass, Splats, Worker};
 use crate::params::ParamReader;
+use crate::record::tally::{
+    pool_cpu_seconds, tallied_pass, ItemTally, PassClock, PassTally, Tally,
+};
 use crate::record::{NoRecord, Recorder, Work};
 use crate::subpath::camera_loop::{camera_sample, CameraScratch, Depths};
 use crate::subpath::connect::{splat_light_subpath_in, JoinFlights};
@@ -439,6 +442,45 @@ impl Upbp {
         )
     }
 
+    /// `pass` with every technique's contributions and time tallied (`crate::record::tally`):
+    /// the image `render_pass` makes, bit for bit. Tracing and storing the light paths (photons,
+    /// beams and their indices) is one phase (`Work::LightWalk`), timed once per pass.
+    pub fn tally_pass(
+        &self,
+        scene: &Scene,
+        seed: u64,
+        pass: u32,
+        every: u64,
+    ) -> (Image, u64, PassTally) {
+        let clock = PassClock::start();
+        let cpu0 = pool_cpu_seconds();
+        let (store, setup) = self.setup(scene, seed, pass);
+        let data = setup.data(self, scene, &store);
+        let walk = pool_cpu_seconds() - cpu0;
+        let items = (scene.camera.pixel_count() as u64).max(store.len() as u64);
+        let p = Pass { seed, pass };
+        let (img, invalid, tally): (Image, u64, ItemTally) = tallied_pass(
+            scene,
+            pass,
+            every,
+            (items, CHUNK),
+            || self.scratch(),
+            |i, splats, scratch, rec: &mut Tally| {
+                let mut worker = Worker {
+                    splats,
+                    scratch,
+                    rec,
+                };
+                self.item(scene, (&data, p), i, &mut worker)
+            },
+        );
+        (
+            img,
+            invalid,
+            tally.finish(clock, &[(Work::LightWalk, walk)]),
+        )
+    }
+
     /// One pass with every path reported to `rec` (for `lt mis-check`), item by item on one
     /// thread; the image is discarded. Returns the pass's setup.
     pub fn record_pass<R: Recorder>(
@@ -463,6 +505,15 @@ impl Upbp {
             self.item(scene, (&data, Pass { seed, pass }), i, &mut worker);
         }
         setup
+    }
+}
+
+/// Adds a pass's image to a run's sum (`Run::pass` and the tallied run: the same sums).
+pub fn add_pass(sum: &mut Image, image: &Image) {
+    for (s, v) in sum.data.iter_mut().zip(&image.data) {
+        for c in 0..3 {
+            s[c] += v[c];
+        }
     }
 }
 
@@ -545,11 +596,7 @@ impl ProgressiveRun for Run<'_> {
             pass,
         };
         let (image, invalid) = self.upbp.render_pass(self.scene, &data, p);
-        for (s, v) in self.sum.data.iter_mut().zip(&image.data) {
-            for c in 0..3 {
-                s[c] += v[c];
-            }
-        }
+        add_pass(&mut self.sum, &image);
         self.passes += 1;
         let r1 = self.upbp.params.volume.radius as f64;
         self.log.photon_paths.push(setup.light_paths);

@@ -18,7 +18,7 @@ use super::light_store::{LightPath, LightStore};
 use super::rates::{camera_vertex, junction, Needs};
 use super::weights::{weight, VertexRate};
 use crate::density::surface_merge::SurfaceGather;
-use crate::record::{Recorder, VolumeMerged};
+use crate::record::{Recorder, VolumeFamily, VolumeMerged, Work};
 use crate::subpath::camera_loop::{CameraPolicy, Joins, SampleCtx, Weight};
 use crate::subpath::connect::JoinFlights;
 use crate::subpath::strategy_weight::{with_chain_in, Split};
@@ -602,11 +602,18 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
             return;
         }
         if !zv.in_medium() {
-            self.surface_merges(scene, z, ctx, l);
+            if p.store.surface_grid.is_some() {
+                self.surface_merges(scene, z, ctx, l);
+                ctx.rec.lap(Work::Merge { t: t as u16 });
+            }
             return;
         }
         if p.set.beam_points_eta > 0.0 {
             self.beam_points(scene, z, ctx, l);
+            ctx.rec.lap(Work::VolumeMerge {
+                family: VolumeFamily::Bp2d,
+                t: t as u16,
+            });
         }
         let (Some(grid), Some(m)) = (p.store.points.as_ref(), medium_of(zv)) else {
             return;
@@ -656,6 +663,10 @@ impl<const MEDIA: bool> CameraPolicy for Policy<'_, MEDIA> {
                 });
             }
             *l += value * w as f32;
+        });
+        ctx.rec.lap(Work::VolumeMerge {
+            family: VolumeFamily::Pp3d,
+            t: t as u16,
         });
     }
 

@@ -134,11 +134,14 @@ pub fn figure(
     )?;
     out.table(
         "upbp-contributions",
-        "Figure (b): the share of upbp's image each technique carries",
+        "Figure (b): the share of upbp's image and time each technique carries",
         &format!(
-            "Per technique family, its MIS-weighted estimate's part of upbp's pixel mean over the \
-             same runs as the table above ({} % Student-t intervals over the runs); `sum / image` \
-             checks the shares against the plain render of the same seed (largest relative \
+            "Per technique family, its MIS-weighted estimate's part of upbp's pixel mean, and its \
+             code's part of the run's CPU time (the techniques study's tally, one item in 16 \
+             timed; the light paths' tracing and storing, the camera walks and what no lap covers \
+             are rows of their own), over the same runs as the table above ({} % Student-t \
+             intervals over the runs). Each tallied run is its plain render bit for bit (checked); \
+             `sum / image` checks the shares against that render's mean (largest relative \
              difference over the runs).",
             super::super::output::pct(conf)
         ),
@@ -148,6 +151,9 @@ pub fn figure(
             "share",
             "share lo",
             "share hi",
+            "time share",
+            "time lo",
+            "time hi",
             "sum / image − 1",
         ],
         share_rows,
@@ -212,7 +218,7 @@ fn robustness(by_scene: &[(String, Vec<(String, f64)>)]) -> Vec<(String, Vec<f64
         .collect()
 }
 
-/// upbp's per-family shares on one scene, one row per family.
+/// upbp's per-family shares of the image and of the CPU time on one scene, one row per family.
 fn share_table(
     ctx: &StudyContext,
     scene: &str,
@@ -220,10 +226,17 @@ fn share_table(
     conf: f64,
 ) -> Result<Vec<Vec<String>>, String> {
     let mut per_run = Vec::new();
+    let mut time_per_run = Vec::new();
     let mut worst: f64 = 0.0;
     for e in &upbp.entries {
-        let s = shares(ctx, &e.record.spec)?;
         let img = e.image()?;
+        let s = shares(ctx, &e.record.spec, &img)?;
+        if !s.bit_equal {
+            return Err(format!(
+                "{scene}: upbp's tallied run {} is not its plain render bit for bit",
+                e.record.spec.label()
+            ));
+        }
         let image_mean = img
             .data
             .iter()
@@ -232,6 +245,8 @@ fn share_table(
             / img.data.len().max(1) as f64;
         worst = worst.max((s.sum / image_mean - 1.0).abs());
         per_run.push(s.by.map(|v| v / s.sum));
+        let total: f64 = s.seconds.iter().sum();
+        time_per_run.push(s.seconds.map(|v| v / total));
     }
     Ok(FAMILIES
         .iter()
@@ -239,12 +254,17 @@ fn share_table(
         .map(|(i, f)| {
             let v: Vec<f64> = per_run.iter().map(|r| r[i]).collect();
             let m = mean_of_runs(&v, conf);
+            let tv: Vec<f64> = time_per_run.iter().map(|r| r[i]).collect();
+            let tm = mean_of_runs(&tv, conf);
             vec![
                 scene.to_string(),
                 f.to_string(),
                 num(m.estimate),
                 num(m.lo),
                 num(m.hi),
+                num(tm.estimate),
+                num(tm.lo),
+                num(tm.hi),
                 format!("{worst:.1e}"),
             ]
         })

@@ -9,7 +9,7 @@ use crate::runs::RunSpec;
 use crate::study::metrics::mean_of_runs;
 use crate::study::output::{num, stem, StudyOutput};
 use crate::study::StudyContext;
-use lt_integrators::record::Work;
+use lt_integrators::record::{VolumeFamily, Work};
 use lt_integrators::tally::{label, pool_cpu_seconds};
 use lt_integrators::tally_run::{tally_run, Tallied};
 use serde_json::{json, Value};
@@ -187,6 +187,7 @@ fn order(w: Work) -> (u8, u16, u16) {
         Work::CameraWalk => (1, 0, 0),
         Work::Connection { s, t } => (2, s + t - 1, s),
         Work::Merge { t } => (3, t, 0),
+        Work::VolumeMerge { family, t } => (4, t, family as u16),
     }
 }
 
@@ -280,6 +281,9 @@ fn family(name: &str) -> &'static str {
     if name.starts_with("merge") {
         return "merges";
     }
+    if let Work::VolumeMerge { .. } = parse_label(name) {
+        return "volumetric merges";
+    }
     if name.starts_with("s=0,") {
         "emission hits (s=0)"
     } else if name.starts_with("s=1,") {
@@ -291,7 +295,7 @@ fn family(name: &str) -> &'static str {
     }
 }
 
-const FAMILIES: [&str; 8] = [
+const FAMILIES: [&str; 9] = [
     "light walk",
     "camera walk",
     "emission hits (s=0)",
@@ -299,6 +303,7 @@ const FAMILIES: [&str; 8] = [
     "light tracing (t=1)",
     "connections (s,t≥2)",
     "merges",
+    "volumetric merges",
     "other",
 ];
 
@@ -443,6 +448,12 @@ fn parse_label(s: &str) -> Work {
     };
     if s.starts_with("merge") {
         return Work::Merge { t: num_after("t=") };
+    }
+    for family in VolumeFamily::ALL {
+        if s.starts_with(family.name()) {
+            let t = num_after("t=");
+            return Work::VolumeMerge { family, t };
+        }
     }
     Work::Connection {
         s: num_after("s="),

@@ -235,7 +235,8 @@ impl Recorder for Probe {
             Work::Connection { s: 1, .. } => self.shadow_rays_fixed += 1,
             Work::Connection { .. } => self.vertex_connections += 1,
             Work::Merge { .. } => self.merge_queries[self.pixel] += 1,
-            Work::LightWalk => {}
+            // eamis runs vcm, which has no volumetric merges.
+            Work::LightWalk | Work::VolumeMerge { .. } => {}
         }
     }
 }
