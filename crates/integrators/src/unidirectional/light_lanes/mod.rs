@@ -1,0 +1,59 @@
+//! `light` with `lanes=8`: the same estimator as `light` (`unidirectional::light`), run eight
+//! light subpaths at a time (issue 47, item 3).
+//!
+//! Each lane is one light subpath drawing from exactly the stream the scalar `light` uses for it
+//! (`Sampler::for_item(Domain::Light, seed, item, pass)`), through the scalar functions in the
+//! scalar order, so every splat is the scalar splat's bits; the splats are recorded in the scalar
+//! order (subpath by subpath, vertex by vertex) into the same chunks of `light::CHUNK` subpaths
+//! (`film::splat::splat_pass_with`), so the image is the scalar `light`'s bit for bit at any
+//! thread count — which is the whole test (`tests/light_lanes.rs`). The scalar `light` stays the
+//! reference.
+//!
+//! What runs lane-wide and what per lane (`walk.rs`, `connect.rs`):
+//! - the closest hits of the eight walks' rays, bounce by bounce: the ray core's packet query
+//!   (`Scene::intersect_packet`);
+//! - the shadow rays of the connections to the lens: the packet occlusion query
+//!   (`Scene::resolve_shadow_packet`), eight connections at a time in splat order, whichever
+//!   subpaths they come from;
+//! - per lane, through the scalar functions: emission sampling, vertex construction, BSDF
+//!   sampling and Russian roulette, the lens sample and the BSDF towards it.
+//!
+//! Participating media are not handled: `lanes=8` on a scene with media is refused in one line
+//! (`light::LightParams::read`).
+
+mod connect;
+mod walk;
+
+use super::light::{LightParams, CHUNK};
+use crate::film::splat::splat_pass_with;
+use lt_core::Scene;
+use lt_estimators::Image;
+
+/// Light subpaths per batch (one packet of rays).
+pub const LANES: usize = lt_core::geometry::packet::PACKET;
+
+/// `LightTracer::render_pass` for a scene without media, `LANES` subpaths at a time. Batches never
+/// straddle a chunk (`CHUNK` is a multiple of `LANES`), so each chunk records exactly the
+/// subpaths, and the splats, that the scalar chunk records.
+pub fn render_pass(params: &LightParams, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
+    const _: () = assert!(CHUNK % LANES as u64 == 0);
+    let cam = &scene.camera;
+    let m = params.light_paths.unwrap_or(cam.pixel_count() as u64);
+    let scale = 1.0 / m as f32;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let batches = m.div_ceil(LANES as u64);
+    let limits = params.walk_limits();
+    splat_pass_with(
+        w,
+        h,
+        batches,
+        CHUNK / LANES as u64,
+        || walk::Batch::new(limits),
+        |b, splats, batch| {
+            let first = b * LANES as u64;
+            let items = first..(first + LANES as u64).min(m);
+            batch.walk(scene, (seed, pass), items);
+            connect::splat_batch(scene, batch, scale, splats);
+        },
+    )
+}
