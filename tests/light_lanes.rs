@@ -40,7 +40,8 @@ fn bits(
 }
 
 /// Asserts that `light` and `light lanes=8` agree on `name` (or both refuse it); true when they
-/// rendered.
+/// rendered something other than black (light tracing cannot see some scenes: a caustic seen
+/// only through a delta surface).
 fn same_image(name: &str, scene: &lt_core::Scene) -> bool {
     let scalar = IntegratorParams::new().with("light_paths", LIGHT_PATHS);
     let lanes = scalar.clone().with("lanes", 8);
@@ -51,10 +52,6 @@ fn same_image(name: &str, scene: &lt_core::Scene) -> bool {
         );
         return false;
     };
-    assert!(
-        reference.0.iter().any(|&b| b != 0),
-        "{name}: black reference"
-    );
     for threads in [1, 2] {
         let got = bits(scene, &lanes, threads).expect("lanes=8 renders what light renders");
         let first = reference.0.iter().zip(&got.0).position(|(a, b)| a != b);
@@ -66,7 +63,7 @@ fn same_image(name: &str, scene: &lt_core::Scene) -> bool {
             got.1
         );
     }
-    true
+    reference.0.iter().any(|&b| b != 0)
 }
 
 #[test]
@@ -76,8 +73,8 @@ fn light_lanes_give_the_scalar_light_image_bit_for_bit_on_every_shipped_scene() 
         .iter()
         .filter(|name| same_image(name, &shipped_scene(name, Some(RESOLUTION))))
         .count();
-    // Only scenes with an orthographic camera may be refused.
-    assert!(rendered + 2 >= names.len(), "{rendered} of {}", names.len());
+    // Only a few scenes (an orthographic camera, a caustic behind glass) may be refused or black.
+    assert!(rendered + 3 >= names.len(), "{rendered} of {}", names.len());
     let path = scenes_dir().join("bitterli/veach-bidir/scene.xml");
     let opts = lt_scene_io::LoadOptions {
         defines: vec![("integrator".into(), "path".into())],
