@@ -166,8 +166,10 @@ impl Flat {
         // Inactive lanes start "blocked", so they never hold the loop open; they answer false.
         let mut done = active.map(|a| !a);
         for (j, &id) in self.quad_ids.iter().enumerate() {
-            if id == u32::MAX || done.iter().all(|&b| b) {
-                break; // padding (which only ends the list), or nothing left to decide
+            // Padding only ends the list; whether anything is left to decide is asked once per
+            // `CHUNK` parallelograms (asked per parallelogram it cost more than it saved).
+            if id == u32::MAX || (j % CHUNK == 0 && done.iter().all(|&b| b)) {
+                break;
             }
             let (f, l) = (&self.quads.chunks[j / CHUNK], j % CHUNK);
             let v = |k: usize| Vec3::new(f[k][l], f[k + 1][l], f[k + 2][l]);

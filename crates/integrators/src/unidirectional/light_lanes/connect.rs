@@ -1,12 +1,12 @@
-//! A batch's connections to the lens, splatted in the scalar order: `LightTracer::render_pass`'s
+//! A chunk's connections to the lens, splatted in the scalar order: `LightTracer::render_pass`'s
 //! loop over each subpath's vertices, with `subpath::connect::connect_to_camera` (without media)
 //! split at its visibility test so that the shadow rays go through the packet occlusion query
-//! eight at a time.
+//! eight at a time, whichever subpaths they come from.
 
-use super::walk::Batch;
 use super::LANES;
 use crate::film::splat::Splats;
 use crate::subpath::connect::eval_towards;
+use crate::subpath::walk::Subpath;
 use lt_core::bsdf::TransportMode;
 use lt_core::math::{Color, Vec2};
 use lt_core::path::scatter::connectable;
@@ -23,28 +23,70 @@ struct Pending {
     shadow: ShadowRay,
 }
 
-/// Every connection of the batch's subpaths, in subpath then vertex order, splatted (times
-/// `scale`) where visible.
-pub fn splat_batch(scene: &Scene, batch: &mut Batch, scale: f32, splats: &mut Splats) {
-    let mut pending = Vec::with_capacity(LANES * 4);
-    for i in 0..batch.len {
-        let (sub, sampler) = (&batch.subpaths[i], &mut batch.samplers[i]);
+/// A chunk's connections: found as each subpath's walk ends (`add_subpath`), splatted at the end
+/// in the scalar order (`splat`).
+pub struct Connections {
+    pending: Vec<Pending>,
+    /// Per subpath of the chunk (index from the chunk's first), its connections in `pending`:
+    /// (first, count).
+    of_item: Vec<(u32, u32)>,
+    first_item: u64,
+}
+
+impl Connections {
+    pub fn new() -> Connections {
+        Connections {
+            pending: Vec::new(),
+            of_item: Vec::new(),
+            first_item: 0,
+        }
+    }
+
+    /// Forgets the last chunk; the next holds `count` subpaths from `first_item` on.
+    pub fn clear(&mut self, first_item: u64, count: usize) {
+        self.pending.clear();
+        self.of_item.clear();
+        self.of_item.resize(count, (0, 0));
+        self.first_item = first_item;
+    }
+
+    /// `LightTracer::render_pass`'s loop over one subpath's vertices up to the shadow rays: each
+    /// connectable vertex joined to the lens (drawing from the subpath's own `sampler`).
+    pub fn add_subpath(&mut self, scene: &Scene, item: u64, sub: &Subpath, sampler: &mut Sampler) {
+        let first = self.pending.len();
         for y in &sub.vertices {
             if !connectable(scene, y) {
                 continue;
             }
             if let Some(c) = lens_connection(scene, y, sampler) {
-                pending.push(c);
+                self.pending.push(c);
             }
         }
+        let count = self.pending.len() - first;
+        self.of_item[(item - self.first_item) as usize] = (first as u32, count as u32);
     }
-    let film = scene.camera.film();
-    for group in pending.chunks(LANES) {
-        let queries =
-            std::array::from_fn(|k| group.get(k).map_or(ShadowRay::Known(false), |c| c.shadow));
-        let visible = scene.resolve_shadow_packet(&queries);
-        for (c, _) in group.iter().zip(visible).filter(|(_, v)| *v) {
-            splats.add_filtered(film, c.raster, c.value * scale);
+
+    /// The chunk's shadow rays, `LANES` at a time in the order they were found, then every
+    /// visible connection splatted (times `scale`) subpath by subpath, vertex by vertex: the
+    /// scalar order.
+    pub fn splat(&mut self, scene: &Scene, scale: f32, splats: &mut Splats) {
+        let mut visible = vec![false; self.pending.len()];
+        for (group, vis) in self.pending.chunks(LANES).zip(visible.chunks_mut(LANES)) {
+            let queries =
+                std::array::from_fn(|k| group.get(k).map_or(ShadowRay::Known(false), |c| c.shadow));
+            let answers = scene.resolve_shadow_packet(&queries);
+            vis.copy_from_slice(&answers[..vis.len()]);
+        }
+        let film = scene.camera.film();
+        for &(first, count) in &self.of_item {
+            let range = first as usize..(first + count) as usize;
+            for (c, _) in self.pending[range.clone()]
+                .iter()
+                .zip(&visible[range])
+                .filter(|(_, v)| **v)
+            {
+                splats.add_filtered(film, c.raster, c.value * scale);
+            }
         }
     }
 }

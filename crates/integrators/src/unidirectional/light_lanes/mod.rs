@@ -11,10 +11,11 @@
 //!
 //! What runs lane-wide and what per lane (`walk.rs`, `connect.rs`):
 //! - the closest hits of the eight walks' rays, bounce by bounce: the ray core's packet query
-//!   (`Scene::intersect_packet`);
+//!   (`Scene::intersect_packet`); a lane whose walk ends takes the chunk's next subpath, so the
+//!   packets stay full until the chunk runs out;
 //! - the shadow rays of the connections to the lens: the packet occlusion query
-//!   (`Scene::resolve_shadow_packet`), eight connections at a time in splat order, whichever
-//!   subpaths they come from;
+//!   (`Scene::resolve_shadow_packet`), eight connections at a time, whichever subpaths they come
+//!   from; the visible ones are splatted after the chunk's walks, in the scalar order;
 //! - per lane, through the scalar functions: emission sampling, vertex construction, BSDF
 //!   sampling and Russian roulette, the lens sample and the BSDF towards it.
 //!
@@ -26,34 +27,38 @@ mod walk;
 
 use super::light::{LightParams, CHUNK};
 use crate::film::splat::splat_pass_with;
+use connect::Connections;
 use lt_core::Scene;
 use lt_estimators::Image;
+use walk::WalkLanes;
 
-/// Light subpaths per batch (one packet of rays).
+/// Light subpaths walked together (one packet of rays).
 pub const LANES: usize = lt_core::geometry::packet::PACKET;
 
-/// `LightTracer::render_pass` for a scene without media, `LANES` subpaths at a time. Batches never
-/// straddle a chunk (`CHUNK` is a multiple of `LANES`), so each chunk records exactly the
-/// subpaths, and the splats, that the scalar chunk records.
+/// `LightTracer::render_pass` for a scene without media, `LANES` subpaths at a time, in the scalar
+/// chunks of `CHUNK` subpaths: each chunk records exactly the splats the scalar chunk records, in
+/// its order.
 pub fn render_pass(params: &LightParams, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
-    const _: () = assert!(CHUNK % LANES as u64 == 0);
     let cam = &scene.camera;
     let m = params.light_paths.unwrap_or(cam.pixel_count() as u64);
     let scale = 1.0 / m as f32;
     let (w, h) = (cam.width as usize, cam.height as usize);
-    let batches = m.div_ceil(LANES as u64);
     let limits = params.walk_limits();
+    let scratch = || (WalkLanes::new(limits), Connections::new());
+    // One work item per scalar chunk.
     splat_pass_with(
         w,
         h,
-        batches,
-        CHUNK / LANES as u64,
-        || walk::Batch::new(limits),
-        |b, splats, batch| {
-            let first = b * LANES as u64;
-            let items = first..(first + LANES as u64).min(m);
-            batch.walk(scene, (seed, pass), items);
-            connect::splat_batch(scene, batch, scale, splats);
+        m.div_ceil(CHUNK),
+        1,
+        scratch,
+        |c, splats, (lanes, found)| {
+            let items = c * CHUNK..((c + 1) * CHUNK).min(m);
+            found.clear(items.start, (items.end - items.start) as usize);
+            lanes.walk(scene, (seed, pass), items, |item, sub, sampler| {
+                found.add_subpath(scene, item, sub, sampler)
+            });
+            found.splat(scene, scale, splats);
         },
     )
 }

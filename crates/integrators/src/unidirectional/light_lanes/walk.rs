@@ -1,6 +1,8 @@
-//! The walks of a batch of light subpaths, bounce by bounce: `subpath::walk::light_subpath`
-//! (`light_start`, then `random_walk` in importance mode) on every lane, the closest hits through
-//! the packet query.
+//! The walks of a chunk's light subpaths, `LANES` at a time and bounce by bounce:
+//! `subpath::walk::light_subpath` (`light_start`, then `random_walk` in importance mode) on every
+//! lane, the closest hits through the packet query. A lane whose walk ends hands its subpath to
+//! the caller and takes the chunk's next subpath before the next bounce, so packets stay full
+//! until the chunk runs out.
 
 use super::LANES;
 use crate::subpath::walk::{continue_path, Emission, Subpath, WalkLimits, WalkPoint, WalkRules};
@@ -8,57 +10,73 @@ use lt_core::geometry::Ray;
 use lt_core::math::{Color, Vec3};
 use lt_core::path::PathVertex;
 use lt_core::sampling::{Domain, Sampler};
+use lt_core::scene::SurfaceHit;
 use lt_core::Scene;
 use std::ops::Range;
 
-/// A batch's subpaths and each lane's stream, kept across the batches of a chunk (buffers reused).
-pub struct Batch {
+/// The state `random_walk` keeps in locals, per lane, with each lane's subpath and stream
+/// (buffers reused across the chunks a thread renders).
+pub struct WalkLanes {
     limits: WalkLimits,
-    /// Subpaths in the batch (≤ `LANES`; fewer in the pass's last batch).
-    pub len: usize,
-    pub subpaths: [Subpath; LANES],
-    pub samplers: [Sampler; LANES],
-}
-
-/// The state `random_walk` keeps in locals, per lane.
-struct WalkLanes {
     alive: [bool; LANES],
+    /// Each lane's subpath, as its index in the pass.
+    item: [u64; LANES],
+    subpaths: [Subpath; LANES],
+    samplers: [Sampler; LANES],
     ray: [Ray; LANES],
     beta: [Color; LANES],
     pdf: [f32; LANES],
     rules: [WalkRules; LANES],
 }
 
-impl Batch {
-    pub fn new(limits: WalkLimits) -> Batch {
-        Batch {
+impl WalkLanes {
+    pub fn new(limits: WalkLimits) -> WalkLanes {
+        WalkLanes {
             limits,
-            len: 0,
+            alive: [false; LANES],
+            item: [0; LANES],
             subpaths: std::array::from_fn(|_| Subpath::with_capacity(limits.max_vertices)),
             samplers: std::array::from_fn(|_| Sampler::for_item(Domain::Light, 0, 0, 0)),
-        }
-    }
-
-    /// Traces the light subpaths `items` of pass `pass` of the run seeded by `seed`, as
-    /// `light_subpath` traces each.
-    pub fn walk(&mut self, scene: &Scene, (seed, pass): (u64, u32), items: Range<u64>) {
-        self.len = items.clone().count();
-        let mut lanes = WalkLanes {
-            alive: [false; LANES],
             ray: [Ray::new(Vec3::ZERO, Vec3::Z); LANES], // idle lanes' rays are never traced
             beta: [Color::ZERO; LANES],
             pdf: [0.0; LANES],
             rules: [WalkRules::camera(0); LANES],
-        };
-        for (i, item) in items.enumerate() {
-            self.samplers[i] = Sampler::for_item(Domain::Light, seed, item, pass as u64);
-            self.start(scene, i, &mut lanes);
         }
-        while lanes.alive.iter().any(|&a| a) {
-            let hits = scene.intersect_packet(&lanes.ray, &lanes.alive);
+    }
+
+    /// Traces the light subpaths `items` of pass `pass` of the run seeded by `seed`, each as
+    /// `light_subpath` traces it, and calls `done(item, subpath, its stream)` once per subpath
+    /// when its walk has ended (in the order walks end, not item order).
+    pub fn walk(
+        &mut self,
+        scene: &Scene,
+        (seed, pass): (u64, u32),
+        items: Range<u64>,
+        mut done: impl FnMut(u64, &Subpath, &mut Sampler),
+    ) {
+        let mut next = items.start;
+        loop {
+            for i in 0..LANES {
+                while !self.alive[i] && next < items.end {
+                    self.item[i] = next;
+                    self.samplers[i] = Sampler::for_item(Domain::Light, seed, next, pass as u64);
+                    next += 1;
+                    self.start(scene, i);
+                    if !self.alive[i] {
+                        done(self.item[i], &self.subpaths[i], &mut self.samplers[i]);
+                    }
+                }
+            }
+            if !self.alive.iter().any(|&a| a) {
+                return;
+            }
+            let hits = scene.intersect_packet(&self.ray, &self.alive);
             for (i, hit) in hits.iter().enumerate() {
-                if lanes.alive[i] {
-                    lanes.alive[i] = self.step(scene, i, hit.as_ref(), &mut lanes);
+                if self.alive[i] {
+                    self.alive[i] = self.step(scene, i, hit.as_ref());
+                    if !self.alive[i] {
+                        done(self.item[i], &self.subpaths[i], &mut self.samplers[i]);
+                    }
                 }
             }
         }
@@ -66,7 +84,7 @@ impl Batch {
 
     /// `light_start` on lane `i`: y0 on a light, and the emitted ray (the lane stays idle when
     /// nothing is emitted or the limits allow y0 alone).
-    fn start(&mut self, scene: &Scene, i: usize, lanes: &mut WalkLanes) {
+    fn start(&mut self, scene: &Scene, i: usize) {
         let (out, sampler) = (&mut self.subpaths[i], &mut self.samplers[i]);
         out.vertices.clear();
         out.escape = None;
@@ -83,30 +101,24 @@ impl Batch {
             return;
         }
         let start = e.walk_start(scene);
-        lanes.rules[i] = start.rules(self.limits.rr_depth);
-        lanes.alive[i] = true;
-        lanes.ray[i] = start.ray;
-        lanes.beta[i] = start.beta;
-        lanes.pdf[i] = start.pdf;
+        self.rules[i] = start.rules(self.limits.rr_depth);
+        self.alive[i] = true;
+        self.ray[i] = start.ray;
+        self.beta[i] = start.beta;
+        self.pdf[i] = start.pdf;
     }
 
     /// One turn of `random_walk`'s loop on lane `i`, whose ray's closest hit is `hit`; false when
     /// the walk ends. (A light walk records no escape: that is for radiance-mode walks.)
-    fn step(
-        &mut self,
-        scene: &Scene,
-        i: usize,
-        hit: Option<&lt_core::scene::SurfaceHit>,
-        lanes: &mut WalkLanes,
-    ) -> bool {
+    fn step(&mut self, scene: &Scene, i: usize, hit: Option<&SurfaceHit>) -> bool {
         let Some(hit) = hit else {
             return false;
         };
         let out = &mut self.subpaths[i];
-        let wo = -lanes.ray[i].d;
+        let wo = -self.ray[i].d;
         let n = out.vertices.len();
         let prev = out.vertices.last().expect("the endpoint is pushed first");
-        let v = PathVertex::surface(hit, wo, lanes.beta[i], lanes.pdf[i], prev);
+        let v = PathVertex::surface(hit, wo, self.beta[i], self.pdf[i], prev);
         out.vertices.push(v);
         if n + 1 >= self.limits.max_vertices {
             return false;
@@ -115,21 +127,14 @@ impl Batch {
         // (light tracing has one technique).
         let sf = hit.shading_frame();
         let at = WalkPoint { hit, sf: &sf, wo };
-        let sampler = &mut self.samplers[i];
-        let depth = n as u32;
-        let Some(bs) = continue_path(
-            scene,
-            &at,
-            &lanes.rules[i],
-            &mut lanes.beta[i],
-            depth,
-            sampler,
-        ) else {
+        let (rules, sampler) = (&self.rules[i], &mut self.samplers[i]);
+        let Some(bs) = continue_path(scene, &at, rules, &mut self.beta[i], n as u32, sampler)
+        else {
             return false;
         };
         out.vertices[n].delta = bs.delta;
-        lanes.pdf[i] = bs.pdf_w;
-        lanes.ray[i] = hit.spawn_ray(bs.wi);
+        self.pdf[i] = bs.pdf_w;
+        self.ray[i] = hit.spawn_ray(bs.wi);
         true
     }
 }

@@ -15,7 +15,7 @@ use lt_core::bsdf::{ShadingFrame, TransportMode};
 use lt_core::geometry::Ray;
 use lt_core::math::{is_valid_color, Color, Vec3};
 use lt_core::sampling::{Domain, Sampler};
-use lt_core::scene::{ShadowRay, SurfaceHit};
+use lt_core::scene::SurfaceHit;
 use lt_core::Scene;
 
 /// Renders pixels `first .. first + row.len()` of pass `pass` of the run seeded by `seed` into
@@ -194,8 +194,7 @@ fn emitters(pt: &Pt, scene: &Scene, lanes: &mut PathLanes, hits: &[Option<Surfac
 }
 
 /// Next-event estimation at every live non-delta vertex: `Pt::direct_light`'s draws and queries
-/// per lane, the shadow rays through the packet occlusion query, its weight and sum through
-/// `kernels::add_next_event`.
+/// per lane, its weight and sum through `kernels::add_next_event`.
 fn next_event(
     pt: &Pt,
     scene: &Scene,
@@ -205,8 +204,6 @@ fn next_event(
 ) {
     let mut ran = [false; LANES];
     let mut ne = NextEventLanes::default();
-    // Lanes that stop before the shadow ray keep a query that traces nothing.
-    let mut shadow = [ShadowRay::Known(false); LANES];
     for i in live(&lanes.alive) {
         let (Some(hit), Some(sf)) = (&hits[i], &frames[i]) else {
             continue;
@@ -232,22 +229,15 @@ fn next_event(
         let ev = scene
             .material(hit.material)
             .eval(sf, wo, ls.wi, TransportMode::Radiance);
-        if ev.f_cos == Color::ZERO {
+        if ev.f_cos == Color::ZERO || !scene.visible_light(hit, &ls) {
             continue;
         }
-        // Found unless the shadow ray is blocked (resolved below for all lanes at once).
-        shadow[i] = scene.light_shadow(hit, &ls);
         ne.found[i] = true;
         ne.f_cos.set(i, ev.f_cos);
         ne.radiance.set(i, ls.radiance);
         ne.light_pdf[i] = pmf * ls.pdf_w;
         ne.bsdf_pdf[i] = ev.pdf_w;
         ne.weight_one[i] = ls.delta || pt.params.techniques == Techniques::Light;
-    }
-    // `scene.visible_light` of every lane that got this far, through the packet query.
-    let visible = scene.resolve_shadow_packet(&shadow);
-    for i in 0..LANES {
-        ne.found[i] &= visible[i];
     }
     kernels::add_next_event(pt, &mut lanes.l, &ran, &lanes.beta, &ne);
 }
