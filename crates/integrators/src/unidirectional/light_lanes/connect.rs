@@ -34,9 +34,11 @@ pub struct Connections {
 }
 
 impl Connections {
-    pub fn new() -> Connections {
+    /// Room for `per_chunk` connections before the first reallocation (each chunk starts a new
+    /// one: `splat_pass_with` makes its scratch per chunk).
+    pub fn with_capacity(per_chunk: usize) -> Connections {
         Connections {
-            pending: Vec::new(),
+            pending: Vec::with_capacity(per_chunk),
             of_item: Vec::new(),
             first_item: 0,
         }
