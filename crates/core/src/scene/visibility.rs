@@ -170,8 +170,8 @@ impl Scene {
         ShadowRay::Ray(Ray::new(a.towards(dir), dir))
     }
 
-    /// The answers to `PACKET` shadow queries (`Scene::connection_shadow`,
-    /// `Scene::light_shadow`), each the one the scalar visibility functions give: the first rays
+    /// The answers to `PACKET` shadow queries (`Scene::connection_shadow`), each the one the
+    /// scalar visibility functions give: the first rays
     /// through the ray core's packet occlusion query, a blocked segment's two halves per lane.
     pub fn resolve_shadow_packet(&self, q: &[ShadowRay; PACKET]) -> [bool; PACKET] {
         let rays: [Ray; PACKET] = std::array::from_fn(|i| match q[i] {
@@ -245,25 +245,11 @@ impl Scene {
     /// the emitter itself.)
     #[inline]
     pub fn visible_light(&self, from: &SurfaceHit, ls: &crate::light::LightLiSample) -> bool {
-        // `light_shadow` resolved, written out so the one-ray path builds no `ShadowRay`.
         if !ls.distance.is_finite() {
             return self.unoccluded_towards(from, ls.wi);
         }
         let n = if ls.delta { Vec3::ZERO } else { ls.n };
         self.segment_unoccluded(
-            self.end(from.p, from.p_err, from.ng),
-            self.end(ls.p, ls.p_err, n),
-        )
-    }
-
-    /// `visible_light` as a query to resolve (`resolve_shadow_packet`).
-    #[inline]
-    pub fn light_shadow(&self, from: &SurfaceHit, ls: &crate::light::LightLiSample) -> ShadowRay {
-        if !ls.distance.is_finite() {
-            return Self::ray_shadow(self.end(from.p, from.p_err, from.ng), ls.wi);
-        }
-        let n = if ls.delta { Vec3::ZERO } else { ls.n };
-        self.segment_shadow(
             self.end(from.p, from.p_err, from.ng),
             self.end(ls.p, ls.p_err, n),
         )
