@@ -14,6 +14,7 @@ mod consistency;
 mod crossings;
 mod directional;
 mod furnace;
+mod light_lanes;
 mod light_paths;
 mod material_grid;
 mod media;

@@ -355,6 +355,18 @@ impl Accel {
         }
     }
 
+    /// `occluded` of each ray of a packet whose `active` flag is set (false on the others): the
+    /// flat core tests the rays together (`packet.rs`), the other cores one by one.
+    pub fn occluded_packet(&self, rays: &[Ray; PACKET], active: &[bool; PACKET]) -> [bool; PACKET] {
+        match &self.structure {
+            Structure::Flat(flat) if !self.prims.is_empty() => {
+                let sheared = std::array::from_fn(|i| self.sheared(rays[i].o, rays[i].d));
+                flat.occluded_packet(&self.prims, rays, &sheared, active)
+            }
+            _ => std::array::from_fn(|i| active[i] && self.occluded(&rays[i])),
+        }
+    }
+
     /// `intersect` with a traversal stack of `N` entries: obvhs's `ray_traverse`, on our state.
     #[inline(always)]
     fn closest<const N: usize>(&self, bvh: &CwBvh, ray: &Ray) -> Option<PrimHit> {
@@ -667,13 +679,16 @@ mod tests {
         assert!(ties > 100, "only {ties} ties");
     }
 
-    /// The packet query (`packet.rs`) answers each active ray of a packet exactly as the
+    /// The packet queries (`packet.rs`) answer each active ray of a packet exactly as the
     /// single-ray scalar reference does — distance bits and primitive, ties at shared edges
-    /// included — and inactive rays with `None`, at every width the CPU runs and every scale,
-    /// on boxes alone (parallelograms only) and with spheres, triangles and disks added.
+    /// included; occluded or not — and inactive rays with `None` (not occluded), at every width
+    /// the CPU runs and every scale, on boxes alone (parallelograms only) and with spheres,
+    /// triangles and disks added.
     #[test]
     fn packet_query_is_the_single_ray_query_bit_for_bit() {
         let mut ties = 0;
+        // Active rays the scalar query finds open and blocked.
+        let mut open_blocked = [0usize; 2];
         for (scale, extra) in [(1e-3f32, 40), (1.0, 0), (1.0, 40), (1e6, 40)] {
             let mut s = Sampler::new(17, scale.to_bits() as u64 + extra, 0);
             let mut prims = boxes(scale);
@@ -695,6 +710,11 @@ mod tests {
                     let h = active[i].then(|| scalar.intersect(&rays[i])).flatten();
                     h.map(|h| (h.t.to_bits(), h.prim))
                 });
+                let blocked: [bool; PACKET] =
+                    std::array::from_fn(|i| active[i] && scalar.occluded(&rays[i]));
+                for b in blocked.iter().zip(&active).filter(|(_, &a)| a) {
+                    open_blocked[*b.0 as usize] += 1;
+                }
                 for c in &cores {
                     let got = c.intersect_packet(&rays, &active);
                     let got = got.map(|h| h.map(|h| (h.t.to_bits(), h.prim)));
@@ -702,11 +722,18 @@ mod tests {
                         got, expected,
                         "scale {scale}, rays {rays:?}, active {active:?}"
                     );
+                    assert_eq!(
+                        c.occluded_packet(&rays, &active),
+                        blocked,
+                        "occlusion: scale {scale}, rays {rays:?}, active {active:?}"
+                    );
                 }
             }
             ties += assert_same_hits(&scalar, &[], &prims, &rays, scale);
         }
         assert!(ties > 100, "only {ties} ties");
+        // Both answers of the occlusion query must be exercised, each many times.
+        assert!(open_blocked.iter().all(|&n| n > 1000), "{open_blocked:?}");
     }
 
     /// The wide BVH gives the scalar reference's answer bit for bit at every width the CPU runs:

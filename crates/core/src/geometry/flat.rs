@@ -283,7 +283,7 @@ impl Flat {
 
 /// Whether any lane hit.
 #[inline(always)]
-fn blocks<const W: usize>(ts: &[f32; W]) -> bool {
+pub(super) fn blocks<const W: usize>(ts: &[f32; W]) -> bool {
     ts.iter().fold(false, |any, &t| any | (t < f32::INFINITY))
 }
 

@@ -1,5 +1,5 @@
-//! Packet queries: the closest hits of `PACKET` rays at once (the rays of one bounce of the
-//! lane-parallel `pt`, issue 47 item 3).
+//! Packet queries: the closest hits, or the occlusion, of `PACKET` rays at once (the rays of one
+//! bounce, or the shadow rays, of the lane-parallel `pt` and `light`, issue 47 item 3).
 //!
 //! The flat core (`flat.rs`) vectorises one ray over many parallelograms; here the axes swap:
 //! each parallelogram is loaded once and tested against the packet's rays in one loop the
@@ -14,8 +14,13 @@
 //! the order the candidates arrive in cannot change it. Every ray's hit is therefore
 //! `Flat::closest`'s (held to it by `accel`'s test `packet_query_is_the_single_ray_query_bit_for_bit`).
 //! Other cores answer a packet one ray at a time (`Accel::intersect_packet`).
+//!
+//! Occlusion (`Flat::occluded_packet`) runs the same loop with a blocked flag per lane in place of
+//! the nearest pair, and stops once every active lane is blocked. Whether a ray is blocked is
+//! whether any primitive's distance is finite — an "or" over the same per-primitive tests
+//! `Flat::occluded` runs, which no order of evaluation can change.
 
-use super::flat::{nearer, take_hits, Flat, Isa, NONE};
+use super::flat::{blocks, nearer, take_hits, Flat, Isa, NONE};
 use super::primitive::{PrimHit, Primitive};
 use super::ray::Ray;
 use super::soa::CHUNK;
@@ -110,6 +115,90 @@ impl Flat {
                 best = nearer(best, t, p);
             }
             best
+        })
+    }
+
+    /// Per ray of `rays` whose `active` flag is set, `Flat::occluded`'s answer; false on the
+    /// others.
+    pub fn occluded_packet(
+        &self,
+        prims: &[Primitive],
+        rays: &[Ray; PACKET],
+        sheared: &[ShearedRay; PACKET],
+        active: &[bool; PACKET],
+    ) -> [bool; PACKET] {
+        // SAFETY: as in `closest_packet`.
+        match self.isa {
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 | Isa::Avx512 => unsafe {
+                self.occluded_packet_avx2(prims, rays, sheared, active)
+            },
+            _ => self.occluded_packet_in::<4>(prims, rays, sheared, active),
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn occluded_packet_avx2(
+        &self,
+        prims: &[Primitive],
+        rays: &[Ray; PACKET],
+        sheared: &[ShearedRay; PACKET],
+        active: &[bool; PACKET],
+    ) -> [bool; PACKET] {
+        self.occluded_packet_in::<8>(prims, rays, sheared, active)
+    }
+
+    /// Parallelograms across the packet until every active lane is blocked; then, per lane still
+    /// open, spheres `W` at a time and the rest one by one (`Flat::occluded_in`'s order per ray).
+    #[inline(always)]
+    fn occluded_packet_in<const W: usize>(
+        &self,
+        prims: &[Primitive],
+        rays: &[Ray; PACKET],
+        sheared: &[ShearedRay; PACKET],
+        active: &[bool; PACKET],
+    ) -> [bool; PACKET] {
+        let lane = |f: fn(&Ray) -> f32| -> [f32; PACKET] { std::array::from_fn(|i| f(&rays[i])) };
+        let (ox, oy, oz) = (lane(|r| r.o.x), lane(|r| r.o.y), lane(|r| r.o.z));
+        let (dx, dy, dz) = (lane(|r| r.d.x), lane(|r| r.d.y), lane(|r| r.d.z));
+        let t_max = lane(|r| r.t_max);
+        // Inactive lanes start "blocked", so they never hold the loop open; they answer false.
+        let mut done = active.map(|a| !a);
+        for (j, &id) in self.quad_ids.iter().enumerate() {
+            // Padding only ends the list; whether anything is left to decide is asked once per
+            // `CHUNK` parallelograms (asked per parallelogram it cost more than it saved).
+            if id == u32::MAX || (j % CHUNK == 0 && done.iter().all(|&b| b)) {
+                break;
+            }
+            let (f, l) = (&self.quads.chunks[j / CHUNK], j % CHUNK);
+            let v = |k: usize| Vec3::new(f[k][l], f[k + 1][l], f[k + 2][l]);
+            let q = [v(0), v(3), v(6), v(9), v(12), v(15), v(18), v(21)];
+            for i in 0..PACKET {
+                let o = Vec3::new(ox[i], oy[i], oz[i]);
+                let d = Vec3::new(dx[i], dy[i], dz[i]);
+                let t = super::quad::distance(q, o, o.abs(), d, t_max[i]);
+                done[i] |= t < f32::INFINITY;
+            }
+        }
+        std::array::from_fn(|i| {
+            if !active[i] {
+                return false;
+            }
+            if done[i] {
+                return true;
+            }
+            let (o, d, t_max) = (rays[i].o, rays[i].d, rays[i].t_max);
+            for (g, ids) in self.sphere_ids.chunks_exact(W).enumerate() {
+                if ids[0] != u32::MAX && blocks(&self.spheres.distances::<W>(g * W, o, d, t_max)) {
+                    return true;
+                }
+            }
+            self.triangles.iter().any(|&p| {
+                prims[p as usize]
+                    .intersect(&sheared[i], o, d, t_max)
+                    .is_finite()
+            })
         })
     }
 }

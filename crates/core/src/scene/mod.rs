@@ -17,7 +17,7 @@ pub use media::{
     ConnectionFlight, Crossing, MediumInterface, MediumPiece, SegmentCrossing,
     MAX_MEDIUM_INTERFACES,
 };
-pub use visibility::ConnectionEnd;
+pub use visibility::{ConnectionEnd, ShadowRay};
 
 use crate::bsdf::Material;
 use crate::camera::Camera;

@@ -6,6 +6,7 @@
 //! a rounding bound, so the same code holds at millimetre scale, at 1e6 and far from the origin.
 
 use super::{ray_stats, Scene, SurfaceHit};
+use crate::geometry::packet::PACKET;
 use crate::geometry::{offset_ray_origin, Ray};
 use crate::math::{gamma, Vec3};
 
@@ -18,6 +19,21 @@ pub struct ConnectionEnd {
     pub p_err: Vec3,
     pub ng: Vec3,
     pub infinite: bool,
+}
+
+/// A shadow query built but not yet traced: what `connection_visible` and `visible_light` trace,
+/// split from the tracing so that a packet of queries can share the ray core's packet occlusion
+/// query (`Scene::resolve_shadow_packet`, the lane-parallel `pt` and `light`).
+#[derive(Clone, Copy, Debug)]
+pub enum ShadowRay {
+    /// Decided without tracing (true: visible).
+    Known(bool),
+    /// One ray towards a light at infinity: visible when nothing blocks it.
+    Ray(Ray),
+    /// A segment between finite ends: visible when nothing blocks the `whole` ray; if something
+    /// does, the segment is traced again in two halves, from the moved a (`whole.o`) and from
+    /// the moved b (`ob`), `len` being the distance between them.
+    Segment { whole: Ray, ob: Vec3, len: f32 },
 }
 
 /// One end of a shadow ray: a point, its per-axis error bound and its geometric normal (zero when
@@ -61,15 +77,25 @@ impl Scene {
         End { p, err, ng }
     }
 
-    /// True when nothing blocks the segment between two finite ends.
+    /// True when nothing blocks the segment between two finite ends. (Building and resolving are
+    /// inlined here, and the public functions call this rather than resolving a built query, so
+    /// the one-ray path carries no `ShadowRay`: measured, that cost scalar `pt` 0.6 % more
+    /// instructions on the Cornell box.)
     fn segment_unoccluded(&self, a: End, b: End) -> bool {
+        self.resolve_shadow(self.segment_shadow(a, b))
+    }
+
+    /// The shadow query of the segment between two finite ends: both ends moved out of their
+    /// error boxes, the ray stopping short of b's (see `resolve_shadow` for the retry).
+    #[inline(always)]
+    fn segment_shadow(&self, a: End, b: End) -> ShadowRay {
         let ab = b.p - a.p;
         let (oa, ob) = (a.towards(ab), b.towards(-ab));
         let d = ob - oa;
         // Ends within each other's rounding (or non-finite input): nothing can be told to lie
         // between them.
         if !(d.dot(ab) > 0.0) {
-            return d.is_finite();
+            return ShadowRay::Known(d.is_finite());
         }
         let len = d.length();
         let dir = d / len;
@@ -77,26 +103,47 @@ impl Scene {
         // the rounding of `len` itself.
         let t_max = (len - dir.abs().dot(b.err)) * (1.0 - gamma(2));
         if !(t_max > 0.0) {
-            return true;
+            return ShadowRay::Known(true);
         }
-        ray_stats::count_shadow();
-        if !self.accel.occluded(&Ray {
-            o: oa,
-            d: dir,
-            t_max,
-        }) {
-            return true;
+        ShadowRay::Segment {
+            whole: Ray {
+                o: oa,
+                d: dir,
+                t_max,
+            },
+            ob,
+            len,
         }
-        // Something was hit. It may be a neighbour of b that b's rounding put b behind (b within
-        // its error box of an edge it shares with that surface): seen from b such a surface is
-        // rejected as the plane the ray leaves, but seen from a it is crossed, at a grazing angle
-        // possibly well before b's error box. So each half of the segment is traced from its own
-        // end, where that protection applies; the halves overlap by the rounding of `len`.
+    }
+
+    /// The answer to a shadow query, traced one ray at a time.
+    #[inline(always)]
+    fn resolve_shadow(&self, q: ShadowRay) -> bool {
+        match q {
+            ShadowRay::Known(visible) => visible,
+            ShadowRay::Ray(ray) => {
+                ray_stats::count_shadow();
+                !self.accel.occluded(&ray)
+            }
+            ShadowRay::Segment { whole, ob, len } => {
+                ray_stats::count_shadow();
+                !self.accel.occluded(&whole) || self.halves_unoccluded(whole, ob, len)
+            }
+        }
+    }
+
+    /// A segment whose whole ray was blocked, traced again in two halves. What was hit may be a
+    /// neighbour of b that b's rounding put b behind (b within its error box of an edge it shares
+    /// with that surface): seen from b such a surface is rejected as the plane the ray leaves, but
+    /// seen from a it is crossed, at a grazing angle possibly well before b's error box. So each
+    /// half of the segment is traced from its own end, where that protection applies; the halves
+    /// overlap by the rounding of `len`.
+    fn halves_unoccluded(&self, whole: Ray, ob: Vec3, len: f32) -> bool {
         let half = 0.5 * len * (1.0 + gamma(2));
         ray_stats::count_shadow();
         if self.accel.occluded(&Ray {
-            o: oa,
-            d: dir,
+            o: whole.o,
+            d: whole.d,
             t_max: half,
         }) {
             return false;
@@ -104,18 +151,45 @@ impl Scene {
         ray_stats::count_shadow();
         !self.accel.occluded(&Ray {
             o: ob,
-            d: -dir,
+            d: -whole.d,
             t_max: half,
         })
     }
 
     /// True when nothing blocks the ray from a finite end in unit direction `dir` (unbounded).
     fn ray_unoccluded(&self, a: End, dir: Vec3) -> bool {
+        self.resolve_shadow(Self::ray_shadow(a, dir))
+    }
+
+    /// The shadow query of the unbounded ray from a finite end in unit direction `dir`.
+    #[inline(always)]
+    fn ray_shadow(a: End, dir: Vec3) -> ShadowRay {
         if !(dir.length_squared() > 0.0) {
-            return false;
+            return ShadowRay::Known(false);
         }
-        ray_stats::count_shadow();
-        !self.accel.occluded(&Ray::new(a.towards(dir), dir))
+        ShadowRay::Ray(Ray::new(a.towards(dir), dir))
+    }
+
+    /// The answers to `PACKET` shadow queries (`Scene::connection_shadow`), each the one the
+    /// scalar visibility functions give: the first rays
+    /// through the ray core's packet occlusion query, a blocked segment's two halves per lane.
+    pub fn resolve_shadow_packet(&self, q: &[ShadowRay; PACKET]) -> [bool; PACKET] {
+        let rays: [Ray; PACKET] = std::array::from_fn(|i| match q[i] {
+            ShadowRay::Ray(ray) | ShadowRay::Segment { whole: ray, .. } => ray,
+            ShadowRay::Known(_) => Ray::new(Vec3::ZERO, Vec3::Z), // never traced
+        });
+        let traced: [bool; PACKET] = std::array::from_fn(|i| !matches!(q[i], ShadowRay::Known(_)));
+        for _ in traced.iter().filter(|&&t| t) {
+            ray_stats::count_shadow();
+        }
+        let blocked = self.accel.occluded_packet(&rays, &traced);
+        std::array::from_fn(|i| match q[i] {
+            ShadowRay::Known(visible) => visible,
+            ShadowRay::Ray(_) => !blocked[i],
+            ShadowRay::Segment { whole, ob, len } => {
+                !blocked[i] || self.halves_unoccluded(whole, ob, len)
+            }
+        })
     }
 
     /// Visibility between two path vertices, either of which may sit at infinity (then `p` is
@@ -125,6 +199,7 @@ impl Scene {
         a: impl Into<ConnectionEnd>,
         b: impl Into<ConnectionEnd>,
     ) -> bool {
+        // `connection_shadow` resolved, written out so the one-ray path builds no `ShadowRay`.
         let (a, b): (ConnectionEnd, ConnectionEnd) = (a.into(), b.into());
         match (a.infinite, b.infinite) {
             (true, true) => false,
@@ -132,6 +207,23 @@ impl Scene {
             (false, true) => self.ray_unoccluded(self.end(a.p, a.p_err, a.ng), b.p),
             (false, false) => {
                 self.segment_unoccluded(self.end(a.p, a.p_err, a.ng), self.end(b.p, b.p_err, b.ng))
+            }
+        }
+    }
+
+    /// `connection_visible` as a query to resolve (`resolve_shadow_packet`).
+    pub fn connection_shadow(
+        &self,
+        a: impl Into<ConnectionEnd>,
+        b: impl Into<ConnectionEnd>,
+    ) -> ShadowRay {
+        let (a, b): (ConnectionEnd, ConnectionEnd) = (a.into(), b.into());
+        match (a.infinite, b.infinite) {
+            (true, true) => ShadowRay::Known(false),
+            (true, false) => Self::ray_shadow(self.end(b.p, b.p_err, b.ng), a.p),
+            (false, true) => Self::ray_shadow(self.end(a.p, a.p_err, a.ng), b.p),
+            (false, false) => {
+                self.segment_shadow(self.end(a.p, a.p_err, a.ng), self.end(b.p, b.p_err, b.ng))
             }
         }
     }

@@ -15,7 +15,9 @@
 //! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
+//! | `lanes` | 1 or 8 | 1 | 8: the same image bit for bit, eight subpaths at a time (`light_lanes`; no media) |
 
+use super::light_lanes::LANES;
 use crate::film::splat::splat_pass_with;
 use crate::params::ParamReader;
 use crate::subpath::connect::connect_to_camera;
@@ -32,6 +34,8 @@ pub struct LightParams {
     pub rr_depth: u32,
     /// `None`: one light subpath per pixel.
     pub light_paths: Option<u64>,
+    /// Walk eight subpaths at a time (`unidirectional::light_lanes`).
+    pub lanes: bool,
 }
 
 impl LightParams {
@@ -43,11 +47,34 @@ impl LightParams {
                     .into(),
             );
         }
+        let lanes = r
+            .get_with("lanes", |v| match v {
+                "1" => Ok(false),
+                "8" => Ok(true),
+                _ => Err(format!("'{v}' is not a lane width (known: 1, {LANES})")),
+            })?
+            .unwrap_or(false);
+        if lanes && scene.has_media {
+            return Err(format!(
+                "light: lanes={LANES} does not handle participating media yet; the scene has {} \
+                 media (lanes=1 renders it)",
+                scene.media.len()
+            ));
+        }
         Ok(LightParams {
             max_depth: r.max_depth(scene)?,
             rr_depth: r.rr_depth(scene)?,
             light_paths: r.light_paths()?,
+            lanes,
         })
+    }
+
+    /// The subpaths' limits: s light vertices and the pinhole make a path of s segments.
+    pub fn walk_limits(&self) -> WalkLimits {
+        WalkLimits {
+            max_vertices: self.max_depth as usize,
+            rr_depth: self.rr_depth,
+        }
     }
 }
 
@@ -56,7 +83,7 @@ pub struct LightTracer {
 }
 
 /// Light subpaths per splat chunk: enough to amortise the chunk's bookkeeping.
-const CHUNK: u64 = 1024;
+pub(super) const CHUNK: u64 = 1024;
 
 impl Integrator for LightTracer {
     fn name(&self) -> &'static str {
@@ -66,11 +93,10 @@ impl Integrator for LightTracer {
     fn render_pass(&self, scene: &Scene, seed: u64, pass: u32) -> (Image, u64) {
         let cam = &scene.camera;
         let m = self.params.light_paths.unwrap_or(cam.pixel_count() as u64);
-        let limits = WalkLimits {
-            // s light vertices and the pinhole make a path of s segments.
-            max_vertices: self.params.max_depth as usize,
-            rr_depth: self.params.rr_depth,
-        };
+        if self.params.lanes {
+            return super::light_lanes::render_pass(&self.params, scene, seed, pass);
+        }
+        let limits = self.params.walk_limits();
         let scale = 1.0 / m as f32;
         let (w, h) = (cam.width as usize, cam.height as usize);
         if scene.has_media {

@@ -3,6 +3,7 @@
 //! to the lens).
 
 pub mod light;
+pub mod light_lanes;
 pub mod pt;
 pub mod pt_bsdf;
 pub mod pt_lanes;

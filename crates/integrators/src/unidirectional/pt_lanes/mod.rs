@@ -19,7 +19,11 @@
 //! so the packet stays full until the row runs out. Measured (results/bench.md, "Lane-parallel
 //! `pt`, second cut"): the packet query pays on the flat core; a lane kernel for the
 //! parallelogram light's `sample_li` did not (the transposition into lanes cost more than the
-//! arithmetic it shared) and was dropped.
+//! arithmetic it shared) and was dropped. Nor did the packet occlusion query for the shadow
+//! rays (`Scene::resolve_shadow_packet`, which `light_lanes` uses): a bounce's packet has lanes
+//! with no shadow ray (emitter hits, retired paths, back-facing light samples), and the flat
+//! core's packet loop costs the same for them, so it took 6 % more instructions than the shadow
+//! rays one by one (results/bench.md, "packet shadow rays").
 //!
 //! Participating media are not handled: `lanes=8` on a scene with media is refused in one line
 //! (`registry`).
