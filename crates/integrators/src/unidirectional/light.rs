@@ -15,75 +15,22 @@
 //! | `max_depth` | u32 | scene `[render] max_depth` (8) | longest path in segments, camera ray included |
 //! | `rr_depth` | u32 | scene `[render] rr_depth` (5) | Russian roulette from this many segments on |
 //! | `light_paths` | u64 | the pixel count | light subpaths per pass |
-//! | `lanes` | 1 or 8 | 1 | 8: the same image bit for bit, eight subpaths at a time (`light_lanes`; no media) |
+//! | `lanes` | 1/8 | 1 | 8: the same image bit for bit, eight subpaths at a time (`light_lanes`; no media) |
 
-use super::light_lanes::LANES;
+pub use super::light_params::LightParams;
+use super::light_params::CHUNK;
 use crate::film::splat::splat_pass_with;
-use crate::params::ParamReader;
 use crate::subpath::connect::connect_to_camera;
-use crate::subpath::walk::{light_subpath, Subpath, WalkLimits};
+use crate::subpath::walk::{light_subpath, Subpath};
 use crate::Integrator;
 use lt_core::path::scatter::connectable;
 use lt_core::sampling::{Domain, Sampler};
 use lt_core::Scene;
 use lt_estimators::Image;
 
-#[derive(Clone, Copy, Debug)]
-pub struct LightParams {
-    pub max_depth: u32,
-    pub rr_depth: u32,
-    /// `None`: one light subpath per pixel.
-    pub light_paths: Option<u64>,
-    /// Walk eight subpaths at a time (`unidirectional::light_lanes`).
-    pub lanes: bool,
-}
-
-impl LightParams {
-    pub fn read(scene: &Scene, r: &ParamReader) -> Result<LightParams, String> {
-        if scene.camera.is_delta_direction() {
-            return Err(
-                "light tracing cannot see through an orthographic camera (a delta in \
-                        direction: no connection reaches it); use pt or bdpt"
-                    .into(),
-            );
-        }
-        let lanes = r
-            .get_with("lanes", |v| match v {
-                "1" => Ok(false),
-                "8" => Ok(true),
-                _ => Err(format!("'{v}' is not a lane width (known: 1, {LANES})")),
-            })?
-            .unwrap_or(false);
-        if lanes && scene.has_media {
-            return Err(format!(
-                "light: lanes={LANES} does not handle participating media yet; the scene has {} \
-                 media (lanes=1 renders it)",
-                scene.media.len()
-            ));
-        }
-        Ok(LightParams {
-            max_depth: r.max_depth(scene)?,
-            rr_depth: r.rr_depth(scene)?,
-            light_paths: r.light_paths()?,
-            lanes,
-        })
-    }
-
-    /// The subpaths' limits: s light vertices and the pinhole make a path of s segments.
-    pub fn walk_limits(&self) -> WalkLimits {
-        WalkLimits {
-            max_vertices: self.max_depth as usize,
-            rr_depth: self.rr_depth,
-        }
-    }
-}
-
 pub struct LightTracer {
     pub params: LightParams,
 }
-
-/// Light subpaths per splat chunk: enough to amortise the chunk's bookkeeping.
-pub(super) const CHUNK: u64 = 1024;
 
 impl Integrator for LightTracer {
     fn name(&self) -> &'static str {

@@ -4,6 +4,7 @@
 
 pub mod light;
 pub mod light_lanes;
+pub mod light_params;
 pub mod pt;
 pub mod pt_bsdf;
 pub mod pt_lanes;

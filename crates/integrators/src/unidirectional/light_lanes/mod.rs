@@ -25,15 +25,14 @@
 mod connect;
 mod walk;
 
-use super::light::{LightParams, CHUNK};
+use super::light_params::{LightParams, CHUNK};
 use crate::film::splat::splat_pass_with;
 use connect::Connections;
 use lt_core::Scene;
 use lt_estimators::Image;
 use walk::WalkLanes;
 
-/// Light subpaths walked together (one packet of rays).
-pub const LANES: usize = lt_core::geometry::packet::PACKET;
+pub use super::light_params::LANES;
 
 /// `LightTracer::render_pass` for a scene without media, `LANES` subpaths at a time, in the scalar
 /// chunks of `CHUNK` subpaths: each chunk records exactly the splats the scalar chunk records, in
